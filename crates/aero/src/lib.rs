@@ -1,0 +1,1 @@
+//! Quasi-steady blade-element aerodynamics and wing planform integrals (thesis §3.2.4).

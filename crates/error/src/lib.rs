@@ -1,0 +1,242 @@
+//! The single error enum of paritysim.
+//!
+//! Every crate returns [`Error`]; the Python bindings map each variant to one exception class
+//! (see `python/paritysim/_core.pyi`):
+//!
+//! | variant              | Python class                                          |
+//! |----------------------|-------------------------------------------------------|
+//! | `InvalidParameter`   | `InvalidParameterError(ParitysimError, ValueError)`   |
+//! | `OutOfDomain`        | `OutOfDomainError(ParitysimError, ValueError)`        |
+//! | `Geometry`           | `GeometryError(ParitysimError, ValueError)`           |
+//! | `Shape`              | `ShapeError(ParitysimError, ValueError)`              |
+//! | `Constraint`         | `ConstraintError(ParitysimError, ValueError)`         |
+//! | `Singular`           | `SingularError(ParitysimError, ArithmeticError)`      |
+//! | `Integration`        | `IntegrationError(ParitysimError, RuntimeError)`      |
+//! | `Cancelled`          | `CancelledError(ParitysimError)`                      |
+//!
+//! Use [`ensure!`] / [`bail!`] and the `check_*` helpers so that every message names the
+//! offending field and the allowed range.
+
+use std::borrow::Cow;
+use std::fmt;
+
+/// Result alias used across paritysim.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Every failure paritysim can report.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A parameter is non-finite or outside its allowed range.
+    #[error("invalid `{field}` = {value}: must be {allowed}")]
+    InvalidParameter {
+        /// Dotted path of the field, e.g. `shoulder.alpha2`.
+        field: Cow<'static, str>,
+        /// The rejected value, formatted.
+        value: String,
+        /// Human-readable allowed range, e.g. `in (0, pi]`.
+        allowed: String,
+    },
+    /// Valid parameters, but the requested configuration is unreachable
+    /// (e.g. outside the shoulder joint limit of eq. 2.10).
+    #[error("{what} is out of its domain: {detail}")]
+    OutOfDomain {
+        /// What was evaluated.
+        what: Cow<'static, str>,
+        /// Why it is out of domain, with numbers.
+        detail: String,
+    },
+    /// A geometric description (planform outline, layup) is malformed.
+    #[error("invalid geometry: {0}")]
+    Geometry(String),
+    /// Arrays or matrices with mismatching or wrong dimensions.
+    #[error("shape mismatch: {0}")]
+    Shape(String),
+    /// A constraint matrix is rank deficient or the initial state violates it.
+    #[error("constraint error: {0}")]
+    Constraint(String),
+    /// A linear system that must be solved is singular at this configuration.
+    #[error("singular configuration: {0}")]
+    Singular(String),
+    /// Time integration failed; carries where it failed (diffsol-style).
+    #[error("integration failed at t = {time} ms: {reason} (state = {state:?})")]
+    Integration {
+        /// Time of failure, ms.
+        time: f64,
+        /// State vector at the failure.
+        state: Vec<f64>,
+        /// What went wrong (step size underflow, non-finite state, ...).
+        reason: String,
+    },
+    /// Work was cancelled by the caller.
+    #[error("cancelled")]
+    Cancelled,
+}
+
+impl Error {
+    /// Stable name of the variant; the Python class is `<kind>Error`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Error::InvalidParameter { .. } => "InvalidParameter",
+            Error::OutOfDomain { .. } => "OutOfDomain",
+            Error::Geometry(_) => "Geometry",
+            Error::Shape(_) => "Shape",
+            Error::Constraint(_) => "Constraint",
+            Error::Singular(_) => "Singular",
+            Error::Integration { .. } => "Integration",
+            Error::Cancelled => "Cancelled",
+        }
+    }
+
+    /// The field named by an [`Error::InvalidParameter`], if any.
+    pub fn field(&self) -> Option<&str> {
+        match self {
+            Error::InvalidParameter { field, .. } => Some(field),
+            _ => None,
+        }
+    }
+
+    /// Builds an [`Error::InvalidParameter`].
+    pub fn invalid(
+        field: impl Into<Cow<'static, str>>,
+        value: impl fmt::Display,
+        allowed: impl Into<String>,
+    ) -> Self {
+        Error::InvalidParameter {
+            field: field.into(),
+            value: value.to_string(),
+            allowed: allowed.into(),
+        }
+    }
+
+    /// Prefixes the field path of an [`Error::InvalidParameter`] (e.g. `wing.` + `mass`),
+    /// so nested specs report full dotted paths. Other variants are returned unchanged.
+    pub fn in_field(self, prefix: &str) -> Self {
+        match self {
+            Error::InvalidParameter {
+                field,
+                value,
+                allowed,
+            } => Error::InvalidParameter {
+                field: Cow::Owned(format!("{prefix}.{field}")),
+                value,
+                allowed,
+            },
+            other => other,
+        }
+    }
+}
+
+/// Returns early with an error (polars-style).
+///
+/// `bail!(invalid "field", value, "allowed")` or `bail!(Singular "format {}", args)`.
+#[macro_export]
+macro_rules! bail {
+    (invalid $field:expr, $value:expr, $allowed:expr $(,)?) => {
+        return Err($crate::Error::invalid($field, $value, $allowed))
+    };
+    ($variant:ident $($fmt:tt)+) => {
+        return Err($crate::Error::$variant(format!($($fmt)+)))
+    };
+}
+
+/// Returns early with an error unless `cond` holds.
+///
+/// `ensure!(x > 0.0, invalid "mass", x, "> 0")` or `ensure!(ok, Shape "len {} != {}", a, b)`.
+#[macro_export]
+macro_rules! ensure {
+    ($cond:expr, $($rest:tt)+) => {
+        if !($cond) {
+            $crate::bail!($($rest)+);
+        }
+    };
+}
+
+/// Rejects NaN and infinities.
+pub fn check_finite(field: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(Error::invalid(field, value, "a finite number"))
+    }
+}
+
+/// Requires a finite `value > 0`.
+pub fn check_positive(field: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::invalid(field, value, "finite and > 0"))
+    }
+}
+
+/// Requires a finite `value >= 0`.
+pub fn check_non_negative(field: &'static str, value: f64) -> Result<f64> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::invalid(field, value, "finite and >= 0"))
+    }
+}
+
+/// Requires `lo <= value <= hi` (closed interval), finite.
+pub fn check_in_closed(field: &'static str, value: f64, lo: f64, hi: f64) -> Result<f64> {
+    if value.is_finite() && value >= lo && value <= hi {
+        Ok(value)
+    } else {
+        Err(Error::invalid(field, value, format!("in [{lo}, {hi}]")))
+    }
+}
+
+/// Requires every element of a slice to be finite; names the first bad index.
+pub fn check_all_finite(field: &'static str, values: &[f64]) -> Result<()> {
+    match values.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(Error::invalid(
+            format!("{field}[{i}]"),
+            values[i],
+            "a finite number",
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn needs_positive(x: f64) -> Result<f64> {
+        ensure!(x > 0.0, invalid "x", x, "> 0");
+        Ok(x)
+    }
+
+    #[test]
+    fn messages_name_field_and_range() {
+        let e = needs_positive(-1.0).unwrap_err();
+        assert_eq!(e.kind(), "InvalidParameter");
+        assert_eq!(e.field(), Some("x"));
+        assert_eq!(e.to_string(), "invalid `x` = -1: must be > 0");
+        let nested = e.in_field("wing");
+        assert_eq!(nested.field(), Some("wing.x"));
+    }
+
+    #[test]
+    fn nan_is_rejected_everywhere() {
+        assert!(check_finite("a", f64::NAN).is_err());
+        assert!(check_positive("a", f64::NAN).is_err());
+        assert!(check_non_negative("a", f64::INFINITY).is_err());
+        assert!(check_in_closed("a", f64::NAN, 0.0, 1.0).is_err());
+        let e = check_all_finite("v", &[1.0, f64::NAN]).unwrap_err();
+        assert_eq!(e.field(), Some("v[1]"));
+    }
+
+    #[test]
+    fn bail_with_message_variant() {
+        fn f() -> Result<()> {
+            bail!(Singular "det = {}", 0.0);
+        }
+        assert_eq!(
+            f().unwrap_err().to_string(),
+            "singular configuration: det = 0"
+        );
+    }
+}

@@ -1,0 +1,343 @@
+//! Planar drivetrains: actuator coordinates `q = (q1, q2)` to stroke angles `φ = (φL, φR)`.
+//!
+//! Every drivetrain returns the stroke angles, the Jacobian `J = ∂φ/∂q` and the Hessians
+//! `H_k = ∂²φ_k/∂q²`, so that `φ̈ = J q̈ + h(q, q̇)` with `h_k = q̇ᵀ H_k q̇`
+//! ([`DrivetrainEval::velocity_product`]). Output order is (left, right), as in eq. 3.21.
+//! Sign convention of eq. 2.15: positive `q1` gives negative stroke angles on both wings;
+//! positive `q2` raises the right whippletree end (right stroke decreases, left increases).
+//!
+//! # Topology (Fig. 2.7a is not in the text; this is our design, consistent with §2.3.1–2.3.2)
+//!
+//! ```text
+//!            q2 (whippletree rotation)
+//!   E_L o=================o=================o E_R      whippletree, length L0 = hL + hR,
+//!       |      hL         W (pivot, moves    |         centre pivot W driven along y by the
+//!       |                    by q1 along y)  | rod L2  actuator (q1)
+//!       |                                    |
+//!       o------* G_L              G_R *------o          crank L3 from ground pivot G to the
+//!        crank L3                     crank L3           rod end, horizontal at rest
+//!   (wing L on the crank)         (wing R on the crank)
+//! ```
+//!
+//! Each side is a rod-crank: the rod (length L2) connects the whippletree end to the tip of the
+//! output crank (length L3) that pivots on ground and carries the wing. At rest the rod is
+//! vertical and the crank horizontal (perpendicular: best transmission angle, equal gain up and
+//! down), so the small-motion gain is exactly `T = 1/L3` rad/mm and the linearisation of the
+//! linkage at rest is eq. 2.15 with `L = L0/2` (checked in the tests).
+//!
+//! * **HMF four-bar** (§2.3.1): the central link is rigid (`q2 ≡ 0`) and drives both rods; with
+//!   the thesis' L3 = 400 µm, L2 = 800 µm a 400 µm stroke gives 60.0° (±30°).
+//! * **Drag PARITY linkage** (§2.3.2, §3.3.2 lengths L0..L4 = 5000, 2500, 800, 400, 800 µm):
+//!   L0 = whippletree length, L1 = 2500 µm = each whippletree arm (L0/2, pivot unbiased),
+//!   L2 = rod, L3 = crank; L4 = 800 µm is the wing-side output link, which does not enter the
+//!   planar map under the massless-mechanism assumption. With these lengths ±200 µm gives
+//!   ±30° (−29.7°/+30.3°), not the thesis' "approximately ±35°", which would need a crank of
+//!   ≈350 µm: the crank length is a parameter.
+//! * **Biased pivot** (§2.4.2): arms `hL = L0 r/(1+r)`, `hR = L0/(1+r)` for arm ratio `r = hL/hR`.
+
+use nalgebra::{Matrix2, Vector2};
+use paritysim_error::{Error, Result, bail, check_finite, check_positive};
+
+/// Result of evaluating a drivetrain at `(q1, q2)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DrivetrainEval {
+    /// `(φL, φR)`, rad.
+    pub stroke: Vector2<f64>,
+    /// `J[k][i] = ∂φ_k/∂q_i` (rad/mm for q1, rad/rad for q2).
+    pub jacobian: Matrix2<f64>,
+    /// `H_k[i][j] = ∂²φ_k/∂q_i∂q_j` for k = left, right.
+    pub hessian: [Matrix2<f64>; 2],
+}
+
+impl DrivetrainEval {
+    /// `h_k = q̇ᵀ H_k q̇`, the velocity-product term in `φ̈ = J q̈ + h`.
+    #[inline]
+    pub fn velocity_product(&self, q_dot: &Vector2<f64>) -> Vector2<f64> {
+        Vector2::new(
+            q_dot.dot(&(self.hessian[0] * q_dot)),
+            q_dot.dot(&(self.hessian[1] * q_dot)),
+        )
+    }
+}
+
+/// One side's rod-crank (see the module sketch). Lengths in mm.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RodCrank {
+    crank: f64,
+    rod: f64,
+}
+
+/// Crank angle `β` of a rod-crank and its derivatives w.r.t. the rod-top displacement.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct SideEval {
+    beta: f64,
+    grad: Vector2<f64>,
+    hess: Matrix2<f64>,
+}
+
+impl RodCrank {
+    /// The §3.3.2 / §2.3.1 side: crank L3 = 0.4 mm, rod L2 = 0.8 mm.
+    pub const THESIS: RodCrank = RodCrank {
+        crank: 0.4,
+        rod: 0.8,
+    };
+
+    /// Validates `crank > 0`, `rod > 0` (mm).
+    pub fn new(crank_mm: f64, rod_mm: f64) -> Result<Self> {
+        Ok(Self {
+            crank: check_positive("crank_mm", crank_mm)?,
+            rod: check_positive("rod_mm", rod_mm)?,
+        })
+    }
+
+    /// Crank length L3 (mm).
+    pub fn crank(&self) -> f64 {
+        self.crank
+    }
+
+    /// Rod length L2 (mm).
+    pub fn rod(&self) -> f64 {
+        self.rod
+    }
+
+    /// Solves `|top − tip(β)| = rod` for the crank angle given the rod-top displacement
+    /// `(dx, dy)` from rest, by implicit differentiation of
+    /// `F = (X − L3 cos β)² + (Y − L3 sin β)² − L2²`.
+    fn solve(&self, dx: f64, dy: f64) -> Result<SideEval> {
+        let (l3, l2) = (self.crank, self.rod);
+        let (x, y) = (l3 + dx, l2 + dy);
+        let r = x.hypot(y);
+        let k = (x * x + y * y + l3 * l3 - l2 * l2) / (2.0 * l3 * r);
+        // Beyond |k| = 1 the rod cannot reach; near it the linkage toggles (infinite gain).
+        if !(k.abs() < 1.0 - 1e-9) || !r.is_finite() {
+            return Err(Error::OutOfDomain {
+                what: "rod-crank linkage".into(),
+                detail: format!(
+                    "rod top displaced by ({dx}, {dy}) mm cannot be reached by crank {l3} mm \
+                     and rod {l2} mm (toggle or beyond)"
+                ),
+            });
+        }
+        let beta = y.atan2(x) - k.acos();
+        let (sb, cb) = beta.sin_cos();
+        let f_x = 2.0 * (x - l3 * cb);
+        let f_y = 2.0 * (y - l3 * sb);
+        let f_b = 2.0 * l3 * (x * sb - y * cb);
+        let f_xb = 2.0 * l3 * sb;
+        let f_yb = -2.0 * l3 * cb;
+        let f_bb = 2.0 * l3 * (x * cb + y * sb);
+        let b_x = -f_x / f_b;
+        let b_y = -f_y / f_b;
+        // β_ab = −(F_ab + F_aβ β_b + F_bβ β_a + F_ββ β_a β_b) / F_β, with F_XX = F_YY = 2, F_XY = 0.
+        let b_xx = -(2.0 + 2.0 * f_xb * b_x + f_bb * b_x * b_x) / f_b;
+        let b_yy = -(2.0 + 2.0 * f_yb * b_y + f_bb * b_y * b_y) / f_b;
+        let b_xy = -(f_xb * b_y + f_yb * b_x + f_bb * b_x * b_y) / f_b;
+        Ok(SideEval {
+            beta,
+            grad: Vector2::new(b_x, b_y),
+            hess: Matrix2::new(b_xx, b_xy, b_xy, b_yy),
+        })
+    }
+
+    /// Stroke angle `φ = −β` of a side whose whippletree end sits at arm `arm` (mm) with sign
+    /// `side` (+1 right, −1 left), with its gradient and Hessian in `(q1, q2)`.
+    fn side_stroke(
+        &self,
+        q1: f64,
+        q2: f64,
+        arm: f64,
+        side: f64,
+    ) -> Result<(f64, Vector2<f64>, Matrix2<f64>)> {
+        let (s2, c2) = q2.sin_cos();
+        // Rod-top displacement (dx, dy) and its q-derivatives.
+        let dx = arm * (c2 - 1.0);
+        let dy = q1 + side * arm * s2;
+        let e = self.solve(dx, dy)?;
+        // ∂(dx, dy)/∂q: rows (dx, dy), columns (q1, q2).
+        let d = Matrix2::new(0.0, -arm * s2, 1.0, side * arm * c2);
+        let grad = d.transpose() * e.grad;
+        // Only ∂²/∂q2² of (dx, dy) is non-zero.
+        let dxx = -arm * c2;
+        let dyy = -side * arm * s2;
+        let mut hess = d.transpose() * e.hess * d;
+        hess[(1, 1)] += e.grad[0] * dxx + e.grad[1] * dyy;
+        Ok((-e.beta, -grad, -hess))
+    }
+}
+
+/// HMF symmetric four-bar (§2.3.1): 1 DOF, `q2` is ignored (held at zero).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HmfFourBar {
+    side: RodCrank,
+}
+
+/// Drag PARITY linear map of eq. 2.15 with a (possibly biased) whippletree.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinearDifferential {
+    transmission_ratio: f64,
+    left_arm: f64,
+    right_arm: f64,
+}
+
+/// Drag PARITY nonlinear linkage (§2.3.2): whippletree plus two rod-cranks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinkageDifferential {
+    side: RodCrank,
+    left_arm: f64,
+    right_arm: f64,
+}
+
+/// Splits a whippletree of `length` (mm) into `(left, right)` arms with `ratio = left/right`.
+fn split_arms(length: f64, ratio: f64) -> Result<(f64, f64)> {
+    check_positive("whippletree_length_mm", length)?;
+    check_positive("arm_ratio", ratio)?;
+    Ok((length * ratio / (1.0 + ratio), length / (1.0 + ratio)))
+}
+
+/// Limit on `|q2|`: beyond ±π/2 the whippletree folds over.
+const Q2_LIMIT: f64 = std::f64::consts::FRAC_PI_2;
+
+impl HmfFourBar {
+    /// HMF four-bar with the given side linkage.
+    pub fn new(side: RodCrank) -> Self {
+        Self { side }
+    }
+
+    /// Side linkage.
+    pub fn side(&self) -> RodCrank {
+        self.side
+    }
+}
+
+impl LinearDifferential {
+    /// Eq. 2.15 with transmission ratio `T` (rad/mm), mean arm `L` (mm) and arm ratio
+    /// `r = hL/hR` (1 = centred pivot): `φL = −T q1 + T hL q2`, `φR = −T q1 − T hR q2` with
+    /// `hL = 2L r/(1+r)`, `hR = 2L/(1+r)`.
+    pub fn new(transmission_ratio: f64, arm_length_mm: f64, arm_ratio: f64) -> Result<Self> {
+        check_positive("transmission_ratio", transmission_ratio)?;
+        let (left_arm, right_arm) = split_arms(
+            2.0 * check_positive("arm_length_mm", arm_length_mm)?,
+            arm_ratio,
+        )?;
+        Ok(Self {
+            transmission_ratio,
+            left_arm,
+            right_arm,
+        })
+    }
+
+    /// `T` (rad/mm).
+    pub fn transmission_ratio(&self) -> f64 {
+        self.transmission_ratio
+    }
+
+    /// `(hL, hR)` (mm).
+    pub fn arms(&self) -> (f64, f64) {
+        (self.left_arm, self.right_arm)
+    }
+}
+
+impl LinkageDifferential {
+    /// Linkage with whippletree `length` L0 (mm) and arm ratio `r = hL/hR`.
+    pub fn new(side: RodCrank, whippletree_length_mm: f64, arm_ratio: f64) -> Result<Self> {
+        let (left_arm, right_arm) = split_arms(whippletree_length_mm, arm_ratio)?;
+        Ok(Self {
+            side,
+            left_arm,
+            right_arm,
+        })
+    }
+
+    /// The §3.3.2 linkage: L0 = 5 mm, L2 = 0.8 mm, L3 = 0.4 mm, centred pivot.
+    pub fn thesis() -> Self {
+        Self {
+            side: RodCrank::THESIS,
+            left_arm: 2.5,
+            right_arm: 2.5,
+        }
+    }
+
+    /// Side linkage.
+    pub fn side(&self) -> RodCrank {
+        self.side
+    }
+
+    /// `(hL, hR)` (mm).
+    pub fn arms(&self) -> (f64, f64) {
+        (self.left_arm, self.right_arm)
+    }
+}
+
+/// Any planar drivetrain.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Drivetrain {
+    /// HMF four-bar, 1 DOF.
+    HmfFourBar(HmfFourBar),
+    /// Drag PARITY, linear map of eq. 2.15.
+    LinearDifferential(LinearDifferential),
+    /// Drag PARITY, nonlinear linkage.
+    LinkageDifferential(LinkageDifferential),
+}
+
+impl Drivetrain {
+    /// Number of kinematic degrees of freedom (1 for the HMF, 2 for Drag PARITY).
+    pub fn dof(&self) -> usize {
+        match self {
+            Drivetrain::HmfFourBar(_) => 1,
+            _ => 2,
+        }
+    }
+
+    /// Short name (`hmf_four_bar`, `linear_differential`, `linkage_differential`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Drivetrain::HmfFourBar(_) => "hmf_four_bar",
+            Drivetrain::LinearDifferential(_) => "linear_differential",
+            Drivetrain::LinkageDifferential(_) => "linkage_differential",
+        }
+    }
+
+    /// Stroke angles, Jacobian and Hessians at `(q1, q2)` (mm, rad).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for non-finite input; [`Error::OutOfDomain`] when a linkage
+    /// cannot reach the pose (rod too short, toggle) or `|q2| >= π/2`.
+    pub fn evaluate(&self, q1: f64, q2: f64) -> Result<DrivetrainEval> {
+        check_finite("q1", q1)?;
+        check_finite("q2", q2)?;
+        match self {
+            Drivetrain::HmfFourBar(d) => {
+                let (phi, grad, hess) = d.side.side_stroke(q1, 0.0, 0.0, 1.0)?;
+                // q2 is not a coordinate of the HMF: zero column and zero second derivatives.
+                let j = Matrix2::new(grad[0], 0.0, grad[0], 0.0);
+                let h = Matrix2::new(hess[(0, 0)], 0.0, 0.0, 0.0);
+                Ok(DrivetrainEval {
+                    stroke: Vector2::new(phi, phi),
+                    jacobian: j,
+                    hessian: [h, h],
+                })
+            }
+            Drivetrain::LinearDifferential(d) => {
+                let t = d.transmission_ratio;
+                let j = Matrix2::new(-t, t * d.left_arm, -t, -t * d.right_arm);
+                Ok(DrivetrainEval {
+                    stroke: j * Vector2::new(q1, q2),
+                    jacobian: j,
+                    hessian: [Matrix2::zeros(); 2],
+                })
+            }
+            Drivetrain::LinkageDifferential(d) => {
+                if q2.abs() >= Q2_LIMIT {
+                    bail!(invalid "q2", q2, "in (-pi/2, pi/2) rad (whippletree folds over)");
+                }
+                let (pl, gl, hl) = d.side.side_stroke(q1, q2, d.left_arm, -1.0)?;
+                let (pr, gr, hr) = d.side.side_stroke(q1, q2, d.right_arm, 1.0)?;
+                Ok(DrivetrainEval {
+                    stroke: Vector2::new(pl, pr),
+                    jacobian: Matrix2::new(gl[0], gl[1], gr[0], gr[1]),
+                    hessian: [hl, hr],
+                })
+            }
+        }
+    }
+}

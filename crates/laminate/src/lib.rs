@@ -1,0 +1,1 @@
+//! Laminate plate theory for piezoelectric bimorph actuators, flexures and PC-MEMS layups.
