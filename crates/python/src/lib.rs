@@ -1,1 +1,24 @@
-//! placeholder
+//! `paritysim._core`: the only crate that knows PyO3.
+//!
+//! Thin by design: convert numpy/Python values, release the GIL (`Python::detach`), call the
+//! pure-Rust crates, convert the result back. Every `paritysim_error::Error` becomes the matching
+//! exception of the tree built in [`errors`]; nothing here panics on user input.
+
+use pyo3::prelude::*;
+
+mod aero;
+mod convert;
+mod errors;
+mod kinematics;
+mod laminate;
+
+/// The native module.
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    errors::register(m)?;
+    kinematics::register(m)?;
+    aero::register(m)?;
+    laminate::register(m)?;
+    Ok(())
+}

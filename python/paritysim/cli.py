@@ -1,0 +1,78 @@
+"""The ``paritysim`` command line."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from tqdm import tqdm
+
+from ._core import ParitysimError
+
+
+def _fig2_9(out: Path) -> list[Path]:
+    from . import plots
+    from .trials import fig2_9
+
+    df = fig2_9()
+    written = [out / "fig2_9.parquet", out / "fig2_9.csv"]
+    df.write_parquet(written[0])
+    df.write_csv(written[1])
+    written.append(plots.save(plots.fig2_9(df), out / "fig2_9.png"))
+    return written
+
+
+#: CLI trial names -> runner writing files into the output directory.
+TRIALS: dict[str, Callable[[Path], list[Path]]] = {
+    "fig2.9": _fig2_9,
+}
+
+
+def _reproduce(args: argparse.Namespace) -> int:
+    names = list(TRIALS) if args.all else args.names
+    if not names:
+        print("nothing to reproduce: name a trial or pass --all; available: " + ", ".join(TRIALS), file=sys.stderr)
+        return 2
+    unknown = [n for n in names if n not in TRIALS]
+    if unknown:
+        print(f"unknown trial(s) {unknown}; available: {', '.join(TRIALS)}", file=sys.stderr)
+        return 2
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    for name in tqdm(names, desc="reproducing", unit="trial", disable=args.quiet):
+        start = time.perf_counter()
+        written = TRIALS[name](out)
+        if not args.quiet:
+            tqdm.write(f"{name}: {time.perf_counter() - start:.2f} s -> " + ", ".join(str(p) for p in written))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser (exposed for tests and docs)."""
+    parser = argparse.ArgumentParser(prog="paritysim", description="Simulate flapping-wing drivetrains and reproduce the thesis trials.")
+    parser.add_argument("--version", action="version", version=f"paritysim {__import__('paritysim').__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+    rep = sub.add_parser("reproduce", help="reproduce thesis tables and figures")
+    rep.add_argument("names", nargs="*", help=f"trials to run: {', '.join(TRIALS)}")
+    rep.add_argument("--all", action="store_true", help="run every implemented trial")
+    rep.add_argument("--out", default="results", help="output directory (default: results/)")
+    rep.add_argument("--quiet", action="store_true", help="no progress output")
+    rep.set_defaults(func=_reproduce)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``paritysim`` console script."""
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args))
+    except ParitysimError as exc:
+        print(f"paritysim: error: {type(exc).__name__}: {exc}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

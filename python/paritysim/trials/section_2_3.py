@@ -1,0 +1,56 @@
+"""§2.3.3: the spherical shoulder's transmission map (Fig. 2.9)."""
+
+from __future__ import annotations
+
+import numpy as np
+import polars as pl
+
+from ..kinematics import shoulder_map
+
+#: The three (alpha2, alpha3) configurations of Fig. 2.9, in degrees.
+FIG2_9_CONFIGS_DEG: tuple[tuple[float, float], ...] = ((90.0, 0.0), (90.0, 45.0), (120.0, 60.0))
+
+#: The walking-trajectory box of §2.3.3 for the (90°, 45°) shoulder: phi_w in ±60°, theta_w in [0°, 45°].
+FIG2_9_BOX_DEG = {"phi": (-60.0, 60.0), "theta": (0.0, 45.0)}
+
+
+def fig2_9(step_deg: float = 1.0, limit_deg: float = 90.0) -> pl.DataFrame:
+    """Fig. 2.9: the wing deviation theta_w over (phi, theta) for the three shoulders.
+
+    Parameters
+    ----------
+    step_deg:
+        Grid spacing in degrees (> 0).
+    limit_deg:
+        The grid spans ``[-limit_deg, limit_deg]`` in phi and theta (in (0, 90]).
+
+    Returns
+    -------
+    DataFrame with columns ``alpha2_deg, alpha3_deg, phi_deg, theta_deg, theta_w_deg,
+    reachable``; ``theta_w_deg`` is null where the pose is outside the joint limit.
+    """
+    from .._core import InvalidParameterError
+
+    if not (np.isfinite(step_deg) and step_deg > 0):
+        raise InvalidParameterError(f"invalid `step_deg` = {step_deg}: must be finite and > 0")
+    if not (np.isfinite(limit_deg) and 0 < limit_deg <= 90):
+        raise InvalidParameterError(f"invalid `limit_deg` = {limit_deg}: must be in (0, 90]")
+    axis = np.arange(-limit_deg, limit_deg + 0.5 * step_deg, step_deg)
+    phi_deg, theta_deg = np.meshgrid(axis, axis, indexing="xy")
+    frames = []
+    for a2, a3 in FIG2_9_CONFIGS_DEG:
+        out = shoulder_map(np.radians(a2), np.radians(a3), np.radians(phi_deg), np.radians(theta_deg))
+        n = phi_deg.size
+        frames.append(
+            pl.DataFrame(
+                {
+                    "alpha2_deg": np.full(n, a2),
+                    "alpha3_deg": np.full(n, a3),
+                    "phi_deg": phi_deg.ravel(),
+                    "theta_deg": theta_deg.ravel(),
+                    "theta_w_deg": np.degrees(out["theta_w"].ravel()),
+                    "reachable": out["reachable"].ravel(),
+                }
+            ).with_columns(pl.col("theta_w_deg").fill_nan(None))
+        )
+    return pl.concat(frames)
