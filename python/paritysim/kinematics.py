@@ -38,7 +38,8 @@ def shoulder_map(alpha2: float, alpha3: float, phi: ArrayLike, theta: ArrayLike)
     -------
     dict with arrays of the broadcast shape: ``gamma2``, ``gamma3``, ``gamma5``,
     ``theta_w`` (= ``gamma5``, the wing deviation angle) and boolean ``reachable``.
-    Where ``reachable`` is False (outside the joint limit of eq. 2.10) the angles are NaN.
+    Where ``reachable`` is False (outside the joint limit of eq. 2.10, or at a singular pose
+    where eqs. 2.12/2.13 have no unique solution) the angles are NaN.
 
     Raises
     ------

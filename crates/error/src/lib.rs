@@ -146,7 +146,9 @@ macro_rules! bail {
 #[macro_export]
 macro_rules! ensure {
     ($cond:expr, $($rest:tt)+) => {
-        if !($cond) {
+        // Bound first so a NaN comparison counts as failing, without negating a float compare.
+        let holds: bool = $cond;
+        if !holds {
             $crate::bail!($($rest)+);
         }
     };

@@ -1,4 +1,5 @@
 //! Criterion benches: shoulder pose + partials, and each drivetrain evaluation.
+#![allow(missing_docs)] // criterion_group! generates undocumented items
 
 use criterion::{Criterion, black_box, criterion_group, criterion_main};
 use paritysim_kinematics::drivetrain::{HmfFourBar, LinearDifferential, LinkageDifferential};

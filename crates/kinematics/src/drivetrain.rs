@@ -109,7 +109,7 @@ impl RodCrank {
         let r = x.hypot(y);
         let k = (x * x + y * y + l3 * l3 - l2 * l2) / (2.0 * l3 * r);
         // Beyond |k| = 1 the rod cannot reach; near it the linkage toggles (infinite gain).
-        if !(k.abs() < 1.0 - 1e-9) || !r.is_finite() {
+        if k.is_nan() || k.abs() >= 1.0 - 1e-9 || !r.is_finite() {
             return Err(Error::OutOfDomain {
                 what: "rod-crank linkage".into(),
                 detail: format!(

@@ -115,12 +115,15 @@ fn shoulder_partials<'py>(
     Ok(out)
 }
 
+/// Constructor name and arguments: what `__reduce__` hands to `paritysim._drivetrain_pickle.rebuild`.
+type ConstructorArgs = (String, Vec<f64>);
+
 /// A planar drivetrain mapping `(q1, q2)` (mm, rad) to stroke angles `(φL, φR)` (rad).
 #[pyclass(name = "Drivetrain", module = "paritysim._core", frozen)]
 #[derive(Clone)]
 pub struct PyDrivetrain {
     pub inner: Drivetrain,
-    args: (String, Vec<f64>),
+    args: ConstructorArgs,
 }
 
 #[pymethods]
@@ -270,7 +273,7 @@ impl PyDrivetrain {
 
     fn __reduce__<'py>(
         slf: &Bound<'py, Self>,
-    ) -> PyResult<(Bound<'py, PyAny>, (String, Vec<f64>))> {
+    ) -> PyResult<(Bound<'py, PyAny>, ConstructorArgs)> {
         let py = slf.py();
         let rebuild = py
             .import("paritysim._drivetrain_pickle")?

@@ -1,0 +1,57 @@
+"""The CLI and the Fig. 2.9 trial."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import polars as pl
+import pytest
+
+import paritysim as ps
+from paritysim.cli import main
+
+FIG2_9_COLUMNS = ["alpha2_deg", "alpha3_deg", "phi_deg", "theta_deg", "theta_w_deg", "reachable"]
+
+
+def test_fig2_9_dataframe() -> None:
+    df = ps.trials.fig2_9(step_deg=5.0)
+    assert df.columns == FIG2_9_COLUMNS
+    configs = df.select("alpha2_deg", "alpha3_deg").unique().sort("alpha2_deg", "alpha3_deg").rows()
+    assert configs == [(90.0, 0.0), (90.0, 45.0), (120.0, 60.0)]
+    # theta_w is null exactly where unreachable; (90°, 0°) satisfies eq. 2.10 everywhere, and only
+    # its corners |phi| = |theta| = 90° (singular: eq. 2.13 has zero determinant) are masked.
+    assert df.filter(~pl.col("reachable"))["theta_w_deg"].null_count() == df.filter(~pl.col("reachable")).height
+    masked = df.filter((pl.col("alpha3_deg") == 0.0) & ~pl.col("reachable"))
+    assert set(zip(masked["phi_deg"].abs(), masked["theta_deg"].abs())) == {(90.0, 90.0)}
+    # near the origin the joint is decoupled: theta_w(0, eps) ~ eps (§2.3.3)
+    near = df.filter((pl.col("phi_deg") == 0.0) & (pl.col("theta_deg") == 5.0))
+    np.testing.assert_allclose(near["theta_w_deg"].to_numpy(), 5.0, atol=1e-9)
+
+
+def test_fig2_9_rejects_bad_grid() -> None:
+    with pytest.raises(ps.InvalidParameterError, match="step_deg"):
+        ps.trials.fig2_9(step_deg=0.0)
+
+
+def test_cli_writes_parquet_csv_and_png(tmp_path: Path) -> None:
+    assert main(["reproduce", "fig2.9", "--out", str(tmp_path), "--quiet"]) == 0
+    df = pl.read_parquet(tmp_path / "fig2_9.parquet")
+    assert df.columns == FIG2_9_COLUMNS and df.height > 1000
+    assert pl.read_csv(tmp_path / "fig2_9.csv").columns == FIG2_9_COLUMNS
+    png = (tmp_path / "fig2_9.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 20_000
+
+
+def test_cli_unknown_trial_fails_clearly(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["reproduce", "fig9.99", "--out", "unused"]) == 2
+    assert "available" in capsys.readouterr().err
+
+
+def test_console_script_runs(tmp_path: Path) -> None:
+    exe = Path(sys.executable).with_name("paritysim")
+    res = subprocess.run([str(exe), "reproduce", "--all", "--out", str(tmp_path), "--quiet"], capture_output=True, text=True, check=False)
+    assert res.returncode == 0, res.stderr
+    assert (tmp_path / "fig2_9.parquet").exists()
