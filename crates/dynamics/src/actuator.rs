@@ -1,0 +1,228 @@
+//! Zeroth-order piezoelectric actuator (§3.2.2 item 4): a voltage-proportional force in
+//! parallel with a linear spring, acting on the drivetrain input `q1`.
+//!
+//! Thesis values (§3.3.1): stiffness 467 mN/mm, 120 mN amplitude at 100 V (1.2 mN/V).
+
+use paritysim_error::{Error, Result, bail, check_finite, check_non_negative, check_positive};
+
+/// How the DC part of the drive voltage enters (ERRATA item 14: not specified by the thesis).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum DcOffset {
+    /// The offset produces a static force (shifts the equilibrium of `q1`).
+    #[default]
+    AsForce,
+    /// The offset only biases the piezo (unipolar drive) and produces no net force.
+    Ignore,
+}
+
+/// Drive voltage `V(t)`; time in ms.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Waveform {
+    /// `V(t) = offset + amplitude · sin(2π f t + phase)` (eq. 3.24), `f` in kHz (1/ms).
+    Sine {
+        /// Amplitude (V).
+        amplitude_v: f64,
+        /// Frequency (kHz = cycles per ms).
+        frequency_khz: f64,
+        /// DC offset (V).
+        offset_v: f64,
+        /// Phase (rad).
+        phase: f64,
+    },
+    /// One period of samples, linearly interpolated and repeated with `period_ms`.
+    Sampled {
+        /// Sample times in `[0, period_ms)`, strictly increasing (ms).
+        times_ms: Vec<f64>,
+        /// Voltages (V).
+        voltages_v: Vec<f64>,
+        /// Period (ms).
+        period_ms: f64,
+    },
+}
+
+impl Waveform {
+    /// A validated sine; `frequency_hz` in Hz (converted to kHz internally).
+    pub fn sine(amplitude_v: f64, frequency_hz: f64, offset_v: f64, phase: f64) -> Result<Self> {
+        check_finite("amplitude_v", amplitude_v)?;
+        check_finite("offset_v", offset_v)?;
+        check_finite("phase", phase)?;
+        if !(frequency_hz.is_finite() && frequency_hz > 0.0 && frequency_hz <= 1.0e5) {
+            bail!(invalid "frequency_hz", frequency_hz, "in (0, 1e5] Hz");
+        }
+        Ok(Waveform::Sine {
+            amplitude_v,
+            frequency_khz: frequency_hz * 1e-3,
+            offset_v,
+            phase,
+        })
+    }
+
+    /// A validated periodic sampled waveform.
+    pub fn sampled(times_ms: Vec<f64>, voltages_v: Vec<f64>, period_ms: f64) -> Result<Self> {
+        check_positive("period_ms", period_ms)?;
+        if times_ms.is_empty() {
+            bail!(invalid "times_ms", "[]", "at least one sample");
+        }
+        if times_ms.len() != voltages_v.len() {
+            bail!(Shape "times_ms has {} samples but voltages_v has {}", times_ms.len(), voltages_v.len());
+        }
+        paritysim_error::check_all_finite("times_ms", &times_ms)?;
+        paritysim_error::check_all_finite("voltages_v", &voltages_v)?;
+        for i in 0..times_ms.len() {
+            let ok = times_ms[i] >= 0.0
+                && times_ms[i] < period_ms
+                && (i == 0 || times_ms[i] > times_ms[i - 1]);
+            if !ok {
+                return Err(Error::invalid(
+                    format!("times_ms[{i}]"),
+                    times_ms[i],
+                    "strictly increasing within [0, period_ms)",
+                ));
+            }
+        }
+        Ok(Waveform::Sampled {
+            times_ms,
+            voltages_v,
+            period_ms,
+        })
+    }
+
+    /// Period (ms).
+    pub fn period(&self) -> f64 {
+        match self {
+            Waveform::Sine { frequency_khz, .. } => 1.0 / frequency_khz,
+            Waveform::Sampled { period_ms, .. } => *period_ms,
+        }
+    }
+
+    /// Mean (DC) voltage.
+    pub fn offset(&self) -> f64 {
+        match self {
+            Waveform::Sine { offset_v, .. } => *offset_v,
+            Waveform::Sampled {
+                voltages_v,
+                times_ms,
+                period_ms,
+            } => {
+                // Exact mean of the periodic piecewise-linear interpolant.
+                let n = times_ms.len();
+                let mut area = 0.0;
+                for i in 0..n {
+                    let (t0, v0) = (times_ms[i], voltages_v[i]);
+                    let (t1, v1) = if i + 1 < n {
+                        (times_ms[i + 1], voltages_v[i + 1])
+                    } else {
+                        (times_ms[0] + period_ms, voltages_v[0])
+                    };
+                    area += 0.5 * (v0 + v1) * (t1 - t0);
+                }
+                area / period_ms
+            }
+        }
+    }
+
+    /// `V(t)` (V).
+    #[inline]
+    pub fn voltage(&self, t: f64) -> f64 {
+        match self {
+            Waveform::Sine {
+                amplitude_v,
+                frequency_khz,
+                offset_v,
+                phase,
+            } => offset_v + amplitude_v * (std::f64::consts::TAU * frequency_khz * t + phase).sin(),
+            Waveform::Sampled {
+                times_ms,
+                voltages_v,
+                period_ms,
+            } => {
+                let n = times_ms.len();
+                let tau = t.rem_euclid(*period_ms);
+                // Index of the last sample at or before tau (wrapping before the first).
+                let k = times_ms.partition_point(|&s| s <= tau);
+                let (i0, t0) = if k == 0 {
+                    (n - 1, times_ms[n - 1] - period_ms)
+                } else {
+                    (k - 1, times_ms[k - 1])
+                };
+                let (i1, t1) = if k == n {
+                    (0, times_ms[0] + period_ms)
+                } else {
+                    (k, times_ms[k])
+                };
+                if t1 <= t0 {
+                    return voltages_v[i0];
+                }
+                let w = (tau - t0) / (t1 - t0);
+                voltages_v[i0] * (1.0 - w) + voltages_v[i1] * w
+            }
+        }
+    }
+}
+
+/// Piezo actuator: `F(t) = force_per_volt · V(t)` in parallel with `stiffness` on `q1`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Actuator {
+    force_per_volt: f64,
+    stiffness: f64,
+    waveform: Waveform,
+    dc_offset: DcOffset,
+}
+
+impl Actuator {
+    /// `force_per_volt` in mN/V (>= 0), `stiffness` in mN/mm (>= 0).
+    pub fn new(
+        force_per_volt: f64,
+        stiffness: f64,
+        waveform: Waveform,
+        dc_offset: DcOffset,
+    ) -> Result<Self> {
+        Ok(Self {
+            force_per_volt: check_non_negative("force_per_volt", force_per_volt)?,
+            stiffness: check_non_negative("stiffness", stiffness)?,
+            waveform,
+            dc_offset,
+        })
+    }
+
+    /// The §3.3.1 actuator (467 mN/mm, 1.2 mN/V) with the given waveform.
+    pub fn thesis(waveform: Waveform) -> Self {
+        Self {
+            force_per_volt: 1.2,
+            stiffness: 467.0,
+            waveform,
+            dc_offset: DcOffset::AsForce,
+        }
+    }
+
+    /// Force (mN) at time `t` (ms).
+    #[inline]
+    pub fn force(&self, t: f64) -> f64 {
+        let v = self.waveform.voltage(t);
+        let v = match self.dc_offset {
+            DcOffset::AsForce => v,
+            DcOffset::Ignore => v - self.waveform.offset(),
+        };
+        self.force_per_volt * v
+    }
+
+    /// Stiffness K1 (mN/mm).
+    pub fn stiffness(&self) -> f64 {
+        self.stiffness
+    }
+
+    /// Force per volt (mN/V).
+    pub fn force_per_volt(&self) -> f64 {
+        self.force_per_volt
+    }
+
+    /// Waveform.
+    pub fn waveform(&self) -> &Waveform {
+        &self.waveform
+    }
+
+    /// DC-offset treatment.
+    pub fn dc_offset(&self) -> DcOffset {
+        self.dc_offset
+    }
+}

@@ -1,0 +1,457 @@
+//! A device: wings + constraints + drivetrain + actuator, and its right-hand side.
+//!
+//! Configuration `p = (φL, θL, ψL, φR, θR, ψR)` (eq. 3.21; one wing uses the first three).
+//! Under the massless-mechanism assumption (§3.2.2 item 5) the drivetrain adds no inertia: its
+//! springs (actuator K1 on `q1`, balance beam K2 on `q2`) and the actuator force act on the
+//! stroke angles through the drivetrain Jacobian `J = ∂φ/∂q`: `Q = Jᵀ τ_φ`, so
+//! `τ_φ = J⁻ᵀ Q` with `Q = (F(t) − K1 q1, −K2 q2)`. `q` is recovered from `φ` by Newton's method
+//! on the drivetrain map.
+
+use nalgebra::{Matrix2, Vector2, Vector3};
+use paritysim_constraints::{Constraints, Mat6, Vec6};
+use paritysim_error::{Error, Result, bail, check_non_negative};
+use paritysim_kinematics::Drivetrain;
+
+use crate::actuator::Actuator;
+use crate::integrate::{STATE_LEN, State};
+use crate::wing::{Wing, WingTerms};
+
+/// A drivetrain with its balance-beam spring.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Transmission {
+    kinematics: Drivetrain,
+    balance_stiffness: f64,
+}
+
+impl Transmission {
+    /// `balance_stiffness` K2 on `q2` in mN·mm/rad (>= 0; ERRATA item 14: not given by the
+    /// thesis).
+    pub fn new(kinematics: Drivetrain, balance_stiffness: f64) -> Result<Self> {
+        Ok(Self {
+            kinematics,
+            balance_stiffness: check_non_negative("balance_stiffness", balance_stiffness)?,
+        })
+    }
+
+    /// Drivetrain kinematics.
+    pub fn kinematics(&self) -> &Drivetrain {
+        &self.kinematics
+    }
+
+    /// K2 (mN·mm/rad).
+    pub fn balance_stiffness(&self) -> f64 {
+        self.balance_stiffness
+    }
+}
+
+/// How the constraints are enforced.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Formulation {
+    /// Reduced coordinates `p = p_part + N z` (cannot drift; the default).
+    #[default]
+    NullSpace,
+    /// Lagrange-multiplier projection of eq. 3.20 (with ERRATA item 4's `Cᵀ`) on the full `p`.
+    Projection,
+}
+
+/// Everything needed to build a [`Device`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct DeviceSpec {
+    /// One or two wings (left first).
+    pub wings: Vec<Wing>,
+    /// `C p = c0`.
+    pub constraints: Constraints,
+    /// Drivetrain from the actuator to the stroke angles (required with an actuator).
+    pub transmission: Option<Transmission>,
+    /// Piezo actuator on `q1`.
+    pub actuator: Option<Actuator>,
+    /// Constraint formulation.
+    pub formulation: Formulation,
+}
+
+/// The validated, immutable model (`Send + Sync`; shared across threads by sweeps).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Device {
+    spec: DeviceSpec,
+    n_coords: usize,
+    /// Columns of the coordinate map `p = offset + basis · x`: `N` (null space) or `I`.
+    basis: Mat6,
+    offset: Vec6,
+    n_dof: usize,
+}
+
+/// The drivetrain state recovered from the stroke angles.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct DriveState {
+    /// `(q1, q2)` (mm, rad).
+    pub q: Vector2<f64>,
+    /// `(q̇1, q̇2)`.
+    pub q_dot: Vector2<f64>,
+    /// Actuator force F(t) (mN).
+    pub actuator_force: f64,
+    /// Generalised torques on `(φL, φR)` from the drivetrain (mN·mm).
+    pub stroke_torque: Vector2<f64>,
+    /// Drivetrain spring energy ½K1q1² + ½K2q2² (µJ).
+    pub potential: f64,
+}
+
+/// A full evaluation of the model at `(t, p, ṗ)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Evaluation {
+    /// Configuration.
+    pub p: Vec6,
+    /// Velocities.
+    pub p_dot: Vec6,
+    /// Accelerations.
+    pub p_ddot: Vec6,
+    /// Per-wing terms (the second is unused for one wing).
+    pub wings: [WingTerms; 2],
+    /// Drivetrain state.
+    pub drive: DriveState,
+}
+
+impl Device {
+    /// Validates the spec and precomputes the coordinate map.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a wrong wing count; [`Error::Shape`] when `C` does not have
+    /// 3 columns per wing; [`Error::Constraint`] when an actuator has no drivetrain, a 2-DOF
+    /// drivetrain has one wing, or a 1-DOF drivetrain drives two wings whose strokes `C` does not
+    /// tie together (`φL = φR`).
+    pub fn new(spec: DeviceSpec) -> Result<Self> {
+        let n_wings = spec.wings.len();
+        if !(1..=2).contains(&n_wings) {
+            bail!(invalid "wings", n_wings, "1 or 2 wings");
+        }
+        let n_coords = 3 * n_wings;
+        if spec.constraints.n_coords() != n_coords {
+            bail!(Shape "C has {} columns but {n_wings} wing(s) need {n_coords}", spec.constraints.n_coords());
+        }
+        if spec.actuator.is_some() && spec.transmission.is_none() {
+            bail!(Constraint "an actuator needs a transmission (drivetrain) to act on the wings");
+        }
+        if let Some(tr) = &spec.transmission {
+            let dof = tr.kinematics.dof();
+            if dof == 2 && n_wings != 2 {
+                bail!(Constraint "the {} drivetrain drives two wings but the device has one", tr.kinematics.name());
+            }
+            if dof == 1 && n_wings == 2 {
+                let n = spec.constraints.null_basis();
+                let tied =
+                    (0..spec.constraints.n_free()).all(|k| (n[(0, k)] - n[(3, k)]).abs() < 1e-12);
+                if !tied {
+                    bail!(Constraint
+                        "the 1-DOF {} drivetrain requires C to impose phi_L = phi_R (e.g. configuration hmf)",
+                        tr.kinematics.name());
+                }
+            }
+        }
+        let (basis, offset, n_dof) = match spec.formulation {
+            Formulation::NullSpace => (
+                *spec.constraints.null_basis(),
+                *spec.constraints.particular(),
+                spec.constraints.n_free(),
+            ),
+            Formulation::Projection => {
+                let mut b = Mat6::zeros();
+                for i in 0..n_coords {
+                    b[(i, i)] = 1.0;
+                }
+                (b, Vec6::zeros(), n_coords)
+            }
+        };
+        Ok(Self {
+            spec,
+            n_coords,
+            basis,
+            offset,
+            n_dof,
+        })
+    }
+
+    /// The spec this model was built from.
+    pub fn spec(&self) -> &DeviceSpec {
+        &self.spec
+    }
+
+    /// Number of wings.
+    pub fn n_wings(&self) -> usize {
+        self.spec.wings.len()
+    }
+
+    /// Number of configuration coordinates (3 or 6).
+    pub fn n_coords(&self) -> usize {
+        self.n_coords
+    }
+
+    /// Number of integrated coordinates (`n_free` for null-space, `n_coords` for projection).
+    pub fn n_dof(&self) -> usize {
+        self.n_dof
+    }
+
+    /// Drive period (ms), if there is an actuator.
+    pub fn period(&self) -> Option<f64> {
+        self.spec.actuator.as_ref().map(|a| a.waveform().period())
+    }
+
+    /// `(p, ṗ)` from an integrator state.
+    #[inline]
+    pub fn coordinates(&self, y: &State) -> (Vec6, Vec6) {
+        let mut x = Vec6::zeros();
+        let mut xd = Vec6::zeros();
+        for i in 0..self.n_dof {
+            x[i] = y[i];
+            xd[i] = y[6 + i];
+        }
+        (self.offset + self.basis * x, self.basis * xd)
+    }
+
+    /// An integrator state from `(p, ṗ)` after checking `C p = c0`, `C ṗ = 0`.
+    ///
+    /// # Errors
+    /// [`Error::Constraint`] for an inconsistent initial state; [`Error::InvalidParameter`] for
+    /// non-finite values.
+    pub fn state_from(&self, p: &Vec6, p_dot: &Vec6) -> Result<State> {
+        paritysim_error::check_all_finite("initial.p", p.as_slice())?;
+        paritysim_error::check_all_finite("initial.p_dot", p_dot.as_slice())?;
+        self.spec.constraints.check_consistent(p, p_dot, 1e-10)?;
+        let x = self.basis.transpose() * (p - self.offset);
+        let xd = self.basis.transpose() * p_dot;
+        let mut y = [0.0; STATE_LEN];
+        for i in 0..self.n_dof {
+            y[i] = x[i];
+            y[6 + i] = xd[i];
+        }
+        Ok(y)
+    }
+
+    /// Drivetrain state at `(t, p, ṗ)`.
+    pub fn drive(&self, t: f64, p: &Vec6, p_dot: &Vec6) -> Result<DriveState> {
+        let Some(tr) = &self.spec.transmission else {
+            return Ok(DriveState::default());
+        };
+        let dt = &tr.kinematics;
+        let k1 = self.spec.actuator.as_ref().map_or(0.0, |a| a.stiffness());
+        let force = self.spec.actuator.as_ref().map_or(0.0, |a| a.force(t));
+        let k2 = tr.balance_stiffness;
+        if dt.dof() == 1 {
+            let target = p[0];
+            let (q1, slope) = invert_1dof(dt, target)?;
+            let q1_dot = p_dot[0] / slope;
+            let generalized = force - k1 * q1;
+            return Ok(DriveState {
+                q: Vector2::new(q1, 0.0),
+                q_dot: Vector2::new(q1_dot, 0.0),
+                actuator_force: force,
+                // Acts through φL only; C ties φR to it.
+                stroke_torque: Vector2::new(generalized / slope, 0.0),
+                potential: 0.5 * k1 * q1 * q1,
+            });
+        }
+        let target = Vector2::new(p[0], p[3]);
+        let (q, jac) = invert_2dof(dt, &target)?;
+        let lu = jac.lu();
+        let q_dot = lu
+            .solve(&Vector2::new(p_dot[0], p_dot[3]))
+            .ok_or_else(|| singular_drive(&q))?;
+        let generalized = Vector2::new(force - k1 * q.x, -k2 * q.y);
+        let stroke_torque = jac
+            .transpose()
+            .lu()
+            .solve(&generalized)
+            .ok_or_else(|| singular_drive(&q))?;
+        Ok(DriveState {
+            q,
+            q_dot,
+            actuator_force: force,
+            stroke_torque,
+            potential: 0.5 * k1 * q.x * q.x + 0.5 * k2 * q.y * q.y,
+        })
+    }
+
+    /// Full evaluation at `(t, p, ṗ)`, including the constrained accelerations.
+    pub fn evaluate(&self, t: f64, p: &Vec6, p_dot: &Vec6) -> Result<Evaluation> {
+        let mut wings = [empty_terms(); 2];
+        let mut mass = Mat6::identity();
+        let mut force = Vec6::zeros();
+        for (w, wing) in self.spec.wings.iter().enumerate() {
+            let k = 3 * w;
+            let pw = Vector3::new(p[k], p[k + 1], p[k + 2]);
+            let vw = Vector3::new(p_dot[k], p_dot[k + 1], p_dot[k + 2]);
+            let terms = wing.terms(&pw, &vw)?;
+            mass.fixed_view_mut::<3, 3>(k, k).copy_from(&terms.mass);
+            let f = terms.aero - terms.coriolis - terms.spring;
+            force.fixed_view_mut::<3, 1>(k, 0).copy_from(&f);
+            wings[w] = terms;
+        }
+        let drive = self.drive(t, p, p_dot)?;
+        force[0] += drive.stroke_torque.x;
+        if self.n_wings() == 2 {
+            force[3] += drive.stroke_torque.y;
+        }
+        let p_ddot = match self.spec.formulation {
+            Formulation::NullSpace => {
+                let n = self.n_dof;
+                let mut reduced_mass = self.basis.transpose() * mass * self.basis;
+                for i in n..6 {
+                    for j in 0..6 {
+                        reduced_mass[(i, j)] = if i == j { 1.0 } else { 0.0 };
+                        reduced_mass[(j, i)] = if i == j { 1.0 } else { 0.0 };
+                    }
+                }
+                let mut reduced_force = self.basis.transpose() * force;
+                for i in n..6 {
+                    reduced_force[i] = 0.0;
+                }
+                let x_ddot = reduced_mass
+                    .cholesky()
+                    .ok_or_else(|| {
+                        Error::Singular(format!(
+                            "reduced mass matrix is not positive definite at p = {:?}",
+                            p.as_slice()
+                        ))
+                    })?
+                    .solve(&reduced_force);
+                self.basis * x_ddot
+            }
+            Formulation::Projection => {
+                let m_inv = mass.try_inverse().ok_or_else(|| {
+                    Error::Singular(format!("mass matrix is singular at p = {:?}", p.as_slice()))
+                })?;
+                self.spec.constraints.project(&m_inv, &force)?
+            }
+        };
+        Ok(Evaluation {
+            p: *p,
+            p_dot: *p_dot,
+            p_ddot,
+            wings,
+            drive,
+        })
+    }
+
+    /// The right-hand side `ẏ = f(t, y)`; also integrates the actuator work and the
+    /// aerodynamic work into the last two state entries.
+    pub fn rhs(&self, t: f64, y: &State, dydt: &mut State) -> Result<()> {
+        let (p, p_dot) = self.coordinates(y);
+        let e = self.evaluate(t, &p, &p_dot)?;
+        let x_ddot = self.basis.transpose() * e.p_ddot;
+        for i in 0..6 {
+            dydt[i] = if i < self.n_dof { y[6 + i] } else { 0.0 };
+            dydt[6 + i] = if i < self.n_dof { x_ddot[i] } else { 0.0 };
+        }
+        dydt[12] = e.drive.actuator_force * e.drive.q_dot.x;
+        let mut aero_power = 0.0;
+        for (w, terms) in e.wings.iter().take(self.n_wings()).enumerate() {
+            aero_power += terms.aero.dot(&Vector3::new(
+                p_dot[3 * w],
+                p_dot[3 * w + 1],
+                p_dot[3 * w + 2],
+            ));
+        }
+        dydt[13] = aero_power;
+        Ok(())
+    }
+
+    /// Mechanical energy: kinetic + joint springs + drivetrain springs (µJ).
+    pub fn energy(&self, e: &Evaluation) -> f64 {
+        e.wings
+            .iter()
+            .take(self.n_wings())
+            .map(|w| w.kinetic + w.potential)
+            .sum::<f64>()
+            + e.drive.potential
+    }
+}
+
+fn singular_drive(q: &Vector2<f64>) -> Error {
+    Error::Singular(format!(
+        "drivetrain Jacobian is singular at q = ({}, {})",
+        q.x, q.y
+    ))
+}
+
+fn empty_terms() -> WingTerms {
+    WingTerms {
+        mass: nalgebra::Matrix3::identity(),
+        coriolis: Vector3::zeros(),
+        spring: Vector3::zeros(),
+        aero: Vector3::zeros(),
+        aero_frame6: Vector3::zeros(),
+        j6: nalgebra::Matrix3::identity(),
+        omega: Vector3::zeros(),
+        jdot_pdot: Vector3::zeros(),
+        rotation: nalgebra::Matrix3::identity(),
+        theta_w: 0.0,
+        potential: 0.0,
+        kinetic: 0.0,
+    }
+}
+
+const NEWTON_TOL: f64 = 1e-14;
+const NEWTON_MAX: usize = 30;
+
+/// Solves `φ(q1) = target` for a 1-DOF drivetrain; returns `q1` and `dφ/dq1`.
+fn invert_1dof(dt: &Drivetrain, target: f64) -> Result<(f64, f64)> {
+    let e0 = dt.evaluate(0.0, 0.0)?;
+    let mut q1 = (target - e0.stroke.x) / e0.jacobian[(0, 0)];
+    for _ in 0..NEWTON_MAX {
+        let e = dt
+            .evaluate(q1, 0.0)
+            .map_err(|e| unreachable_stroke(e, target))?;
+        let slope = e.jacobian[(0, 0)];
+        let step = (e.stroke.x - target) / slope;
+        q1 -= step;
+        if step.abs() <= NEWTON_TOL * (1.0 + q1.abs()) {
+            let e = dt.evaluate(q1, 0.0)?;
+            return Ok((q1, e.jacobian[(0, 0)]));
+        }
+    }
+    Err(Error::OutOfDomain {
+        what: "drivetrain inverse".into(),
+        detail: format!("no convergence for stroke {target} rad"),
+    })
+}
+
+/// Solves `φ(q) = target` for a 2-DOF drivetrain; returns `q` and `J(q)`.
+fn invert_2dof(dt: &Drivetrain, target: &Vector2<f64>) -> Result<(Vector2<f64>, Matrix2<f64>)> {
+    let e0 = dt.evaluate(0.0, 0.0)?;
+    let j0 = e0.jacobian.lu();
+    let mut q = j0
+        .solve(&(target - e0.stroke))
+        .ok_or_else(|| singular_drive(&Vector2::zeros()))?;
+    for _ in 0..NEWTON_MAX {
+        let e = dt
+            .evaluate(q.x, q.y)
+            .map_err(|e| unreachable_stroke(e, target.x))?;
+        let step = e
+            .jacobian
+            .lu()
+            .solve(&(e.stroke - target))
+            .ok_or_else(|| singular_drive(&q))?;
+        q -= step;
+        if step.amax() <= NEWTON_TOL * (1.0 + q.amax()) {
+            let e = dt.evaluate(q.x, q.y)?;
+            return Ok((q, e.jacobian));
+        }
+    }
+    Err(Error::OutOfDomain {
+        what: "drivetrain inverse".into(),
+        detail: format!(
+            "no convergence for strokes ({}, {}) rad",
+            target.x, target.y
+        ),
+    })
+}
+
+fn unreachable_stroke(e: Error, target: f64) -> Error {
+    match e {
+        Error::OutOfDomain { what, detail } => Error::OutOfDomain {
+            what,
+            detail: format!(
+                "{detail}; the wings reached a stroke ({target} rad) the drivetrain cannot produce"
+            ),
+        },
+        other => other,
+    }
+}

@@ -1,0 +1,284 @@
+//! One wing on a spherical shoulder (§3.2.3, Appendix A).
+//!
+//! The wing (frame 6) is the only inertia (§3.2.2 item 5). With `ω = J6 ṗ` the angular
+//! velocity in frame 6 (A.10) and `I` constant in frame 6, Euler's equations
+//! `I ω̇ + ω × I ω = τ⁶` projected by `J6ᵀ` give the Euler-Lagrange form of A.13:
+//!
+//! ```text
+//! M(p) = J6ᵀ I J6                                  (A.36)
+//! c(p, ṗ) = J6ᵀ (I (J̇6 ṗ) + ω × I ω)               (replaces A.37–A.38, see ERRATA items 1–2)
+//! ```
+//!
+//! `J̇6 ṗ` is assembled from link angular velocities (no second partials of the printed
+//! A.26–A.28 are used). The tests check `M` and `c` against an independent formulation:
+//! finite-differenced link rotations and Christoffel symbols of a finite-differenced `M`.
+
+use nalgebra::{Matrix3, Vector2, Vector3};
+use paritysim_error::{Error, Result, check_finite, check_non_negative};
+use paritysim_kinematics::SphericalShoulder;
+
+/// A torsion spring at a shoulder joint: `τ = k (γ − γ0) + k3 (γ − γ0)³`.
+///
+/// `k` in mN·mm/rad, `k3` in mN·mm/rad³ (a hardening law when `k3 > 0`), `γ0` in rad.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct JointSpring {
+    stiffness: f64,
+    cubic: f64,
+    rest_angle: f64,
+}
+
+impl JointSpring {
+    /// A linear spring (A.7). `stiffness >= 0`, finite rest angle.
+    pub fn linear(stiffness: f64, rest_angle: f64) -> Result<Self> {
+        Self::nonlinear(stiffness, 0.0, rest_angle)
+    }
+
+    /// A spring with an added cubic term (`cubic >= 0`: hardening, never negative stiffness).
+    pub fn nonlinear(stiffness: f64, cubic: f64, rest_angle: f64) -> Result<Self> {
+        Ok(Self {
+            stiffness: check_non_negative("stiffness", stiffness)?,
+            cubic: check_non_negative("cubic", cubic)?,
+            rest_angle: check_finite("rest_angle", rest_angle)?,
+        })
+    }
+
+    /// `∂V/∂γ`.
+    #[inline]
+    pub fn torque(&self, gamma: f64) -> f64 {
+        let d = gamma - self.rest_angle;
+        self.stiffness * d + self.cubic * d * d * d
+    }
+
+    /// Stored energy `V(γ)` (µJ).
+    #[inline]
+    pub fn energy(&self, gamma: f64) -> f64 {
+        let d = gamma - self.rest_angle;
+        0.5 * self.stiffness * d * d + 0.25 * self.cubic * d.powi(4)
+    }
+
+    /// Linear stiffness (mN·mm/rad).
+    pub fn stiffness(&self) -> f64 {
+        self.stiffness
+    }
+}
+
+/// Aerodynamic model of a wing, evaluated inside the right-hand side (allocation-free).
+#[derive(Clone, Debug, PartialEq)]
+pub enum WingAero {
+    /// No aerodynamics (vacuum).
+    None,
+    /// Quadratic drag about the stroke axis, `τ = −Ω C sgn(φ̇) φ̇²`, the fixed-wing model of
+    /// §2.6.1 (eq. 2.16, `C = 1`) or eq. 3.8 at α = 90° (`C = C_N(90°)`); ERRATA item 12.
+    StrokeDrag {
+        /// Drag parameter Ω1 (mg·mm²).
+        omega1: f64,
+        /// Dimensionless multiplier `C`.
+        coefficient: f64,
+    },
+}
+
+impl WingAero {
+    /// The §3.3 fixed-wing drag `Ω φ̇²` scaled by `coefficient`.
+    pub fn stroke_drag(omega1: f64, coefficient: f64) -> Result<Self> {
+        Ok(WingAero::StrokeDrag {
+            omega1: check_non_negative("omega1", omega1)?,
+            coefficient: check_non_negative("coefficient", coefficient)?,
+        })
+    }
+
+    /// Aerodynamic torque on the wing, in frame 6.
+    #[inline]
+    fn torque(&self, p_dot: &Vector3<f64>, r61: &Matrix3<f64>) -> Vector3<f64> {
+        match self {
+            WingAero::None => Vector3::zeros(),
+            WingAero::StrokeDrag {
+                omega1,
+                coefficient,
+            } => {
+                let rate = p_dot.x;
+                // Torque about the stroke axis x̂ (ground), expressed in frame 6.
+                let stroke_axis_6 = r61.row(0).transpose();
+                stroke_axis_6 * (-omega1 * coefficient * rate.abs() * rate)
+            }
+        }
+    }
+}
+
+/// A wing: shoulder, inertia about the spherical centre (frame 6), six joint springs, aero.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Wing {
+    shoulder: SphericalShoulder,
+    inertia: Matrix3<f64>,
+    springs: [JointSpring; 6],
+    aero: WingAero,
+}
+
+/// Everything the dynamics need from one wing at `(p, ṗ)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WingTerms {
+    /// `M(p)` (mg·mm²).
+    pub mass: Matrix3<f64>,
+    /// `c(p, ṗ)` (mN·mm).
+    pub coriolis: Vector3<f64>,
+    /// `∂V/∂p` of the joint springs (mN·mm).
+    pub spring: Vector3<f64>,
+    /// Aerodynamic generalised torque `J6ᵀ τ⁶` (mN·mm).
+    pub aero: Vector3<f64>,
+    /// Aerodynamic torque in frame 6 (mN·mm).
+    pub aero_frame6: Vector3<f64>,
+    /// `J6` (A.9).
+    pub j6: Matrix3<f64>,
+    /// `ω⁶ = J6 ṗ` (rad/ms).
+    pub omega: Vector3<f64>,
+    /// `J̇6 ṗ` (rad/ms²).
+    pub jdot_pdot: Vector3<f64>,
+    /// `R_6^1`.
+    pub rotation: Matrix3<f64>,
+    /// Wing deviation `θ_w = γ5` (rad).
+    pub theta_w: f64,
+    /// Spring energy (µJ).
+    pub potential: f64,
+    /// Kinetic energy `½ ωᵀ I ω` (µJ).
+    pub kinetic: f64,
+}
+
+impl Wing {
+    /// A wing with a full inertia tensor (mg·mm², frame 6, about the spherical centre).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `inertia` when it is non-finite, not symmetric or not
+    /// positive definite.
+    pub fn new(
+        shoulder: SphericalShoulder,
+        inertia: Matrix3<f64>,
+        springs: [JointSpring; 6],
+        aero: WingAero,
+    ) -> Result<Self> {
+        for (k, v) in inertia.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(Error::invalid(
+                    format!("inertia[{}][{}]", k % 3, k / 3),
+                    v,
+                    "a finite number (mg mm^2)",
+                ));
+            }
+        }
+        let asym = (inertia - inertia.transpose()).amax();
+        if asym > 1e-12 * inertia.amax().max(1.0) {
+            return Err(Error::invalid(
+                "inertia",
+                format!("{inertia:?}"),
+                "a symmetric tensor",
+            ));
+        }
+        if inertia.cholesky().is_none() {
+            return Err(Error::invalid(
+                "inertia",
+                format!("{:?}", inertia.symmetric_eigenvalues().as_slice()),
+                "positive definite (all eigenvalues > 0)",
+            ));
+        }
+        Ok(Self {
+            shoulder,
+            inertia,
+            springs,
+            aero,
+        })
+    }
+
+    /// A wing whose only inertia is `ixx` about the stroke axis plus small `iyy = izz` so the
+    /// tensor is positive definite; convenient for fixed-wing studies.
+    pub fn stroke_only(shoulder: SphericalShoulder, ixx: f64, aero: WingAero) -> Result<Self> {
+        let ixx = paritysim_error::check_positive("ixx", ixx)?;
+        Self::new(
+            shoulder,
+            Matrix3::from_diagonal(&Vector3::new(ixx, ixx, ixx)),
+            [JointSpring::default(); 6],
+            aero,
+        )
+    }
+
+    /// Shoulder.
+    pub fn shoulder(&self) -> &SphericalShoulder {
+        &self.shoulder
+    }
+
+    /// Inertia tensor (frame 6).
+    pub fn inertia(&self) -> &Matrix3<f64> {
+        &self.inertia
+    }
+
+    /// Joint springs `γ1..γ6`.
+    pub fn springs(&self) -> &[JointSpring; 6] {
+        &self.springs
+    }
+
+    /// Aerodynamic model.
+    pub fn aero(&self) -> &WingAero {
+        &self.aero
+    }
+
+    /// Mass matrix, Coriolis, spring and aero terms at `(p, ṗ)`.
+    ///
+    /// # Errors
+    /// [`Error::OutOfDomain`] outside the shoulder's joint limit, [`Error::Singular`] at a
+    /// singular shoulder pose.
+    pub fn terms(&self, p: &Vector3<f64>, p_dot: &Vector3<f64>) -> Result<WingTerms> {
+        let (phi, theta, psi) = (p.x, p.y, p.z);
+        let pose = self.shoulder.pose(phi, theta, psi)?;
+        let [_, g2, g3, _, g5, _] = pose.joint_angles;
+        let d = self.shoulder.partials_at(phi, theta, g2, g5)?;
+        let j6 = self.shoulder.jacobian(&pose, &d);
+        let r61 = pose.link_rotations[5];
+        let omega = j6 * p_dot;
+
+        // J̇6 ṗ from link angular velocities, in ground frame then rotated to frame 6.
+        let rates = Vector2::new(p_dot.x, p_dot.y);
+        let g5_dot = d.gamma5.dot(&rates);
+        let y3 = pose.link_rotations[2] * Vector3::y();
+        let z4 = pose.link_rotations[3] * Vector3::z();
+        let omega4 = Vector3::x() * p_dot.x + y3 * g5_dot;
+        let accel_ground = y3 * rates.dot(&(d.gamma5_hessian * rates))
+            + Vector3::x().cross(&y3) * (g5_dot * p_dot.x)
+            + omega4.cross(&z4) * p_dot.z;
+        let jdot_pdot = r61.transpose() * accel_ground;
+
+        let i_omega = self.inertia * omega;
+        let mass = j6.transpose() * self.inertia * j6;
+        let coriolis = j6.transpose() * (self.inertia * jdot_pdot + omega.cross(&i_omega));
+
+        // A.6: Σ_j V_j'(γ_j) ∇γ_j.
+        let s = &self.springs;
+        let gammas = [phi, g2, g3, theta, g5, psi];
+        let grads = [
+            Vector3::new(1.0, 0.0, 0.0),
+            Vector3::new(d.gamma2[0], d.gamma2[1], 0.0),
+            Vector3::new(d.gamma3[0], d.gamma3[1], 0.0),
+            Vector3::new(0.0, 1.0, 0.0),
+            Vector3::new(d.gamma5[0], d.gamma5[1], 0.0),
+            Vector3::new(0.0, 0.0, 1.0),
+        ];
+        let mut spring = Vector3::zeros();
+        let mut potential = 0.0;
+        for j in 0..6 {
+            spring += grads[j] * s[j].torque(gammas[j]);
+            potential += s[j].energy(gammas[j]);
+        }
+
+        let aero_frame6 = self.aero.torque(p_dot, &r61);
+        Ok(WingTerms {
+            mass,
+            coriolis,
+            spring,
+            aero: j6.transpose() * aero_frame6,
+            aero_frame6,
+            j6,
+            omega,
+            jdot_pdot,
+            rotation: r61,
+            theta_w: g5,
+            potential,
+            kinetic: 0.5 * omega.dot(&i_omega),
+        })
+    }
+}

@@ -1,0 +1,475 @@
+//! Integration tests of paritysim-dynamics: each checks physics against an independent
+//! formulation or a conservation law, never against recorded outputs.
+
+use approx::assert_relative_eq;
+use nalgebra::{Matrix3, Vector3};
+use paritysim_constraints::{Constraints, Vec6};
+use paritysim_dynamics::device::{Device, DeviceSpec, Formulation, Transmission};
+use paritysim_dynamics::simulate::PerturbTarget;
+use paritysim_dynamics::{
+    Actuator, DcOffset, JointSpring, Perturbation, SimulationOptions, Waveform, Wing, WingAero,
+    simulate,
+};
+use paritysim_kinematics::drivetrain::{HmfFourBar, LinkageDifferential};
+use paritysim_kinematics::{Drivetrain, RodCrank, SphericalShoulder};
+
+fn shoulder(a2: f64, a3: f64) -> SphericalShoulder {
+    SphericalShoulder::new(a2.to_radians(), a3.to_radians()).unwrap()
+}
+
+/// A full, positive-definite inertia tensor with Ixz ≠ 0 (a Table 3.3-like wing, mg·mm²).
+fn full_inertia() -> Matrix3<f64> {
+    Matrix3::new(29.0, 0.4, -3.1, 0.4, 30.5, 0.7, -3.1, 0.7, 2.2)
+}
+
+fn springs(k: [f64; 6]) -> [JointSpring; 6] {
+    k.map(|k| JointSpring::linear(k, 0.0).unwrap())
+}
+
+// ------------------------------------------------------------- M and c
+
+/// Angular velocity in frame 6 from finite differences of R_6^1 (independent of J6).
+fn omega_fd(sh: &SphericalShoulder, p: &Vector3<f64>, v: &Vector3<f64>) -> Vector3<f64> {
+    let h = 1e-6;
+    let r = |s: f64| {
+        sh.pose(p.x + v.x * s, p.y + v.y * s, p.z + v.z * s)
+            .unwrap()
+            .link_rotations[5]
+    };
+    let w = r(0.0).transpose() * (r(h) - r(-h)) / (2.0 * h);
+    Vector3::new(w[(2, 1)], w[(0, 2)], w[(1, 0)])
+}
+
+/// `M = J6ᵀ I J6` with J6's columns from finite-differenced rotations.
+fn mass_fd(sh: &SphericalShoulder, inertia: &Matrix3<f64>, p: &Vector3<f64>) -> Matrix3<f64> {
+    let j = Matrix3::from_columns(&[
+        omega_fd(sh, p, &Vector3::x()),
+        omega_fd(sh, p, &Vector3::y()),
+        omega_fd(sh, p, &Vector3::z()),
+    ]);
+    j.transpose() * inertia * j
+}
+
+#[test]
+fn mass_and_coriolis_match_christoffel_symbols() {
+    let inertia = full_inertia();
+    for (a2, a3) in [(90.0, 0.0), (120.0, 60.0)] {
+        let sh = shoulder(a2, a3);
+        let wing = Wing::new(sh, inertia, [JointSpring::default(); 6], WingAero::None).unwrap();
+        let states = [
+            (Vector3::new(0.3, -0.2, 0.5), Vector3::new(0.7, -0.4, 1.3)),
+            (Vector3::new(-0.6, 0.35, -0.9), Vector3::new(-1.1, 0.5, 0.2)),
+            (Vector3::new(0.1, 0.5, 1.2), Vector3::new(0.3, 0.9, -0.8)),
+        ];
+        for (p, v) in states {
+            let terms = wing.terms(&p, &v).unwrap();
+            let m_fd = mass_fd(&sh, &inertia, &p);
+            assert_relative_eq!(terms.mass, m_fd, epsilon = 1e-6, max_relative = 1e-6);
+            // c_i = Σ_jk Γ_ijk v_j v_k with Γ from finite differences of our own M(p), which the
+            // line above ties to the independent M.
+            let h = 1e-5;
+            let dm: Vec<Matrix3<f64>> = (0..3)
+                .map(|k| {
+                    let e = Vector3::ith(k, h);
+                    (wing.terms(&(p + e), &v).unwrap().mass
+                        - wing.terms(&(p - e), &v).unwrap().mass)
+                        / (2.0 * h)
+                })
+                .collect();
+            let mut c = Vector3::zeros();
+            for i in 0..3 {
+                for j in 0..3 {
+                    for k in 0..3 {
+                        c[i] += 0.5 * (dm[k][(i, j)] + dm[j][(i, k)] - dm[i][(j, k)]) * v[j] * v[k];
+                    }
+                }
+            }
+            assert_relative_eq!(terms.coriolis, c, epsilon = 1e-6, max_relative = 1e-6);
+        }
+    }
+}
+
+// ------------------------------------------------------------- energy
+
+fn free_wing_device(formulation: Formulation) -> Device {
+    let wing = Wing::new(
+        shoulder(120.0, 60.0),
+        full_inertia(),
+        springs([20.0, 3.0, 2.0, 15.0, 4.0, 1.5]),
+        WingAero::None,
+    )
+    .unwrap();
+    Device::new(DeviceSpec {
+        wings: vec![wing],
+        constraints: Constraints::none(3).unwrap(),
+        transmission: None,
+        actuator: None,
+        formulation,
+    })
+    .unwrap()
+}
+
+#[test]
+fn unforced_wing_conserves_energy_over_100_oscillations() {
+    use paritysim_dynamics::integrate::{Integrator, Method, RungeKutta};
+    let device = free_wing_device(Formulation::NullSpace);
+    let p0 = Vec6::new(0.4, -0.2, 0.6, 0.0, 0.0, 0.0);
+    let v0 = Vec6::new(0.1, 0.05, -0.2, 0.0, 0.0, 0.0);
+    let mut y = device.state_from(&p0, &v0).unwrap();
+    let energy = |y: &paritysim_dynamics::State, t: f64| {
+        let (p, v) = device.coordinates(y);
+        device.energy(&device.evaluate(t, &p, &v).unwrap())
+    };
+    let e0 = energy(&y, 0.0);
+    let rk = RungeKutta::new(Method::Dop853, 1e-13, 1e-15, 1_000_000).unwrap();
+    // Slowest mode: φ with I ≈ 29 mg·mm² and k ≈ 20 mN·mm/rad: period ≈ 7.6 ms. Each segment ends
+    // on a solver step (dense output between steps is less accurate than the steps themselves).
+    let (segment, mut t, mut worst, mut phi_max) = (7.6, 0.0, 0.0f64, 0.0f64);
+    for _ in 0..100 {
+        y = rk
+            .integrate(&device, t, &y, t + segment, &[t + segment])
+            .unwrap()[0];
+        t += segment;
+        worst = worst.max((energy(&y, t) - e0).abs() / e0);
+        phi_max = phi_max.max(device.coordinates(&y).0[0].abs());
+    }
+    assert!(worst < 1e-9, "relative energy drift {worst:e}");
+    assert!(phi_max > 0.1, "it really oscillates");
+}
+
+fn parity_device(omega_left: f64, k2: f64, config: &str, formulation: Formulation) -> Device {
+    parity_device_with(
+        omega_left,
+        k2,
+        config,
+        formulation,
+        Drivetrain::LinkageDifferential(LinkageDifferential::thesis()),
+    )
+}
+
+/// Long runs use eq. 2.15 (no reach limit): with a soft K2 the start-up transient of the
+/// whippletree is slow and large.
+fn linear_parity(omega_left: f64, formulation: Formulation) -> Device {
+    let linear = Drivetrain::LinearDifferential(
+        paritysim_kinematics::drivetrain::LinearDifferential::new(2.5, 2.5, 1.0).unwrap(),
+    );
+    parity_device_with(omega_left, 20.0, "drag_parity_fixed", formulation, linear)
+}
+
+fn parity_device_with(
+    omega_left: f64,
+    k2: f64,
+    config: &str,
+    formulation: Formulation,
+    drivetrain: Drivetrain,
+) -> Device {
+    let sh = shoulder(90.0, 0.0);
+    let wing = |omega: f64| {
+        Wing::new(
+            sh,
+            Matrix3::from_diagonal(&Vector3::new(29.0, 29.0, 1.0)),
+            [JointSpring::default(); 6],
+            WingAero::stroke_drag(omega, 1.0).unwrap(),
+        )
+        .unwrap()
+    };
+    // 50 V keeps the unit-coefficient drag device inside the linkage's reach (about ±48°).
+    let waveform = Waveform::sine(50.0, 110.0, 0.0, 0.0).unwrap();
+    Device::new(DeviceSpec {
+        wings: vec![wing(omega_left), wing(31.3)],
+        constraints: Constraints::configuration(config).unwrap(),
+        transmission: Some(Transmission::new(drivetrain, k2).unwrap()),
+        actuator: Some(Actuator::thesis(waveform)),
+        formulation,
+    })
+    .unwrap()
+}
+
+#[test]
+fn actuator_work_equals_dissipation_plus_energy_change() {
+    let device = parity_device(18.75, 5.0, "drag_parity_fixed", Formulation::NullSpace);
+    let options = SimulationOptions {
+        rtol: 1e-12,
+        atol: 1e-13,
+        max_cycles: 3,
+        min_cycles: 3,
+        ..Default::default()
+    };
+    let r = simulate(&device, &options).unwrap();
+    let t = &r.trajectory;
+    let energy = t.column("mechanical_energy").unwrap();
+    let w_act = *t.column("work_actuator").unwrap().last().unwrap();
+    let w_aero = *t.column("work_aero").unwrap().last().unwrap();
+    let delta_e = energy.last().unwrap() - energy[0];
+    let balance = (w_act + w_aero - delta_e).abs() / w_act.abs();
+    assert!(
+        w_aero < 0.0 && w_act > 0.0,
+        "aero dissipates, actuator injects: {w_act} {w_aero}"
+    );
+    assert!(balance < 1e-6, "energy balance residual {balance:e}");
+}
+
+// ------------------------------------------------------------- constraints
+
+#[test]
+fn null_space_cannot_drift_over_1000_wingbeats() {
+    let device = linear_parity(18.75, Formulation::NullSpace);
+    let options = SimulationOptions {
+        max_cycles: 1000,
+        min_cycles: 1000,
+        steady_tol: 1e-30,
+        ..Default::default()
+    };
+    let r = simulate(&device, &options).unwrap();
+    assert_eq!(r.cycles_run, 1000);
+    let c = Constraints::configuration("drag_parity_fixed").unwrap();
+    let t = &r.trajectory;
+    for i in 0..t.time.len() {
+        let p = Vec6::from_fn(|k, _| {
+            t.column(&format!(
+                "{}_{}",
+                if k < 3 { "left" } else { "right" },
+                ["phi", "theta", "psi"][k % 3]
+            ))
+            .unwrap()[i]
+        });
+        assert!(c.residual(&p) < 1e-12);
+    }
+}
+
+#[test]
+fn projection_agrees_with_null_space() {
+    let options = SimulationOptions {
+        rtol: 1e-13,
+        atol: 1e-14,
+        max_cycles: 5,
+        min_cycles: 5,
+        ..Default::default()
+    };
+    let a = simulate(&linear_parity(13.15, Formulation::NullSpace), &options).unwrap();
+    let b = simulate(&linear_parity(13.15, Formulation::Projection), &options).unwrap();
+    for name in ["left_phi", "right_phi", "left_phi_dot", "q2"] {
+        let (x, y) = (
+            a.trajectory.column(name).unwrap(),
+            b.trajectory.column(name).unwrap(),
+        );
+        let err = x
+            .iter()
+            .zip(y)
+            .map(|(u, v)| (u - v).abs())
+            .fold(0.0, f64::max);
+        assert!(err < 1e-8, "{name}: {err:e}");
+    }
+}
+
+#[test]
+fn symmetric_parity_stays_symmetric_and_hmf_keeps_strokes_equal() {
+    let options = SimulationOptions {
+        max_cycles: 10,
+        ..Default::default()
+    };
+    let r = simulate(
+        &parity_device(31.3, 0.0, "drag_parity_fixed", Formulation::NullSpace),
+        &options,
+    )
+    .unwrap();
+    let (l, rr) = (
+        r.trajectory.column("left_phi").unwrap(),
+        r.trajectory.column("right_phi").unwrap(),
+    );
+    for (a, b) in l.iter().zip(rr) {
+        assert!((a - b).abs() < 1e-9);
+    }
+    let roll = r.trajectory.column("roll_total").unwrap();
+    assert!(
+        roll.iter().all(|v| v.abs() < 1e-8),
+        "symmetric device has no net roll torque"
+    );
+
+    let sh = shoulder(90.0, 0.0);
+    let wing = |omega: f64| {
+        Wing::new(
+            sh,
+            Matrix3::from_diagonal(&Vector3::new(29.0, 29.0, 1.0)),
+            [JointSpring::default(); 6],
+            WingAero::stroke_drag(omega, 1.0).unwrap(),
+        )
+        .unwrap()
+    };
+    let hmf = Device::new(DeviceSpec {
+        wings: vec![wing(18.75), wing(31.3)],
+        constraints: Constraints::configuration("hmf_fixed").unwrap(),
+        transmission: Some(
+            Transmission::new(
+                Drivetrain::HmfFourBar(HmfFourBar::new(RodCrank::THESIS)),
+                0.0,
+            )
+            .unwrap(),
+        ),
+        actuator: Some(Actuator::thesis(
+            Waveform::sine(50.0, 110.0, 0.0, 0.0).unwrap(),
+        )),
+        formulation: Formulation::NullSpace,
+    })
+    .unwrap();
+    let r = simulate(&hmf, &options).unwrap();
+    let (l, rr) = (
+        r.trajectory.column("left_phi").unwrap(),
+        r.trajectory.column("right_phi").unwrap(),
+    );
+    assert!(
+        l.iter().zip(rr).all(|(a, b)| (a - b).abs() < 1e-13),
+        "hmf: phi_L == phi_R to round-off"
+    );
+    assert!(
+        r.metrics
+            .iter()
+            .any(|(n, v)| n == "left_stroke_amplitude" && *v > 0.1)
+    );
+}
+
+#[test]
+fn inconsistent_initial_state_and_bad_devices_are_rejected() {
+    let rows = vec![
+        vec![1.0, 0.0, 0.0, -1.0, 0.0, 0.0],
+        vec![0.0, 1.0, 0.0, 0.0, 0.0, 0.0],
+    ];
+    let c = Constraints::new(6, &rows, &[0.0, 0.0]).unwrap();
+    let sh = shoulder(90.0, 0.0);
+    let wing = Wing::stroke_only(sh, 29.0, WingAero::None).unwrap();
+    let device = Device::new(DeviceSpec {
+        wings: vec![wing.clone(), wing.clone()],
+        constraints: c,
+        transmission: None,
+        actuator: None,
+        formulation: Formulation::NullSpace,
+    })
+    .unwrap();
+    let options = SimulationOptions {
+        initial: Some((Vec6::new(0.1, 0.0, 0.0, 0.2, 0.0, 0.0), Vec6::zeros())),
+        duration_ms: Some(1.0),
+        ..Default::default()
+    };
+    let err = simulate(&device, &options).unwrap_err();
+    assert_eq!(err.kind(), "Constraint", "{err}");
+
+    // A 1-DOF drivetrain on two wings not tied by C.
+    let err = Device::new(DeviceSpec {
+        wings: vec![wing.clone(), wing.clone()],
+        constraints: Constraints::configuration("drag_parity_fixed").unwrap(),
+        transmission: Some(
+            Transmission::new(
+                Drivetrain::HmfFourBar(HmfFourBar::new(RodCrank::THESIS)),
+                0.0,
+            )
+            .unwrap(),
+        ),
+        actuator: None,
+        formulation: Formulation::NullSpace,
+    })
+    .unwrap_err();
+    assert_eq!(err.kind(), "Constraint");
+    // Non-positive-definite inertia names the field.
+    let err = Wing::new(
+        sh,
+        Matrix3::from_diagonal(&Vector3::new(1.0, -1.0, 1.0)),
+        [JointSpring::default(); 6],
+        WingAero::None,
+    )
+    .unwrap_err();
+    assert_eq!(err.field(), Some("inertia"));
+    assert_eq!(
+        Waveform::sine(1.0, 0.0, 0.0, 0.0).unwrap_err().field(),
+        Some("frequency_hz")
+    );
+    assert_eq!(
+        Waveform::sampled(vec![], vec![], 1.0).unwrap_err().field(),
+        Some("times_ms")
+    );
+}
+
+#[test]
+fn integration_failure_carries_time_and_state() {
+    // A huge force drives the linkage beyond its reach: the model error surfaces as an
+    // integration error with the time and state where it happened.
+    let sh = shoulder(90.0, 0.0);
+    let wing = |omega: f64| {
+        Wing::new(
+            sh,
+            Matrix3::from_diagonal(&Vector3::new(29.0, 29.0, 1.0)),
+            [JointSpring::default(); 6],
+            WingAero::stroke_drag(omega, 1.0).unwrap(),
+        )
+        .unwrap()
+    };
+    let device = Device::new(DeviceSpec {
+        wings: vec![wing(31.3), wing(31.3)],
+        constraints: Constraints::configuration("drag_parity_fixed").unwrap(),
+        transmission: Some(
+            Transmission::new(
+                Drivetrain::LinkageDifferential(LinkageDifferential::thesis()),
+                0.0,
+            )
+            .unwrap(),
+        ),
+        actuator: Some(
+            Actuator::new(
+                1.2,
+                467.0,
+                Waveform::sine(5000.0, 110.0, 0.0, 0.0).unwrap(),
+                DcOffset::AsForce,
+            )
+            .unwrap(),
+        ),
+        formulation: Formulation::NullSpace,
+    })
+    .unwrap();
+    match simulate(&device, &SimulationOptions::default()) {
+        Err(paritysim_dynamics::Error::Integration { time, state, .. }) => {
+            assert!(time > 0.0 && time < 10.0);
+            assert_eq!(state.len(), 14);
+        }
+        other => panic!("expected an integration error, got {other:?}"),
+    }
+}
+
+#[test]
+fn whippletree_kick_decays_for_parity() {
+    let device = linear_parity(18.75, Formulation::NullSpace);
+    let kick = Perturbation {
+        target: PerturbTarget::WhippletreeRate,
+        delta: 0.002,
+        phase: 0.0,
+    };
+    let options = SimulationOptions {
+        max_cycles: 200,
+        record_cycles: 3,
+        perturbation: Some(kick),
+        ..Default::default()
+    };
+    let kicked = simulate(&device, &options).unwrap();
+    let base = simulate(
+        &device,
+        &SimulationOptions {
+            perturbation: None,
+            ..options.clone()
+        },
+    )
+    .unwrap();
+    // The aerodynamic damping of the whippletree mode (eq. 2.19) removes the kicked velocity
+    // within a few ms; the displaced q2 then relaxes slowly through K2 (overdamped mode).
+    let (a, b) = (
+        kicked.trajectory.column("q2_dot").unwrap(),
+        base.trajectory.column("q2_dot").unwrap(),
+    );
+    let n = a.len();
+    let early = (0..n / 6).map(|i| (a[i] - b[i]).abs()).fold(0.0, f64::max);
+    let late = (5 * n / 6..n)
+        .map(|i| (a[i] - b[i]).abs())
+        .fold(0.0, f64::max);
+    assert!(early > 1e-6, "the kick is visible: {early:e}");
+    assert!(
+        late < 0.1 * early,
+        "and decays: early {early:e}, late {late:e}"
+    );
+}
