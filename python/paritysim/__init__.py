@@ -6,13 +6,14 @@ Angles are radians unless an argument name says otherwise (``*_deg``).
 Quick start::
 
     import paritysim as ps
-    df = ps.trials.fig2_9()          # Fig. 2.9 transmission maps as a Polars DataFrame
-    ps.plots.fig2_9(df)              # ... and the figure
+    spec = ps.load_spec("examples/drag_parity.toml")   # build a model
+    result = ps.simulate(spec)                          # run it (Rust, GIL released)
+    result.plot("drag_parity.png")                      # plot it; result.trajectory is Polars
 """
 
 from __future__ import annotations
 
-from . import kinematics, plots, trials
+from . import aero, kinematics, laminate, planform, plots, spec, trials
 from ._core import (
     CancelledError,
     ConstraintError,
@@ -25,9 +26,28 @@ from ._core import (
     SingularError,
     __version__,
 )
-from .kinematics import Drivetrain
+from .planform import Planform
+from .simulation import SimulationResult, simulate
+from .spec import Actuator, Aero, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, Waveform, Wing, load_spec
 
 __all__ = [
+    "Actuator",
+    "Aero",
+    "Planform",
+    "aero",
+    "laminate",
+    "planform",
+    "Configuration",
+    "Options",
+    "Shoulder",
+    "Simulation",
+    "SimulationResult",
+    "Spring",
+    "Waveform",
+    "Wing",
+    "load_spec",
+    "simulate",
+    "spec",
     "CancelledError",
     "ConstraintError",
     "Drivetrain",

@@ -50,6 +50,27 @@ def _reproduce(args: argparse.Namespace) -> int:
     return 0
 
 
+def _run(args: argparse.Namespace) -> int:
+    from . import load_spec, simulate
+
+    spec = load_spec(args.spec)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    stem = Path(args.spec).stem
+    start = time.perf_counter()
+    result = simulate(spec)
+    result.trajectory.write_parquet(out / f"{stem}_trajectory.parquet")
+    result.metrics_frame.write_csv(out / f"{stem}_metrics.csv")
+    result.plot(out / f"{stem}.png")
+    if not args.quiet:
+        state = "converged" if result.converged else "NOT converged"
+        print(f"{stem}: {result.cycles_run} cycles ({state}) in {time.perf_counter() - start:.2f} s -> {out}/{stem}_*")
+        for key in sorted(result.metrics):
+            if key.endswith(("stroke_amplitude", "roll_aero_peak", "work_actuator_per_cycle")):
+                print(f"  {key:32s} {result.metrics[key]: .6g}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser (exposed for tests and docs)."""
     parser = argparse.ArgumentParser(prog="paritysim", description="Simulate flapping-wing drivetrains and reproduce the thesis trials.")
@@ -61,6 +82,11 @@ def build_parser() -> argparse.ArgumentParser:
     rep.add_argument("--out", default="results", help="output directory (default: results/)")
     rep.add_argument("--quiet", action="store_true", help="no progress output")
     rep.set_defaults(func=_reproduce)
+    run = sub.add_parser("run", help="simulate a device spec (TOML) and write trajectory, metrics and a plot")
+    run.add_argument("spec", help="device spec, e.g. examples/drag_parity.toml")
+    run.add_argument("--out", default="results", help="output directory (default: results/)")
+    run.add_argument("--quiet", action="store_true", help="no summary output")
+    run.set_defaults(func=_run)
     return parser
 
 

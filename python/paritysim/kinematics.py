@@ -64,9 +64,10 @@ def shoulder_partials(alpha2: float, alpha3: float, phi: float, theta: float, ps
     return _core.shoulder_partials(float(alpha2), float(alpha3), float(phi), float(theta), float(psi))
 
 
-def drivetrain_map(drivetrain: Drivetrain, q1: ArrayLike, q2: ArrayLike = 0.0) -> dict[str, Any]:
+def drivetrain_map(drivetrain: Any, q1: ArrayLike, q2: ArrayLike = 0.0) -> dict[str, Any]:
     """Evaluate a drivetrain over broadcast arrays ``q1`` (mm) and ``q2`` (rad).
 
+    ``drivetrain`` is a :class:`paritysim.Drivetrain` spec or the native kinematic object.
     Returns ``stroke_left``, ``stroke_right`` (rad), ``jacobian`` (..., 2, 2) and
     ``hessian`` (..., 2, 2, 2).
     """

@@ -12,7 +12,7 @@ import numpy as np
 import polars as pl
 from matplotlib.figure import Figure
 
-__all__ = ["fig2_9", "save"]
+__all__ = ["fig2_9", "save", "simulation"]
 
 
 def fig2_9(df: pl.DataFrame) -> Figure:
@@ -41,6 +41,31 @@ def fig2_9(df: pl.DataFrame) -> Figure:
         ax.set_aspect("equal")
     fig.colorbar(cs, ax=axes, label="wing deviation $\\theta_w$ (deg)")
     fig.suptitle("Fig. 2.9: spherical shoulder transmission map (blank: beyond the joint limit, eq. 2.10)")
+    return fig
+
+
+def simulation(result: object) -> Figure:
+    """Stroke, deviation and rotation angles and the body roll torques of a simulation."""
+    df = result.trajectory  # type: ignore[attr-defined]
+    t = df["time_ms"].to_numpy()
+    prefixes = [p for p in ("left", "right", "wing") if f"{p}_phi" in df.columns]
+    fig, (ax_a, ax_t) = plt.subplots(2, 1, figsize=(10, 7), sharex=True, constrained_layout=True)
+    for p in prefixes:
+        ax_a.plot(t, np.degrees(df[f"{p}_phi"].to_numpy()), label=f"{p} stroke $\\phi$")
+        if np.ptp(df[f"{p}_psi"].to_numpy()) > 1e-9:
+            ax_a.plot(t, np.degrees(df[f"{p}_psi"].to_numpy()), "--", label=f"{p} rotation $\\psi$")
+        if np.ptp(df[f"{p}_theta"].to_numpy()) > 1e-9:
+            ax_a.plot(t, np.degrees(df[f"{p}_theta"].to_numpy()), ":", label=f"{p} deviation $\\theta$")
+        ax_t.plot(t, df[f"{p}_roll_aero"].to_numpy(), label=f"{p} roll, aerodynamic")
+        ax_t.plot(t, df[f"{p}_roll_inertial"].to_numpy(), ":", label=f"{p} roll, inertial")
+    ax_t.plot(t, df["roll_total"].to_numpy(), "k", lw=1.5, label="net body roll")
+    ax_a.set_ylabel("angle (deg)")
+    ax_t.set_ylabel("torque (mN·mm)")
+    ax_t.set_xlabel("time (ms)")
+    ax_a.legend(ncol=2, fontsize=8)
+    ax_t.legend(ncol=2, fontsize=8)
+    name = getattr(getattr(result, "spec", None), "name", "") or "simulation"
+    fig.suptitle(f"{name}: wing angles and body torques over the recorded cycles")
     return fig
 
 

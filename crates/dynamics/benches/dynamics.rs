@@ -1,1 +1,94 @@
-fn main() {}
+//! Criterion benches: right-hand side of one wing and of the constrained two-wing system, and a
+//! 20-wingbeat §3.3 `drag_parity_fixed` run at rtol 1e-8.
+
+#![allow(missing_docs)] // criterion_group! generates undocumented items
+
+use criterion::{Criterion, black_box, criterion_group, criterion_main};
+use nalgebra::{Matrix3, Vector3};
+use paritysim_constraints::{Constraints, Vec6};
+use paritysim_dynamics::device::{Device, DeviceSpec, Formulation, Transmission};
+use paritysim_dynamics::{
+    Actuator, JointSpring, SimulationOptions, Waveform, Wing, WingAero, simulate,
+};
+use paritysim_kinematics::drivetrain::LinkageDifferential;
+use paritysim_kinematics::{Drivetrain, SphericalShoulder};
+
+fn wing(omega: f64) -> Wing {
+    let sh = SphericalShoulder::new(std::f64::consts::FRAC_PI_2, 0.0).unwrap();
+    Wing::new(
+        sh,
+        Matrix3::from_diagonal(&Vector3::new(29.0, 29.0, 1.0)),
+        [JointSpring::default(); 6],
+        WingAero::stroke_drag(omega, 3.4609).unwrap(),
+    )
+    .unwrap()
+}
+
+fn section_3_3_device() -> Device {
+    Device::new(DeviceSpec {
+        wings: vec![wing(31.3), wing(31.3)],
+        constraints: Constraints::configuration("drag_parity_fixed").unwrap(),
+        transmission: Some(
+            Transmission::new(
+                Drivetrain::LinkageDifferential(LinkageDifferential::thesis()),
+                1.0,
+            )
+            .unwrap(),
+        ),
+        actuator: Some(Actuator::thesis(
+            Waveform::sine(100.0, 110.0, 0.0, 0.0).unwrap(),
+        )),
+        formulation: Formulation::NullSpace,
+    })
+    .unwrap()
+}
+
+fn rhs(c: &mut Criterion) {
+    let sh = SphericalShoulder::new(120f64.to_radians(), 60f64.to_radians()).unwrap();
+    let full = Matrix3::new(29.0, 0.4, -3.1, 0.4, 30.5, 0.7, -3.1, 0.7, 2.2);
+    let springs = [JointSpring::linear(10.0, 0.0).unwrap(); 6];
+    let one = Wing::new(sh, full, springs, WingAero::stroke_drag(31.3, 1.0).unwrap()).unwrap();
+    let p = Vector3::new(0.3, 0.1, 0.4);
+    let v = Vector3::new(0.5, -0.2, 1.0);
+    c.bench_function("rhs_one_wing_terms", |b| {
+        b.iter(|| one.terms(black_box(&p), black_box(&v)).unwrap())
+    });
+
+    let device = section_3_3_device();
+    let y = device
+        .state_from(
+            &Vec6::new(0.2, 0.0, 0.0, 0.25, 0.0, 0.0),
+            &Vec6::new(0.3, 0.0, 0.0, 0.25, 0.0, 0.0),
+        )
+        .unwrap();
+    let mut dydt = [0.0; paritysim_dynamics::STATE_LEN];
+    c.bench_function("rhs_two_wing_drag_parity_fixed", |b| {
+        b.iter(|| {
+            device
+                .rhs(black_box(1.0), black_box(&y), &mut dydt)
+                .unwrap()
+        })
+    });
+}
+
+fn run(c: &mut Criterion) {
+    let device = section_3_3_device();
+    let options = SimulationOptions {
+        rtol: 1e-8,
+        atol: 1e-10,
+        min_cycles: 19,
+        max_cycles: 19,
+        steady_tol: 1e-30,
+        samples_per_cycle: 100,
+        ..Default::default()
+    };
+    let mut group = c.benchmark_group("simulate");
+    group.sample_size(20);
+    group.bench_function("drag_parity_fixed_20_wingbeats_rtol_1e-8", |b| {
+        b.iter(|| simulate(&device, &options).unwrap())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, rhs, run);
+criterion_main!(benches);

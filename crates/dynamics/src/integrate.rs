@@ -118,7 +118,7 @@ impl Integrator for RungeKutta {
         t_end: f64,
         times: &[f64],
     ) -> Result<Vec<State>> {
-        if !(t_end > t0) {
+        if t_end.is_nan() || t_end <= t0 {
             return Err(Error::invalid("t_end", t_end, format!("> t0 = {t0}")));
         }
         let adapter = Adapter {

@@ -131,10 +131,10 @@ fn validate(options: &SimulationOptions) -> Result<()> {
         bail!(invalid "max_cycles", options.max_cycles, "in [1, 100000]");
     }
     if let Some(p) = options.perturbation {
-        if !(p.delta.is_finite()) {
+        if !p.delta.is_finite() {
             bail!(invalid "perturbation.delta", p.delta, "a finite number (rad/ms)");
         }
-        if !(p.phase >= 0.0 && p.phase < 1.0) {
+        if !(0.0..1.0).contains(&p.phase) {
             bail!(invalid "perturbation.phase", p.phase, "in [0, 1)");
         }
     }

@@ -271,9 +271,7 @@ impl PyDrivetrain {
         self.args == other.args
     }
 
-    fn __reduce__<'py>(
-        slf: &Bound<'py, Self>,
-    ) -> PyResult<(Bound<'py, PyAny>, ConstructorArgs)> {
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, ConstructorArgs)> {
         let py = slf.py();
         let rebuild = py
             .import("paritysim._drivetrain_pickle")?

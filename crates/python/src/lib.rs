@@ -8,6 +8,7 @@ use pyo3::prelude::*;
 
 mod aero;
 mod convert;
+mod dynamics;
 mod errors;
 mod kinematics;
 mod laminate;
@@ -18,6 +19,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     errors::register(m)?;
     kinematics::register(m)?;
+    dynamics::register(m)?;
     aero::register(m)?;
     laminate::register(m)?;
     Ok(())

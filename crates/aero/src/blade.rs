@@ -1,0 +1,531 @@
+//! Quasi-steady blade-element model of §3.2.4: wind-relative state (eq. 3.4) and the moments
+//! `M_N, M_T, M_rd, M_r` (eqs. 3.8–3.11), plus lift/drag forces and body-axis torques.
+//!
+//! # Frames
+//! The wing angles `(φ, θ, ψ)` are the wing's intrinsic x-y-z Euler angles (stroke, deviation,
+//! rotation: `φ_w, θ_w, ψ_w` of §3.2.3), so the wing frame 6 is
+//! `R_6^1 = R_x(φ) R_y(θ) R_z(ψ)` (eqs. 2.2–2.5 with `γ5 = θ_w`; for the (α2, α3) = (90°, 0°)
+//! shoulder `θ_w ≈ θ` near mid-stroke, ERRATA item 6). The ground/body frame 1 is the shoulder
+//! ground. In the wing frame: `x̂` chordwise toward the leading edge, `ẑ` spanwise along the
+//! hinge, `ŷ = ẑ × x̂` the wing normal. The wing's angular velocity in the wing frame is
+//!
+//! ```text
+//! ω = R_z(ψ)ᵀ (φ̇ cos θ, θ̇, φ̇ sin θ) + (0, 0, ψ̇)
+//!   = (φ̇ cos θ cos ψ + θ̇ sin ψ,  −φ̇ cos θ sin ψ + θ̇ cos ψ,  φ̇ sin θ + ψ̇).
+//! ```
+//!
+//! A blade element at span `z` moves with `z ω × ẑ = z (ω_y, −ω_x, 0)`: everything
+//! translational depends on `(ω_x, ω_y)` only, and the model can be evaluated from `ω` alone
+//! ([`BladeElementModel::moments_omega`]; `ω = J6 ṗ` with the Jacobian of eq. A.9).
+//!
+//! # Wind-relative coordinates and α (eq. 3.4, ERRATA item 5)
+//! In the hinge frame the element velocity is `z (θ̇, −φ̇ cos θ, 0)`. Write it as
+//! `−z φ̇_rw (−sin δ, cos δ, 0)`: `φ̇_rw = sgn(φ̇ cos θ) √((φ̇ cos θ)² + θ̇²)` is the
+//! **wind-relative stroke velocity** and `δ = atan(θ̇ / (φ̇ cos θ))` the tilt of the relative
+//! wind; `ψ_rw = ψ − δ` (wrapped to (−π, π]) is the **wind-relative rotation**, zero with the
+//! wing perpendicular to the relative wind; `ψ̇_rw = ω_z = ψ̇ + φ̇ sin θ` is the spanwise
+//! rotation rate used by the rotational damping. With `θ = θ̇ = 0` these are `φ̇_rw = φ̇`,
+//! `ψ_rw = ψ`, `ψ̇_rw = ψ̇`.
+//!
+//! **One sign convention.** With the frames of eqs. 2.2–2.4 and the leading edge at `+x`, a
+//! positive `ψ` at positive stroke velocity tilts the leading edge *backwards*. We define α as
+//! the geometric angle between the chord (toward the leading edge) and the velocity, which gives
+//!
+//! ```text
+//! α = π/2 + ψ_rw sgn(φ̇_rw)        (|ψ_rw| <= π/2; in general α = acos(−sgn(φ̇_rw) sin ψ_rw))
+//! ```
+//!
+//! i.e. eq. 3.4 with the sign of `ψ_rw` flipped (ERRATA item 5). The leading edge leads when
+//! `ψ` has the opposite sign of `φ̇`: passive rotation makes `ψ` lag `φ` by ~90° and gives
+//! `α = 90° − |ψ|` (α ≈ 30° mid-stroke at |ψ| = 60°, α = 90° at stroke reversal).
+//!
+//! # Moments (torque vector in the wing frame, mN·mm)
+//! With `W² = ω_x² + ω_y² = φ̇_rw²`, `σ = sgn(ω_x)` (= `sgn φ̇_rw` while `|ψ_rw| < π/2`) and
+//! the centre of pressure `x_cp(z) = l(z) − d̂_cp c(z)`, integrating `r × dF` over the strips:
+//!
+//! ```text
+//! M_N  = −Ω1 σ W² C_N(α)                       about x̂   (eq. 3.8)
+//! M_T  = −Ω1 W² C_T(α)                          about ŷ   (eq. 3.9, see below)
+//! M_r  = −(Ω3 d̂_cp(α) − Ω4) σ W² C_N(α)         about ẑ   (eq. 3.11)
+//! M_rd = −Ω2 C_rd ω_z |ω_z|                      about ẑ   (eq. 3.10)
+//! ```
+//!
+//! `C_T` is referred to the chord (positive toward the trailing edge, [`crate::coefficients`]);
+//! with that definition the derivation gives no `sgn(φ̇_rw)` in `M_T`: a chordwise drag pushes
+//! toward the trailing edge on both half-strokes, so its moment about the wing normal keeps its
+//! sign in the wing frame. The printed eq. 3.9 carries `sgn(φ̇_rw)`, which is only consistent
+//! with a `C_T` signed by the stroke direction. Not an ERRATA item yet; flagged in the tests.
+//!
+//! Power checks (tested): `(M_N, M_T)·(ω_x, ω_y) = −Ω1 |W|³ C_D(α) <= 0` and
+//! `M_rd ω_z = −Ω2 C_rd |ω_z|³ <= 0`. All four moments are odd in `ω`.
+//!
+//! ERRATA item 12 (drag torque `Ω φ̇²` of eq. 2.16 vs `Ω C_N φ̇²` of eq. 3.8) is exposed as
+//! [`NormalForceLaw`].
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use nalgebra::{Matrix3, Vector3};
+use paritysim_error::{Result, bail, check_finite, check_non_negative};
+
+use crate::coefficients::{
+    CoefficientModel, CoefficientSet, DEFAULT_ROTATIONAL_DAMPING, center_of_pressure,
+    from_normal_tangential,
+};
+
+/// The aerodynamic wing parameters of eqs. 3.12–3.15 (mg·mm²) and the force parameter.
+///
+/// Build from a planform with [`crate::Planform::omegas`], or from published numbers (e.g.
+/// Table 3.3) with [`Omegas::new`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Omegas {
+    /// Ω1 = ½ρ∬z³dA (eq. 3.12): stroke moments `M_N`, `M_T`.
+    pub omega1: f64,
+    /// Ω2 = ½ρ∬|x|³dA (eq. 3.13): rotational damping `M_rd`.
+    pub omega2: f64,
+    /// Ω3 = ½ρ∫z²c²dz (eq. 3.14): centre-of-pressure part of `M_r`.
+    pub omega3: f64,
+    /// Ω4 = ½ρ∫z²lc dz (eq. 3.15): leading-edge offset part of `M_r`.
+    pub omega4: f64,
+    /// `½ρ∬z²dA` (mg·mm): lift and drag *forces* are this times `W² C_L`, `W² C_D`. `None` when
+    /// only the moments are known (Table 3.3); [`BladeElementModel::loads`] then fails.
+    pub force: Option<f64>,
+}
+
+impl Omegas {
+    /// Published Ω1..Ω4 without a planform (no force parameter).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) unless `omega1 > 0`, `omega2 >= 0`, `omega3 >= 0` and
+    /// `omega4` is finite.
+    pub fn new(omega1: f64, omega2: f64, omega3: f64, omega4: f64) -> Result<Self> {
+        let o = Self {
+            omega1,
+            omega2,
+            omega3,
+            omega4,
+            force: None,
+        };
+        o.validate()?;
+        Ok(o)
+    }
+
+    /// Adds the force parameter `½ρ∬z²dA` (mg·mm).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) (`force`) unless finite and >= 0.
+    pub fn with_force(mut self, force: f64) -> Result<Self> {
+        check_non_negative("force", force)?;
+        self.force = Some(force);
+        Ok(self)
+    }
+
+    /// Checks the ranges listed in [`Self::new`] (and `force >= 0` when present).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) naming `omegas.omegaK` or `omegas.force`.
+    pub fn validate(&self) -> Result<()> {
+        let r = (|| -> Result<()> {
+            paritysim_error::check_positive("omega1", self.omega1)?;
+            check_non_negative("omega2", self.omega2)?;
+            check_non_negative("omega3", self.omega3)?;
+            check_finite("omega4", self.omega4)?;
+            if let Some(f) = self.force {
+                check_non_negative("force", f)?;
+            }
+            Ok(())
+        })();
+        r.map_err(|e| e.in_field("omegas"))
+    }
+}
+
+/// Which coefficient multiplies `Ω1 φ̇_rw²` in the normal moment (ERRATA item 12).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NormalForceLaw {
+    /// `M_N = −Ω1 sgn(φ̇_rw) φ̇_rw² C_N(α)`, eqs. 3.8–3.11 as printed (default).
+    #[default]
+    Coefficient,
+    /// `M_N = −Ω1 sgn(φ̇_rw) φ̇_rw²` (eq. 2.16, the "drag parameter" Ω of §2.6 and §3.3 with
+    /// the coefficient absorbed): `C_N ≡ 1`, `C_T ≡ 0` everywhere (so `C_L = cos α`,
+    /// `C_D = sin α` in [`BladeElementModel::loads`]).
+    Unit,
+}
+
+/// Wing angles (rad) and rates (rad/ms): stroke `φ`, deviation `θ` (= `θ_w`), rotation `ψ`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct WingState {
+    /// Stroke angle φ (rad).
+    pub phi: f64,
+    /// Deviation angle θ_w (rad).
+    pub theta: f64,
+    /// Rotation angle ψ (rad).
+    pub psi: f64,
+    /// φ̇ (rad/ms).
+    pub phi_dot: f64,
+    /// θ̇_w (rad/ms).
+    pub theta_dot: f64,
+    /// ψ̇ (rad/ms).
+    pub psi_dot: f64,
+}
+
+/// Wind-relative coordinates of §3.2.4 (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WindRelative {
+    /// φ̇_rw (rad/ms), signed like `φ̇ cos θ` (like `θ̇` when that is 0).
+    pub phi_dot_rw: f64,
+    /// ψ_rw (rad) in (−π, π]: rotation from the attitude perpendicular to the relative wind.
+    pub psi_rw: f64,
+    /// ψ̇_rw = ω_z = ψ̇ + φ̇ sin θ (rad/ms).
+    pub psi_dot_rw: f64,
+    /// Angle of attack α ∈ [0, π] (rad); π/2 by convention when the wing does not translate.
+    pub alpha: f64,
+}
+
+#[inline]
+fn wrap_pi(a: f64) -> f64 {
+    if a > -PI && a <= PI {
+        return a;
+    }
+    let r = a.rem_euclid(2.0 * PI);
+    if r > PI { r - 2.0 * PI } else { r }
+}
+
+impl WingState {
+    /// A validated state.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) naming the first non-finite field.
+    pub fn new(
+        phi: f64,
+        theta: f64,
+        psi: f64,
+        phi_dot: f64,
+        theta_dot: f64,
+        psi_dot: f64,
+    ) -> Result<Self> {
+        check_finite("phi", phi)?;
+        check_finite("theta", theta)?;
+        check_finite("psi", psi)?;
+        check_finite("phi_dot", phi_dot)?;
+        check_finite("theta_dot", theta_dot)?;
+        check_finite("psi_dot", psi_dot)?;
+        Ok(Self {
+            phi,
+            theta,
+            psi,
+            phi_dot,
+            theta_dot,
+            psi_dot,
+        })
+    }
+
+    /// A state without deviation (`θ = θ̇ = 0`).
+    ///
+    /// # Errors
+    /// As [`Self::new`].
+    pub fn planar(phi: f64, psi: f64, phi_dot: f64, psi_dot: f64) -> Result<Self> {
+        Self::new(phi, 0.0, psi, phi_dot, 0.0, psi_dot)
+    }
+
+    /// Angular velocity of the wing in the wing frame (rad/ms), see the module docs.
+    #[inline]
+    pub fn angular_velocity(&self) -> Vector3<f64> {
+        let (st, ct) = self.theta.sin_cos();
+        let (sp, cp) = self.psi.sin_cos();
+        let a = self.phi_dot * ct;
+        Vector3::new(
+            a * cp + self.theta_dot * sp,
+            -a * sp + self.theta_dot * cp,
+            self.phi_dot * st + self.psi_dot,
+        )
+    }
+
+    /// `R_6^1 = R_x(φ) R_y(θ) R_z(ψ)`: wing-frame vectors to the body (shoulder ground) frame.
+    pub fn rotation(&self) -> Matrix3<f64> {
+        let (sf, cf) = self.phi.sin_cos();
+        let (st, ct) = self.theta.sin_cos();
+        let (sp, cp) = self.psi.sin_cos();
+        let rx = Matrix3::new(1.0, 0.0, 0.0, 0.0, cf, -sf, 0.0, sf, cf);
+        let ry = Matrix3::new(ct, 0.0, st, 0.0, 1.0, 0.0, -st, 0.0, ct);
+        let rz = Matrix3::new(cp, -sp, 0.0, sp, cp, 0.0, 0.0, 0.0, 1.0);
+        rx * ry * rz
+    }
+
+    /// The wind-relative coordinates `(φ̇_rw, ψ_rw, ψ̇_rw, α)`.
+    pub fn wind_relative(&self) -> WindRelative {
+        let s = self.phi_dot * self.theta.cos();
+        let d = self.theta_dot;
+        let w = s.hypot(d);
+        let sign = if s >= 0.0 { 1.0 } else { -1.0 };
+        let delta = if w > 0.0 {
+            (sign * d).atan2(s.abs())
+        } else {
+            0.0
+        };
+        let omega = self.angular_velocity();
+        WindRelative {
+            phi_dot_rw: sign * w,
+            psi_rw: wrap_pi(self.psi - delta),
+            psi_dot_rw: omega.z,
+            alpha: alpha_from_omega(&omega),
+        }
+    }
+}
+
+/// `sgn` with `sgn(0) = 0`: a wing moving exactly edgewise (`ω_x = 0`, α = 0 or π) has no
+/// normal velocity and gets no normal force, even where a fit has `C_N(0) = C_L(0) ≠ 0`.
+#[inline]
+fn sign(v: f64) -> f64 {
+    if v > 0.0 {
+        1.0
+    } else if v < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
+/// α ∈ [0, π] from the wing-frame angular velocity (π/2 when `ω_x = ω_y = 0`).
+#[inline]
+fn alpha_from_omega(omega: &Vector3<f64>) -> f64 {
+    if omega.x == 0.0 && omega.y == 0.0 {
+        FRAC_PI_2
+    } else {
+        omega.x.abs().atan2(omega.y)
+    }
+}
+
+/// The four moments of eqs. 3.8–3.11 (mN·mm) at one state.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AeroMoments {
+    /// `M_N`, about the wing's chordwise axis `x̂` (eq. 3.8).
+    pub normal: f64,
+    /// `M_T`, about the wing normal `ŷ` (eq. 3.9).
+    pub tangential: f64,
+    /// `M_r`, about the hinge `ẑ` (eq. 3.11).
+    pub rotational: f64,
+    /// `M_rd`, about the hinge `ẑ` (eq. 3.10).
+    pub rotational_damping: f64,
+    /// The angle of attack used (rad).
+    pub alpha: f64,
+}
+
+impl AeroMoments {
+    /// Torque vector in the wing frame: `(M_N, M_T, M_r + M_rd)`.
+    #[inline]
+    pub fn torque(&self) -> Vector3<f64> {
+        Vector3::new(
+            self.normal,
+            self.tangential,
+            self.rotational + self.rotational_damping,
+        )
+    }
+}
+
+/// Lift and drag forces and torques about the spherical centre, in the body frame.
+///
+/// Body axes (Fig. 2.10, as the text describes them): **roll** is the stroke axis `x̂₁` (the
+/// drag torque is always roll-aligned, §2.5.1), **yaw** is `ŷ₁`, the deviation axis at
+/// mid-stroke about which lift acts, **pitch** is `ẑ₁`, the spanwise axis through the wing
+/// roots at `φ = θ = 0`. Vectors are `[roll, yaw, pitch]` components.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AeroLoads {
+    /// Lift force (mN).
+    pub lift: Vector3<f64>,
+    /// Drag force (mN).
+    pub drag: Vector3<f64>,
+    /// Torque of the lift about the spherical centre (mN·mm).
+    pub lift_torque: Vector3<f64>,
+    /// Torque of the drag about the spherical centre (mN·mm).
+    pub drag_torque: Vector3<f64>,
+    /// Rotational damping torque `M_rd ẑ₆` (mN·mm); its net force is neglected.
+    pub damping_torque: Vector3<f64>,
+    /// The wing-frame moments at the same state.
+    pub moments: AeroMoments,
+}
+
+impl AeroLoads {
+    /// Total aerodynamic torque on the wing in the body frame (mN·mm); equals
+    /// `R_6^1 · moments.torque()`.
+    pub fn torque(&self) -> Vector3<f64> {
+        self.lift_torque + self.drag_torque + self.damping_torque
+    }
+
+    /// Roll component of [`Self::torque`] (mN·mm).
+    pub fn roll(&self) -> f64 {
+        self.torque().x
+    }
+
+    /// Yaw component of [`Self::torque`] (mN·mm).
+    pub fn yaw(&self) -> f64 {
+        self.torque().y
+    }
+
+    /// Pitch component of [`Self::torque`] (mN·mm).
+    pub fn pitch(&self) -> f64 {
+        self.torque().z
+    }
+}
+
+/// A wing's quasi-steady aerodynamics: Ω1..Ω4, a coefficient model, `C_rd` and the
+/// [`NormalForceLaw`]. Immutable, `Send + Sync`; [`Self::moments`] allocates nothing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BladeElementModel<C: CoefficientModel = CoefficientSet> {
+    omegas: Omegas,
+    coefficients: C,
+    rotational_damping: f64,
+    law: NormalForceLaw,
+}
+
+impl<C: CoefficientModel> BladeElementModel<C> {
+    /// A model with `C_rd = `[`DEFAULT_ROTATIONAL_DAMPING`] and [`NormalForceLaw::Coefficient`].
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) for out-of-range [`Omegas`] (see [`Omegas::validate`]).
+    pub fn new(omegas: Omegas, coefficients: C) -> Result<Self> {
+        omegas.validate()?;
+        Ok(Self {
+            omegas,
+            coefficients,
+            rotational_damping: DEFAULT_ROTATIONAL_DAMPING,
+            law: NormalForceLaw::Coefficient,
+        })
+    }
+
+    /// Replaces `C_rd` (eq. 3.10).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) (`rotational_damping`) unless finite and >= 0.
+    pub fn with_rotational_damping(mut self, c_rd: f64) -> Result<Self> {
+        check_non_negative("rotational_damping", c_rd)?;
+        self.rotational_damping = c_rd;
+        Ok(self)
+    }
+
+    /// Replaces the normal-force law (ERRATA item 12).
+    pub fn with_normal_force_law(mut self, law: NormalForceLaw) -> Self {
+        self.law = law;
+        self
+    }
+
+    /// The parameters.
+    pub fn omegas(&self) -> &Omegas {
+        &self.omegas
+    }
+
+    /// The coefficient model.
+    pub fn coefficient_model(&self) -> &C {
+        &self.coefficients
+    }
+
+    /// `C_rd`.
+    pub fn rotational_damping(&self) -> f64 {
+        self.rotational_damping
+    }
+
+    /// The normal-force law.
+    pub fn normal_force_law(&self) -> NormalForceLaw {
+        self.law
+    }
+
+    /// `(C_N, C_T)` under the configured law.
+    #[inline]
+    fn normal_tangential(&self, alpha: f64) -> (f64, f64) {
+        match self.law {
+            NormalForceLaw::Coefficient => {
+                let c = self.coefficients.coefficients(alpha);
+                (c.normal, c.tangential)
+            }
+            NormalForceLaw::Unit => (1.0, 0.0),
+        }
+    }
+
+    /// The moments at a wing state (eqs. 3.8–3.11). Infallible; finite input gives finite output.
+    #[inline]
+    pub fn moments(&self, state: &WingState) -> AeroMoments {
+        self.moments_omega(&state.angular_velocity())
+    }
+
+    /// The moments from the wing-frame angular velocity `ω` (rad/ms), e.g. `ω = J6 ṗ`.
+    /// Allocation-free; finite input gives finite output.
+    #[inline]
+    pub fn moments_omega(&self, omega: &Vector3<f64>) -> AeroMoments {
+        let o = &self.omegas;
+        let (wx, wy, wz) = (omega.x, omega.y, omega.z);
+        let w2 = wx * wx + wy * wy;
+        let rotational_damping = -o.omega2 * self.rotational_damping * wz * wz.abs(); // eq. 3.10
+        if w2 == 0.0 {
+            return AeroMoments {
+                rotational_damping,
+                alpha: FRAC_PI_2,
+                ..AeroMoments::default()
+            };
+        }
+        let alpha = wx.abs().atan2(wy);
+        let sigma = sign(wx);
+        let (cn, ct) = self.normal_tangential(alpha);
+        let d_cp = center_of_pressure(alpha); // eq. 3.7
+        AeroMoments {
+            normal: -o.omega1 * sigma * w2 * cn, // eq. 3.8
+            tangential: -o.omega1 * w2 * ct,     // eq. 3.9 (C_T chord-referred, module docs)
+            rotational: -(o.omega3 * d_cp - o.omega4) * sigma * w2 * cn, // eq. 3.11
+            rotational_damping,
+            alpha,
+        }
+    }
+
+    /// Lift and drag forces and torques in the body frame (see [`AeroLoads`]).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) (`omegas.force`) if the model has no force parameter (built
+    /// from [`Omegas::new`] without [`Omegas::with_force`]).
+    pub fn loads(&self, state: &WingState) -> Result<AeroLoads> {
+        let Some(force) = self.omegas.force else {
+            bail!(invalid "omegas.force", "None",
+                "set: build Omegas from a Planform or call Omegas::with_force");
+        };
+        let omega = state.angular_velocity();
+        let moments = self.moments_omega(&omega);
+        let rot = state.rotation();
+        let damping_torque = rot * Vector3::new(0.0, 0.0, moments.rotational_damping);
+        let (wx, wy) = (omega.x, omega.y);
+        let w2 = wx * wx + wy * wy;
+        if w2 == 0.0 {
+            return Ok(AeroLoads {
+                lift: Vector3::zeros(),
+                drag: Vector3::zeros(),
+                lift_torque: Vector3::zeros(),
+                drag_torque: Vector3::zeros(),
+                damping_torque,
+                moments,
+            });
+        }
+        let w = w2.sqrt();
+        let alpha = moments.alpha;
+        let (cn, ct) = self.normal_tangential(alpha);
+        let (cl, cd) = from_normal_tangential(alpha, cn, ct);
+        let sigma = sign(wx);
+        let lift_dir = Vector3::new(sigma * wx / w, sigma * wy / w, 0.0); // ℓ̂
+        let vel_dir = Vector3::new(wy / w, -wx / w, 0.0); // û
+        let o = &self.omegas;
+        // Resultant of z-weighted strip forces acting at (x_cp, 0, z): Σ r × dF = W² r_eff × (C ê).
+        let r_eff = Vector3::new(
+            o.omega4 - center_of_pressure(alpha) * o.omega3,
+            0.0,
+            o.omega1,
+        );
+        Ok(AeroLoads {
+            lift: rot * (lift_dir * (force * w2 * cl)),
+            drag: rot * (vel_dir * (-force * w2 * cd)),
+            lift_torque: rot * r_eff.cross(&lift_dir) * (w2 * cl),
+            drag_torque: rot * r_eff.cross(&vel_dir) * (-w2 * cd),
+            damping_torque,
+            moments,
+        })
+    }
+}
+
+/// The drag torque of eq. 2.16, `−Ω φ̇² sgn(φ̇)` (mN·mm for Ω in mg·mm², φ̇ in rad/ms).
+#[inline]
+pub fn drag_torque_eq_2_16(omega: f64, phi_dot: f64) -> f64 {
+    -omega * phi_dot * phi_dot.abs()
+}

@@ -1,0 +1,145 @@
+"""Quasi-steady blade-element aerodynamics of §3.2.4: coefficients and moments.
+
+Conventions (see the Rust crate ``paritysim-aero`` for the derivations):
+
+* ``alpha`` in [0, pi] rad is the angle between the chord (toward the leading edge) and the
+  wing's velocity: < pi/2 while the leading edge leads. ``alpha = pi/2 + psi_rw*sgn(phi_dot_rw)``,
+  i.e. eq. 3.4 with the sign of ``psi_rw`` flipped (ERRATA item 5), so that passive rotation
+  (psi lagging phi by ~90°) gives alpha = 90° - |psi|.
+* ``C_N = C_L cos a + C_D sin a`` (normal), ``C_T = C_D cos a - C_L sin a`` (chordwise, toward
+  the trailing edge).
+* Moments in the wing frame (x chordwise, y normal, z hinge), mN·mm:
+  ``M_N = -Ω1 sgn(ω_x) W² C_N``, ``M_T = -Ω1 W² C_T``,
+  ``M_r = -(Ω3 d_cp - Ω4) sgn(ω_x) W² C_N``, ``M_rd = -Ω2 C_rd ω_z|ω_z|``.
+* Body axes ``[roll, yaw, pitch]`` = shoulder-ground ``[x, y, z]`` (Fig. 2.10).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from . import _core
+
+__all__ = [
+    "AIR_DENSITY",
+    "DEFAULT_ROTATIONAL_DAMPING",
+    "MODELS",
+    "TABLE_3_3",
+    "center_of_pressure",
+    "coefficients",
+    "moments",
+]
+
+FloatArray = npt.NDArray[np.float64]
+
+#: Air at sea level, 1.2 kg/m³ in mg/mm³.
+AIR_DENSITY: float = _core.AERO_AIR_DENSITY
+#: C_rd of eq. 3.10 (Whitney & Wood 2010, J. Fluid Mech. 660).
+DEFAULT_ROTATIONAL_DAMPING: float = _core.AERO_DEFAULT_ROTATIONAL_DAMPING
+#: Built-in coefficient models.
+MODELS: tuple[str, ...] = tuple(_core.aero_model_names())
+
+#: Table 3.3 (mg·mm²): inertia (frame of Fig. 3.10) and Ω1..Ω4 per wing and trial.
+TABLE_3_3: dict[str, dict[str, float]] = {
+    "left": {"ixx": 49.0, "iyy": 50.5, "izz": 1.56, "ixz": 4.20,
+             "omega1": 46.8, "omega2": 0.587, "omega3": 17.5, "omega4": 0.712},
+    "right_uncut": {"ixx": 47.1, "iyy": 48.6, "izz": 1.49, "ixz": 3.87,
+                    "omega1": 38.2, "omega2": 0.438, "omega3": 13.5, "omega4": 0.952},
+    "right_1cut": {"ixx": 40.6, "iyy": 42.0, "izz": 1.43, "ixz": 3.38,
+                   "omega1": 28.7, "omega2": 0.419, "omega3": 10.6, "omega4": 0.787},
+    "right_2cut": {"ixx": 32.8, "iyy": 34.1, "izz": 1.29, "ixz": 2.97,
+                   "omega1": 21.2, "omega2": 0.387, "omega3": 9.10, "omega4": 0.691},
+}  # fmt: skip
+
+
+def _flat(a: npt.ArrayLike) -> tuple[FloatArray, tuple[int, ...]]:
+    x = np.asarray(a, dtype=np.float64)
+    return np.ascontiguousarray(x).ravel(), x.shape
+
+
+def coefficients(alpha: npt.ArrayLike, model: str = "dickinson1999") -> dict[str, FloatArray]:
+    """Force coefficients at angles of attack ``alpha`` (rad, each in [0, pi]), vectorised.
+
+    ``model`` is ``"dickinson1999"`` (eqs. 3.5-3.6, extended past 90° by flat-plate symmetry)
+    or ``"whitney_wood2010"`` (C_L = 1.8 sin 2a, C_D = 1.9 - 1.5 cos 2a).
+
+    Returns arrays of ``alpha``'s shape: ``lift``, ``drag``, ``normal``, ``tangential`` and
+    ``center_of_pressure`` (eq. 3.7, fraction of chord behind the leading edge).
+
+    Raises ``InvalidParameterError`` for an unknown model or an angle outside [0, pi].
+    """
+    a, shape = _flat(alpha)
+    out = _core.aero_coefficients(a, str(model))
+    return {k: v.reshape(shape) for k, v in out.items()}
+
+
+def center_of_pressure(alpha: npt.ArrayLike) -> FloatArray:
+    """Eq. 3.7: ``0.82 |alpha| / pi + 0.05`` (fraction of the chord behind the leading edge)."""
+    a = np.asarray(alpha, dtype=np.float64)
+    out: FloatArray = 0.82 / np.pi * np.abs(a) + 0.05
+    return out
+
+
+def moments(
+    omegas: Any,
+    phi: npt.ArrayLike = 0.0,
+    theta: npt.ArrayLike = 0.0,
+    psi: npt.ArrayLike = 0.0,
+    phi_dot: npt.ArrayLike = 0.0,
+    theta_dot: npt.ArrayLike = 0.0,
+    psi_dot: npt.ArrayLike = 0.0,
+    *,
+    model: str = "dickinson1999",
+    rotational_damping: float = DEFAULT_ROTATIONAL_DAMPING,
+    normal_force_law: str = "coefficient",
+) -> dict[str, FloatArray]:
+    """Blade-element moments (eqs. 3.8-3.11) over broadcast wing states.
+
+    Parameters
+    ----------
+    omegas:
+        A dict with ``omega1..omega4`` (mg·mm²) and optionally ``force`` (mg·mm), e.g.
+        ``Planform.omegas()`` or ``TABLE_3_3["left"]``; or a sequence ``[Ω1, Ω2, Ω3, Ω4]``.
+    phi, theta, psi:
+        Wing stroke, deviation and rotation angles (rad).
+    phi_dot, theta_dot, psi_dot:
+        Their rates (rad/ms).
+    normal_force_law:
+        ``"coefficient"`` (eq. 3.8, Ω1 C_N φ̇²) or ``"unit"`` (eq. 2.16, Ω φ̇²; ERRATA item 12).
+
+    Returns
+    -------
+    ``normal``, ``tangential``, ``rotational``, ``rotational_damping`` (mN·mm), ``alpha``,
+    ``phi_dot_rw``, ``psi_rw``, ``psi_dot_rw`` of the broadcast shape, ``torque_wing``
+    (..., 3); when ``omegas`` has ``force``, also ``lift``, ``drag`` (mN), ``lift_torque``,
+    ``drag_torque`` and ``torque_body`` (mN·mm), each (..., 3) in body axes [roll, yaw, pitch].
+    """
+    force: float | None = None
+    if isinstance(omegas, dict):
+        values = [float(omegas[f"omega{k}"]) for k in range(1, 5)]
+        if omegas.get("force") is not None:
+            force = float(omegas["force"])
+    else:
+        values = [float(v) for v in omegas]
+        if len(values) != 4:
+            raise _core.ShapeError(f"`omegas` must have 4 values [Ω1, Ω2, Ω3, Ω4], got {len(values)}")
+    arrays = np.broadcast_arrays(*(np.asarray(v, dtype=np.float64) for v in (phi, theta, psi, phi_dot, theta_dot, psi_dot)))
+    shape = arrays[0].shape
+    flat = [np.ascontiguousarray(a).ravel() for a in arrays]
+    out = _core.aero_moments(
+        values,
+        flat[0],
+        flat[1],
+        flat[2],
+        flat[3],
+        flat[4],
+        flat[5],
+        str(model),
+        float(rotational_damping),
+        str(normal_force_law),
+        force,
+    )
+    return {k: (v.reshape((*shape, 3)) if v.ndim == 2 else v.reshape(shape)) for k, v in out.items()}

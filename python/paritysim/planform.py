@@ -1,0 +1,256 @@
+"""Wing planforms: outline polygons, Ω1..Ω4 (eqs. 3.12-3.15) and wing inertia (Table 3.3).
+
+Frame (Fig. 3.1 / Fig. 3.10): points are ``[z, x]`` in mm. ``z`` runs spanwise along the wing
+hinge from the spherical centre (every point needs ``z >= 0``); ``x`` runs chordwise and
+increases toward the **leading edge**; the hinge line is ``x = 0``. A passively rotating wing
+hangs behind its hinge (mostly ``x < 0``); an outline lying entirely at ``x >= 0`` is rejected
+as being on the wrong side of the hinge line (mirror it, ``x -> -x``).
+
+All integrals are exact for the polygon (slab decomposition + Gauss-Legendre, see the Rust
+crate ``paritysim-aero``). Air density defaults to 1.2 kg/m³ = 1.2e-3 mg/mm³.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import numpy.typing as npt
+
+from . import _core
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+__all__ = ["AIR_DENSITY", "Planform"]
+
+#: Air at sea level, 1.2 kg/m³ in mg/mm³.
+AIR_DENSITY: float = _core.AERO_AIR_DENSITY
+
+FloatArray = npt.NDArray[np.float64]
+
+
+def _as_points(points: npt.ArrayLike, name: str = "points") -> FloatArray:
+    a = np.ascontiguousarray(np.asarray(points, dtype=np.float64))
+    if a.ndim != 2 or a.shape[1] != 2:
+        raise _core.ShapeError(f"`{name}` must have shape (n, 2) of [z, x] in mm, got {a.shape}")
+    return a
+
+
+def _rows(values: Iterable[Sequence[float]] | npt.ArrayLike, cols: int, name: str) -> FloatArray:
+    a = np.asarray(values, dtype=np.float64)
+    if a.size == 0:
+        return np.zeros((0, cols))
+    if a.ndim == 1:
+        a = a.reshape(1, -1)
+    if a.ndim != 2 or a.shape[1] != cols:
+        raise _core.ShapeError(f"`{name}` must have shape (n, {cols}), got {a.shape}")
+    return np.ascontiguousarray(a)
+
+
+class Planform:
+    """An immutable, validated wing outline with its exact area integrals.
+
+    Build with :meth:`from_points`, :meth:`rectangle`, :meth:`semi_ellipse` or
+    :meth:`hmf_like`. Invalid outlines raise ``GeometryError`` (self-intersecting, open,
+    degenerate, wrong side of the spherical centre or of the hinge line); bad numbers raise
+    ``InvalidParameterError`` naming the field; wrong array shapes raise ``ShapeError``.
+    """
+
+    __slots__ = ("_props",)
+    _props: dict[str, Any]
+
+    def __init__(self, points: npt.ArrayLike, *, closure_tolerance: float | None = None) -> None:
+        pts = _as_points(points)
+        tol = None if closure_tolerance is None else float(closure_tolerance)
+        props = _core.aero_planform_properties(pts, AIR_DENSITY, tol)
+        props["vertices"].setflags(write=False)
+        object.__setattr__(self, "_props", props)
+
+    def __setattr__(self, name: str, value: object) -> None:
+        raise AttributeError("Planform is immutable")
+
+    # ------------------------------------------------------------------ constructors
+    @classmethod
+    def from_points(cls, points: npt.ArrayLike, closure_tolerance: float | None = None) -> Planform:
+        """Outline vertices ``(n, 2)`` ``[z, x]`` in mm; the closing edge is implicit.
+
+        With ``closure_tolerance`` (mm) the points are a traced outline whose last point must
+        return to within that distance of the first (else ``GeometryError``: open outline).
+        """
+        return cls(points, closure_tolerance=closure_tolerance)
+
+    @classmethod
+    def rectangle(cls, span: float, chord: float, root_offset: float = 0.0, le_offset: float = 0.0) -> Planform:
+        """``z`` in ``[root_offset, root_offset + span]``, ``x`` in ``[le_offset - chord, le_offset]`` (mm)."""
+        return cls(_core.aero_planform_rectangle(float(span), float(chord), float(root_offset), float(le_offset)))
+
+    @classmethod
+    def semi_ellipse(
+        cls,
+        span: float,
+        max_chord: float,
+        root_offset: float = 0.0,
+        le_offset: float = 0.0,
+        segments: int = 256,
+    ) -> Planform:
+        """Straight leading edge at ``x = le_offset``, elliptic trailing edge, zero chord at root
+        and tip; a polygon of ``segments`` equal eccentric-angle steps (integrals converge to
+        the ellipse's as ``segments**-2``)."""
+        return cls(
+            _core.aero_planform_semi_ellipse(
+                float(span), float(max_chord), float(root_offset), float(le_offset), int(segments)
+            )
+        )
+
+    @classmethod
+    def hmf_like(cls, tip_radius: float = 16.6, segments: int = 128) -> Planform:
+        """A smooth HMF-like wing (Fig. 3.10) scaled to ``tip_radius`` mm; at 16.6 mm its
+        Ω1..Ω4 are within 15 % of Table 3.3 (left wing). A stand-in, not the measured outline."""
+        return cls(_core.aero_planform_hmf_like(float(tip_radius), int(segments)))
+
+    # ------------------------------------------------------------------ geometry
+    @property
+    def points(self) -> FloatArray:
+        """Validated vertices ``(n, 2)`` ``[z, x]`` (mm), counter-clockwise, read-only."""
+        v: FloatArray = self._props["vertices"]
+        return v
+
+    @property
+    def area(self) -> float:
+        """Membrane area (mm²)."""
+        return float(self._props["area"])
+
+    @property
+    def span(self) -> float:
+        """Spanwise extent of the membrane, ``max z - min z`` (mm)."""
+        return float(self._props["span"])
+
+    @property
+    def tip_radius(self) -> float:
+        """Distance from the spherical centre to the tip, ``max z`` (mm)."""
+        return float(self._props["tip_radius"])
+
+    @property
+    def root_offset(self) -> float:
+        """Innermost membrane ``z`` (mm)."""
+        return float(self._props["root_offset"])
+
+    @property
+    def mean_chord(self) -> float:
+        """Area / span (mm)."""
+        return float(self._props["mean_chord"])
+
+    @property
+    def centroid(self) -> FloatArray:
+        """Area centroid ``[z, x]`` (mm)."""
+        c: FloatArray = self._props["centroid"].copy()
+        return c
+
+    @property
+    def integrals(self) -> dict[str, float]:
+        """Density-free integrals: ``area, z1, x1, z2, x2, xz, z3, x3_abs, z2_c2, z2_lc``."""
+        return dict(self._props["integrals"])
+
+    def chord(self, z: npt.ArrayLike) -> FloatArray:
+        """Chord ``c(z)`` (mm); 0 outside the span."""
+        zz = np.asarray(z, dtype=np.float64)
+        out = _core.aero_planform_chord(self.points, np.ascontiguousarray(zz).ravel())
+        c: FloatArray = out["chord"].reshape(zz.shape)
+        return c
+
+    def leading_edge(self, z: npt.ArrayLike) -> FloatArray:
+        """Leading edge ``l(z)`` (mm, signed distance ahead of the hinge line); NaN outside the span."""
+        zz = np.asarray(z, dtype=np.float64)
+        out = _core.aero_planform_chord(self.points, np.ascontiguousarray(zz).ravel())
+        l_: FloatArray = out["leading_edge"].reshape(zz.shape)
+        return l_
+
+    def scaled(self, factor: float) -> Planform:
+        """Uniformly scaled about the spherical centre (Ω scale as ``factor**5``)."""
+        if not (np.isfinite(factor) and factor > 0):
+            raise _core.InvalidParameterError(f"invalid `factor` = {factor}: must be finite and > 0")
+        return Planform(self.points * float(factor))
+
+    def translated(self, dz: float = 0.0, dx: float = 0.0) -> Planform:
+        """Shifted by ``dz`` (spanwise) and ``dx`` (toward the leading edge; moves the hinge line by ``-dx``)."""
+        return Planform(self.points + np.array([float(dz), float(dx)]))
+
+    # ------------------------------------------------------------------ parameters
+    def omegas(self, rho: float = AIR_DENSITY) -> dict[str, float]:
+        """Ω1..Ω4 of eqs. 3.12-3.15 (mg·mm²) and ``force`` = ½ρ∬z²dA (mg·mm).
+
+        ``rho`` in mg/mm³ (1.2e-3 for air). No force coefficient is folded in.
+        Raises ``InvalidParameterError`` (``density``) unless ``rho`` is finite and > 0.
+        """
+        p = _core.aero_planform_properties(self.points, float(rho), None)
+        return {k: float(p[k]) for k in ("omega1", "omega2", "omega3", "omega4", "force")}
+
+    def inertia(
+        self,
+        areal_density: float = 0.0,
+        line_masses: Iterable[Sequence[float]] | npt.ArrayLike = (),
+        point_masses: Iterable[Sequence[float]] | npt.ArrayLike = (),
+    ) -> dict[str, Any]:
+        """Mass properties about the spherical centre in the frame of Fig. 3.10.
+
+        Parameters
+        ----------
+        areal_density:
+            Membrane mass per area (mg/mm²).
+        line_masses:
+            Rows ``[z0, x0, z1, x1, linear_density]`` (mm, mg/mm): spars and veins.
+        point_masses:
+            Rows ``[z, x, mass]`` (mm, mg).
+
+        Returns ``mass``, ``center_of_mass`` ``[z, x]``, ``ixx = ∫z²dm``, ``izz = ∫x²dm``,
+        ``iyy = ixx + izz``, ``ixz = -∫xz dm`` (tensor element; positive for a wing behind
+        its hinge, as in Table 3.3) and ``tensor`` (3, 3).
+        """
+        out: dict[str, Any] = _core.aero_planform_inertia(
+            self.points,
+            float(areal_density),
+            _rows(line_masses, 5, "line_masses"),
+            _rows(point_masses, 3, "point_masses"),
+        )
+        return out
+
+    # ------------------------------------------------------------------ display
+    def plot(self, ax: Axes | None = None, *, hinge: bool = True, **kwargs: Any) -> Axes:
+        """Draw the outline (z horizontal, x vertical as in Fig. 3.10) and the hinge line ``x = 0``.
+
+        Extra keyword arguments go to ``Axes.fill``. Returns the Axes.
+        """
+        import matplotlib.pyplot as plt
+
+        if ax is None:
+            _, ax = plt.subplots()
+        pts = np.vstack([self.points, self.points[:1]])
+        style: dict[str, Any] = {"facecolor": "0.85", "edgecolor": "k", "linewidth": 1.0}
+        style.update(kwargs)
+        ax.fill(pts[:, 0], pts[:, 1], **style)
+        if hinge:
+            ax.axhline(0.0, color="C3", linestyle="--", linewidth=1.0, label="hinge line (x = 0)")
+            ax.plot([0.0], [0.0], marker="o", color="C3", linestyle="none", label="spherical centre")
+        ax.set_xlabel("z (mm, spanwise)")
+        ax.set_ylabel("x (mm, toward leading edge)")
+        ax.set_aspect("equal", adjustable="datalim")
+        return ax
+
+    def __repr__(self) -> str:
+        return (
+            f"Planform(n={len(self.points)}, area={self.area:.4g} mm², span={self.span:.4g} mm, "
+            f"tip_radius={self.tip_radius:.4g} mm)"
+        )
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Planform):
+            return NotImplemented
+        return self.points.shape == other.points.shape and bool(np.array_equal(self.points, other.points))
+
+    def __hash__(self) -> int:
+        return hash(self.points.tobytes())
+
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
+        return (Planform, (np.array(self.points),))
