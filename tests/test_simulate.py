@@ -127,3 +127,30 @@ def test_random_specs_raise_typed_errors_or_return_finite_results(ixx, izz, ixz,
     for c in r.trajectory.columns:
         assert np.isfinite(r.trajectory[c].to_numpy()).all(), c
     assert all(math.isfinite(v) or k.endswith("phase_lag") for k, v in r.metrics.items())
+
+
+def test_actuator_from_laminate_feeds_the_engine() -> None:
+    """Issue 9 hand-off: a laminate-designed bimorph drives a simulation with its own constants."""
+    from paritysim import laminate
+
+    bimorph = laminate.Bimorph.design_for(laminate.THESIS_ACTUATOR)
+    act = ps.Actuator.from_laminate(bimorph)
+    assert act.stiffness == pytest.approx(467.0, rel=1e-3)
+    assert act.force_per_volt == pytest.approx(1.2, rel=1e-3)
+    spec = ps.load_spec(EXAMPLES / "hmf.toml").replace(actuator=act)
+    assert ps.simulate(spec).metrics["left_stroke_amplitude"] > 0.1
+
+
+def test_blade_element_rotating_wings_run_and_rotate() -> None:
+    """Configuration #1 (hmf, psi free) with the §3.2.4 blade-element model and a hinge spring:
+    the wings rotate passively and everything stays finite (issue 6 builds on this)."""
+    spec = ps.load_spec(EXAMPLES / "hmf.toml")
+    springs = tuple(ps.Spring(stiffness=k) for k in (0.0, 0.0, 0.0, 0.0, 0.0, 3.0))  # hinge: joint 6 (psi)
+    aero = ps.Aero(kind="blade_element", omega1=46.8, omega2=0.587, omega3=17.5, omega4=0.712)
+    wing = ps.Wing.from_moments(ixx=29.0, iyy=30.0, izz=1.5, ixz=2.0, springs=springs, aero=aero)
+    rotating = spec.replace(wings=(wing, wing), configuration=ps.Configuration("hmf"))
+    r = ps.simulate(rotating, max_cycles=60)
+    assert r.metrics["left_rotation_amplitude"] > 0.1
+    np.testing.assert_allclose(r.trajectory["left_psi"], r.trajectory["right_psi"], atol=1e-9)
+    with pytest.raises(ps.InvalidParameterError, match="model"):
+        ps.simulate(rotating.replace(wings=(dataclasses.replace(wing, aero=dataclasses.replace(aero, model="nope")),) * 2))

@@ -55,15 +55,28 @@ class Spring:
 
 @dataclass(frozen=True)
 class Aero:
-    """Wing aerodynamics. ``stroke_drag``: ``tau = -omega1 * coefficient * sgn(phi_dot) phi_dot^2``.
+    """Wing aerodynamics (Ω in mg·mm²).
 
-    ``coefficient = 1`` is eq. 2.16; ``coefficient = C_N(90°)`` is eq. 3.8 for a fixed wing
-    (ERRATA item 12). ``omega1`` in mg·mm².
+    ``kind = "stroke_drag"``: ``tau = -omega1 * coefficient * sgn(phi_dot) phi_dot^2`` about the
+    stroke axis; ``coefficient = 1`` is eq. 2.16, ``coefficient = C_N(90°)`` is eq. 3.8 for a
+    fixed wing (ERRATA item 12).
+
+    ``kind = "blade_element"``: the quasi-steady model of §3.2.4 (eqs. 3.8-3.11) with
+    ``omega1..omega4`` (e.g. from :meth:`paritysim.Planform.omegas` or Table 3.3), coefficient
+    ``model`` (``dickinson1999`` or ``whitney_wood2010``), rotational damping coefficient
+    ``rotational_damping`` (None: the aero crate's cited default) and ``normal_force_law``
+    (``coefficient`` or ``unit``).
     """
 
     kind: str = "stroke_drag"
     omega1: float = 31.3
     coefficient: float = 1.0
+    omega2: float = 0.0
+    omega3: float = 0.0
+    omega4: float = 0.0
+    model: str = "dickinson1999"
+    rotational_damping: float | None = None
+    normal_force_law: str = "coefficient"
 
 
 @dataclass(frozen=True)
@@ -172,6 +185,20 @@ class Actuator:
     force_per_volt: float = 1.2
     stiffness: float = 467.0
     dc_offset: str = "as_force"
+
+    @classmethod
+    def from_laminate(cls, bimorph: Any, waveform: Waveform | None = None, dc_offset: str = "as_force") -> Actuator:
+        """An actuator whose constants come from laminate plate theory.
+
+        ``bimorph`` is a :class:`paritysim.laminate.Bimorph` (or anything with ``stiffness`` in
+        mN/mm and ``force_per_volt`` in mN/V, e.g. ``ActuatorConstants``).
+        """
+        stiffness = getattr(bimorph, "stiffness", None)
+        force = getattr(bimorph, "force_per_volt", None)
+        if stiffness is None or force is None:  # ActuatorConstants
+            stiffness, force = bimorph.stiffness_mn_per_mm, bimorph.force_per_volt_mn_per_v
+        # The sign of d31 only sets the direction of q1; the engine takes the magnitude.
+        return cls(waveform=waveform or Waveform(), force_per_volt=abs(float(force)), stiffness=float(stiffness), dc_offset=dc_offset)
 
 
 @dataclass(frozen=True)

@@ -14,6 +14,7 @@
 //! finite-differenced link rotations and Christoffel symbols of a finite-differenced `M`.
 
 use nalgebra::{Matrix3, Vector2, Vector3};
+use paritysim_aero::{BladeElementModel, CoefficientSet};
 use paritysim_error::{Error, Result, check_finite, check_non_negative};
 use paritysim_kinematics::SphericalShoulder;
 
@@ -75,6 +76,9 @@ pub enum WingAero {
         /// Dimensionless multiplier `C`.
         coefficient: f64,
     },
+    /// The quasi-steady blade-element model of §3.2.4 (crates/aero): `M_N, M_T, M_r, M_rd` of
+    /// eqs. 3.8–3.11 from the wing's angular velocity `ω = J6 ṗ`, as a torque in frame 6.
+    BladeElement(BladeElementModel<CoefficientSet>),
 }
 
 impl WingAero {
@@ -88,9 +92,15 @@ impl WingAero {
 
     /// Aerodynamic torque on the wing, in frame 6.
     #[inline]
-    fn torque(&self, p_dot: &Vector3<f64>, r61: &Matrix3<f64>) -> Vector3<f64> {
+    fn torque(
+        &self,
+        p_dot: &Vector3<f64>,
+        omega: &Vector3<f64>,
+        r61: &Matrix3<f64>,
+    ) -> Vector3<f64> {
         match self {
             WingAero::None => Vector3::zeros(),
+            WingAero::BladeElement(model) => model.moments_omega(omega).torque(),
             WingAero::StrokeDrag {
                 omega1,
                 coefficient,
@@ -265,7 +275,7 @@ impl Wing {
             potential += s[j].energy(gammas[j]);
         }
 
-        let aero_frame6 = self.aero.torque(p_dot, &r61);
+        let aero_frame6 = self.aero.torque(p_dot, &omega, &r61);
         Ok(WingTerms {
             mass,
             coriolis,

@@ -473,3 +473,95 @@ fn whippletree_kick_decays_for_parity() {
         "and decays: early {early:e}, late {late:e}"
     );
 }
+
+/// The blade-element model of crates/aero on a fixed wing (ψ = θ = 0, α = 90°) is the stroke
+/// drag of eq. 3.8 with `C = C_N(90°)`: two formulations, one trajectory.
+#[test]
+fn blade_element_fixed_wing_equals_stroke_drag_with_cn90() {
+    use paritysim_aero::{BladeElementModel, CoefficientModel, CoefficientSet, Omegas};
+    let coefficients = CoefficientSet::default();
+    let cn90 = coefficients
+        .coefficients(std::f64::consts::FRAC_PI_2)
+        .normal;
+    assert!(cn90 > 3.0 && cn90 < 4.0, "Dickinson C_N(90°) = {cn90}");
+    let blade =
+        BladeElementModel::new(Omegas::new(31.3, 0.6, 17.0, 0.7).unwrap(), coefficients).unwrap();
+    // The generalised stroke torque is the same function of the state, to round-off.
+    let fixed = |aero: WingAero| {
+        Wing::new(
+            shoulder(90.0, 0.0),
+            Matrix3::from_diagonal(&Vector3::new(29.0, 29.0, 1.0)),
+            [JointSpring::default(); 6],
+            aero,
+        )
+        .unwrap()
+    };
+    let (wb, wd) = (
+        fixed(WingAero::BladeElement(blade)),
+        fixed(WingAero::stroke_drag(31.3, cn90).unwrap()),
+    );
+    for k in 0..50 {
+        let (phi, rate) = (-0.8 + 0.032 * k as f64, (k as f64 * 0.37).sin() * 0.7);
+        let (p, v) = (Vector3::new(phi, 0.0, 0.0), Vector3::new(rate, 0.0, 0.0));
+        let (a, b) = (
+            wb.terms(&p, &v).unwrap().aero[0],
+            wd.terms(&p, &v).unwrap().aero[0],
+        );
+        assert!(
+            (a - b).abs() <= 1e-12 * (1.0 + b.abs()),
+            "phi {phi} rate {rate}: {a} vs {b}"
+        );
+    }
+    let make = |aero: WingAero| {
+        let sh = shoulder(90.0, 0.0);
+        let wing = Wing::new(
+            sh,
+            Matrix3::from_diagonal(&Vector3::new(29.0, 29.0, 1.0)),
+            [JointSpring::default(); 6],
+            aero,
+        )
+        .unwrap();
+        Device::new(DeviceSpec {
+            wings: vec![wing.clone(), wing],
+            constraints: Constraints::configuration("hmf_fixed").unwrap(),
+            transmission: Some(
+                Transmission::new(
+                    Drivetrain::HmfFourBar(HmfFourBar::new(RodCrank::THESIS)),
+                    0.0,
+                )
+                .unwrap(),
+            ),
+            actuator: Some(Actuator::thesis(
+                Waveform::sine(100.0, 110.0, 0.0, 0.0).unwrap(),
+            )),
+            formulation: Formulation::NullSpace,
+        })
+        .unwrap()
+    };
+    // M_T and M_r act on the constrained θ, ψ and enter only through round-off of the null-space
+    // basis (1e-17), which can change adaptive step decisions: compare at a tight tolerance.
+    let options = SimulationOptions {
+        rtol: 1e-12,
+        atol: 1e-14,
+        max_cycles: 8,
+        min_cycles: 8,
+        steady_tol: 1e-30,
+        ..Default::default()
+    };
+    let a = simulate(&make(WingAero::BladeElement(blade)), &options).unwrap();
+    let b = simulate(&make(WingAero::stroke_drag(31.3, cn90).unwrap()), &options).unwrap();
+    for name in ["left_phi", "right_roll_aero", "actuator_power"] {
+        let (x, y) = (
+            a.trajectory.column(name).unwrap(),
+            b.trajectory.column(name).unwrap(),
+        );
+        let scale = y.iter().map(|v| v.abs()).fold(1e-300, f64::max);
+        let err = x
+            .iter()
+            .zip(y)
+            .map(|(u, v)| (u - v).abs())
+            .fold(0.0, f64::max)
+            / scale;
+        assert!(err < 1e-7, "{name}: relative {err:e}");
+    }
+}

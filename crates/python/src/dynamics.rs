@@ -13,6 +13,7 @@ use paritysim_dynamics::{
     Wing, WingAero,
 };
 use paritysim_error::{Error, Result};
+
 use paritysim_kinematics::drivetrain::{HmfFourBar, LinearDifferential, LinkageDifferential};
 use paritysim_kinematics::{Drivetrain, RodCrank, SphericalShoulder};
 use pyo3::prelude::*;
@@ -201,7 +202,46 @@ fn parse_wing(node: &Node<'_, '_>) -> Result<Wing> {
             "none" => WingAero::None,
             "stroke_drag" => WingAero::stroke_drag(a.f64("omega1")?, a.f64_or("coefficient", 1.0)?)
                 .map_err(|e| e.in_field(&a.path))?,
-            other => return Err(invalid(&a.field("kind"), other, "one of none, stroke_drag")),
+            "blade_element" => {
+                use paritysim_aero::{BladeElementModel, CoefficientSet, NormalForceLaw, Omegas};
+                let wrap = |e: Error| e.in_field(&a.path);
+                let omegas = Omegas::new(
+                    a.f64("omega1")?,
+                    a.f64_or("omega2", 0.0)?,
+                    a.f64_or("omega3", 0.0)?,
+                    a.f64_or("omega4", 0.0)?,
+                )
+                .map_err(wrap)?;
+                let coefficients = CoefficientSet::from_name(&a.str_or("model", "dickinson1999")?)
+                    .map_err(wrap)?;
+                let law = match a.str_or("normal_force_law", "coefficient")?.as_str() {
+                    "coefficient" => NormalForceLaw::Coefficient,
+                    "unit" => NormalForceLaw::Unit,
+                    other => {
+                        return Err(invalid(
+                            &a.field("normal_force_law"),
+                            other,
+                            "coefficient or unit",
+                        ));
+                    }
+                };
+                let c_rd = a.f64_or(
+                    "rotational_damping",
+                    paritysim_aero::DEFAULT_ROTATIONAL_DAMPING,
+                )?;
+                let model = BladeElementModel::new(omegas, coefficients)
+                    .and_then(|m| m.with_rotational_damping(c_rd))
+                    .map_err(wrap)?
+                    .with_normal_force_law(law);
+                WingAero::BladeElement(model)
+            }
+            other => {
+                return Err(invalid(
+                    &a.field("kind"),
+                    other,
+                    "one of none, stroke_drag, blade_element",
+                ));
+            }
         },
     };
     Wing::new(shoulder, inertia, springs, aero).map_err(|e| e.in_field(&node.path))
