@@ -55,3 +55,16 @@ def test_console_script_runs(tmp_path: Path) -> None:
     res = subprocess.run([str(exe), "reproduce", "--all", "--out", str(tmp_path), "--quiet"], capture_output=True, text=True, check=False)
     assert res.returncode == 0, res.stderr
     assert (tmp_path / "fig2_9.parquet").exists()
+
+
+def test_reproduce_laminate_writes_section(tmp_path: Path) -> None:
+    assert main(["reproduce", "laminate", "--out", str(tmp_path), "--quiet"]) == 0
+    df = pl.read_csv(tmp_path / "laminate.csv")
+    assert df.columns == ["quantity", "value", "unit", "thesis", "note"]
+    row = dict(zip(df["quantity"], df["value"], strict=True))
+    # the designed actuator reproduces the thesis' constants (solved, then re-evaluated)
+    assert row["actuator stiffness"] == pytest.approx(467.0, rel=1e-6)
+    assert row["actuator force per volt"] == pytest.approx(1.2, rel=1e-6)
+    assert row["linkage sublaminate cure curvature (max)"] < 1e-12
+    assert "Laminate design layer" in (tmp_path / "laminate.md").read_text()
+    assert (tmp_path / "laminate.png").read_bytes()[:4] == b"\x89PNG"

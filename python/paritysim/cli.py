@@ -25,9 +25,28 @@ def _fig2_9(out: Path) -> list[Path]:
     return written
 
 
+def _laminate(out: Path) -> list[Path]:
+    import matplotlib.pyplot as plt
+
+    from . import plots
+    from .trials.laminate_design import laminate_summary, report_section
+
+    df, _bimorph, stack = laminate_summary()
+    written = [out / "laminate.parquet", out / "laminate.csv", out / "laminate.md"]
+    df.write_parquet(written[0])
+    df.write_csv(written[1])
+    written[2].write_text(report_section(df))
+    fig, ax = plt.subplots(figsize=(8, 6), constrained_layout=True)
+    stack.plot(ax=ax)
+    ax.set_title("Fig. 4.27: the Mobee 18-layer PC-MEMS stack (computed thickness and layers)")
+    written.append(plots.save(fig, out / "laminate.png"))
+    return written
+
+
 #: CLI trial names -> runner writing files into the output directory.
 TRIALS: dict[str, Callable[[Path], list[Path]]] = {
     "fig2.9": _fig2_9,
+    "laminate": _laminate,
 }
 
 

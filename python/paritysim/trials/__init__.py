@@ -6,6 +6,7 @@ thesis. ``REGISTRY`` maps the CLI names (``paritysim reproduce NAME``) to their 
 
 from __future__ import annotations
 
+from .laminate_design import laminate_summary
 from .section_2_3 import fig2_9
 
-__all__ = ["fig2_9"]
+__all__ = ["fig2_9", "laminate_summary"]

@@ -1,0 +1,56 @@
+"""Laminate design layer (issue 9; thesis §3.3.1 ref. [42], §4.2, §4.4.2, §4.5.3).
+
+Everything here is computed by the laminate model; the thesis' statements are listed beside our
+numbers for comparison only.
+"""
+
+from __future__ import annotations
+
+import polars as pl
+
+from .. import laminate as lam
+from ..spec import Actuator
+
+#: What the thesis states (§3.3.1): 467 mN/mm and 120 mN amplitude at 100 V.
+THESIS_STATEMENTS = {"stiffness": 467.0, "force_per_volt": 1.2}
+
+
+def laminate_summary() -> tuple[pl.DataFrame, lam.Bimorph, lam.Layup]:
+    """The actuator geometry that yields the thesis' constants, the Mobee stack and its cure curl.
+
+    Returns a DataFrame with columns ``quantity, value, unit, thesis, note``, the designed
+    :class:`paritysim.laminate.Bimorph` and the Mobee :class:`paritysim.laminate.Layup`.
+    """
+    bimorph = lam.Bimorph.design_for(lam.THESIS_ACTUATOR)
+    actuator = Actuator.from_laminate(bimorph)
+    stack = lam.Layup.mobee()
+    kappa = stack.thermal_curvature(lam.CURE_DELTA_T)
+    sub = lam.Layup.linkage_sublaminate()
+    sub_kappa = sub.thermal_curvature(lam.CURE_DELTA_T)
+    rows = [
+        ("actuator stiffness", actuator.stiffness, "mN/mm", THESIS_STATEMENTS["stiffness"], "designed bimorph (Mobee actuator layup)"),
+        ("actuator force per volt", actuator.force_per_volt, "mN/V", THESIS_STATEMENTS["force_per_volt"], "120 mN at 100 V"),
+        ("actuator length", bimorph.length, "mm", None, "solved from the free deflection per volt"),
+        ("actuator extension", bimorph.extension, "mm", None, "extension ratio 0.5"),
+        ("actuator base width", bimorph.base_width, "mm", None, "solved from the stiffness (tip/base 0.5)"),
+        ("actuator active mass", bimorph.active_mass, "mg", None, "heavy: the thesis' constants imply a large actuator"),
+        ("Mobee stack layers", float(len(stack)), "-", 18.0, "Fig. 4.27"),
+        ("Mobee stack thickness", stack.total_thickness_mm, "mm", None, "sum of layer thicknesses"),
+        ("Mobee stack areal mass", stack.areal_mass, "mg/mm^2", None, ""),
+        ("Mobee cure curvature kx", float(kappa[0]), "1/mm", None, "cooled from 200 °C (ΔT = -180 K), §4.5.3"),
+        ("Mobee cure curvature ky", float(kappa[1]), "1/mm", None, "asymmetric (titanium on one face)"),
+        ("linkage sublaminate cure curvature (max)", float(abs(sub_kappa).max()), "1/mm", 0.0, "symmetric layup: no curl"),
+    ]
+    df = pl.DataFrame(rows, schema=["quantity", "value", "unit", "thesis", "note"], orient="row")
+    return df, bimorph, stack
+
+
+def report_section(df: pl.DataFrame) -> str:
+    """Markdown section for the reproduction report."""
+    lines = ["## Laminate design layer (§3.3.1 ref. [42], §4.4.2, §4.5.3)", "", "| quantity | paritysim | unit | thesis | note |", "|---|---|---|---|---|"]
+    for q, v, u, t, n in df.iter_rows():
+        lines.append(f"| {q} | {v:.6g} | {u} | {'' if t is None else f'{t:g}'} | {n} |")
+    lines += ["", "The actuator constants are matched by solving for the planform; the result weighs about as much",
+              "as the whole robot, so the thesis' constants were likely derived for a different drive definition",
+              "(see `paritysim.laminate` docs).", ""]
+    return "\n".join(lines)
