@@ -26,6 +26,46 @@ fn springs(k: [f64; 6]) -> [JointSpring; 6] {
     k.map(|k| JointSpring::linear(k, 0.0).unwrap())
 }
 
+/// A fixed-wing study wing: stroke inertia 29 mg·mm² (§3.3.2), no joint springs.
+fn fixed_wing(aero: WingAero) -> Wing {
+    let inertia = Matrix3::from_diagonal(&Vector3::new(29.0, 29.0, 1.0));
+    Wing::new(
+        shoulder(90.0, 0.0),
+        inertia,
+        [JointSpring::default(); 6],
+        aero,
+    )
+    .unwrap()
+}
+
+/// Quadratic stroke drag with unit coefficient (eq. 2.16).
+fn drag(omega: f64) -> WingAero {
+    WingAero::stroke_drag(omega, 1.0).unwrap()
+}
+
+/// Two wings on a drivetrain driven by an actuator.
+fn two_wing_device(
+    wings: [Wing; 2],
+    config: &str,
+    drivetrain: Drivetrain,
+    k2: f64,
+    actuator: Actuator,
+    formulation: Formulation,
+) -> Device {
+    Device::new(DeviceSpec {
+        wings: wings.to_vec(),
+        constraints: Constraints::configuration(config).unwrap(),
+        transmission: Some(Transmission::new(drivetrain, k2).unwrap()),
+        actuator: Some(actuator),
+        formulation,
+    })
+    .unwrap()
+}
+
+fn hmf_drivetrain() -> Drivetrain {
+    Drivetrain::HmfFourBar(HmfFourBar::new(RodCrank::THESIS))
+}
+
 // ------------------------------------------------------------- M and c
 
 /// Angular velocity in frame 6 from finite differences of R_6^1 (independent of J6).
@@ -163,26 +203,17 @@ fn parity_device_with(
     formulation: Formulation,
     drivetrain: Drivetrain,
 ) -> Device {
-    let sh = shoulder(90.0, 0.0);
-    let wing = |omega: f64| {
-        Wing::new(
-            sh,
-            Matrix3::from_diagonal(&Vector3::new(29.0, 29.0, 1.0)),
-            [JointSpring::default(); 6],
-            WingAero::stroke_drag(omega, 1.0).unwrap(),
-        )
-        .unwrap()
-    };
+    let wing = |omega: f64| fixed_wing(drag(omega));
     // 50 V keeps the unit-coefficient drag device inside the linkage's reach (about ±48°).
-    let waveform = Waveform::sine(50.0, 110.0, 0.0, 0.0).unwrap();
-    Device::new(DeviceSpec {
-        wings: vec![wing(omega_left), wing(31.3)],
-        constraints: Constraints::configuration(config).unwrap(),
-        transmission: Some(Transmission::new(drivetrain, k2).unwrap()),
-        actuator: Some(Actuator::thesis(waveform)),
+    let actuator = Actuator::thesis(Waveform::sine(50.0, 110.0, 0.0, 0.0).unwrap());
+    two_wing_device(
+        [wing(omega_left), wing(31.3)],
+        config,
+        drivetrain,
+        k2,
+        actuator,
         formulation,
-    })
-    .unwrap()
+    )
 }
 
 #[test]
@@ -286,32 +317,16 @@ fn symmetric_parity_stays_symmetric_and_hmf_keeps_strokes_equal() {
         "symmetric device has no net roll torque"
     );
 
-    let sh = shoulder(90.0, 0.0);
-    let wing = |omega: f64| {
-        Wing::new(
-            sh,
-            Matrix3::from_diagonal(&Vector3::new(29.0, 29.0, 1.0)),
-            [JointSpring::default(); 6],
-            WingAero::stroke_drag(omega, 1.0).unwrap(),
-        )
-        .unwrap()
-    };
-    let hmf = Device::new(DeviceSpec {
-        wings: vec![wing(18.75), wing(31.3)],
-        constraints: Constraints::configuration("hmf_fixed").unwrap(),
-        transmission: Some(
-            Transmission::new(
-                Drivetrain::HmfFourBar(HmfFourBar::new(RodCrank::THESIS)),
-                0.0,
-            )
-            .unwrap(),
-        ),
-        actuator: Some(Actuator::thesis(
-            Waveform::sine(50.0, 110.0, 0.0, 0.0).unwrap(),
-        )),
-        formulation: Formulation::NullSpace,
-    })
-    .unwrap();
+    let wing = |omega: f64| fixed_wing(drag(omega));
+    let actuator = Actuator::thesis(Waveform::sine(50.0, 110.0, 0.0, 0.0).unwrap());
+    let hmf = two_wing_device(
+        [wing(18.75), wing(31.3)],
+        "hmf_fixed",
+        hmf_drivetrain(),
+        0.0,
+        actuator,
+        Formulation::NullSpace,
+    );
     let r = simulate(&hmf, &options).unwrap();
     let (l, rr) = (
         r.trajectory.column("left_phi").unwrap(),
@@ -392,38 +407,23 @@ fn inconsistent_initial_state_and_bad_devices_are_rejected() {
 fn integration_failure_carries_time_and_state() {
     // A huge force drives the linkage beyond its reach: the model error surfaces as an
     // integration error with the time and state where it happened.
-    let sh = shoulder(90.0, 0.0);
-    let wing = |omega: f64| {
-        Wing::new(
-            sh,
-            Matrix3::from_diagonal(&Vector3::new(29.0, 29.0, 1.0)),
-            [JointSpring::default(); 6],
-            WingAero::stroke_drag(omega, 1.0).unwrap(),
-        )
-        .unwrap()
-    };
-    let device = Device::new(DeviceSpec {
-        wings: vec![wing(31.3), wing(31.3)],
-        constraints: Constraints::configuration("drag_parity_fixed").unwrap(),
-        transmission: Some(
-            Transmission::new(
-                Drivetrain::LinkageDifferential(LinkageDifferential::thesis()),
-                0.0,
-            )
-            .unwrap(),
-        ),
-        actuator: Some(
-            Actuator::new(
-                1.2,
-                467.0,
-                Waveform::sine(5000.0, 110.0, 0.0, 0.0).unwrap(),
-                DcOffset::AsForce,
-            )
-            .unwrap(),
-        ),
-        formulation: Formulation::NullSpace,
-    })
+    let wing = |omega: f64| fixed_wing(drag(omega));
+    let actuator = Actuator::new(
+        1.2,
+        467.0,
+        Waveform::sine(5000.0, 110.0, 0.0, 0.0).unwrap(),
+        DcOffset::AsForce,
+    )
     .unwrap();
+    let linkage = Drivetrain::LinkageDifferential(LinkageDifferential::thesis());
+    let device = two_wing_device(
+        [wing(31.3), wing(31.3)],
+        "drag_parity_fixed",
+        linkage,
+        0.0,
+        actuator,
+        Formulation::NullSpace,
+    );
     match simulate(&device, &SimulationOptions::default()) {
         Err(paritysim_dynamics::Error::Integration { time, state, .. }) => {
             assert!(time > 0.0 && time < 10.0);
@@ -487,18 +487,9 @@ fn blade_element_fixed_wing_equals_stroke_drag_with_cn90() {
     let blade =
         BladeElementModel::new(Omegas::new(31.3, 0.6, 17.0, 0.7).unwrap(), coefficients).unwrap();
     // The generalised stroke torque is the same function of the state, to round-off.
-    let fixed = |aero: WingAero| {
-        Wing::new(
-            shoulder(90.0, 0.0),
-            Matrix3::from_diagonal(&Vector3::new(29.0, 29.0, 1.0)),
-            [JointSpring::default(); 6],
-            aero,
-        )
-        .unwrap()
-    };
     let (wb, wd) = (
-        fixed(WingAero::BladeElement(blade)),
-        fixed(WingAero::stroke_drag(31.3, cn90).unwrap()),
+        fixed_wing(WingAero::BladeElement(blade)),
+        fixed_wing(WingAero::stroke_drag(31.3, cn90).unwrap()),
     );
     for k in 0..50 {
         let (phi, rate) = (-0.8 + 0.032 * k as f64, (k as f64 * 0.37).sin() * 0.7);
@@ -513,30 +504,15 @@ fn blade_element_fixed_wing_equals_stroke_drag_with_cn90() {
         );
     }
     let make = |aero: WingAero| {
-        let sh = shoulder(90.0, 0.0);
-        let wing = Wing::new(
-            sh,
-            Matrix3::from_diagonal(&Vector3::new(29.0, 29.0, 1.0)),
-            [JointSpring::default(); 6],
-            aero,
+        let actuator = Actuator::thesis(Waveform::sine(100.0, 110.0, 0.0, 0.0).unwrap());
+        two_wing_device(
+            [fixed_wing(aero.clone()), fixed_wing(aero)],
+            "hmf_fixed",
+            hmf_drivetrain(),
+            0.0,
+            actuator,
+            Formulation::NullSpace,
         )
-        .unwrap();
-        Device::new(DeviceSpec {
-            wings: vec![wing.clone(), wing],
-            constraints: Constraints::configuration("hmf_fixed").unwrap(),
-            transmission: Some(
-                Transmission::new(
-                    Drivetrain::HmfFourBar(HmfFourBar::new(RodCrank::THESIS)),
-                    0.0,
-                )
-                .unwrap(),
-            ),
-            actuator: Some(Actuator::thesis(
-                Waveform::sine(100.0, 110.0, 0.0, 0.0).unwrap(),
-            )),
-            formulation: Formulation::NullSpace,
-        })
-        .unwrap()
     };
     // M_T and M_r act on the constrained θ, ψ and enter only through round-off of the null-space
     // basis (1e-17), which can change adaptive step decisions: compare at a tight tolerance.

@@ -127,6 +127,30 @@ impl Error {
     }
 }
 
+impl Error {
+    /// Locates an error inside an array evaluation: an invalid field becomes
+    /// `{array}[{index}]` (`array` defaults to the field's own name) and an out-of-domain detail
+    /// is prefixed with the index. Other variants are returned unchanged.
+    pub fn at_index(self, index: usize, array: Option<&str>) -> Self {
+        match self {
+            Error::OutOfDomain { what, detail } => Error::OutOfDomain {
+                what,
+                detail: format!("at index {index}: {detail}"),
+            },
+            Error::InvalidParameter {
+                field,
+                value,
+                allowed,
+            } => Error::InvalidParameter {
+                field: Cow::Owned(format!("{}[{index}]", array.unwrap_or(&field))),
+                value,
+                allowed,
+            },
+            other => other,
+        }
+    }
+}
+
 /// Returns early with an error (polars-style).
 ///
 /// `bail!(invalid "field", value, "allowed")` or `bail!(Singular "format {}", args)`.
@@ -219,6 +243,16 @@ mod tests {
         assert_eq!(e.to_string(), "invalid `x` = -1: must be > 0");
         let nested = e.in_field("wing");
         assert_eq!(nested.field(), Some("wing.x"));
+    }
+
+    #[test]
+    fn at_index_names_the_element() {
+        let e = check_finite("q1", f64::NAN).unwrap_err().at_index(3, None);
+        assert_eq!(e.field(), Some("q1[3]"));
+        let e = check_finite("voltage", f64::NAN)
+            .unwrap_err()
+            .at_index(1, Some("voltages"));
+        assert_eq!(e.field(), Some("voltages[1]"));
     }
 
     #[test]

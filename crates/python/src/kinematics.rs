@@ -218,22 +218,7 @@ impl PyDrivetrain {
                     Vec::with_capacity(8 * n),
                 );
                 for i in 0..n {
-                    let e = d.evaluate(q1[i], q2[i]).map_err(|e| match e {
-                        Error::OutOfDomain { what, detail } => Error::OutOfDomain {
-                            what,
-                            detail: format!("at index {i}: {detail}"),
-                        },
-                        Error::InvalidParameter {
-                            field,
-                            value,
-                            allowed,
-                        } => Error::InvalidParameter {
-                            field: format!("{field}[{i}]").into(),
-                            value,
-                            allowed,
-                        },
-                        other => other,
-                    })?;
+                    let e = d.evaluate(q1[i], q2[i]).map_err(|e| e.at_index(i, None))?;
                     l.push(e.stroke[0]);
                     r.push(e.stroke[1]);
                     for a in 0..2 {

@@ -427,21 +427,9 @@ fn bimorph_to_py<'py>(
     let mut defl = Vec::with_capacity(voltages.len());
     let mut force = Vec::with_capacity(voltages.len());
     for (i, &v) in voltages.iter().enumerate() {
-        let at = |e: Error| match e {
-            Error::OutOfDomain { what, detail } => Error::OutOfDomain {
-                what,
-                detail: format!("at index {i}: {detail}"),
-            },
-            Error::InvalidParameter {
-                field,
-                value,
-                allowed,
-            } => Error::InvalidParameter {
-                field: format!("{field}s[{i}]").into(),
-                value,
-                allowed,
-            },
-            other => other,
+        let at = |e: Error| {
+            let array = format!("{}s", e.field().unwrap_or("voltage"));
+            e.at_index(i, Some(&array))
         };
         defl.push(b.free_deflection(v).map_err(at).py_err()?);
         force.push(b.blocked_force(v).map_err(at).py_err()?);
