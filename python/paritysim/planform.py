@@ -12,6 +12,8 @@ crate ``paritysim-aero``). Air density defaults to 1.2 kg/m³ = 1.2e-3 mg/mm³.
 
 from __future__ import annotations
 
+import math
+
 from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -182,8 +184,10 @@ class Planform:
         """Ω1..Ω4 of eqs. 3.12-3.15 (mg·mm²) and ``force`` = ½ρ∬z²dA (mg·mm).
 
         ``rho`` in mg/mm³ (1.2e-3 for air). No force coefficient is folded in.
-        Raises ``InvalidParameterError`` (``density``) unless ``rho`` is finite and > 0.
+        Raises ``InvalidParameterError`` (``rho``) unless ``rho`` is finite and > 0.
         """
+        if not (math.isfinite(rho) and rho > 0):
+            raise _core.InvalidParameterError(f"invalid `rho` = {rho}: must be finite and > 0 (mg/mm^3; air is 1.2e-3)")
         p = _core.aero_planform_properties(self.points, float(rho), None)
         return {k: float(p[k]) for k in ("omega1", "omega2", "omega3", "omega4", "force")}
 
