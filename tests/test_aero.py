@@ -131,9 +131,9 @@ def test_bad_outlines_raise_geometry_error() -> None:
 
 def test_bad_numbers_raise_invalid_parameter_error() -> None:
     p = Planform.rectangle(10.0, 3.0)
-    with pytest.raises(ps.InvalidParameterError, match="density") as e:
+    with pytest.raises(ps.InvalidParameterError, match="rho") as e:
         p.omegas(rho=-1.2e-3)
-    assert getattr(e.value, "field", None) == "density"
+    assert getattr(e.value, "field", None) == "rho"
     with pytest.raises(ps.InvalidParameterError, match="span"):
         Planform.rectangle(-1.0, 3.0)
     with pytest.raises(ps.InvalidParameterError) as e:

@@ -28,6 +28,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _core
+from ._errors import invalid
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -610,7 +611,7 @@ class Flexure:
     def elastic_limit_angle(self, yield_strain: float = KAPTON_YIELD_STRAIN) -> float:
         """Joint angle (rad) at which the surface strain reaches ``yield_strain``."""
         if not (np.isfinite(yield_strain) and yield_strain > 0):
-            raise _core.InvalidParameterError(f"invalid `yield_strain` = {yield_strain}: must be finite and > 0")
+            raise invalid("yield_strain", yield_strain, "finite and > 0")
         return float(yield_strain / self._data["strain_per_rad"])
 
     def torque(self, angle: float | npt.ArrayLike) -> Any:

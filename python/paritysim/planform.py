@@ -21,6 +21,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _core
+from ._errors import invalid
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -172,7 +173,7 @@ class Planform:
     def scaled(self, factor: float) -> Planform:
         """Uniformly scaled about the spherical centre (Ω scale as ``factor**5``)."""
         if not (np.isfinite(factor) and factor > 0):
-            raise _core.InvalidParameterError(f"invalid `factor` = {factor}: must be finite and > 0")
+            raise invalid("factor", factor, "finite and > 0")
         return Planform(self.points * float(factor))
 
     def translated(self, dz: float = 0.0, dx: float = 0.0) -> Planform:
@@ -187,7 +188,7 @@ class Planform:
         Raises ``InvalidParameterError`` (``rho``) unless ``rho`` is finite and > 0.
         """
         if not (math.isfinite(rho) and rho > 0):
-            raise _core.InvalidParameterError(f"invalid `rho` = {rho}: must be finite and > 0 (mg/mm^3; air is 1.2e-3)")
+            raise invalid("rho", rho, "finite and > 0 (mg/mm^3; air is 1.2e-3)")
         p = _core.aero_planform_properties(self.points, float(rho), None)
         return {k: float(p[k]) for k in ("omega1", "omega2", "omega3", "omega4", "force")}
 

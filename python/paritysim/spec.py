@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from . import _core
+from ._errors import invalid
 
 __all__ = [
     "Actuator",
@@ -117,7 +118,7 @@ class Drivetrain:
     def __post_init__(self) -> None:
         self.kinematics()  # validates kind and lengths in Rust
         if not (math.isfinite(self.balance_stiffness) and self.balance_stiffness >= 0):
-            raise _core.InvalidParameterError(f"invalid `balance_stiffness` = {self.balance_stiffness}: must be finite and >= 0 (mN mm/rad)")
+            raise invalid("balance_stiffness", self.balance_stiffness, "finite and >= 0 (mN mm/rad)")
 
     @classmethod
     def hmf_four_bar(cls, crank_mm: float = 0.4, rod_mm: float = 0.8) -> Drivetrain:
@@ -144,7 +145,7 @@ class Drivetrain:
             return _core.Drivetrain.linear_differential(self.transmission_ratio, self.arm_length_mm, self.arm_ratio)
         if self.kind == "linkage_differential":
             return _core.Drivetrain.linkage_differential(self.crank_mm, self.rod_mm, self.whippletree_length_mm, self.arm_ratio)
-        raise _core.InvalidParameterError(f"invalid `drivetrain.kind` = {self.kind!r}: must be one of hmf_four_bar, linear_differential, linkage_differential")
+        raise invalid("drivetrain.kind", repr(self.kind), "one of hmf_four_bar, linear_differential, linkage_differential")
 
     @property
     def dof(self) -> int:
@@ -305,11 +306,11 @@ _NESTED: dict[tuple[type, str], Any] = {}
 def _build(cls: type, data: Any, path: str) -> Any:
     """Recursively builds dataclasses from plain data, naming unknown fields by path."""
     if not isinstance(data, dict):
-        raise _core.InvalidParameterError(f"invalid `{path or 'spec'}` = {data!r}: must be a table")
+        raise invalid(path or "spec", repr(data), "a table")
     fields = {f.name: f for f in dataclasses.fields(cls)}
     unknown = sorted(set(data) - set(fields))
     if unknown:
-        raise _core.InvalidParameterError(f"invalid `{path + '.' if path else ''}{unknown[0]}`: unknown field; valid fields: {', '.join(fields)}")
+        raise invalid(f"{path + '.' if path else ''}{unknown[0]}", "<unknown field>", f"a known field; valid fields: {', '.join(fields)}")
     kwargs: dict[str, Any] = {}
     for name, value in data.items():
         sub = f"{path}.{name}" if path else name

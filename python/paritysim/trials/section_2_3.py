@@ -29,12 +29,12 @@ def fig2_9(step_deg: float = 1.0, limit_deg: float = 90.0) -> pl.DataFrame:
     DataFrame with columns ``alpha2_deg, alpha3_deg, phi_deg, theta_deg, theta_w_deg,
     reachable``; ``theta_w_deg`` is null where the pose is outside the joint limit.
     """
-    from .._core import InvalidParameterError
+    from .._errors import invalid
 
     if not (np.isfinite(step_deg) and step_deg > 0):
-        raise InvalidParameterError(f"invalid `step_deg` = {step_deg}: must be finite and > 0")
+        raise invalid("step_deg", step_deg, "finite and > 0")
     if not (np.isfinite(limit_deg) and 0 < limit_deg <= 90):
-        raise InvalidParameterError(f"invalid `limit_deg` = {limit_deg}: must be in (0, 90]")
+        raise invalid("limit_deg", limit_deg, "in (0, 90]")
     axis = np.arange(-limit_deg, limit_deg + 0.5 * step_deg, step_deg)
     phi_deg, theta_deg = np.meshgrid(axis, axis, indexing="xy")
     frames = []
