@@ -238,7 +238,7 @@ class Simulation:
     configuration: Configuration = field(default_factory=Configuration)
     drivetrain: Drivetrain | None = None
     actuator: Actuator | None = None
-    formulation: str = "null_space"
+    formulation: str = "auto"
     options: Options = field(default_factory=Options)
     name: str = ""
 

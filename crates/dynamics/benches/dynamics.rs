@@ -24,7 +24,7 @@ fn wing(omega: f64) -> Wing {
     .unwrap()
 }
 
-fn section_3_3_device() -> Device {
+fn section_3_3_device(formulation: Formulation) -> Device {
     Device::new(DeviceSpec {
         wings: vec![wing(31.3), wing(31.3)],
         constraints: Constraints::configuration("drag_parity_fixed").unwrap(),
@@ -38,7 +38,7 @@ fn section_3_3_device() -> Device {
         actuator: Some(Actuator::thesis(
             Waveform::sine(100.0, 110.0, 0.0, 0.0).unwrap(),
         )),
-        formulation: Formulation::NullSpace,
+        formulation,
     })
     .unwrap()
 }
@@ -54,7 +54,7 @@ fn rhs(c: &mut Criterion) {
         b.iter(|| one.terms(black_box(&p), black_box(&v)).unwrap())
     });
 
-    let device = section_3_3_device();
+    let device = section_3_3_device(Formulation::NullSpace);
     let y = device
         .state_from(
             &Vec6::new(0.2, 0.0, 0.0, 0.25, 0.0, 0.0),
@@ -62,17 +62,28 @@ fn rhs(c: &mut Criterion) {
         )
         .unwrap();
     let mut dydt = [0.0; paritysim_dynamics::STATE_LEN];
-    c.bench_function("rhs_two_wing_drag_parity_fixed", |b| {
+    c.bench_function("rhs_two_wing_drag_parity_fixed_null_space", |b| {
         b.iter(|| {
             device
                 .rhs(black_box(1.0), black_box(&y), &mut dydt)
                 .unwrap()
         })
     });
+    let fast = section_3_3_device(Formulation::DrivetrainCoordinates);
+    let y = fast
+        .state_from(
+            &Vec6::new(0.2, 0.0, 0.0, 0.25, 0.0, 0.0),
+            &Vec6::new(0.3, 0.0, 0.0, 0.25, 0.0, 0.0),
+        )
+        .unwrap();
+    c.bench_function(
+        "rhs_two_wing_drag_parity_fixed_drivetrain_coordinates",
+        |b| b.iter(|| fast.rhs(black_box(1.0), black_box(&y), &mut dydt).unwrap()),
+    );
 }
 
 fn run(c: &mut Criterion) {
-    let device = section_3_3_device();
+    let device = section_3_3_device(Formulation::Auto);
     let options = SimulationOptions {
         rtol: 1e-8,
         atol: 1e-10,
@@ -86,6 +97,10 @@ fn run(c: &mut Criterion) {
     group.sample_size(20);
     group.bench_function("drag_parity_fixed_20_wingbeats_rtol_1e-8", |b| {
         b.iter(|| simulate(&device, &options).unwrap())
+    });
+    let general = section_3_3_device(Formulation::NullSpace);
+    group.bench_function("drag_parity_fixed_20_wingbeats_rtol_1e-8_null_space", |b| {
+        b.iter(|| simulate(&general, &options).unwrap())
     });
     group.finish();
 }

@@ -47,11 +47,76 @@ impl Transmission {
 /// How the constraints are enforced.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Formulation {
-    /// Reduced coordinates `p = p_part + N z` (cannot drift; the default).
+    /// [`Formulation::DrivetrainCoordinates`] when the device allows it, else
+    /// [`Formulation::NullSpace`] (the default).
     #[default]
+    Auto,
+    /// Reduced coordinates `p = p_part + N z` (cannot drift).
     NullSpace,
     /// Lagrange-multiplier projection of eq. 3.20 (with ERRATA item 4's `Cᵀ`) on the full `p`.
     Projection,
+    /// Fixed wings only stroking (θ = ψ = 0 imposed by `C`, α2 = 90° shoulders so θ_w ≡ 0, no
+    /// springs on joints 2, 3, 5): integrate the drivetrain coordinates `q` directly with
+    /// `M_q = Σ_k I_k J_kᵀ J_k`, `Q = Σ_k J_kᵀ (τ_k − I_k h_k) + (F − K1 q1, −K2 q2)`. Same
+    /// physics as the null-space form without inverse kinematics or shoulder evaluations.
+    DrivetrainCoordinates,
+}
+
+/// Inertias about the stroke axis of a stroke-only device (see
+/// [`Formulation::DrivetrainCoordinates`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct StrokeOnly {
+    stroke_inertia: [f64; 2],
+}
+
+/// Why a device cannot use drivetrain coordinates (None when it can).
+fn stroke_only(spec: &DeviceSpec) -> std::result::Result<StrokeOnly, String> {
+    if spec.wings.len() != 2 {
+        return Err("it needs two wings".into());
+    }
+    let Some(tr) = &spec.transmission else {
+        return Err("it needs a drivetrain".into());
+    };
+    let c = &spec.constraints;
+    let n = c.null_basis();
+    for k in 0..c.n_free() {
+        for i in [1, 2, 4, 5] {
+            if n[(i, k)].abs() > 1e-12 {
+                return Err(
+                    "C must fix theta and psi of both wings (a *_fixed configuration)".into(),
+                );
+            }
+        }
+    }
+    if [1, 2, 4, 5]
+        .iter()
+        .any(|&i| c.particular()[i].abs() > 1e-15)
+    {
+        return Err("theta and psi must be held at zero".into());
+    }
+    if c.n_free() != tr.kinematics.dof() {
+        return Err(format!(
+            "C leaves {} stroke coordinates but the drivetrain has {} DOF",
+            c.n_free(),
+            tr.kinematics.dof()
+        ));
+    }
+    let mut stroke_inertia = [0.0; 2];
+    for (k, wing) in spec.wings.iter().enumerate() {
+        if (wing.shoulder().alpha2() - std::f64::consts::FRAC_PI_2).abs() > 1e-15 {
+            return Err(
+                "the shoulders must have alpha2 = 90 deg (theta_w = 0 at theta = 0)".into(),
+            );
+        }
+        if [1, 2, 4]
+            .iter()
+            .any(|&j| wing.springs()[j] != crate::wing::JointSpring::default())
+        {
+            return Err("joint springs 2, 3 and 5 must be absent".into());
+        }
+        stroke_inertia[k] = wing.inertia()[(0, 0)];
+    }
+    Ok(StrokeOnly { stroke_inertia })
 }
 
 /// Everything needed to build a [`Device`].
@@ -78,6 +143,8 @@ pub struct Device {
     basis: Mat6,
     offset: Vec6,
     n_dof: usize,
+    formulation: Formulation,
+    stroke_only: Option<StrokeOnly>,
 }
 
 /// The drivetrain state recovered from the stroke angles.
@@ -146,8 +213,22 @@ impl Device {
                 }
             }
         }
-        let (basis, offset, n_dof) = match spec.formulation {
-            Formulation::NullSpace => (
+        let fast = stroke_only(&spec);
+        let formulation = match (spec.formulation, &fast) {
+            (Formulation::Auto, Ok(_)) => Formulation::DrivetrainCoordinates,
+            (Formulation::Auto, Err(_)) => Formulation::NullSpace,
+            (Formulation::DrivetrainCoordinates, Err(why)) => {
+                bail!(Constraint "drivetrain coordinates are not available for this device: {why}")
+            }
+            (f, _) => f,
+        };
+        let stroke_only = if formulation == Formulation::DrivetrainCoordinates {
+            fast.ok()
+        } else {
+            None
+        };
+        let (basis, offset, n_dof) = match formulation {
+            Formulation::NullSpace | Formulation::Auto | Formulation::DrivetrainCoordinates => (
                 *spec.constraints.null_basis(),
                 *spec.constraints.particular(),
                 spec.constraints.n_free(),
@@ -166,6 +247,8 @@ impl Device {
             basis,
             offset,
             n_dof,
+            formulation,
+            stroke_only,
         })
     }
 
@@ -189,21 +272,48 @@ impl Device {
         self.n_dof
     }
 
+    /// The formulation in use (`Auto` resolved).
+    pub fn formulation(&self) -> Formulation {
+        self.formulation
+    }
+
     /// Drive period (ms), if there is an actuator.
     pub fn period(&self) -> Option<f64> {
         self.spec.actuator.as_ref().map(|a| a.waveform().period())
     }
 
     /// `(p, ṗ)` from an integrator state.
+    ///
+    /// # Errors
+    /// With drivetrain coordinates, [`Error::OutOfDomain`] when `q` is beyond the linkage's reach.
     #[inline]
-    pub fn coordinates(&self, y: &State) -> (Vec6, Vec6) {
+    pub fn coordinates(&self, y: &State) -> Result<(Vec6, Vec6)> {
+        if self.stroke_only.is_some() {
+            let dt = self.drivetrain();
+            let q = Vector2::new(y[0], if self.n_dof == 2 { y[1] } else { 0.0 });
+            let q_dot = Vector2::new(y[6], if self.n_dof == 2 { y[7] } else { 0.0 });
+            let e = dt.evaluate(q.x, q.y)?;
+            let phi_dot = e.jacobian * q_dot;
+            let p = Vec6::new(e.stroke.x, 0.0, 0.0, e.stroke.y, 0.0, 0.0);
+            let p_dot = Vec6::new(phi_dot.x, 0.0, 0.0, phi_dot.y, 0.0, 0.0);
+            return Ok((p, p_dot));
+        }
         let mut x = Vec6::zeros();
         let mut xd = Vec6::zeros();
         for i in 0..self.n_dof {
             x[i] = y[i];
             xd[i] = y[6 + i];
         }
-        (self.offset + self.basis * x, self.basis * xd)
+        Ok((self.offset + self.basis * x, self.basis * xd))
+    }
+
+    fn drivetrain(&self) -> &Drivetrain {
+        &self
+            .spec
+            .transmission
+            .as_ref()
+            .expect("validated: stroke-only devices have a drivetrain")
+            .kinematics
     }
 
     /// An integrator state from `(p, ṗ)` after checking `C p = c0`, `C ṗ = 0`.
@@ -215,6 +325,15 @@ impl Device {
         paritysim_error::check_all_finite("initial.p", p.as_slice())?;
         paritysim_error::check_all_finite("initial.p_dot", p_dot.as_slice())?;
         self.spec.constraints.check_consistent(p, p_dot, 1e-10)?;
+        if self.stroke_only.is_some() {
+            let drive = self.drive(0.0, p, p_dot)?;
+            let mut y = [0.0; STATE_LEN];
+            for i in 0..self.n_dof {
+                y[i] = drive.q[i];
+                y[6 + i] = drive.q_dot[i];
+            }
+            return Ok(y);
+        }
         let x = self.basis.transpose() * (p - self.offset);
         let xd = self.basis.transpose() * p_dot;
         let mut y = [0.0; STATE_LEN];
@@ -289,8 +408,9 @@ impl Device {
         if self.n_wings() == 2 {
             force[3] += drive.stroke_torque.y;
         }
-        let p_ddot = match self.spec.formulation {
-            Formulation::NullSpace => {
+        // The null-space solve also serves the drivetrain-coordinate devices here (recording).
+        let p_ddot = match self.formulation {
+            Formulation::NullSpace | Formulation::Auto | Formulation::DrivetrainCoordinates => {
                 let n = self.n_dof;
                 let mut reduced_mass = self.basis.transpose() * mass * self.basis;
                 for i in n..6 {
@@ -333,7 +453,10 @@ impl Device {
     /// The right-hand side `ẏ = f(t, y)`; also integrates the actuator work and the
     /// aerodynamic work into the last two state entries.
     pub fn rhs(&self, t: f64, y: &State, dydt: &mut State) -> Result<()> {
-        let (p, p_dot) = self.coordinates(y);
+        if let Some(fast) = &self.stroke_only {
+            return self.rhs_drivetrain(fast, t, y, dydt);
+        }
+        let (p, p_dot) = self.coordinates(y)?;
         let e = self.evaluate(t, &p, &p_dot)?;
         let x_ddot = self.basis.transpose() * e.p_ddot;
         for i in 0..6 {
@@ -349,6 +472,114 @@ impl Device {
                 p_dot[3 * w + 2],
             ));
         }
+        dydt[13] = aero_power;
+        Ok(())
+    }
+
+    /// Full evaluation from an integrator state. Drivetrain-coordinate devices use the forward
+    /// map and their own equations (no inverse kinematics); others go through [`Self::evaluate`].
+    pub fn evaluate_state(&self, t: f64, y: &State) -> Result<Evaluation> {
+        let Some(fast) = &self.stroke_only else {
+            let (p, p_dot) = self.coordinates(y)?;
+            return self.evaluate(t, &p, &p_dot);
+        };
+        let dt = self.drivetrain();
+        let two = self.n_dof == 2;
+        let q = Vector2::new(y[0], if two { y[1] } else { 0.0 });
+        let q_dot = Vector2::new(y[6], if two { y[7] } else { 0.0 });
+        let mut dydt = [0.0; STATE_LEN];
+        self.rhs_drivetrain(fast, t, y, &mut dydt)?;
+        let q_ddot = Vector2::new(dydt[6], if two { dydt[7] } else { 0.0 });
+        let e = dt.evaluate(q.x, q.y)?;
+        let phi_dot = e.jacobian * q_dot;
+        let phi_ddot = e.jacobian * q_ddot + e.velocity_product(&q_dot);
+        let p = Vec6::new(e.stroke.x, 0.0, 0.0, e.stroke.y, 0.0, 0.0);
+        let p_dot = Vec6::new(phi_dot.x, 0.0, 0.0, phi_dot.y, 0.0, 0.0);
+        let p_ddot = Vec6::new(phi_ddot.x, 0.0, 0.0, phi_ddot.y, 0.0, 0.0);
+        let mut wings = [empty_terms(); 2];
+        for (k, wing) in self.spec.wings.iter().enumerate() {
+            wings[k] = wing.terms(
+                &Vector3::new(p[3 * k], 0.0, 0.0),
+                &Vector3::new(p_dot[3 * k], 0.0, 0.0),
+            )?;
+        }
+        let actuator = self.spec.actuator.as_ref();
+        let force = actuator.map_or(0.0, |a| a.force(t));
+        let k1 = actuator.map_or(0.0, |a| a.stiffness());
+        let k2 = self
+            .spec
+            .transmission
+            .as_ref()
+            .map_or(0.0, |tr| tr.balance_stiffness);
+        let generalized = Vector2::new(force - k1 * q.x, -k2 * q.y);
+        let stroke_torque = if two {
+            e.jacobian
+                .transpose()
+                .lu()
+                .solve(&generalized)
+                .ok_or_else(|| singular_drive(&q))?
+        } else {
+            Vector2::new(generalized.x / e.jacobian[(0, 0)], 0.0)
+        };
+        let drive = DriveState {
+            q,
+            q_dot,
+            actuator_force: force,
+            stroke_torque,
+            potential: 0.5 * k1 * q.x * q.x + 0.5 * k2 * q.y * q.y,
+        };
+        Ok(Evaluation {
+            p,
+            p_dot,
+            p_ddot,
+            wings,
+            drive,
+        })
+    }
+
+    /// Right-hand side in drivetrain coordinates (see [`Formulation::DrivetrainCoordinates`]).
+    fn rhs_drivetrain(&self, fast: &StrokeOnly, t: f64, y: &State, dydt: &mut State) -> Result<()> {
+        let dt = self.drivetrain();
+        let two = self.n_dof == 2;
+        let q = Vector2::new(y[0], if two { y[1] } else { 0.0 });
+        let q_dot = Vector2::new(y[6], if two { y[7] } else { 0.0 });
+        let e = dt.evaluate(q.x, q.y)?;
+        let phi_dot = e.jacobian * q_dot;
+        let h = e.velocity_product(&q_dot);
+        let actuator = self.spec.actuator.as_ref();
+        let force = actuator.map_or(0.0, |a| a.force(t));
+        let k1 = actuator.map_or(0.0, |a| a.stiffness());
+        let k2 = self
+            .spec
+            .transmission
+            .as_ref()
+            .map_or(0.0, |tr| tr.balance_stiffness);
+        let mut mass = Matrix2::zeros();
+        let mut generalized = Vector2::new(force - k1 * q.x, -k2 * q.y);
+        let mut aero_power = 0.0;
+        for k in 0..2 {
+            let wing = &self.spec.wings[k];
+            let row = e.jacobian.row(k).transpose();
+            let inertia = fast.stroke_inertia[k];
+            let tau_aero = wing.aero().stroke_torque(phi_dot[k]);
+            let tau = tau_aero - wing.springs()[0].torque(e.stroke[k]) - inertia * h[k];
+            mass += row * row.transpose() * inertia;
+            generalized += row * tau;
+            aero_power += tau_aero * phi_dot[k];
+        }
+        let q_ddot = if two {
+            mass.lu()
+                .solve(&generalized)
+                .ok_or_else(|| singular_drive(&q))?
+        } else {
+            Vector2::new(generalized.x / mass[(0, 0)], 0.0)
+        };
+        dydt.fill(0.0);
+        for i in 0..self.n_dof {
+            dydt[i] = q_dot[i];
+            dydt[6 + i] = q_ddot[i];
+        }
+        dydt[12] = force * q_dot.x;
         dydt[13] = aero_power;
         Ok(())
     }

@@ -248,7 +248,7 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
 }
 
 fn apply_kick(device: &Device, t: f64, y: &State, kick: Perturbation) -> Result<State> {
-    let (p, mut p_dot) = device.coordinates(y);
+    let (p, mut p_dot) = device.coordinates(y)?;
     match kick.target {
         PerturbTarget::WhippletreeRate => {
             let Some(tr) = &device.spec().transmission else {
@@ -349,8 +349,8 @@ pub fn record(device: &Device, times: &[f64], states: &[State]) -> Result<Trajec
     names.extend(device_cols.iter().map(|s| s.to_string()));
     let mut data: Vec<Vec<f64>> = vec![Vec::with_capacity(times.len()); names.len()];
     for (t, y) in times.iter().zip(states) {
-        let (p, p_dot) = device.coordinates(y);
-        let e = device.evaluate(*t, &p, &p_dot)?;
+        let e = device.evaluate_state(*t, y)?;
+        let (p, p_dot) = (e.p, e.p_dot);
         let mut col = 0;
         let mut push = |v: f64| {
             data[col].push(v);

@@ -90,6 +90,21 @@ impl WingAero {
         })
     }
 
+    /// Torque about the stroke axis of a wing that only strokes (θ = ψ = 0, `ω = φ̇ x̂`).
+    #[inline]
+    pub fn stroke_torque(&self, phi_dot: f64) -> f64 {
+        match self {
+            WingAero::None => 0.0,
+            WingAero::StrokeDrag {
+                omega1,
+                coefficient,
+            } => -omega1 * coefficient * phi_dot.abs() * phi_dot,
+            WingAero::BladeElement(model) => {
+                model.moments_omega(&Vector3::new(phi_dot, 0.0, 0.0)).normal
+            }
+        }
+    }
+
     /// Aerodynamic torque on the wing, in frame 6.
     #[inline]
     fn torque(

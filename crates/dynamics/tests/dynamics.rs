@@ -157,7 +157,7 @@ fn unforced_wing_conserves_energy_over_100_oscillations() {
     let v0 = Vec6::new(0.1, 0.05, -0.2, 0.0, 0.0, 0.0);
     let mut y = device.state_from(&p0, &v0).unwrap();
     let energy = |y: &paritysim_dynamics::State, t: f64| {
-        let (p, v) = device.coordinates(y);
+        let (p, v) = device.coordinates(y).unwrap();
         device.energy(&device.evaluate(t, &p, &v).unwrap())
     };
     let e0 = energy(&y, 0.0);
@@ -171,7 +171,7 @@ fn unforced_wing_conserves_energy_over_100_oscillations() {
             .unwrap()[0];
         t += segment;
         worst = worst.max((energy(&y, t) - e0).abs() / e0);
-        phi_max = phi_max.max(device.coordinates(&y).0[0].abs());
+        phi_max = phi_max.max(device.coordinates(&y).unwrap().0[0].abs());
     }
     assert!(worst < 1e-9, "relative energy drift {worst:e}");
     assert!(phi_max > 0.1, "it really oscillates");
@@ -540,4 +540,100 @@ fn blade_element_fixed_wing_equals_stroke_drag_with_cn90() {
             / scale;
         assert!(err < 1e-7, "{name}: relative {err:e}");
     }
+}
+
+/// Drivetrain coordinates (q, forward map only) against the general null-space formulation
+/// (wing coordinates, inverse kinematics, full shoulder): the same trajectories.
+#[test]
+fn drivetrain_coordinates_agree_with_null_space() {
+    // 60 V: the cut (lighter) left wing strokes further and must stay inside the linkage's reach.
+    let actuator = || Actuator::thesis(Waveform::sine(60.0, 110.0, 0.0, 0.0).unwrap());
+    let wing = |omega: f64| fixed_wing(WingAero::stroke_drag(omega, 3.4609).unwrap());
+    let linkage = || Drivetrain::LinkageDifferential(LinkageDifferential::thesis());
+    let cases: [(&str, fn() -> Drivetrain, f64); 3] = [
+        (
+            "drag_parity_fixed",
+            || {
+                Drivetrain::LinearDifferential(
+                    paritysim_kinematics::drivetrain::LinearDifferential::new(2.5, 2.5, 1.0)
+                        .unwrap(),
+                )
+            },
+            20.0,
+        ),
+        (
+            "drag_parity_fixed",
+            || Drivetrain::LinkageDifferential(LinkageDifferential::thesis()),
+            500.0,
+        ),
+        ("hmf_fixed", hmf_drivetrain, 0.0),
+    ];
+    for (config, drivetrain, k2) in cases {
+        let make = |f: Formulation| {
+            two_wing_device(
+                [wing(18.75), wing(31.3)],
+                config,
+                drivetrain(),
+                k2,
+                actuator(),
+                f,
+            )
+        };
+        let fast = make(Formulation::Auto);
+        assert_eq!(
+            fast.formulation(),
+            Formulation::DrivetrainCoordinates,
+            "{config}"
+        );
+        // Compare step-aligned end states (dense output between steps is only ~1e-8 accurate).
+        use paritysim_dynamics::integrate::{Integrator, Method, RungeKutta};
+        let rk = RungeKutta::new(Method::Dop853, 1e-12, 1e-14, 1_000_000).unwrap();
+        let general = make(Formulation::NullSpace);
+        let period = 1.0 / 0.110;
+        for cycles in [1.0, 3.0, 6.0] {
+            let end = |d: &Device| {
+                let y0 = d.state_from(&Vec6::zeros(), &Vec6::zeros()).unwrap();
+                let y = rk
+                    .integrate(d, 0.0, &y0, cycles * period, &[cycles * period])
+                    .unwrap()[0];
+                (d.coordinates(&y).unwrap(), y[12], y[13])
+            };
+            let (((pa, va), wa, aa), ((pb, vb), wb, ab)) = (end(&fast), end(&general));
+            let rel = |a: f64, b: f64| (a - b).abs() / (1e-3 + b.abs());
+            for k in [0, 3] {
+                assert!(
+                    rel(pa[k], pb[k]) < 1e-9,
+                    "{config} {cycles} cycles phi[{k}]: {} vs {}",
+                    pa[k],
+                    pb[k]
+                );
+                assert!(
+                    rel(va[k], vb[k]) < 1e-9,
+                    "{config} {cycles} cycles phi_dot[{k}]: {} vs {}",
+                    va[k],
+                    vb[k]
+                );
+            }
+            assert!(
+                rel(wa, wb) < 1e-9 && rel(aa, ab) < 1e-9,
+                "{config}: work {wa} vs {wb}, aero {aa} vs {ab}"
+            );
+        }
+    }
+    // Rotating wings cannot use it: Auto falls back, an explicit request is a typed error.
+    let rotating = |f: Formulation| {
+        Device::new(DeviceSpec {
+            wings: vec![wing(31.3), wing(31.3)],
+            constraints: Constraints::configuration("drag_parity").unwrap(),
+            transmission: Some(Transmission::new(linkage(), 0.0).unwrap()),
+            actuator: Some(actuator()),
+            formulation: f,
+        })
+    };
+    assert_eq!(
+        rotating(Formulation::Auto).unwrap().formulation(),
+        Formulation::NullSpace
+    );
+    let err = rotating(Formulation::DrivetrainCoordinates).unwrap_err();
+    assert!(err.to_string().contains("theta and psi"), "{err}");
 }

@@ -118,8 +118,12 @@ impl RodCrank {
                 ),
             });
         }
-        let beta = y.atan2(x) - k.acos();
-        let (sb, cb) = beta.sin_cos();
+        // β = atan2(y, x) − acos(k), by angle subtraction: one sqrt and one atan2 instead of
+        // atan2 + acos + sin_cos (this sits inside the right-hand side).
+        let (ca, sa) = (x / r, y / r);
+        let (ck, sk) = (k, (1.0 - k * k).sqrt());
+        let (sb, cb) = (sa * ck - ca * sk, ca * ck + sa * sk);
+        let beta = sb.atan2(cb);
         let f_x = 2.0 * (x - l3 * cb);
         let f_y = 2.0 * (y - l3 * sb);
         let f_b = 2.0 * l3 * (x * sb - y * cb);

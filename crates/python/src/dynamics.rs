@@ -389,10 +389,18 @@ fn parse_device(spec: &Bound<'_, PyDict>) -> Result<Device> {
             )
         }
     };
-    let formulation = match root.str_or("formulation", "null_space")?.as_str() {
+    let formulation = match root.str_or("formulation", "auto")?.as_str() {
+        "auto" => Formulation::Auto,
         "null_space" => Formulation::NullSpace,
         "projection" => Formulation::Projection,
-        other => return Err(invalid("formulation", other, "null_space or projection")),
+        "drivetrain_coordinates" => Formulation::DrivetrainCoordinates,
+        other => {
+            return Err(invalid(
+                "formulation",
+                other,
+                "auto, null_space, projection or drivetrain_coordinates",
+            ));
+        }
     };
     Device::new(DeviceSpec {
         wings,
