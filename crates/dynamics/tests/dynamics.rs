@@ -542,6 +542,9 @@ fn blade_element_fixed_wing_equals_stroke_drag_with_cn90() {
     }
 }
 
+/// (configuration, drivetrain, K2) of a cross-check case.
+type Case = (&'static str, fn() -> Drivetrain, f64);
+
 /// Drivetrain coordinates (q, forward map only) against the general null-space formulation
 /// (wing coordinates, inverse kinematics, full shoulder): the same trajectories.
 #[test]
@@ -550,7 +553,7 @@ fn drivetrain_coordinates_agree_with_null_space() {
     let actuator = || Actuator::thesis(Waveform::sine(60.0, 110.0, 0.0, 0.0).unwrap());
     let wing = |omega: f64| fixed_wing(WingAero::stroke_drag(omega, 3.4609).unwrap());
     let linkage = || Drivetrain::LinkageDifferential(LinkageDifferential::thesis());
-    let cases: [(&str, fn() -> Drivetrain, f64); 3] = [
+    let cases: [Case; 3] = [
         (
             "drag_parity_fixed",
             || {
