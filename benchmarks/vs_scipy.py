@@ -114,8 +114,14 @@ def main() -> None:
     t_py = min(_timed(lambda: run_baseline(params | {"omega_left": args.omega_left}, args.cycles, args.rtol, atol, 0.0)) for _ in range(max(1, args.repeat // 3)))
     base = run_baseline(params, args.cycles, args.rtol, atol, 0.0)
     print(f"{args.cycles} wingbeats, rtol {args.rtol:g}: paritysim {t_rs * 1e3:.2f} ms, numpy+scipy {t_py * 1e3:.1f} ms, ratio {t_py / t_rs:.0f}x")
+    worst = 0.0
     for key in ("left_stroke_amplitude", "right_stroke_amplitude"):
-        print(f"  {key:24s} paritysim {ours[key]:.9f}  scipy {base[key]:.9f}  diff {abs(ours[key] - base[key]):.2e}")
+        diff = abs(ours[key] - base[key])
+        worst = max(worst, diff / abs(base[key]))
+        print(f"  {key:24s} paritysim {ours[key]:.9f}  scipy {base[key]:.9f}  diff {diff:.2e}")
+    if worst > 1e-4:
+        raise SystemExit(f"MISMATCH: the two models disagree by {worst:.1e} (relative)")
+    print(f"  metrics agree to {worst:.1e} (relative)")
 
 
 def _timed(f: callable) -> float:

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -32,12 +33,18 @@ class SimulationResult:
         rotation behind stroke, peak and mean torques, work per cycle...).
     """
 
-    trajectory: pl.DataFrame
     metrics: dict[str, float]
     cycles_run: int
     converged: bool
     period_ms: float
     spec: Simulation
+    columns: dict[str, np.ndarray] = field(repr=False)
+
+    @cached_property
+    def trajectory(self) -> pl.DataFrame:
+        """The recorded window as a Polars DataFrame (built on first access from the numpy
+        columns the Rust core returned)."""
+        return pl.DataFrame(self.columns)
 
     @property
     def cycle(self) -> pl.DataFrame:
@@ -80,12 +87,11 @@ def simulate(spec: Simulation, **option_overrides: Any) -> SimulationResult:
     if option_overrides:
         spec = spec.replace(options=dataclasses.replace(spec.options, **option_overrides))
     raw = _core.simulate(spec.device_dict(), spec.options_dict())
-    columns = {"time_ms": raw["time_ms"], **raw["columns"]}
     return SimulationResult(
-        trajectory=pl.DataFrame(columns),
-        metrics=dict(raw["metrics"]),
+        metrics=raw["metrics"],
         cycles_run=int(raw["cycles_run"]),
         converged=bool(raw["converged"]),
         period_ms=float(raw["period_ms"]),
         spec=spec,
+        columns={"time_ms": raw["time_ms"], **raw["columns"]},
     )

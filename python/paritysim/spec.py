@@ -11,6 +11,7 @@ Units: mg-mm-ms-rad-V; names carry the unit where it could be misread (``frequen
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -242,8 +243,19 @@ class Simulation:
     options: Options = field(default_factory=Options)
     name: str = ""
 
+    @functools.cached_property
+    def _device_dict(self) -> dict[str, Any]:
+        return self._build_device_dict()
+
+    @functools.cached_property
+    def _options_dict(self) -> dict[str, Any]:
+        return _strip_none(dataclasses.asdict(self.options))
+
     def device_dict(self) -> dict[str, Any]:
-        """The device part as the plain dict the Rust core reads."""
+        """The device part as the plain dict the Rust core reads (cached: specs are frozen)."""
+        return self._device_dict
+
+    def _build_device_dict(self) -> dict[str, Any]:
         d = _strip_none(dataclasses.asdict(self))
         d.pop("options", None)
         d.pop("name", None)
@@ -254,8 +266,8 @@ class Simulation:
         return d
 
     def options_dict(self) -> dict[str, Any]:
-        """The options as a plain dict."""
-        return _strip_none(dataclasses.asdict(self.options))
+        """The options as a plain dict (cached)."""
+        return self._options_dict
 
     def validate(self) -> Simulation:
         """Validates in Rust; returns self or raises a ``ParitysimError`` naming the field."""

@@ -640,3 +640,118 @@ fn drivetrain_coordinates_agree_with_null_space() {
     let err = rotating(Formulation::DrivetrainCoordinates).unwrap_err();
     assert!(err.to_string().contains("theta and psi"), "{err}");
 }
+
+// A global allocator needs `unsafe impl`; this test-only module is the one place that allows it.
+#[allow(unsafe_code)]
+mod allocation {
+    //! "No heap allocation inside the RHS", checked with a counting global allocator that only
+    //! counts on the current thread while a flag is set (tests run on several threads).
+    use std::alloc::{GlobalAlloc, Layout, System};
+    use std::cell::Cell;
+
+    thread_local! {
+        static COUNTING: Cell<bool> = const { Cell::new(false) };
+        static COUNT: Cell<usize> = const { Cell::new(0) };
+    }
+
+    struct Counting;
+
+    unsafe impl GlobalAlloc for Counting {
+        unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+            if COUNTING.with(|c| c.get()) {
+                COUNT.with(|n| n.set(n.get() + 1));
+            }
+            unsafe { System.alloc(layout) }
+        }
+        unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+            unsafe { System.dealloc(ptr, layout) }
+        }
+    }
+
+    #[global_allocator]
+    static ALLOCATOR: Counting = Counting;
+
+    /// Number of allocations made by `f` on this thread.
+    pub fn count<R>(f: impl FnOnce() -> R) -> (R, usize) {
+        COUNT.with(|n| n.set(0));
+        COUNTING.with(|c| c.set(true));
+        let r = f();
+        COUNTING.with(|c| c.set(false));
+        (r, COUNT.with(|n| n.get()))
+    }
+}
+
+#[test]
+fn right_hand_side_does_not_allocate() {
+    let actuator = || Actuator::thesis(Waveform::sine(100.0, 110.0, 0.0, 0.0).unwrap());
+    let wing = || fixed_wing(WingAero::stroke_drag(31.3, 3.4609).unwrap());
+    let linkage = || Drivetrain::LinkageDifferential(LinkageDifferential::thesis());
+    let blade = paritysim_aero::BladeElementModel::new(
+        paritysim_aero::Omegas::new(46.8, 0.59, 17.5, 0.71).unwrap(),
+        paritysim_aero::CoefficientSet::default(),
+    )
+    .unwrap();
+    let rotating = Wing::new(
+        shoulder(120.0, 60.0),
+        full_inertia(),
+        springs([0.0, 0.0, 0.0, 0.0, 0.0, 3.0]),
+        WingAero::BladeElement(blade),
+    )
+    .unwrap();
+    let devices = [
+        two_wing_device(
+            [wing(), wing()],
+            "drag_parity_fixed",
+            linkage(),
+            1.0,
+            actuator(),
+            Formulation::DrivetrainCoordinates,
+        ),
+        two_wing_device(
+            [wing(), wing()],
+            "drag_parity_fixed",
+            linkage(),
+            1.0,
+            actuator(),
+            Formulation::NullSpace,
+        ),
+        two_wing_device(
+            [wing(), wing()],
+            "drag_parity_fixed",
+            linkage(),
+            1.0,
+            actuator(),
+            Formulation::Projection,
+        ),
+        two_wing_device(
+            [rotating.clone(), rotating],
+            "drag_parity",
+            linkage(),
+            1.0,
+            actuator(),
+            Formulation::NullSpace,
+        ),
+    ];
+    for device in &devices {
+        let y = device
+            .state_from(
+                &Vec6::new(0.2, 0.0, 0.0, 0.25, 0.0, 0.0),
+                &Vec6::new(0.3, 0.0, 0.0, 0.25, 0.0, 0.0),
+            )
+            .unwrap();
+        let mut dydt = [0.0; paritysim_dynamics::STATE_LEN];
+        let (result, allocations) = allocation::count(|| {
+            (0..100).try_for_each(|k| device.rhs(0.1 * k as f64, &y, &mut dydt))
+        });
+        result.unwrap();
+        assert_eq!(
+            allocations,
+            0,
+            "{:?}: {allocations} allocations in 100 right-hand sides",
+            device.formulation()
+        );
+    }
+    // The counter works: a Vec allocates.
+    let (_, n) = allocation::count(|| vec![1.0f64; 8]);
+    assert!(n >= 1);
+}
