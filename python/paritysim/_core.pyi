@@ -113,3 +113,9 @@ def laminate_castellated_joint(
     flexure_length: float,
 ) -> dict[str, Any]: ...
 # --- laminate (end) ---
+
+# --- stability (begin) ---
+# --- stability (end) ---
+
+# --- sweep (begin) ---
+# --- sweep (end) ---

@@ -13,57 +13,30 @@ from tqdm import tqdm
 from ._core import ParitysimError
 
 
-def _fig2_9(out: Path) -> list[Path]:
-    from . import plots
-    from .trials import fig2_9
+def _trials() -> dict[str, Callable[[Path], list[Path]]]:
+    from .trials import REGISTRY
 
-    df = fig2_9()
-    written = [out / "fig2_9.parquet", out / "fig2_9.csv"]
-    df.write_parquet(written[0])
-    df.write_csv(written[1])
-    written.append(plots.save(plots.fig2_9(df), out / "fig2_9.png"))
-    return written
-
-
-def _laminate(out: Path) -> list[Path]:
-    import matplotlib.pyplot as plt
-
-    from . import plots
-    from .trials.laminate_design import laminate_summary, report_section
-
-    df, _bimorph, stack = laminate_summary()
-    written = [out / "laminate.parquet", out / "laminate.csv", out / "laminate.md"]
-    df.write_parquet(written[0])
-    df.write_csv(written[1])
-    written[2].write_text(report_section(df))
-    fig, ax = plt.subplots(figsize=(8, 6), constrained_layout=True)
-    stack.plot(ax=ax)
-    ax.set_title("Fig. 4.27: the Mobee 18-layer PC-MEMS stack (computed thickness and layers)")
-    written.append(plots.save(fig, out / "laminate.png"))
-    return written
-
-
-#: CLI trial names -> runner writing files into the output directory.
-TRIALS: dict[str, Callable[[Path], list[Path]]] = {
-    "fig2.9": _fig2_9,
-    "laminate": _laminate,
-}
+    return REGISTRY
 
 
 def _reproduce(args: argparse.Namespace) -> int:
-    names = list(TRIALS) if args.all else args.names
+    if args.list:
+        print("\n".join(_trials()))
+        return 0
+    trials = _trials()
+    names = list(trials) if args.all else args.names
     if not names:
-        print("nothing to reproduce: name a trial or pass --all; available: " + ", ".join(TRIALS), file=sys.stderr)
+        print("nothing to reproduce: name a trial or pass --all; available: " + ", ".join(trials), file=sys.stderr)
         return 2
-    unknown = [n for n in names if n not in TRIALS]
+    unknown = [n for n in names if n not in trials]
     if unknown:
-        print(f"unknown trial(s) {unknown}; available: {', '.join(TRIALS)}", file=sys.stderr)
+        print(f"unknown trial(s) {unknown}; available: {', '.join(trials)}", file=sys.stderr)
         return 2
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     for name in tqdm(names, desc="reproducing", unit="trial", disable=args.quiet):
         start = time.perf_counter()
-        written = TRIALS[name](out)
+        written = trials[name](out)
         if not args.quiet:
             tqdm.write(f"{name}: {time.perf_counter() - start:.2f} s -> " + ", ".join(str(p) for p in written))
     return 0
@@ -96,7 +69,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"paritysim {__import__('paritysim').__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     rep = sub.add_parser("reproduce", help="reproduce thesis tables and figures")
-    rep.add_argument("names", nargs="*", help=f"trials to run: {', '.join(TRIALS)}")
+    rep.add_argument("names", nargs="*", help="trials to run (see `paritysim reproduce --list`)")
+    rep.add_argument("--list", action="store_true", help="list the available trials and exit")
     rep.add_argument("--all", action="store_true", help="run every implemented trial")
     rep.add_argument("--out", default="results", help="output directory (default: results/)")
     rep.add_argument("--quiet", action="store_true", help="no progress output")
@@ -106,6 +80,12 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--out", default="results", help="output directory (default: results/)")
     run.add_argument("--quiet", action="store_true", help="no summary output")
     run.set_defaults(func=_run)
+    try:  # `paritysim sweep` lives with the sweep engine (issue 8)
+        from .sweep_cli import add_parser as add_sweep_parser
+    except ImportError:
+        pass
+    else:
+        add_sweep_parser(sub)
     return parser
 
 

@@ -12,6 +12,8 @@ mod dynamics;
 mod errors;
 mod kinematics;
 mod laminate;
+mod stability;
+mod sweep;
 
 /// The native module.
 #[pymodule]
@@ -22,5 +24,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     dynamics::register(m)?;
     aero::register(m)?;
     laminate::register(m)?;
+    stability::register(m)?;
+    sweep::register(m)?;
     Ok(())
 }

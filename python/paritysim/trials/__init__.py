@@ -1,12 +1,31 @@
 """Reproductions of the dissertation's trials, one module per thesis section.
 
 Each function returns Polars DataFrames computed by the model; nothing is copied from the
-thesis. ``REGISTRY`` maps the CLI names (``paritysim reproduce NAME``) to their runners.
+thesis. A module may define ``CLI_TRIALS: dict[str, Callable[[Path], list[Path]]]`` (name ->
+runner writing files into an output directory) and ``REPORT_SECTIONS`` (name -> callable
+returning markdown); :data:`REGISTRY` collects them for ``paritysim reproduce``.
 """
 
 from __future__ import annotations
 
+import importlib
+import pkgutil
+from collections.abc import Callable
+from pathlib import Path
+
 from .laminate_design import laminate_summary
 from .section_2_3 import fig2_9
 
-__all__ = ["fig2_9", "laminate_summary"]
+__all__ = ["REGISTRY", "fig2_9", "laminate_summary"]
+
+
+def _discover() -> dict[str, Callable[[Path], list[Path]]]:
+    registry: dict[str, Callable[[Path], list[Path]]] = {}
+    for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
+        module = importlib.import_module(f"{__name__}.{info.name}")
+        registry.update(getattr(module, "CLI_TRIALS", {}))
+    return registry
+
+
+#: CLI trial name -> runner(out_dir) -> written files, from every trial module.
+REGISTRY: dict[str, Callable[[Path], list[Path]]] = _discover()

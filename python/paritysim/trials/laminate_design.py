@@ -6,6 +6,8 @@ numbers for comparison only.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import polars as pl
 
 from .. import laminate as lam
@@ -54,3 +56,23 @@ def report_section(df: pl.DataFrame) -> str:
               "as the whole robot, so the thesis' constants were likely derived for a different drive definition",
               "(see `paritysim.laminate` docs).", ""]
     return "\n".join(lines)
+
+
+def _cli_laminate(out: Path) -> list[Path]:
+    import matplotlib.pyplot as plt
+
+    from .. import plots
+
+    df, _bimorph, stack = laminate_summary()
+    written = [out / "laminate.parquet", out / "laminate.csv", out / "laminate.md"]
+    df.write_parquet(written[0])
+    df.write_csv(written[1])
+    written[2].write_text(report_section(df))
+    fig, ax = plt.subplots(figsize=(8, 6), constrained_layout=True)
+    stack.plot(ax=ax)
+    ax.set_title("Fig. 4.27: the Mobee 18-layer PC-MEMS stack (computed thickness and layers)")
+    written.append(plots.save(fig, out / "laminate.png"))
+    return written
+
+
+CLI_TRIALS = {"laminate": _cli_laminate}

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import polars as pl
 
@@ -54,3 +56,17 @@ def fig2_9(step_deg: float = 1.0, limit_deg: float = 90.0) -> pl.DataFrame:
             ).with_columns(pl.col("theta_w_deg").fill_nan(None))
         )
     return pl.concat(frames)
+
+
+def _cli_fig2_9(out: Path) -> list[Path]:
+    from .. import plots
+
+    df = fig2_9()
+    written = [out / "fig2_9.parquet", out / "fig2_9.csv"]
+    df.write_parquet(written[0])
+    df.write_csv(written[1])
+    written.append(plots.save(plots.fig2_9(df), out / "fig2_9.png"))
+    return written
+
+
+CLI_TRIALS = {"fig2.9": _cli_fig2_9}
