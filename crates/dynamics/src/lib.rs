@@ -16,9 +16,11 @@
 
 pub mod actuator;
 pub mod device;
+pub mod floquet;
 pub mod integrate;
 pub mod metrics;
 pub mod simulate;
+pub mod sweep;
 pub mod wing;
 
 pub use actuator::{Actuator, DcOffset, Waveform};

@@ -1,6 +1,11 @@
 //! Integration tests of paritysim-dynamics: each checks physics against an independent
 //! formulation or a conservation law, never against recorded outputs.
 
+#[path = "dynamics/floquet.rs"]
+mod floquet;
+#[path = "dynamics/sweep.rs"]
+mod sweep;
+
 use approx::assert_relative_eq;
 use nalgebra::{Matrix3, Vector3};
 use paritysim_constraints::{Constraints, Vec6};

@@ -1,0 +1,1 @@
+//! floquet: placeholder (filled by its issue).

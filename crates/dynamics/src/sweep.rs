@@ -1,0 +1,1 @@
+//! sweep: placeholder (filled by its issue).

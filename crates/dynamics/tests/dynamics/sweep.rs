@@ -1,0 +1,4 @@
+//! sweep tests (submodule of the one dynamics integration binary).
+
+#[allow(unused_imports)]
+use super::*;
