@@ -26,6 +26,7 @@ from ._core import (
     SingularError,
     __version__,
 )
+from .calibration import CalibrationResult, calibrate
 from .planform import Planform
 from .simulation import SimulationResult, simulate
 from .spec import Actuator, Aero, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, Waveform, Wing, load_spec
@@ -33,7 +34,9 @@ from .spec import Actuator, Aero, Configuration, Drivetrain, Options, Shoulder, 
 __all__ = [
     "Actuator",
     "Aero",
+    "CalibrationResult",
     "Planform",
+    "calibrate",
     "aero",
     "laminate",
     "planform",

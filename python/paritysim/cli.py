@@ -39,6 +39,13 @@ def _reproduce(args: argparse.Namespace) -> int:
         written = trials[name](out)
         if not args.quiet:
             tqdm.write(f"{name}: {time.perf_counter() - start:.2f} s -> " + ", ".join(str(p) for p in written))
+    if args.all:
+        from .report import write_report
+
+        start = time.perf_counter()
+        path = write_report(out)
+        if not args.quiet:
+            print(f"report: {time.perf_counter() - start:.2f} s -> {path}")
     return 0
 
 

@@ -47,7 +47,7 @@ def laminate_summary() -> tuple[pl.DataFrame, lam.Bimorph, lam.Layup]:
     return df, bimorph, stack
 
 
-def report_section(df: pl.DataFrame) -> str:
+def report_markdown(df: pl.DataFrame) -> str:
     """Markdown section for the reproduction report."""
     lines = ["## Laminate design layer (§3.3.1 ref. [42], §4.4.2, §4.5.3)", "", "| quantity | paritysim | unit | thesis | note |", "|---|---|---|---|---|"]
     for q, v, u, t, n in df.iter_rows():
@@ -67,7 +67,7 @@ def _cli_laminate(out: Path) -> list[Path]:
     written = [out / "laminate.parquet", out / "laminate.csv", out / "laminate.md"]
     df.write_parquet(written[0])
     df.write_csv(written[1])
-    written[2].write_text(report_section(df))
+    written[2].write_text(report_markdown(df))
     fig, ax = plt.subplots(figsize=(8, 6), constrained_layout=True)
     stack.plot(ax=ax)
     ax.set_title("Fig. 4.27: the Mobee 18-layer PC-MEMS stack (computed thickness and layers)")
@@ -76,3 +76,9 @@ def _cli_laminate(out: Path) -> list[Path]:
 
 
 CLI_TRIALS = {"laminate": _cli_laminate}
+
+
+def report_section(out: Path | None = None) -> str:
+    """Markdown for the report (the laminate trial's table and figure)."""
+    df, _bimorph, _stack = laminate_summary()
+    return report_markdown(df) + "\n![Fig. 4.27 stack](laminate.png)\n"

@@ -1,0 +1,210 @@
+"""``paritysim.calibrate``: fit model parameters to target metrics or a measured trajectory.
+
+The thesis fitted its model to high-speed video (§3.3.3); this is the same workflow. Each
+residual evaluation runs simulations in Rust with the GIL released, so the finite-difference
+Jacobian columns run in parallel threads (``workers``).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import threading
+from collections.abc import Callable, Mapping
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import polars as pl
+from scipy.optimize import least_squares
+
+from ._errors import invalid
+from .simulation import simulate
+from .spec import Simulation
+
+__all__ = ["CalibrationResult", "calibrate", "set_path"]
+
+_TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(\d+|\*)\]")
+
+
+def set_path(data: dict[str, Any], path: str, value: float) -> None:
+    """Set ``value`` at a dotted path in nested plain data, e.g. ``"drivetrain.balance_stiffness"``,
+    ``"wings[0].aero.omega1"``, ``"wings[*].inertia[0][0]"`` (``*``: every element).
+
+    Raises ``InvalidParameterError`` naming the path when it does not exist.
+    """
+    tokens = [m.group(1) if m.group(1) is not None else m.group(2) for m in _TOKEN.finditer(path)]
+    if not tokens or "".join(f".{t}" if not (t.isdigit() or t == "*") else f"[{t}]" for t in tokens).lstrip(".") != path:
+        raise invalid("path", repr(path), "a dotted path like 'wings[0].aero.omega1'")
+
+    def walk(node: Any, i: int) -> None:
+        key = tokens[i]
+        last = i == len(tokens) - 1
+        if key == "*":
+            if not isinstance(node, list):
+                raise invalid("path", repr(path), f"'*' must index a list (at step {i})")
+            for k in range(len(node)):
+                if last:
+                    node[k] = value
+                else:
+                    walk(node[k], i + 1)
+            return
+        if key.isdigit():
+            if not isinstance(node, list) or int(key) >= len(node):
+                raise invalid("path", repr(path), f"an existing list index at '[{key}]'")
+            idx: Any = int(key)
+        else:
+            if not isinstance(node, dict) or key not in node:
+                keys = ", ".join(node) if isinstance(node, dict) else "(not a table)"
+                raise invalid("path", repr(path), f"an existing field at '{key}'; here: {keys}")
+            idx = key
+        if last:
+            node[idx] = value
+        else:
+            node[idx] = list(node[idx]) if isinstance(node[idx], tuple) else node[idx]
+            walk(node[idx], i + 1)
+
+    walk(data, 0)
+
+
+def _lists(x: Any) -> Any:
+    if isinstance(x, dict):
+        return {k: _lists(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [_lists(v) for v in x]
+    return x
+
+
+@dataclass(frozen=True)
+class CalibrationResult:
+    """Fitted ``values``, final ``residuals`` (model − target, scaled), ``cost`` (½Σr²),
+    optimiser ``success``/``message``, and every evaluation in ``iterations``."""
+
+    values: dict[str, float]
+    residuals: np.ndarray
+    cost: float
+    success: bool
+    message: str
+    iterations: pl.DataFrame
+    model_outputs: dict[str, float]
+
+
+def calibrate(
+    model: Simulation | Callable[..., Mapping[str, float]],
+    targets: Mapping[str, float] | pl.DataFrame,
+    free: Mapping[str, tuple[float, float]],
+    *,
+    x0: Mapping[str, float] | None = None,
+    scale: Mapping[str, float] | None = None,
+    workers: int = 2,
+    max_nfev: int = 100,
+    xtol: float = 1e-10,
+    diff_step: float = 1e-4,
+) -> CalibrationResult:
+    """Least-squares fit of the ``free`` parameters (name -> (low, high)).
+
+    ``model``: a :class:`Simulation` (names are dotted paths into ``spec.to_dict()``, see
+    :func:`set_path`; outputs are the simulation metrics) or a callable ``f(**values)``
+    returning a mapping of outputs.
+
+    ``diff_step``: finite-difference step as a fraction of each parameter's bound range.
+    Simulation outputs (sampled peaks, steady-state detection) carry small discontinuities,
+    so the step must be well above round-off.
+
+    ``targets``: ``{output: value}`` (residual ``(model − target)/scale``, scale defaults to
+    ``max(|target|, 1e-12)``), or a DataFrame with ``time_ms`` and columns of the trajectory to
+    match (e.g. ``right_phi``), compared on the recorded window after aligning time origins.
+    """
+    if not (math.isfinite(diff_step) and 0 < diff_step < 0.5):
+        raise invalid("diff_step", diff_step, "in (0, 0.5)")
+    names = list(free)
+    if not names:
+        raise invalid("free", "{}", "at least one parameter with (low, high) bounds")
+    lo = np.array([float(free[n][0]) for n in names])
+    hi = np.array([float(free[n][1]) for n in names])
+    for n, a, b in zip(names, lo, hi, strict=True):
+        if not (math.isfinite(a) and math.isfinite(b) and a < b):
+            raise invalid(f"free.{n}", (a, b), "finite bounds with low < high")
+    start = np.array([float((x0 or {}).get(n, 0.5 * (a + b))) for n, a, b in zip(names, lo, hi, strict=True)])
+    trajectory_target = isinstance(targets, pl.DataFrame)
+
+    if isinstance(model, Simulation):
+        base = _lists(model.to_dict())
+        if not trajectory_target:
+            # Validate every path before running anything.
+            for n in names:
+                set_path(_lists(model.to_dict()), n, 0.0)
+
+        def outputs(values: dict[str, float]) -> dict[str, Any]:
+            data = _lists(base)
+            for n, v in values.items():
+                set_path(data, n, v)
+            result = simulate(Simulation.from_dict(data))
+            out: dict[str, Any] = dict(result.metrics)
+            if trajectory_target:
+                out["__trajectory__"] = result.trajectory
+            return out
+    else:
+
+        def outputs(values: dict[str, float]) -> dict[str, Any]:
+            return dict(model(**values))
+
+    if trajectory_target:
+        columns = [c for c in targets.columns if c != "time_ms"]
+        t_target = targets["time_ms"].to_numpy() - targets["time_ms"][0]
+
+        def residual_of(out: dict[str, Any]) -> np.ndarray:
+            traj = out["__trajectory__"]
+            t = traj["time_ms"].to_numpy() - traj["time_ms"][0]
+            res = []
+            for c in columns:
+                sim = np.interp(t_target, t, traj[c].to_numpy())
+                res.append((sim - targets[c].to_numpy()) / max(float(np.abs(targets[c].to_numpy()).max()), 1e-12))
+            return np.concatenate(res)
+    else:
+        keys = list(targets)
+        scales = np.array([float((scale or {}).get(k, max(abs(float(targets[k])), 1e-12))) for k in keys])
+        goal = np.array([float(targets[k]) for k in keys])
+
+        def residual_of(out: dict[str, Any]) -> np.ndarray:
+            missing = [k for k in keys if k not in out]
+            if missing:
+                raise invalid("targets", missing[0], f"an output of the model; available: {', '.join(sorted(k for k in out if not k.startswith('__')))}")
+            return (np.array([float(out[k]) for k in keys]) - goal) / scales
+
+    log: list[dict[str, float]] = []
+    lock = threading.Lock()
+
+    def evaluate(x: np.ndarray) -> np.ndarray:
+        values = dict(zip(names, (float(v) for v in x), strict=True))
+        r = residual_of(outputs(values))
+        with lock:
+            log.append({**values, "cost": 0.5 * float(r @ r)})
+        return r
+
+    pool = ThreadPoolExecutor(max_workers=max(1, workers))
+
+    def jacobian(x: np.ndarray, *_: Any) -> np.ndarray:
+        steps = diff_step * (hi - lo)
+        # step inwards at the upper bound
+        signed = np.where(x + steps > hi, -steps, steps)
+        f0 = evaluate(x)
+        columns = list(pool.map(lambda i: evaluate(np.where(np.arange(len(x)) == i, x + signed, x)), range(len(x))))
+        return np.column_stack([(c - f0) / s for c, s in zip(columns, signed, strict=True)])
+
+    try:
+        fit = least_squares(evaluate, start, jac=jacobian, bounds=(lo, hi), x_scale="jac", max_nfev=max_nfev, xtol=xtol)
+    finally:
+        pool.shutdown()
+    values = dict(zip(names, (float(v) for v in fit.x), strict=True))
+    final = outputs(values)
+    return CalibrationResult(
+        values=values,
+        residuals=np.asarray(fit.fun),
+        cost=float(fit.cost),
+        success=bool(fit.success),
+        message=str(fit.message),
+        iterations=pl.DataFrame(log),
+        model_outputs={k: float(v) for k, v in final.items() if not k.startswith("__")},
+    )
