@@ -105,5 +105,69 @@ fn run(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, rhs, run);
+/// §3.4: two rotating Table 3.3 wings (blade element, hinge spring), Drag PARITY (#3).
+fn rotating(c: &mut Criterion) {
+    use paritysim_aero::{BladeElementModel, CoefficientSet, Omegas};
+    let sh = SphericalShoulder::new(std::f64::consts::FRAC_PI_2, 0.0).unwrap();
+    let wing = |ixx: f64, iyy: f64, izz: f64, ixz: f64, o: [f64; 4]| {
+        let inertia = Matrix3::new(ixx, 0.0, ixz, 0.0, iyy, 0.0, ixz, 0.0, izz);
+        let mut springs = [JointSpring::default(); 6];
+        springs[5] = JointSpring::linear(2.53, 0.0).unwrap();
+        let blade = BladeElementModel::new(
+            Omegas::new(o[0], o[1], o[2], o[3]).unwrap(),
+            CoefficientSet::default(),
+        )
+        .unwrap();
+        Wing::new(sh, inertia, springs, WingAero::BladeElement(blade)).unwrap()
+    };
+    let device = Device::new(DeviceSpec {
+        wings: vec![
+            wing(49.0, 50.5, 1.56, 4.2, [46.8, 0.587, 17.5, 0.712]),
+            wing(40.6, 42.0, 1.43, 3.38, [28.7, 0.419, 10.6, 0.787]),
+        ],
+        constraints: Constraints::configuration("drag_parity").unwrap(),
+        transmission: Some(
+            Transmission::new(
+                Drivetrain::LinearDifferential(
+                    paritysim_kinematics::drivetrain::LinearDifferential::new(
+                        35f64.to_radians() / 0.2,
+                        2.5,
+                        1.0,
+                    )
+                    .unwrap(),
+                ),
+                0.0,
+            )
+            .unwrap(),
+        ),
+        actuator: Some(
+            Actuator::new(
+                1.2,
+                467.0,
+                Waveform::sine(100.0, 110.0, 100.0, 0.0).unwrap(),
+                paritysim_dynamics::DcOffset::Ignore,
+            )
+            .unwrap(),
+        ),
+        formulation: Formulation::Auto,
+    })
+    .unwrap();
+    let options = SimulationOptions {
+        rtol: 1e-8,
+        atol: 1e-10,
+        min_cycles: 14,
+        max_cycles: 14,
+        steady_tol: 1e-30,
+        samples_per_cycle: 100,
+        ..Default::default()
+    };
+    let mut group = c.benchmark_group("simulate");
+    group.sample_size(20);
+    group.bench_function("section_3_4_rotating_15_wingbeats_rtol_1e-8", |b| {
+        b.iter(|| simulate(&device, &options).unwrap())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, rhs, run, rotating);
 criterion_main!(benches);
