@@ -29,7 +29,7 @@ from ._core import (
 from .calibration import CalibrationResult, calibrate
 from .planform import Planform
 from .simulation import SimulationResult, simulate
-from .spec import Actuator, Aero, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, Waveform, Wing, load_spec
+from .spec import Actuator, Aero, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, TunableHinge, Waveform, Wing, load_spec
 
 __all__ = [
     "Actuator",
@@ -46,6 +46,7 @@ __all__ = [
     "Simulation",
     "SimulationResult",
     "Spring",
+    "TunableHinge",
     "Waveform",
     "Wing",
     "load_spec",

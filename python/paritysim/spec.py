@@ -32,6 +32,7 @@ __all__ = [
     "Shoulder",
     "Simulation",
     "Spring",
+    "TunableHinge",
     "Waveform",
     "Wing",
     "load_spec",
@@ -82,6 +83,16 @@ class Aero:
 
 
 @dataclass(frozen=True)
+class TunableHinge:
+    """The tunable wing hinge of §2.5.1: ``V = ½ (k0 + k1 θ + k2 θ²) ψ²`` (mN·mm/rad); stiffer
+    with deviation. Validated in Rust (``k(θ) > 0`` for every θ)."""
+
+    k0: float
+    k1: float = 0.0
+    k2: float = 0.0
+
+
+@dataclass(frozen=True)
 class Wing:
     """A wing: inertia tensor about the spherical centre in frame 6 (mg·mm², 3×3), shoulder,
     six joint springs (joints 1..6; None = no springs) and aerodynamics (None = vacuum)."""
@@ -90,6 +101,7 @@ class Wing:
     shoulder: Shoulder = field(default_factory=Shoulder)
     springs: tuple[Spring, ...] | None = None
     aero: Aero | None = None
+    tunable_hinge: TunableHinge | None = None
 
     @classmethod
     def from_moments(cls, ixx: float, iyy: float, izz: float, ixz: float = 0.0, **kwargs: Any) -> Wing:
@@ -339,6 +351,7 @@ def _convert(cls: type, name: str, value: Any, path: str) -> Any:
         (Actuator, "waveform"): Waveform,
         (Wing, "shoulder"): Shoulder,
         (Wing, "aero"): Aero,
+        (Wing, "tunable_hinge"): TunableHinge,
     }
     if (cls, name) in nested:
         return _build(nested[(cls, name)], value, path)

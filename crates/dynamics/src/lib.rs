@@ -28,4 +28,4 @@ pub use device::{Device, DeviceSpec, Formulation, Transmission};
 pub use integrate::{Integrator, Method, STATE_LEN, State};
 pub use paritysim_error::{Error, Result};
 pub use simulate::{Perturbation, SimulationOptions, SimulationResult, Trajectory, simulate};
-pub use wing::{JointSpring, Wing, WingAero};
+pub use wing::{JointSpring, TunableHinge, Wing, WingAero};

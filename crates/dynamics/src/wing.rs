@@ -63,6 +63,43 @@ impl JointSpring {
     }
 }
 
+/// The tunable wing hinge of §2.5.1: a hinge whose stiffness rises with wing deviation,
+/// `V = ½ k(θ) ψ²` with `k(θ) = k0 + k1 θ + k2 θ²` (mN·mm/rad; θ the shoulder's input deviation).
+/// Generalised forces: `∂V/∂ψ = k(θ) ψ`, `∂V/∂θ = ½ k'(θ) ψ²`. The thesis gives no law; this
+/// quadratic family covers a signed (k1) and a symmetric (k2) stiffening.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TunableHinge {
+    k0: f64,
+    k1: f64,
+    k2: f64,
+}
+
+impl TunableHinge {
+    /// Requires `k0 > 0` and `k2 >= 0`, and `k(θ) > 0` for all θ (`k1² < 4 k0 k2`, or `k1 = 0`).
+    pub fn new(k0: f64, k1: f64, k2: f64) -> Result<Self> {
+        paritysim_error::check_positive("k0", k0)?;
+        check_finite("k1", k1)?;
+        check_non_negative("k2", k2)?;
+        if k1 != 0.0 && k1 * k1 >= 4.0 * k0 * k2 {
+            return Err(Error::invalid(
+                "k1",
+                k1,
+                format!(
+                    "|k1| < 2 sqrt(k0 k2) = {} so that k(theta) > 0 for every theta",
+                    2.0 * (k0 * k2).sqrt()
+                ),
+            ));
+        }
+        Ok(Self { k0, k1, k2 })
+    }
+
+    /// `k(θ)`.
+    #[inline]
+    pub fn stiffness(&self, theta: f64) -> f64 {
+        self.k0 + (self.k1 + self.k2 * theta) * theta
+    }
+}
+
 /// Aerodynamic model of a wing, evaluated inside the right-hand side (allocation-free).
 #[derive(Clone, Debug, PartialEq)]
 pub enum WingAero {
@@ -136,6 +173,7 @@ pub struct Wing {
     inertia: Matrix3<f64>,
     springs: [JointSpring; 6],
     aero: WingAero,
+    tunable_hinge: Option<TunableHinge>,
 }
 
 /// Everything the dynamics need from one wing at `(p, ṗ)`.
@@ -208,6 +246,7 @@ impl Wing {
             inertia,
             springs,
             aero,
+            tunable_hinge: None,
         })
     }
 
@@ -221,6 +260,17 @@ impl Wing {
             [JointSpring::default(); 6],
             aero,
         )
+    }
+
+    /// Adds the tunable hinge of §2.5.1 (in addition to any joint-6 spring).
+    pub fn with_tunable_hinge(mut self, hinge: TunableHinge) -> Self {
+        self.tunable_hinge = Some(hinge);
+        self
+    }
+
+    /// The tunable hinge, if any.
+    pub fn tunable_hinge(&self) -> Option<&TunableHinge> {
+        self.tunable_hinge.as_ref()
     }
 
     /// Shoulder.
@@ -288,6 +338,13 @@ impl Wing {
         for j in 0..6 {
             spring += grads[j] * s[j].torque(gammas[j]);
             potential += s[j].energy(gammas[j]);
+        }
+
+        if let Some(h) = &self.tunable_hinge {
+            let k = h.stiffness(theta);
+            spring.z += k * psi;
+            spring.y += 0.5 * (h.k1 + 2.0 * h.k2 * theta) * psi * psi;
+            potential += 0.5 * k * psi * psi;
         }
 
         let aero_frame6 = self.aero.torque(p_dot, &omega, &r61);

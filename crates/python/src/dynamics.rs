@@ -244,7 +244,19 @@ fn parse_wing(node: &Node<'_, '_>) -> Result<Wing> {
             }
         },
     };
-    Wing::new(shoulder, inertia, springs, aero).map_err(|e| e.in_field(&node.path))
+    let wing = Wing::new(shoulder, inertia, springs, aero).map_err(|e| e.in_field(&node.path))?;
+    let mut h3 = None;
+    Ok(match child(node, "tunable_hinge", &mut h3)? {
+        None => wing,
+        Some(t) => wing.with_tunable_hinge(
+            paritysim_dynamics::TunableHinge::new(
+                t.f64("k0")?,
+                t.f64_or("k1", 0.0)?,
+                t.f64_or("k2", 0.0)?,
+            )
+            .map_err(|e| e.in_field(&t.path))?,
+        ),
+    })
 }
 
 fn parse_drivetrain(node: &Node<'_, '_>) -> Result<Drivetrain> {
@@ -303,7 +315,7 @@ fn parse_waveform(node: &Node<'_, '_>) -> Result<Waveform> {
 }
 
 /// Builds and validates a device from its dict spec.
-fn parse_device(spec: &Bound<'_, PyDict>) -> Result<Device> {
+pub(crate) fn parse_device(spec: &Bound<'_, PyDict>) -> Result<Device> {
     let root = Node {
         dict: spec,
         path: String::new(),
@@ -411,7 +423,10 @@ fn parse_device(spec: &Bound<'_, PyDict>) -> Result<Device> {
     })
 }
 
-fn parse_options(options: &Bound<'_, PyDict>, n_coords: usize) -> Result<SimulationOptions> {
+pub(crate) fn parse_options(
+    options: &Bound<'_, PyDict>,
+    n_coords: usize,
+) -> Result<SimulationOptions> {
     let n = Node {
         dict: options,
         path: "options".into(),
