@@ -154,3 +154,13 @@ def test_blade_element_rotating_wings_run_and_rotate() -> None:
     np.testing.assert_allclose(r.trajectory["left_psi"], r.trajectory["right_psi"], atol=1e-9)
     with pytest.raises(ps.InvalidParameterError, match="model"):
         ps.simulate(rotating.replace(wings=(dataclasses.replace(wing, aero=dataclasses.replace(aero, model="nope")),) * 2))
+
+
+@pytest.mark.parametrize(("frequency_hz", "amplitude_v"), [(150.0, 50.0), (300.0, 100.0)])
+def test_last_sample_lands_on_the_window_end(frequency_hz: float, amplitude_v: float) -> None:
+    """Regression: t_start + window·k/n rounded one ulp past the window end at some drive
+    frequencies, and the solver returned one sample short."""
+    spec = ps.load_spec(EXAMPLES / "hmf.toml")
+    spec = spec.replace(actuator=dataclasses.replace(spec.actuator, waveform=ps.Waveform(amplitude_v=amplitude_v, frequency_hz=frequency_hz)))
+    r = ps.simulate(spec, max_cycles=40)
+    assert r.trajectory.height == 2 * 200 + 1

@@ -13,7 +13,7 @@ Quick start::
 
 from __future__ import annotations
 
-from . import aero, kinematics, laminate, planform, plots, spec, trials
+from . import aero, kinematics, laminate, planform, plots, spec, stability, trials
 from ._core import (
     CancelledError,
     ConstraintError,
@@ -29,6 +29,9 @@ from ._core import (
 from .calibration import CalibrationResult, calibrate
 from .planform import Planform
 from .simulation import SimulationResult, simulate
+
+# `paritysim.sweep` is the function (the module stays importable as paritysim.sweep via importlib).
+from .sweep import grid, sweep  # noqa: E402
 from .spec import Actuator, Aero, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, TunableHinge, Waveform, Wing, load_spec
 
 __all__ = [
@@ -51,6 +54,9 @@ __all__ = [
     "Wing",
     "load_spec",
     "simulate",
+    "stability",
+    "grid",
+    "sweep",
     "spec",
     "CancelledError",
     "ConstraintError",

@@ -207,11 +207,20 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
     y[12] = 0.0;
     y[13] = 0.0;
     let t_start = t;
+    // The last sample is exactly the window's end: t_start + window·k/n can round one ulp past
+    // it, and the solver would then return one sample short.
+    let t_end = t_start + window;
     let times: Vec<f64> = (0..=n_samples)
-        .map(|k| t_start + window * k as f64 / n_samples as f64)
+        .map(|k| {
+            if k == n_samples {
+                t_end
+            } else {
+                t_start + window * k as f64 / n_samples as f64
+            }
+        })
         .collect();
     let states = match options.perturbation {
-        None => integrator.integrate(device, t_start, &y, t_start + window, &times)?,
+        None => integrator.integrate(device, t_start, &y, t_end, &times)?,
         Some(kick) => {
             let t_kick = t_start + kick.phase * period.unwrap_or(window);
             let (before, after): (Vec<f64>, Vec<f64>) = times.iter().partition(|&&s| s < t_kick);
@@ -226,13 +235,7 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
                 y
             };
             let y_kicked = apply_kick(device, t_kick, &y_kick, kick)?;
-            states.extend(integrator.integrate(
-                device,
-                t_kick,
-                &y_kicked,
-                t_start + window,
-                &after,
-            )?);
+            states.extend(integrator.integrate(device, t_kick, &y_kicked, t_end, &after)?);
             states
         }
     };

@@ -1,1 +1,502 @@
-//! sweep: placeholder (filled by its issue).
+//! Parameter sweeps: many independent simulations on a local rayon pool.
+//!
+//! A sweep is a list of points; each point is a device (plus its options) built from a base
+//! design and a row of parameter values. Every point runs [`simulate`](crate::simulate()) on its
+//! own and produces the selected metrics (and optionally its last recorded cycle):
+//!
+//! * **Order and determinism.** Results come back in input order whatever the thread count;
+//!   each point's computation is independent and sequential, so results are bit-identical for 1
+//!   and N threads.
+//! * **Failures are rows.** A point whose device cannot be built (an invalid combination) or
+//!   whose integration fails yields `Err(error)` in its slot; every other point is kept. A panic
+//!   inside a point is caught and reported the same way (it never unwinds into the caller).
+//! * **Progress and cancellation.** [`SweepControl`] holds an atomic counter of finished points
+//!   (poll it from another thread) and a cancel flag: once set, no new point starts, the running
+//!   ones finish and the unstarted slots come back as `None`.
+//! * **Threads.** [`resolve_threads`]: an explicit count, else the environment variable
+//!   [`THREADS_ENV`] (`PARITYSIM_THREADS`), else all available cores. Each run builds its own
+//!   pool, so the global rayon pool is never touched.
+//!
+//! ```
+//! use paritysim_dynamics::sweep::{Grid, SweepControl, SweepSettings, sweep};
+//! # use paritysim_dynamics::{Device, DeviceSpec, Formulation, Wing, WingAero, JointSpring, SimulationOptions};
+//! # use paritysim_constraints::Constraints;
+//! # use paritysim_kinematics::SphericalShoulder;
+//! # use nalgebra::Matrix3;
+//! // A free wing on a stroke spring, swept over the spring stiffness.
+//! let build = |values: &[f64]| {
+//!     let mut springs = [JointSpring::default(); 6];
+//!     springs[0] = JointSpring::linear(values[0], 0.0)?;
+//!     let wing = Wing::new(
+//!         SphericalShoulder::new(std::f64::consts::FRAC_PI_2, 0.0)?,
+//!         Matrix3::from_diagonal_element(10.0),
+//!         springs,
+//!         WingAero::None,
+//!     )?;
+//!     Device::new(DeviceSpec {
+//!         wings: vec![wing],
+//!         constraints: Constraints::none(3)?,
+//!         transmission: None,
+//!         actuator: None,
+//!         formulation: Formulation::Auto,
+//!     })
+//! };
+//! let grid = Grid::new().axis("stiffness", [1.0, 2.0, 4.0])?;
+//! let options = SimulationOptions {
+//!     duration_ms: Some(5.0),
+//!     initial: Some((nalgebra::Vector6::zeros(), nalgebra::Vector6::new(0.1, 0.0, 0.0, 0.0, 0.0, 0.0))),
+//!     ..Default::default()
+//! };
+//! let control = SweepControl::new();
+//! let result = sweep(&grid.table(), build, &options, &SweepSettings::default(), &control)?;
+//! assert_eq!(result.rows.len(), 3);
+//! assert_eq!(control.finished(), 3);
+//! # Ok::<(), paritysim_dynamics::Error>(())
+//! ```
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+use rayon::prelude::*;
+
+use paritysim_error::{Error, Result, bail};
+
+use crate::device::Device;
+use crate::metrics;
+use crate::simulate::{SimulationOptions, Trajectory, record, simulate};
+
+/// Environment variable read by [`resolve_threads`] when no thread count is given:
+/// a positive integer (`PARITYSIM_THREADS=4`).
+pub const THREADS_ENV: &str = "PARITYSIM_THREADS";
+
+/// Largest accepted thread count (a sanity bound against typos such as `threads=10000`).
+pub const MAX_THREADS: usize = 1024;
+
+/// The thread count a sweep uses: `requested` if given, else [`THREADS_ENV`], else the number
+/// of available cores.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for `0`, more than [`MAX_THREADS`], or an environment value that
+/// is not such an integer (the message names `threads` or `PARITYSIM_THREADS`).
+pub fn resolve_threads(requested: Option<usize>) -> Result<usize> {
+    let allowed = format!("an integer in [1, {MAX_THREADS}]");
+    if let Some(n) = requested {
+        if !(1..=MAX_THREADS).contains(&n) {
+            bail!(invalid "threads", n, allowed);
+        }
+        return Ok(n);
+    }
+    if let Ok(raw) = std::env::var(THREADS_ENV) {
+        let raw = raw.trim();
+        if !raw.is_empty() {
+            return match raw.parse::<usize>() {
+                Ok(n) if (1..=MAX_THREADS).contains(&n) => Ok(n),
+                _ => Err(Error::invalid(THREADS_ENV, format!("{raw:?}"), allowed)),
+            };
+        }
+    }
+    Ok(std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
+/// Progress counter and cancel flag shared between a running sweep and its observers
+/// (wrap it in an `Arc` to share it with another thread).
+#[derive(Debug, Default)]
+pub struct SweepControl {
+    finished: AtomicUsize,
+    cancelled: AtomicBool,
+}
+
+impl SweepControl {
+    /// A fresh control: nothing finished, not cancelled.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Points finished so far (successfully or not).
+    pub fn finished(&self) -> usize {
+        self.finished.load(Ordering::Acquire)
+    }
+
+    /// Stops scheduling new points; running points finish normally.
+    pub fn cancel(&self) {
+        self.cancelled.store(true, Ordering::Release);
+    }
+
+    /// Whether [`SweepControl::cancel`] was called.
+    pub fn is_cancelled(&self) -> bool {
+        self.cancelled.load(Ordering::Acquire)
+    }
+}
+
+/// Runs `f(0..n)` on a pool of `threads` threads; slot `i` holds `f(i)`, or `None` when the
+/// point was not started because the sweep was cancelled. A panic in `f` becomes an
+/// [`Error::Integration`] whose reason starts with `internal error (panic)`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a bad thread count; the pool itself failing to start is
+/// reported the same way (`threads`).
+pub fn run_indexed<T, F>(
+    n: usize,
+    threads: usize,
+    control: &SweepControl,
+    f: F,
+) -> Result<Vec<Option<Result<T>>>>
+where
+    T: Send,
+    F: Fn(usize) -> Result<T> + Sync,
+{
+    let threads = resolve_threads(Some(threads))?;
+    let one = |i: usize| -> Option<Result<T>> {
+        if control.is_cancelled() {
+            return None;
+        }
+        let out = catch_unwind(AssertUnwindSafe(|| f(i))).unwrap_or_else(|payload| {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| (*s).to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            Err(Error::Integration {
+                time: f64::NAN,
+                state: Vec::new(),
+                reason: format!("internal error (panic) at sweep point {i}: {what}"),
+            })
+        });
+        control.finished.fetch_add(1, Ordering::AcqRel);
+        Some(out)
+    };
+    if threads == 1 {
+        // No pool: the calling thread does the work (and tests the sequential path).
+        return Ok((0..n).map(one).collect());
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .thread_name(|i| format!("paritysim-sweep-{i}"))
+        .build()
+        .map_err(|e| {
+            Error::invalid(
+                "threads",
+                threads,
+                format!("a count the OS can start ({e})"),
+            )
+        })?;
+    // One point per task: points take milliseconds, so scheduling overhead is negligible and
+    // fine-grained stealing keeps both ends of the run busy.
+    Ok(pool.install(|| (0..n).into_par_iter().with_max_len(1).map(one).collect()))
+}
+
+/// The metric names [`simulate`](crate::simulate()) reports for this device, in order.
+pub fn metric_names(device: &Device) -> Vec<String> {
+    metrics::compute(device, &Trajectory::default(), device.period())
+        .into_iter()
+        .map(|(name, _)| name)
+        .collect()
+}
+
+/// The trajectory column names [`simulate`](crate::simulate()) records for this device
+/// (without `time_ms`), in order.
+pub fn trajectory_columns(device: &Device) -> Vec<String> {
+    record(device, &[], &[])
+        .map(|t| t.columns.into_iter().map(|(name, _)| name).collect())
+        .unwrap_or_default()
+}
+
+/// Checks requested names against the allowed ones; `None` selects them all.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `field` and listing the valid names.
+pub fn select(field: &str, requested: Option<&[String]>, valid: &[String]) -> Result<Vec<String>> {
+    let Some(requested) = requested else {
+        return Ok(valid.to_vec());
+    };
+    for name in requested {
+        if !valid.contains(name) {
+            return Err(Error::invalid(
+                field.to_string(),
+                format!("{name:?}"),
+                format!("one of: {}", valid.join(", ")),
+            ));
+        }
+    }
+    Ok(requested.to_vec())
+}
+
+/// What each point reports.
+#[derive(Clone, Debug, PartialEq, Eq, Default)]
+pub struct SweepSettings {
+    /// Threads (`None`: [`resolve_threads`]).
+    pub threads: Option<usize>,
+    /// Metric names to keep, in this order (`None`: all of [`metric_names`]).
+    pub metrics: Option<Vec<String>>,
+    /// Keep the last recorded cycle of each point.
+    pub keep_cycle: bool,
+}
+
+/// The outcome of one successful point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointOutput {
+    /// Selected metric values, aligned with the requested names (NaN if a name is missing).
+    pub metrics: Vec<f64>,
+    /// Whether the steady-state tolerance was met.
+    pub converged: bool,
+    /// Cycles simulated before recording.
+    pub cycles_run: usize,
+    /// The last recorded cycle (its closing sample included), when asked for.
+    pub cycle: Option<Trajectory>,
+}
+
+/// Simulates one point and keeps what the sweep asked for.
+///
+/// # Errors
+/// Whatever [`simulate`](crate::simulate()) returns.
+pub fn run_point(
+    device: &Device,
+    options: &SimulationOptions,
+    metric_names: &[String],
+    keep_cycle: bool,
+) -> Result<PointOutput> {
+    let result = simulate(device, options)?;
+    let metrics = metric_names
+        .iter()
+        .map(|name| {
+            result
+                .metrics
+                .iter()
+                .find(|(n, _)| n == name)
+                .map_or(f64::NAN, |(_, v)| *v)
+        })
+        .collect();
+    let cycle = keep_cycle.then(|| {
+        let traj = result.trajectory;
+        let len = traj.time.len();
+        let keep = if result.period_ms.is_finite() {
+            (options.samples_per_cycle + 1).min(len)
+        } else {
+            len
+        };
+        let start = len - keep;
+        Trajectory {
+            time: traj.time[start..].to_vec(),
+            columns: traj
+                .columns
+                .into_iter()
+                .map(|(name, v)| (name, v[start..].to_vec()))
+                .collect(),
+        }
+    });
+    Ok(PointOutput {
+        metrics,
+        converged: result.converged,
+        cycles_run: result.cycles_run,
+        cycle,
+    })
+}
+
+/// Runs prepared points: slot `i` is `(device, options)` or the error that prevented building
+/// it (kept as that point's result). `metric_names` are those to report (see [`select`]).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a bad thread count only; point failures are per-slot.
+pub fn run_points(
+    points: &[Result<(Device, SimulationOptions)>],
+    metric_names: &[String],
+    keep_cycle: bool,
+    threads: Option<usize>,
+    control: &SweepControl,
+) -> Result<Vec<Option<Result<PointOutput>>>> {
+    let threads = resolve_threads(threads)?;
+    run_indexed(points.len(), threads, control, |i| match &points[i] {
+        Ok((device, options)) => run_point(device, options, metric_names, keep_cycle),
+        Err(e) => Err(e.clone()),
+    })
+}
+
+/// A table of parameter values: named columns, one row per point.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct ParameterTable {
+    /// Column names (e.g. `drivetrain.balance_stiffness`).
+    pub names: Vec<String>,
+    /// Rows, each as long as `names`.
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl ParameterTable {
+    /// Explicit rows.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for duplicate names; [`Error::Shape`] for a row of the wrong
+    /// length.
+    pub fn new(names: Vec<String>, rows: Vec<Vec<f64>>) -> Result<Self> {
+        for (i, name) in names.iter().enumerate() {
+            if names[..i].contains(name) {
+                return Err(Error::invalid(
+                    format!("parameters[{i}]"),
+                    format!("{name:?}"),
+                    "a name not used by another column",
+                ));
+            }
+        }
+        if let Some((i, row)) = rows
+            .iter()
+            .enumerate()
+            .find(|(_, r)| r.len() != names.len())
+        {
+            bail!(Shape "row {i} has {} values but there are {} parameters", row.len(), names.len());
+        }
+        Ok(Self { names, rows })
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// Whether there are no points.
+    pub fn is_empty(&self) -> bool {
+        self.rows.is_empty()
+    }
+}
+
+/// A Cartesian product of named axes (the first axis varies slowest, like
+/// `itertools.product`).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Grid {
+    axes: Vec<(String, Vec<f64>)>,
+}
+
+impl Grid {
+    /// An empty grid (one point with no parameters).
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds an axis.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a repeated name or an empty axis.
+    pub fn axis(mut self, name: &str, values: impl IntoIterator<Item = f64>) -> Result<Self> {
+        if self.axes.iter().any(|(n, _)| n == name) {
+            bail!(invalid format!("grid.{name}"), "a repeated axis", "each parameter once");
+        }
+        let values: Vec<f64> = values.into_iter().collect();
+        if values.is_empty() {
+            bail!(invalid format!("grid.{name}"), "[]", "at least one value");
+        }
+        self.axes.push((name.to_string(), values));
+        Ok(self)
+    }
+
+    /// Number of points (the product of the axis lengths).
+    pub fn len(&self) -> usize {
+        self.axes.iter().map(|(_, v)| v.len()).product()
+    }
+
+    /// Whether the grid has no points (never: an empty grid is one point).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The values of point `index` (row-major: the last axis varies fastest).
+    pub fn point(&self, mut index: usize) -> Vec<f64> {
+        let mut out = vec![0.0; self.axes.len()];
+        for (k, (_, values)) in self.axes.iter().enumerate().rev() {
+            out[k] = values[index % values.len()];
+            index /= values.len();
+        }
+        out
+    }
+
+    /// All points as a table.
+    pub fn table(&self) -> ParameterTable {
+        ParameterTable {
+            names: self.axes.iter().map(|(n, _)| n.clone()).collect(),
+            rows: (0..self.len()).map(|i| self.point(i)).collect(),
+        }
+    }
+}
+
+/// One row of a [`SweepResult`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepRow {
+    /// Position in the input table.
+    pub index: usize,
+    /// The parameter values of this point.
+    pub parameters: Vec<f64>,
+    /// Its metrics, or why it failed.
+    pub outcome: Result<PointOutput>,
+}
+
+/// The finished rows of a sweep, in input order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepResult {
+    /// Parameter names (the table's columns).
+    pub parameters: Vec<String>,
+    /// Metric names (the columns of [`PointOutput::metrics`]).
+    pub metrics: Vec<String>,
+    /// Finished points in input order (fewer than the table when cancelled).
+    pub rows: Vec<SweepRow>,
+    /// Whether the sweep was cancelled before every point ran.
+    pub cancelled: bool,
+}
+
+/// Sweeps a table: `build(values)` makes each point's device (an `Err` there becomes that
+/// point's error row), all points share `options`.
+///
+/// Metric names are validated against the device of the first point that builds, before any
+/// simulation runs.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for an unknown metric name or a bad thread count. Point failures
+/// are reported in their rows.
+pub fn sweep<F>(
+    table: &ParameterTable,
+    build: F,
+    options: &SimulationOptions,
+    settings: &SweepSettings,
+    control: &SweepControl,
+) -> Result<SweepResult>
+where
+    F: Fn(&[f64]) -> Result<Device> + Sync,
+{
+    let threads = resolve_threads(settings.threads)?;
+    let devices: Vec<Result<(Device, SimulationOptions)>> =
+        run_indexed(table.len(), threads, &SweepControl::new(), |i| {
+            build(&table.rows[i]).map(|d| (d, options.clone()))
+        })?
+        .into_iter()
+        .map(|slot| slot.unwrap_or(Err(Error::Cancelled)))
+        .collect();
+    let names = match devices.iter().find_map(|d| d.as_ref().ok()) {
+        Some((device, _)) => select(
+            "metrics",
+            settings.metrics.as_deref(),
+            &metric_names(device),
+        )?,
+        None => settings.metrics.clone().unwrap_or_default(),
+    };
+    let slots = run_points(
+        &devices,
+        &names,
+        settings.keep_cycle,
+        Some(threads),
+        control,
+    )?;
+    let cancelled = slots.iter().any(Option::is_none);
+    let rows = slots
+        .into_iter()
+        .enumerate()
+        .filter_map(|(index, slot)| {
+            slot.map(|outcome| SweepRow {
+                index,
+                parameters: table.rows[index].clone(),
+                outcome,
+            })
+        })
+        .collect();
+    Ok(SweepResult {
+        parameters: table.names.clone(),
+        metrics: names,
+        rows,
+        cancelled,
+    })
+}

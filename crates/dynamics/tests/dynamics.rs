@@ -767,18 +767,30 @@ fn right_hand_side_does_not_allocate() {
 fn tunable_hinge_forces_are_the_gradient_of_its_energy() {
     use paritysim_dynamics::TunableHinge;
     let hinge = TunableHinge::new(2.0, 1.5, 4.0).unwrap();
-    let wing = Wing::new(shoulder(90.0, 0.0), full_inertia(), springs([5.0, 0.0, 0.0, 8.0, 0.0, 0.0]), WingAero::None).unwrap().with_tunable_hinge(hinge);
+    let wing = Wing::new(
+        shoulder(90.0, 0.0),
+        full_inertia(),
+        springs([5.0, 0.0, 0.0, 8.0, 0.0, 0.0]),
+        WingAero::None,
+    )
+    .unwrap()
+    .with_tunable_hinge(hinge);
     let h = 1e-6;
     for p in [Vector3::new(0.2, 0.3, -0.5), Vector3::new(-0.4, -0.2, 0.8)] {
         let v = Vector3::zeros();
         let t = wing.terms(&p, &v).unwrap();
         for k in 0..3 {
             let e = Vector3::ith(k, h);
-            let dv = (wing.terms(&(p + e), &v).unwrap().potential - wing.terms(&(p - e), &v).unwrap().potential) / (2.0 * h);
+            let dv = (wing.terms(&(p + e), &v).unwrap().potential
+                - wing.terms(&(p - e), &v).unwrap().potential)
+                / (2.0 * h);
             assert_relative_eq!(t.spring[k], dv, epsilon = 1e-7, max_relative = 1e-7);
         }
     }
-    assert!(TunableHinge::new(1.0, 3.0, 1.0).is_err(), "k(theta) would go negative");
+    assert!(
+        TunableHinge::new(1.0, 3.0, 1.0).is_err(),
+        "k(theta) would go negative"
+    );
     use paritysim_dynamics::integrate::{Integrator, Method, RungeKutta};
     let device = Device::new(DeviceSpec {
         wings: vec![wing],
@@ -788,7 +800,9 @@ fn tunable_hinge_forces_are_the_gradient_of_its_energy() {
         formulation: Formulation::NullSpace,
     })
     .unwrap();
-    let mut y = device.state_from(&Vec6::new(0.3, 0.2, 0.5, 0.0, 0.0, 0.0), &Vec6::zeros()).unwrap();
+    let mut y = device
+        .state_from(&Vec6::new(0.3, 0.2, 0.5, 0.0, 0.0, 0.0), &Vec6::zeros())
+        .unwrap();
     let energy = |y: &paritysim_dynamics::State| {
         let (p, v) = device.coordinates(y).unwrap();
         device.energy(&device.evaluate(0.0, &p, &v).unwrap())
@@ -797,7 +811,15 @@ fn tunable_hinge_forces_are_the_gradient_of_its_energy() {
     let rk = RungeKutta::new(Method::Dop853, 1e-12, 1e-14, 1_000_000).unwrap();
     let mut worst = 0.0f64;
     for k in 0..20 {
-        y = rk.integrate(&device, k as f64 * 10.0, &y, (k + 1) as f64 * 10.0, &[(k + 1) as f64 * 10.0]).unwrap()[0];
+        y = rk
+            .integrate(
+                &device,
+                k as f64 * 10.0,
+                &y,
+                (k + 1) as f64 * 10.0,
+                &[(k + 1) as f64 * 10.0],
+            )
+            .unwrap()[0];
         worst = worst.max((energy(&y) - e0).abs() / e0);
     }
     assert!(worst < 1e-8, "relative energy drift {worst:e}");

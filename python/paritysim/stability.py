@@ -1,0 +1,485 @@
+"""Stability of flapping (thesis §2.6), disturbance rejection (§2.7), and the Floquet analysis
+of the full nonlinear model.
+
+Linearised model (§2.6)
+    :func:`hill_monodromy`, :func:`hill_floquet`, :func:`region` and :func:`stability_chart`
+    analyse ``x'' + β0|cos t| x' + κ x = 0`` (eq. 2.25, period π) and place points in the
+    regions of Fig. 2.13 (Region I with the corrected bound of ERRATA item 9);
+    :func:`brockett` and :func:`brockett_hill` are eqs. 2.57-2.58; :func:`hill_parameters`
+    maps physical parameters to (β0, κ1, κ2) with the factors of ERRATA item 7.
+Disturbance rejection (§2.7)
+    :func:`lti_transfer` is eq. 2.59; :func:`linearise` derives β* and κ0 from a device's
+    periodic orbit; :func:`disturbance_response` measures the same transfer on the nonlinear
+    model (a sinusoidal roll torque on the wings, body roll torque out).
+Full nonlinear model
+    :func:`floquet` finds the periodic orbit by shooting and returns its Floquet multipliers;
+    :func:`k2_sweep` repeats that over the balance-beam stiffness K2.
+
+Plots: :func:`plot_fig2_13`, :func:`plot_chart_map`, :func:`plot_bode`, :func:`plot_k2_sweep`.
+Units: mg-mm-ms-rad; frequencies in Hz, rates in 1/ms.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import matplotlib.pyplot as plt
+import numpy as np
+import polars as pl
+from matplotlib.figure import Figure
+
+from . import _core
+from ._errors import invalid
+from .spec import Simulation
+
+__all__ = [
+    "FloquetResult",
+    "brockett",
+    "brockett_hill",
+    "disturbance_response",
+    "floquet",
+    "hill_floquet",
+    "hill_monodromy",
+    "hill_parameters",
+    "hill_solution",
+    "k2_sweep",
+    "linearise",
+    "lti_transfer",
+    "plot_bode",
+    "plot_chart_map",
+    "plot_fig2_13",
+    "plot_k2_sweep",
+    "region",
+    "stability_chart",
+]
+
+#: Region names of Fig. 2.13 by index.
+REGIONS = {1: "I", 2: "II", 3: "III", 4: "IV"}
+
+
+def _f64(x: Any, name: str) -> np.ndarray:
+    a = np.ascontiguousarray(np.atleast_1d(np.asarray(x, dtype=np.float64)))
+    if a.ndim != 1:
+        raise invalid(name, f"array of shape {a.shape}", "a scalar or a 1-D array")
+    return a
+
+
+# ------------------------------------------------------------------ §2.6: eq. 2.25
+
+
+def hill_monodromy(beta0: float, kappa: float, t0: float = -math.pi / 2) -> np.ndarray:
+    """Monodromy matrix ``M(t0) = Π(t0 + π, t0)`` of eq. 2.25 (2×2; eq. 2.30).
+
+    At ``t0 = -π/2`` and ``kappa = 0`` it is eq. 2.50; its determinant is ``e^{-2 beta0}``
+    (eq. 2.45) for every ``kappa`` and ``t0``.
+    """
+    return _core.stability_hill_monodromy(float(beta0), float(kappa), float(t0))
+
+
+def hill_solution(beta0: float, kappa: float, t: Any, t0: float = -math.pi / 2) -> np.ndarray:
+    """Solution matrices ``Π(t_i, t0)`` (eq. 2.33) at each ``t_i >= t0``, shape ``(n, 2, 2)``."""
+    return _core.stability_hill_solution(float(beta0), float(kappa), float(t0), _f64(t, "t"))
+
+
+def hill_floquet(beta0: float, kappa: float) -> dict[str, Any]:
+    """Floquet analysis of eq. 2.25 at one point.
+
+    Returns a dict: ``monodromy`` (at t0 = -π/2), ``a`` (half trace), ``b`` (determinant),
+    ``multipliers`` (complex, eq. 2.37), ``spectral_radius``, ``region`` (1-4, Fig. 2.13) and
+    ``stable`` (Region I).
+    """
+    return _core.stability_hill_floquet(float(beta0), float(kappa))
+
+
+def region(a: Any, b: Any) -> np.ndarray:
+    """Region (1-4) of Fig. 2.13 for half trace ``a`` and determinant ``b`` (arrays).
+
+    Region I is ``b <= 1, |a| <= (1 + b)/2`` (ERRATA item 9; the printed Region III bound
+    ``a > (b - 1)/2`` would mark stable systems unstable).
+    """
+    return _core.stability_region(_f64(a, "a"), _f64(b, "b"))
+
+
+def stability_chart(beta0: Any, kappa: Any, *, brockett: bool = True) -> pl.DataFrame:
+    """Floquet stability over the grid ``beta0 × kappa`` (computed in parallel in Rust).
+
+    Returns one row per point (β0 outer, κ inner): ``beta0, kappa, a, b, spectral_radius,
+    region`` (1-4), ``region_name`` (I-IV), ``stable`` and, with ``brockett=True``,
+    ``brockett_bounded`` (Brockett's guarantee of eqs. 2.57-2.58; false where it does not
+    apply, κ <= 0).
+    """
+    raw = _core.stability_chart(_f64(beta0, "beta0"), _f64(kappa, "kappa"))
+    df = pl.DataFrame(raw).with_columns(
+        pl.col("region").cast(pl.Int8),
+        pl.col("region").replace_strict(REGIONS, return_dtype=pl.String).alias("region_name"),
+    )
+    if brockett:
+        beta = raw["beta0"]
+        kap = raw["kappa"]
+        guaranteed = np.zeros(beta.size, dtype=bool)
+        for i in np.flatnonzero(kap > 0):
+            guaranteed[i] = _core.stability_brockett_hill(float(beta[i]), float(kap[i]))["bounded"]
+        df = df.with_columns(pl.Series("brockett_bounded", guaranteed))
+    return df
+
+
+def brockett(delta: float, period: float, damping_integral: float = 0.0) -> dict[str, Any]:
+    """Brockett's criterion (eqs. 2.56-2.58) for ``x'' + g(t) x' + x = 0`` with ``|g| <= 2 delta``
+    and period ``period``: ``bounded`` is True when all solutions are guaranteed bounded (a
+    False guarantees nothing); ``n`` and ``interval`` are the integer and interval of eq. 2.57."""
+    return _core.stability_brockett(float(delta), float(period), float(damping_integral))
+
+
+def brockett_hill(beta0: float, kappa: float) -> dict[str, Any]:
+    """Brockett's criterion for eq. 2.25 (κ > 0), after rescaling time by √κ."""
+    return _core.stability_brockett_hill(float(beta0), float(kappa))
+
+
+def hill_parameters(
+    *,
+    inertia: float,
+    drag: float,
+    transmission_ratio: float,
+    arm_length_mm: float,
+    k1: float,
+    k2: float,
+    stroke_amplitude: float,
+    frequency_hz: float,
+) -> dict[str, float]:
+    """(β0, κ1, κ2) of §2.6.1 from physical parameters, with ERRATA item 7's factors.
+
+    ``β0 = 2 Ω Φ / I`` (Φ = T·A the stroke amplitude in rad; the printed ``2ΩA/I`` lacks T),
+    ``κ1 = K1/(2 I T² ω0²)``, ``κ2 = K2/(2 I T² L² ω0²)``. Also returns eq. 2.59's
+    ``beta_star = (2/π) β0 ω0`` (1/ms), ``kappa0 = κ2 ω0²`` (1/ms²) and ``omega0`` (rad/ms).
+    Units: inertia and drag Ω in mg·mm², T in rad/mm, L in mm, K1 in mN/mm, K2 in mN·mm/rad.
+    """
+    return _core.stability_hill_parameters(
+        float(inertia), float(drag), float(transmission_ratio), float(arm_length_mm), float(k1), float(k2), float(stroke_amplitude), float(frequency_hz)
+    )
+
+
+# ------------------------------------------------------------------ §2.7 and the nonlinear model
+
+
+def lti_transfer(beta_star: float, kappa0: float, frequency_hz: Any) -> np.ndarray:
+    """Eq. 2.59, ``κ0 / (s² + β* s + κ0)`` at ``s = 2πi f`` (s in rad/ms): complex array."""
+    return _core.stability_lti_transfer(float(beta_star), float(kappa0), _f64(frequency_hz, "frequency_hz"))
+
+
+def _device(spec: Simulation | dict[str, Any]) -> dict[str, Any]:
+    if isinstance(spec, Simulation):
+        return spec.device_dict()
+    if isinstance(spec, dict):
+        return spec
+    raise invalid("spec", type(spec).__name__, "a paritysim.Simulation or a device dict")
+
+
+@dataclass(frozen=True)
+class FloquetResult:
+    """Periodic orbit and Floquet multipliers of a device (see :func:`floquet`).
+
+    Attributes
+    ----------
+    multipliers:
+        Complex Floquet multipliers, largest modulus first (finite-difference monodromy:
+        moduli below ~1e-6 are at its resolution).
+    monodromy:
+        Jacobian of the stroboscopic map over ``coordinates`` (the integrated coordinates and
+        rates, e.g. ``q1, q2, q1_dot, q2_dot``).
+    stability:
+        ``asymptotic``, ``marginal`` (largest |ρ| within ``max(1e-5, monodromy_uncertainty)``
+        of 1) or ``unstable``.
+    monodromy_uncertainty:
+        Largest entry of the difference between the monodromies computed with ``fd_step`` and
+        ``4 fd_step``: an estimate of the finite-difference error.
+    slowest_decay_ms:
+        ``T / -ln|ρ|`` of the slowest decaying multiplier (None if none decays).
+    growth_time_ms:
+        ``T / ln|ρ|max`` of an unstable orbit (None otherwise).
+    whippletree_multipliers:
+        Multipliers of the (q2, q2_dot) block for a Drag PARITY device in drivetrain
+        coordinates (exact for a symmetric orbit, see ``whippletree_coupling``), else None.
+    """
+
+    multipliers: np.ndarray
+    spectral_radius: float
+    stability: str
+    slowest_decay_ms: float | None
+    growth_time_ms: float | None
+    max_exponent_per_ms: float
+    period_ms: float
+    coordinates: list[str]
+    orbit_state: np.ndarray
+    monodromy: np.ndarray = field(repr=False)
+    whippletree_multipliers: np.ndarray | None
+    whippletree_coupling: float | None
+    monodromy_uncertainty: float
+    method: str
+    newton_iterations: int
+    cycles_simulated: int
+    residual: float
+
+    @property
+    def asymptotically_stable(self) -> bool:
+        """All multipliers strictly inside the unit circle."""
+        return self.stability == "asymptotic"
+
+    @property
+    def frame(self) -> pl.DataFrame:
+        """The multipliers as a DataFrame: ``re, im, modulus, exponent_per_ms`` (Re ln ρ / T)."""
+        m = self.multipliers
+        modulus = np.abs(m)
+        with np.errstate(divide="ignore"):
+            exponent = np.where(modulus > 0, np.log(np.where(modulus > 0, modulus, 1.0)) / self.period_ms, -np.inf)
+        return pl.DataFrame({"re": m.real, "im": m.imag, "modulus": modulus, "exponent_per_ms": exponent})
+
+
+def _shooting(options: dict[str, Any]) -> dict[str, Any] | None:
+    return {k: v for k, v in options.items() if v is not None} or None
+
+
+def floquet(spec: Simulation | dict[str, Any], **options: Any) -> FloquetResult:
+    """Periodic orbit of a driven device by shooting, and its Floquet multipliers.
+
+    Newton on the stroboscopic map over one drive period (cycle-to-cycle simulation as the
+    fallback, which finds stable orbits only), then a central-difference monodromy over the
+    integrated coordinates and rates (work integrals excluded). ``options``: ``rtol`` (1e-12),
+    ``atol`` (1e-14), ``method``, ``max_steps``, ``t0`` (section time, ms), ``warmup_cycles``
+    (20), ``warmup_tol``, ``max_newton`` (20), ``tol`` (1e-10), ``fd_step`` (1e-5),
+    ``fallback_cycles`` (2000).
+
+    Raises
+    ------
+    ConstraintError
+        Without an actuator (no period).
+    IntegrationError
+        When no orbit is found (``.state`` holds the best state).
+    """
+    raw = _core.stability_floquet(_device(spec), _shooting(options))
+    return FloquetResult(
+        multipliers=raw["multipliers"],
+        spectral_radius=float(raw["spectral_radius"]),
+        stability=str(raw["stability"]),
+        slowest_decay_ms=raw["slowest_decay_ms"],
+        growth_time_ms=raw["growth_time_ms"],
+        max_exponent_per_ms=float(raw["max_exponent_per_ms"]),
+        period_ms=float(raw["period_ms"]),
+        coordinates=list(raw["coordinates"]),
+        orbit_state=raw["orbit_state"],
+        monodromy=raw["monodromy"],
+        whippletree_multipliers=raw["whippletree_multipliers"],
+        whippletree_coupling=raw["whippletree_coupling"],
+        monodromy_uncertainty=float(raw["monodromy_uncertainty"]),
+        method=str(raw["method"]),
+        newton_iterations=int(raw["newton_iterations"]),
+        cycles_simulated=int(raw["cycles_simulated"]),
+        residual=float(raw["residual"]),
+    )
+
+
+def k2_sweep(spec: Simulation | dict[str, Any], k2: Any, **options: Any) -> pl.DataFrame:
+    """:func:`floquet` over balance-beam stiffnesses ``k2`` (mN·mm/rad), in parallel in Rust.
+
+    Columns: ``k2, spectral_radius, whippletree_radius`` (null without a whippletree block),
+    ``max_exponent_per_ms, slowest_decay_ms`` (null when nothing decays), ``stability`` and
+    ``moduli`` (list column: |ρ| of every multiplier, largest first).
+    """
+    raw = _core.stability_k2_sweep(_device(spec), _f64(k2, "k2"), _shooting(options))
+    return pl.DataFrame(
+        {
+            "k2": raw["k2"],
+            "spectral_radius": raw["spectral_radius"],
+            "whippletree_radius": raw["whippletree_radius"],
+            "max_exponent_per_ms": raw["max_exponent_per_ms"],
+            "slowest_decay_ms": raw["slowest_decay_ms"],
+            "stability": raw["stability"],
+            "moduli": [list(np.abs(row)) for row in raw["multipliers"]],
+        }
+    ).with_columns(pl.col("whippletree_radius", "slowest_decay_ms").fill_nan(None))
+
+
+def linearise(spec: Simulation | dict[str, Any], samples: int = 2000, **options: Any) -> dict[str, Any]:
+    """Places a fixed-wing Drag PARITY device on the charts of §2.6-2.7 from its periodic orbit.
+
+    Returns ``physical`` (inertia, drag Ω·C, T, L, K1, K2, stroke amplitude Φ, frequency),
+    ``hill`` (β0, κ1, κ2; ERRATA item 7), and three eq. 2.59 models (``beta_star`` in 1/ms,
+    ``kappa0`` in 1/ms²): ``lti`` (cycle-averaged aerodynamic damping and K2 of the
+    whippletree mode, as §2.7 builds it), ``lti_sinusoidal`` (the same for sinusoidal
+    flapping) and ``lti_averaged`` (cycle average of the full model's variational equation,
+    which adds the linkage's ``geometric_stiffness`` in mN·mm/rad).
+    """
+    return _core.stability_linearise(_device(spec), _shooting(options), int(samples))
+
+
+def disturbance_response(
+    spec: Simulation | dict[str, Any],
+    frequency_hz: Any,
+    amplitude: float = 0.1,
+    *,
+    settle_cycles: int | None = None,
+    max_window_cycles: int | None = None,
+    samples_per_cycle: int | None = None,
+    **options: Any,
+) -> pl.DataFrame:
+    """Body roll response of the nonlinear model to a wing roll disturbance torque, with eq. 2.59.
+
+    A torque ``amplitude · sin(2π f t)`` (mN·mm) is applied as stroke torques ``(-d/2, +d/2)``
+    on the two wings, starting on the periodic orbit; after ``settle_cycles`` the complex
+    amplitude of the body roll torque (wing momentum balance) at ``f`` is divided by that of
+    the disturbance (± runs differenced). Fixed-wing devices only.
+
+    Columns: ``frequency_hz, gain, phase_rad`` (nonlinear), ``lti_gain, lti_phase_rad``
+    (eq. 2.59 from :func:`linearise`'s ``lti``; null for a 1-DOF drivetrain, which has no
+    whippletree mode), ``lti_averaged_gain``, ``drift`` (change
+    between two consecutive windows: a settled, stable response has drift << 1) and
+    ``window_ms``.
+    """
+    freqs = _f64(frequency_hz, "frequency_hz")
+    dist = {"settle_cycles": settle_cycles, "max_window_cycles": max_window_cycles, "samples_per_cycle": samples_per_cycle}
+    device = _device(spec)
+    raw = _core.stability_disturbance_response(device, freqs, float(amplitude), _shooting(options), _shooting(dist))
+    h = raw["transfer"]
+    lti = avg = np.full(freqs.size, np.nan + 0j)
+    _, n_dof = _core.validate_device(device)
+    if n_dof == 2:  # eq. 2.59 models the whippletree mode of a 2-DOF (Drag PARITY) drivetrain
+        lin = _core.stability_linearise(device, _shooting(options), 2000)
+        lti = lti_transfer(lin["lti"]["beta_star"], lin["lti"]["kappa0"], freqs)
+        avg = lti_transfer(lin["lti_averaged"]["beta_star"], lin["lti_averaged"]["kappa0"], freqs)
+    return pl.DataFrame(
+        {
+            "frequency_hz": freqs,
+            "gain": np.abs(h),
+            "phase_rad": np.angle(h),
+            "lti_gain": np.abs(lti),
+            "lti_phase_rad": np.angle(lti),
+            "lti_averaged_gain": np.abs(avg),
+            "drift": raw["drift"],
+            "window_ms": raw["window_ms"],
+        }
+    ).with_columns(pl.col("lti_gain", "lti_phase_rad", "lti_averaged_gain").fill_nan(None))
+
+
+# ------------------------------------------------------------------ plots
+
+
+_REGION_COLOURS = {1: "#4daf4a", 2: "#e41a1c", 3: "#377eb8", 4: "#984ea3"}
+
+
+def plot_fig2_13(chart: pl.DataFrame | None = None, points: dict[str, tuple[float, float]] | None = None) -> Figure:
+    """Fig. 2.13: the (a, b) plane of the monodromy matrix with Regions I-IV.
+
+    Boundaries: ``b = 1``, ``a = ±(1 + b)/2`` (ERRATA item 9; the printed ``(b - 1)/2`` dashed
+    for comparison) and the double-root parabola ``b = a²``. ``chart`` (from
+    :func:`stability_chart`) is scattered coloured by region; ``points`` maps labels to (a, b).
+    """
+    fig, ax = plt.subplots(figsize=(7.5, 6), constrained_layout=True)
+    a = np.linspace(-2.5, 2.5, 801)
+    b_grid = np.linspace(-0.5, 2.5, 601)
+    aa, bb = np.meshgrid(a, b_grid)
+    reg = region(aa.ravel(), bb.ravel()).reshape(aa.shape)
+    from matplotlib.colors import ListedColormap
+
+    cmap = ListedColormap([_REGION_COLOURS[i] for i in (1, 2, 3, 4)])
+    ax.pcolormesh(a, b_grid, reg, cmap=cmap, vmin=0.5, vmax=4.5, alpha=0.18, shading="auto")
+    ax.axhline(1.0, color="k", lw=1.0)
+    ax.plot((1 + b_grid) / 2, b_grid, "k", lw=1.0, label="$a = \\pm(1+b)/2$ (ERRATA 9)")
+    ax.plot(-(1 + b_grid) / 2, b_grid, "k", lw=1.0)
+    ax.plot((b_grid - 1) / 2, b_grid, "k--", lw=0.8, label="printed $a = (b-1)/2$")
+    ax.plot(a, a**2, "k:", lw=1.0, label="double root $b = a^2$")
+    for idx, (x, y) in {1: (0.0, 0.35), 2: (0.0, 1.8), 3: (1.8, 0.8), 4: (-1.8, 0.8)}.items():
+        ax.text(x, y, REGIONS[idx], fontsize=16, ha="center", va="center", weight="bold")
+    if chart is not None and chart.height:
+        for idx in (1, 2, 3, 4):
+            sub = chart.filter(pl.col("region") == idx)
+            if sub.height:
+                ax.scatter(sub["a"], sub["b"], s=2, color=_REGION_COLOURS[idx], label=f"chart points, Region {REGIONS[idx]}")
+    for i, (label, (x, y)) in enumerate((points or {}).items()):
+        ax.plot([x], [y], "k*", ms=12)
+        ax.annotate(label, (x, y), textcoords="offset points", xytext=(8, 10 + 16 * i), arrowprops={"arrowstyle": "-", "lw": 0.5})
+    ax.set_xlim(-2.5, 2.5)
+    ax.set_ylim(-0.5, 2.5)
+    ax.set_xlabel("half trace $a = \\mathrm{tr}\\,M/2$ (-)")
+    ax.set_ylabel("determinant $b = \\det M$ (-)")
+    ax.legend(loc="upper left", fontsize=8, markerscale=4)
+    ax.set_title("Fig. 2.13: stability in the trace-determinant plane (Region I stable)")
+    return fig
+
+
+def plot_chart_map(chart: pl.DataFrame, points: dict[str, tuple[float, float]] | None = None) -> Figure:
+    """The stability chart as a map over (β0, κ): log10 of the spectral radius (per period π),
+    the Region I boundary, Brockett's guaranteed region, and optional labelled (β0, κ) points."""
+    beta = np.unique(chart["beta0"].to_numpy())
+    kap = np.unique(chart["kappa"].to_numpy())
+    shape = (beta.size, kap.size)
+    rho = chart["spectral_radius"].to_numpy().reshape(shape).T
+    stable = chart["stable"].to_numpy().reshape(shape).T.astype(float)
+    fig, ax = plt.subplots(figsize=(8, 6), constrained_layout=True)
+    mesh = ax.pcolormesh(beta, kap, np.log10(rho), cmap="RdBu_r", vmin=-2, vmax=2, shading="auto")
+    fig.colorbar(mesh, ax=ax, label="$\\log_{10}\\max|\\rho|$ per period $\\pi$ (-)")
+    ax.contour(beta, kap, stable, levels=[0.5], colors="k", linewidths=1.2)
+    if "brockett_bounded" in chart.columns:
+        guaranteed = chart["brockett_bounded"].to_numpy().reshape(shape).T.astype(float)
+        if guaranteed.any():
+            ax.contourf(beta, kap, guaranteed, levels=[0.5, 1.5], colors="none", hatches=["//"])
+            ax.contour(beta, kap, guaranteed, levels=[0.5], colors="0.3", linewidths=0.8, linestyles="--")
+    for label, (x, y) in (points or {}).items():
+        ax.plot([x], [y], "k*", ms=12)
+        ax.annotate(label, (x, y), textcoords="offset points", xytext=(6, 6))
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    ax.legend(
+        handles=[
+            Line2D([], [], color="k", lw=1.2, label="Region I boundary (stable inside)"),
+            Patch(facecolor="none", edgecolor="0.3", hatch="//", label="Brockett: bounded guaranteed"),
+        ],
+        loc="upper right",
+        fontsize=8,
+    )
+    ax.set_xlabel("damping $\\beta_0$ (-)")
+    ax.set_ylabel("stiffness $\\kappa$ (-)")
+    ax.set_title("Fig. 2.13 as a map: Floquet stability of eq. 2.25 over $(\\beta_0, \\kappa)$")
+    return fig
+
+
+def plot_bode(
+    curves: dict[str, tuple[np.ndarray, np.ndarray]],
+    measured: dict[str, pl.DataFrame] | None = None,
+    mark_hz: float | None = 300.0,
+) -> Figure:
+    """Bode magnitude plot of eq. 2.59: ``curves`` maps labels to (frequency_hz, complex H);
+    ``measured`` maps labels to :func:`disturbance_response` frames (nonlinear points, drawn in
+    the colour of the curve with the same label, if any)."""
+    fig, ax = plt.subplots(figsize=(8.5, 6), constrained_layout=True)
+    colours = {}
+    for label, (f, h) in curves.items():
+        (line,) = ax.loglog(f, np.abs(h), label=f"eq. 2.59: {label}")
+        colours[label] = line.get_color()
+    for label, df in (measured or {}).items():
+        ax.loglog(df["frequency_hz"], df["gain"], "o", color=colours.get(label), label=f"nonlinear model: {label}")
+    if mark_hz is not None:
+        ax.axvline(mark_hz, color="0.5", lw=0.8, ls=":", label=f"{mark_hz:g} Hz")
+    ax.set_xlabel("disturbance frequency (Hz)")
+    ax.set_ylabel("$|\\tau/\\tau_d|$ (-)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    ax.set_title("§2.7, eq. 2.59: wing roll disturbance to body roll torque")
+    return fig
+
+
+def plot_k2_sweep(frames: dict[str, pl.DataFrame]) -> Figure:
+    """Whippletree-mode multiplier |ρ| per drive period vs K2 for each labelled sweep."""
+    fig, ax = plt.subplots(figsize=(8, 5.5), constrained_layout=True)
+    for label, df in frames.items():
+        col = "whippletree_radius" if df["whippletree_radius"].null_count() < df.height else "spectral_radius"
+        ax.semilogx(df["k2"], df[col], "o-", ms=3, label=label)
+    ax.axhline(1.0, color="k", lw=1.0, ls="--", label="$|\\rho| = 1$")
+    ax.set_xlabel("balance-beam stiffness $K_2$ (mN·mm/rad)")
+    ax.set_ylabel("whippletree multiplier $|\\rho|$ per drive period (-)")
+    ax.set_yscale("log")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title("Floquet multiplier of the whippletree mode of the full nonlinear model vs $K_2$")
+    return fig

@@ -1,0 +1,765 @@
+"""Parameter sweeps: thousands of simulations of one design, in parallel, as one DataFrame.
+
+::
+
+    import paritysim as ps
+    spec = ps.load_spec("examples/drag_parity.toml")
+    df = ps.sweep(spec, {"drivetrain.k2": [0.5, 1, 2], "wings.left.omega_ratio": [0.6, 0.8, 1.0]},
+                  metrics=["left_roll_aero_peak", "right_roll_aero_peak"])
+
+Each point is the base spec with some fields overridden, run to periodic steady state by the
+Rust engine on a local thread pool (GIL released). The result has one row per point in input
+order: ``point`` (its index), one column per swept parameter, the metrics, ``converged``,
+``cycles_run``, ``status`` (``"ok"`` or ``"error"``), ``error`` and ``error_kind`` (the message
+and class of a failing point; every other row is kept).
+
+Parameter paths
+---------------
+Dotted paths into the spec, checked before anything runs (an unknown path raises
+``InvalidParameterError`` listing the valid ones; :func:`valid_paths` lists them too):
+
+* ``wings[i].inertia[r][c]``, ``wings[i].shoulder.alpha2``, ``wings[i].springs[j].stiffness``
+  (``cubic``, ``rest_angle``), ``wings[i].aero.omega1`` (and every other ``Aero`` field);
+* ``drivetrain.<field>`` (``balance_stiffness``, ``crank_mm``, ``arm_ratio``, ``kind``...);
+* ``actuator.force_per_volt``, ``actuator.stiffness``, ``actuator.waveform.<field>``
+  (``frequency_hz``, ``amplitude_v``, ``offset_v``...);
+* ``configuration.name``, ``formulation`` and ``options.<field>`` (``max_cycles``, ``rtol``...).
+
+Aliases: ``wings.left`` / ``wings.right`` for ``wings[0]`` / ``wings[1]`` of a two-wing spec;
+``wings[*]`` for every wing at once; ``drivetrain.k2`` for ``drivetrain.balance_stiffness``;
+``actuator.frequency_hz`` and ``actuator.amplitude_v`` (or ``actuator.voltage_v``) for the
+waveform fields; ``wings[i].omega_ratio`` multiplies that wing's ``aero.omega1`` by the value
+(a cut wing of Table 3.2: ``wings.left.omega_ratio = 0.6``).
+
+Threads, progress, checkpoints, clusters
+----------------------------------------
+``threads=None`` uses ``$PARITYSIM_THREADS`` if set, else every core. ``progress=True`` shows a
+tqdm bar (rate, ETA) fed from the engine's atomic counter; Ctrl-C cancels cleanly: running points
+finish, the finished rows are returned (and checkpointed) with a ``RuntimeWarning``.
+``checkpoint="runs/study.parquet"`` flushes finished chunks to ``runs/study.parquet.parts/``
+and writes the complete, ordered table to ``runs/study.parquet`` at the end; re-running the
+same call skips every point already there (points are matched by their parameter values, so an
+extended grid reuses the old points). ``executor=`` takes any ``concurrent.futures.Executor``
+(``ProcessPoolExecutor``, ``dask.distributed.Client.get_executor()``): chunks of points are sent
+to it and each runs on one engine thread.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import contextlib
+import dataclasses
+import hashlib
+import itertools
+import json
+import math
+import os
+import uuid
+import warnings
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import polars as pl
+
+from . import _core
+from ._errors import invalid
+from .spec import Actuator, Aero, Drivetrain, Options, Simulation
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+__all__ = ["THREADS_ENV", "grid", "plot", "sweep", "valid_paths"]
+
+#: Environment variable giving the default thread count (a positive integer).
+THREADS_ENV: str = _core.SWEEP_THREADS_ENV
+
+#: Result columns besides the parameters and metrics.
+STATUS_COLUMNS = ("converged", "cycles_run", "status", "error", "error_kind")
+
+_METADATA_KEY = "paritysim.sweep"
+_FORMAT = 1
+
+# --------------------------------------------------------------------------- parameter paths
+
+_ALIASES = {
+    "drivetrain.k2": "drivetrain.balance_stiffness",
+    "actuator.frequency_hz": "actuator.waveform.frequency_hz",
+    "actuator.amplitude_v": "actuator.waveform.amplitude_v",
+    "actuator.voltage_v": "actuator.waveform.amplitude_v",
+}
+_WAVEFORM_SCALARS = ("kind", "amplitude_v", "frequency_hz", "offset_v", "phase", "period_ms")
+_OPTION_SCALARS = tuple(f.name for f in dataclasses.fields(Options) if f.name not in ("initial_p", "initial_p_dot", "perturbation"))
+_SPRING_FIELDS = ("stiffness", "cubic", "rest_angle")
+_SHOULDER_FIELDS = ("alpha2", "alpha3")
+
+
+@dataclass(frozen=True)
+class _Target:
+    """Where a value goes: the device or options dict, a key path, and an optional scale."""
+
+    section: str  # "device" or "options"
+    keys: tuple[str | int, ...]
+    scale: float | None = None  # ratio aliases: value * scale
+
+
+@dataclass(frozen=True)
+class _Param:
+    name: str
+    targets: tuple[_Target, ...]
+
+
+def _names(cls: type) -> list[str]:
+    return [f.name for f in dataclasses.fields(cls)]
+
+
+def _schema(spec: Simulation) -> dict[str, _Target]:
+    """Every canonical path of this spec and where it points."""
+    out: dict[str, _Target] = {}
+    for i, wing in enumerate(spec.wings):
+        w = f"wings[{i}]"
+        for r, c in itertools.product(range(3), range(3)):
+            out[f"{w}.inertia[{r}][{c}]"] = _Target("device", ("wings", i, "inertia", r, c))
+        for f in _SHOULDER_FIELDS:
+            out[f"{w}.shoulder.{f}"] = _Target("device", ("wings", i, "shoulder", f))
+        for j, f in itertools.product(range(6), _SPRING_FIELDS):
+            out[f"{w}.springs[{j}].{f}"] = _Target("device", ("wings", i, "springs", j, f))
+        if wing.aero is not None:
+            for name in _names(Aero):
+                out[f"{w}.aero.{name}"] = _Target("device", ("wings", i, "aero", name))
+            out[f"{w}.omega_ratio"] = _Target("device", ("wings", i, "aero", "omega1"), float(wing.aero.omega1))
+    out["configuration.name"] = _Target("device", ("configuration",))
+    out["formulation"] = _Target("device", ("formulation",))
+    if spec.drivetrain is not None:
+        for name in _names(Drivetrain):
+            out[f"drivetrain.{name}"] = _Target("device", ("drivetrain", name))
+    if spec.actuator is not None:
+        for name in _names(Actuator):
+            if name != "waveform":
+                out[f"actuator.{name}"] = _Target("device", ("actuator", name))
+        for name in _WAVEFORM_SCALARS:
+            out[f"actuator.waveform.{name}"] = _Target("device", ("actuator", "waveform", name))
+    for name in _OPTION_SCALARS:
+        out[f"options.{name}"] = _Target("options", (name,))
+    return out
+
+
+def _expand(spec: Simulation, path: str) -> list[str] | None:
+    """Canonical paths an alias stands for (None: not an alias form this spec supports)."""
+    n = len(spec.wings)
+    if path.startswith("wings[*]."):
+        return [f"wings[{i}].{path[len('wings[*].') :]}" for i in range(n)]
+    for side, index in (("left", 0), ("right", 1)):
+        if path.startswith(f"wings.{side}."):
+            return [f"wings[{index}].{path[len(f'wings.{side}.') :]}"] if n == 2 else None
+    if path in _ALIASES:
+        return [_ALIASES[path]]
+    return [path]
+
+
+def _resolve(spec: Simulation, path: str, schema: dict[str, _Target]) -> _Param:
+    if not isinstance(path, str):
+        raise invalid("grid", repr(path), "parameter paths given as strings")
+    canonical = _expand(spec, path) or []
+    targets = [schema[c] for c in canonical if c in schema]
+    if not canonical or len(targets) != len(canonical):
+        raise invalid(path, "<unknown parameter path>", "a parameter path of this spec; valid paths: " + _describe(spec, schema))
+    return _Param(path, tuple(targets))
+
+
+def _describe(spec: Simulation, schema: dict[str, _Target]) -> str:
+    """A compact listing of the valid paths for error messages."""
+    n = len(spec.wings)
+    wing = [p[len("wings[0].") :] for p in schema if p.startswith("wings[0].")]
+    wing = [p for p in wing if not p.startswith(("inertia[", "springs["))]
+    parts = [f"wings[i].{{inertia[r][c], springs[j].{{{', '.join(_SPRING_FIELDS)}}}, {', '.join(wing)}}} (i < {n}, j < 6)"]
+    for head in ("drivetrain.", "actuator.waveform.", "actuator.", "options."):
+        names = [p[len(head) :] for p in schema if p.startswith(head) and "." not in p[len(head) :]]
+        if names:
+            parts.append(f"{head}{{{', '.join(names)}}}")
+    parts.append("configuration.name, formulation")
+    aliases = ["wings[*].<field>"]
+    if n == 2:
+        aliases.append("wings.left/right.<field>")
+    aliases += [a for a, c in _ALIASES.items() if c in schema]
+    parts.append("aliases: " + ", ".join(aliases))
+    return "; ".join(parts)
+
+
+def valid_paths(spec: Simulation, aliases: bool = True) -> list[str]:
+    """Every parameter path :func:`sweep` accepts for ``spec`` (canonical, then aliases)."""
+    schema = _schema(spec)
+    out = list(schema)
+    if aliases:
+        out += [a for a, c in _ALIASES.items() if c in schema]
+        fields = sorted({p[len("wings[0].") :] for p in schema if p.startswith("wings[0].")})
+        out += [f"wings[*].{f}" for f in fields]
+        if len(spec.wings) == 2:
+            out += [f"wings.{side}.{f}" for side in ("left", "right") for f in fields]
+    return out
+
+
+def _set(node: Any, keys: Sequence[str | int], value: Any) -> Any:
+    """A copy of ``node`` with ``keys`` set to ``value``; untouched branches are shared."""
+    key = keys[0]
+    if isinstance(node, dict):
+        new: Any = dict(node)
+        child = node.get(key)  # type: ignore[arg-type]
+    else:
+        new = list(node)
+        child = node[key]  # type: ignore[index]
+    if len(keys) == 1:
+        new[key] = value
+        return new
+    if child is None:  # springs absent: six default springs
+        child = [{} for _ in range(6)] if isinstance(keys[1], int) else {}
+    new[key] = _set(child, keys[1:], value)
+    return new
+
+
+def _point_dicts(device: dict[str, Any], options: dict[str, Any], params: Sequence[_Param], row: Sequence[Any]) -> tuple[dict[str, Any], dict[str, Any] | None]:
+    """The device (and, when an option is swept, options) dict of one point."""
+    opts: dict[str, Any] | None = None
+    for param, value in zip(params, row, strict=True):
+        if value is None:  # a null in an explicit table keeps the base value
+            continue
+        if isinstance(value, np.generic):
+            value = value.item()
+        for t in param.targets:
+            v = value * t.scale if t.scale is not None else value
+            if t.section == "device":
+                device = _set(device, t.keys, v)
+            else:
+                opts = _set(opts if opts is not None else options, t.keys, v)
+    return device, opts
+
+
+# ------------------------------------------------------------------------------ grids
+
+
+def grid(axes: Mapping[str, Iterable[Any]]) -> pl.DataFrame:
+    """The Cartesian product of ``axes`` as a DataFrame (first axis slowest, like
+    ``itertools.product``); pass it, filtered or not, as :func:`sweep`'s ``grid``.
+
+    >>> grid({"drivetrain.k2": [1, 2], "actuator.frequency_hz": [100.0, 110.0, 120.0]}).height
+    6
+    """
+    if not isinstance(axes, Mapping):
+        raise invalid("grid", type(axes).__name__, "a mapping from parameter path to values")
+    names = list(axes)
+    values = []
+    for name in names:
+        raw = axes[name]
+        vals = list(np.asarray(raw).ravel().tolist()) if isinstance(raw, np.ndarray) else list(raw) if not isinstance(raw, str | bytes) else [raw]
+        if not vals:
+            raise invalid(f"grid[{name!r}]", "[]", "at least one value")
+        values.append(vals)
+    if not names:
+        return pl.DataFrame()
+    columns: list[list[Any]] = [[] for _ in names]
+    for combo in itertools.product(*values):
+        for k, v in enumerate(combo):
+            columns[k].append(v)
+    return pl.DataFrame({n: pl.Series(n, c, strict=False) for n, c in zip(names, columns, strict=True)})
+
+
+def _table(spec_grid: Any) -> pl.DataFrame:
+    if spec_grid is None:
+        return pl.DataFrame()
+    if isinstance(spec_grid, pl.DataFrame):
+        return spec_grid
+    if isinstance(spec_grid, Mapping):
+        return grid(spec_grid)
+    if isinstance(spec_grid, Sequence) and all(isinstance(r, Mapping) for r in spec_grid):
+        return pl.DataFrame(list(spec_grid), strict=False)
+    raise invalid("grid", type(spec_grid).__name__, "a mapping of axes, a polars DataFrame of rows, or a list of row dicts")
+
+
+# ------------------------------------------------------------------------------ chunks
+
+
+@dataclass(frozen=True)
+class _Chunk:
+    """A picklable batch of points (what an executor worker receives)."""
+
+    device: dict[str, Any]
+    options: dict[str, Any]
+    params: tuple[_Param, ...]
+    rows: list[tuple[Any, ...]]
+    points: list[int]
+    metrics: list[str]
+    keep_cycle: bool
+    threads: int
+
+
+def _prepare(chunk: _Chunk) -> _core.SweepRun:
+    """Builds the point dicts and parses them (GIL held); the run is not started."""
+    devices = []
+    options: list[dict[str, Any]] = []
+    per_point = any(t.section == "options" for p in chunk.params for t in p.targets)
+    for row in chunk.rows:
+        d, o = _point_dicts(chunk.device, chunk.options, chunk.params, row)
+        devices.append(d)
+        options.append(o if o is not None else chunk.options)
+    return _core.SweepRun(devices, options if per_point else chunk.options, chunk.metrics, chunk.keep_cycle, chunk.threads)
+
+
+def _run_chunk(chunk: _Chunk) -> dict[str, Any]:
+    """Runs a chunk to completion (executor workers call this)."""
+    return _prepare(chunk).result()
+
+
+def _frame(raw: dict[str, Any], params: pl.DataFrame, points: Sequence[int], metrics: Sequence[str], cycle_columns: Sequence[str]) -> pl.DataFrame:
+    """The rows of the finished points of a chunk."""
+    finished = np.asarray(raw["finished"], dtype=bool)
+    ok = np.asarray(raw["ok"], dtype=bool)
+    idx = np.flatnonzero(finished)
+    m = np.asarray(raw["metrics"])
+    cols: dict[str, pl.Series] = {"point": pl.Series("point", np.asarray(points, dtype=np.int64)[idx])}
+    taken = params[idx.tolist()] if params.width else None
+    if taken is not None:
+        for name in taken.columns:
+            cols[name] = taken[name]
+    ok_f = ok[idx]
+    for k, name in enumerate(metrics):
+        values = m[idx, k].astype(np.float64)
+        # failed points have no metrics (null); NaN stays NaN for ok points (e.g. no rotation)
+        cols[name] = pl.Series(name, values, dtype=pl.Float64, nan_to_null=False).scatter(np.flatnonzero(~ok_f), None)
+    converged = np.asarray(raw["converged"], dtype=bool)[idx]
+    cycles = np.asarray(raw["cycles_run"], dtype=np.int64)[idx]
+    cols["converged"] = pl.Series("converged", [bool(c) if o else None for c, o in zip(converged, ok_f, strict=True)], dtype=pl.Boolean)
+    cols["cycles_run"] = pl.Series("cycles_run", [int(c) if o else None for c, o in zip(cycles, ok_f, strict=True)], dtype=pl.Int64)
+    cols["status"] = pl.Series("status", np.where(ok_f, "ok", "error").tolist(), dtype=pl.String)
+    errors = [raw["error"][i] for i in idx]
+    kinds = [raw["error_kind"][i] for i in idx]
+    cols["error"] = pl.Series("error", errors, dtype=pl.String)
+    cols["error_kind"] = pl.Series("error_kind", kinds, dtype=pl.String)
+    if cycle_columns:
+        cycle = raw["cycle"]
+        for name in cycle_columns:
+            values = [None if cycle[name][i] is None else np.asarray(cycle[name][i]).tolist() for i in idx]
+            cols[f"cycle_{name}"] = pl.Series(f"cycle_{name}", values, dtype=pl.List(pl.Float64))
+    return pl.DataFrame(cols)
+
+
+# ------------------------------------------------------------------------------ checkpoints
+
+
+class _Checkpoint:
+    """``path`` (the final table) plus ``path.parts/`` (chunks flushed while running)."""
+
+    def __init__(self, path: str | os.PathLike[str], fingerprint: str) -> None:
+        self.path = Path(path)
+        self.parts = self.path.with_name(self.path.name + ".parts")
+        self.fingerprint = fingerprint
+
+    def _check(self, file: Path) -> None:
+        meta = pl.read_parquet_metadata(file)
+        found = meta.get(_METADATA_KEY)
+        if found != self.fingerprint:
+            raise invalid(
+                "checkpoint",
+                str(file),
+                "a checkpoint written by the same sweep (same spec, options, parameter names, metrics and keep_cycle); "
+                "delete it or choose another path",
+            )
+
+    def load(self) -> pl.DataFrame | None:
+        """Every finished row stored so far (final table and parts), or None."""
+        frames = []
+        if self.path.exists():
+            self._check(self.path)
+            frames.append(pl.read_parquet(self.path))
+        if self.parts.is_dir():
+            for part in sorted(self.parts.glob("part-*.parquet")):
+                self._check(part)
+                frames.append(pl.read_parquet(part))
+        if not frames:
+            return None
+        return pl.concat(frames, how="vertical_relaxed")
+
+    def _write(self, df: pl.DataFrame, file: Path) -> None:
+        file.parent.mkdir(parents=True, exist_ok=True)
+        tmp = file.with_name(f".{file.name}.{uuid.uuid4().hex}.tmp")
+        df.write_parquet(tmp, metadata={_METADATA_KEY: self.fingerprint})
+        os.replace(tmp, file)  # atomic: a killed run never leaves half a part
+
+    def flush(self, df: pl.DataFrame) -> None:
+        if df.height:
+            self._write(df, self.parts / f"part-{int(df['point'][0]):09d}-{uuid.uuid4().hex[:8]}.parquet")
+
+    def finish(self, df: pl.DataFrame) -> None:
+        self._write(df, self.path)
+        if self.parts.is_dir():
+            for part in self.parts.glob("part-*.parquet"):
+                part.unlink()
+            with contextlib.suppress(OSError):
+                self.parts.rmdir()
+
+
+def _fingerprint(device: dict[str, Any], options: dict[str, Any], names: Sequence[str], metrics: Sequence[str], cycle: Sequence[str]) -> str:
+    payload = {
+        "format": _FORMAT,
+        "version": _core.__version__,
+        "device": device,
+        "options": options,
+        "parameters": list(names),
+        "metrics": list(metrics),
+        "cycle": list(cycle),
+    }
+    return hashlib.sha256(json.dumps(payload, sort_keys=True, default=repr).encode()).hexdigest()
+
+
+def _key(row: Sequence[Any]) -> tuple[Any, ...]:
+    # Parquet round trips floats exactly; NaN != NaN, so it gets a stand-in to match itself.
+    return tuple(("nan",) if isinstance(v, float) and math.isnan(v) else v for v in row)
+
+
+# ------------------------------------------------------------------------------ sweep
+
+
+def sweep(
+    spec: Simulation,
+    grid: Mapping[str, Iterable[Any]] | pl.DataFrame | Sequence[Mapping[str, Any]] | None = None,
+    *,
+    metrics: Sequence[str] | None = None,
+    keep_cycle: bool | Sequence[str] = False,
+    threads: int | None = None,
+    progress: bool = True,
+    checkpoint: str | os.PathLike[str] | None = None,
+    executor: cf.Executor | None = None,
+    chunk_size: int | None = None,
+    options: Mapping[str, Any] | None = None,
+) -> pl.DataFrame:
+    """Run ``spec`` over a table of parameter overrides; one row per point, in input order.
+
+    Parameters
+    ----------
+    spec:
+        The base design (:class:`paritysim.Simulation`).
+    grid:
+        A mapping ``{path: values}`` (Cartesian product, see :func:`grid`), a Polars DataFrame
+        whose columns are paths and rows are points, or a list of ``{path: value}`` rows.
+        Paths are listed in the module docstring and by :func:`valid_paths`. None runs the
+        base design once.
+    metrics:
+        Metric names to keep (default: all that :func:`paritysim.simulate` reports).
+    keep_cycle:
+        True keeps the last recorded cycle of each point as list columns ``cycle_time_ms``,
+        ``cycle_<column>`` for every trajectory column; a list of trajectory column names keeps
+        only those (plus ``cycle_time_ms``).
+    threads:
+        Engine threads (default ``$PARITYSIM_THREADS``, else every core). With ``executor``,
+        the threads each chunk uses on its worker (default 1).
+    progress:
+        Show a tqdm progress bar.
+    checkpoint:
+        A ``.parquet`` path: finished chunks are flushed as they complete and re-running the
+        same call skips the points already computed.
+    executor:
+        Any ``concurrent.futures.Executor`` (e.g. ``dask.distributed.Client.get_executor()``);
+        chunks of points are submitted to it.
+    chunk_size:
+        Points per chunk (default: 256 per thread locally, about 16 chunks per worker with an
+        executor, at most 256).
+    options:
+        Overrides of ``spec.options`` for every point, e.g. ``{"max_cycles": 50}``.
+
+    Returns
+    -------
+    polars.DataFrame
+        ``point``, the parameter columns, the metrics, ``converged``, ``cycles_run``,
+        ``status`` (``"ok"``/``"error"``), ``error``, ``error_kind`` (and ``cycle_*``).
+
+    Raises
+    ------
+    InvalidParameterError
+        Before any point runs: an unknown parameter path, metric or trajectory column, a bad
+        ``threads`` / ``chunk_size`` / ``options``, or a checkpoint from a different sweep.
+        Invalid base specs raise the usual typed errors. Failures of individual points do not
+        raise: they are rows with ``status = "error"``.
+    """
+    if not isinstance(spec, Simulation):
+        raise invalid("spec", type(spec).__name__, "a paritysim.Simulation")
+    if options:
+        try:
+            spec = spec.replace(options=dataclasses.replace(spec.options, **dict(options)))
+        except TypeError as exc:
+            raise invalid("options", repr(dict(options)), f"fields of paritysim.Options ({exc})") from None
+    table = _table(grid)
+    schema = _schema(spec)
+    params = tuple(_resolve(spec, name, schema) for name in table.columns)
+    seen: dict[tuple[str, tuple[str | int, ...]], str] = {}
+    for p in params:
+        for t in p.targets:
+            other = seen.setdefault((t.section, t.keys), p.name)
+            if other != p.name:
+                raise invalid(p.name, "<same field as " + repr(other) + ">", "each spec field swept by one column only")
+
+    device, opts = spec.device_dict(), spec.options_dict()
+    _core.validate_device(device)  # the base design must be valid (typed error naming the field)
+    _core.SweepRun([device], opts)  # parses the options: raises for a bad option
+    valid_metrics = _core.sweep_metric_names(device)
+    metric_names = list(valid_metrics if metrics is None else metrics)
+    for name in metric_names:
+        if name not in valid_metrics:
+            raise invalid("metrics", repr(name), "one of: " + ", ".join(valid_metrics))
+    cycle_columns = _cycle_columns(device, keep_cycle)
+    if executor is None:
+        n_threads = _core.sweep_resolve_threads(threads)
+    else:
+        if not isinstance(executor, cf.Executor):
+            raise invalid("executor", type(executor).__name__, "a concurrent.futures.Executor")
+        n_threads = _core.sweep_resolve_threads(threads if threads is not None else 1)
+    if chunk_size is not None and (not isinstance(chunk_size, int) or isinstance(chunk_size, bool) or chunk_size < 1):
+        raise invalid("chunk_size", repr(chunk_size), "a positive integer")
+
+    rows = table.rows() if table.width else [()]
+    n = len(rows)
+    store = _Checkpoint(checkpoint, _fingerprint(device, opts, table.columns, metric_names, cycle_columns)) if checkpoint is not None else None
+    done: list[pl.DataFrame] = []
+    todo = list(range(n))
+    if store is not None:
+        previous = store.load()
+        if previous is not None and previous.height:
+            done_frame, todo = _reuse(previous, table, rows)
+            done.append(done_frame)
+
+    if chunk_size is None:
+        if executor is None:
+            chunk_size = 256 * n_threads
+        else:
+            workers = _executor_workers(executor)
+            chunk_size = max(1, min(256, math.ceil(len(todo) / (16 * workers)))) if todo else 1
+    chunks = [todo[i : i + chunk_size] for i in range(0, len(todo), chunk_size)]
+
+    def make(points: list[int]) -> _Chunk:
+        return _Chunk(device, opts, params, [rows[i] for i in points], points, metric_names, bool(cycle_columns), n_threads)
+
+    def frame(points: list[int], raw: dict[str, Any]) -> pl.DataFrame:
+        return _frame(raw, table[points] if table.width else table, points, metric_names, cycle_columns)
+
+    from tqdm.auto import tqdm  # type: ignore[import-untyped]
+
+    bar = tqdm(total=n, initial=n - len(todo), unit="pt", desc="sweep", disable=not progress, smoothing=0.05, dynamic_ncols=True)
+    new: list[pl.DataFrame] = []
+
+    def finished_chunk(df: pl.DataFrame) -> None:
+        new.append(df)
+        if store is not None:
+            store.flush(df)
+
+    try:
+        if executor is None:
+            cancelled = _run_local(chunks, make, frame, finished_chunk, bar)
+        else:
+            cancelled = _run_executor(executor, chunks, make, frame, finished_chunk, bar)
+    finally:
+        bar.close()
+    result = _assemble(done + new, table, metric_names, cycle_columns)
+    if cancelled:
+        warnings.warn(
+            f"sweep cancelled: returning the {result.height} of {n} points that finished" + (f" (checkpointed in {store.parts})" if store else ""),
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    elif store is not None:
+        store.finish(result)
+    return result
+
+
+def _cycle_columns(device: dict[str, Any], keep_cycle: bool | Sequence[str]) -> list[str]:
+    if keep_cycle is False or keep_cycle is None:
+        return []
+    available = ["time_ms", *_core.sweep_trajectory_columns(device)]
+    if keep_cycle is True:
+        return available
+    if isinstance(keep_cycle, str):
+        keep_cycle = [keep_cycle]
+    wanted = ["time_ms", *[c for c in keep_cycle if c != "time_ms"]]
+    for c in wanted:
+        if c not in available:
+            raise invalid("keep_cycle", repr(c), "True or trajectory column names: " + ", ".join(available))
+    return wanted
+
+
+def _executor_workers(executor: cf.Executor) -> int:
+    n = getattr(executor, "_max_workers", None)
+    if isinstance(n, int) and n > 0:
+        return n
+    client = getattr(executor, "_client", None)  # dask.distributed.client.ClientExecutor
+    if client is not None:
+        with contextlib.suppress(Exception):
+            return max(1, sum(client.nthreads().values()))
+    return 4
+
+
+def _reuse(previous: pl.DataFrame, table: pl.DataFrame, rows: list[tuple[Any, ...]]) -> tuple[pl.DataFrame, list[int]]:
+    """Rows of ``previous`` that match points of ``table`` (by parameter values), renumbered,
+    and the points still to run."""
+    names = table.columns
+    stored = previous.select(names).rows() if names else [()] * previous.height
+    index: dict[tuple[Any, ...], int] = {}
+    for i, row in enumerate(stored):
+        index.setdefault(_key(row), i)
+    take, points, todo = [], [], []
+    for i, row in enumerate(rows):
+        j = index.get(_key(row))
+        if j is None:
+            todo.append(i)
+        else:
+            take.append(j)
+            points.append(i)
+    if not take:
+        return previous.clear(), todo
+    reused = previous[take].with_columns(pl.Series("point", points, dtype=pl.Int64))
+    if names:  # keep the caller's dtypes for the parameter columns
+        reused = reused.with_columns(table[points].get_columns())
+    return reused, todo
+
+
+def _assemble(frames: list[pl.DataFrame], table: pl.DataFrame, metrics: Sequence[str], cycle: Sequence[str]) -> pl.DataFrame:
+    frames = [f for f in frames if f.height]
+    if not frames:
+        empty = _frame(
+            {"finished": np.zeros(0, bool), "ok": np.zeros(0, bool), "metrics": np.zeros((0, len(metrics))), "converged": np.zeros(0, bool),
+             "cycles_run": np.zeros(0, np.int64), "error": [], "error_kind": [], "cycle": {c: [] for c in cycle}},
+            table.clear() if table.width else table, [], metrics, cycle,
+        )  # fmt: skip
+        return empty
+    return pl.concat(frames, how="vertical_relaxed").sort("point")
+
+
+def _run_local(
+    chunks: list[list[int]],
+    make: Callable[[list[int]], _Chunk],
+    frame: Callable[[list[int], dict[str, Any]], pl.DataFrame],
+    finished_chunk: Callable[[pl.DataFrame], None],
+    bar: Any,
+) -> bool:
+    """Runs the chunks one after the other on the local engine, keeping its threads busy: chunk
+    k+1 is parsed while chunk k runs and started as soon as k ends, before k's rows are framed
+    and flushed. Returns True when interrupted (Ctrl-C)."""
+    pending: Iterator[list[int]] = iter(chunks)
+    started: list[tuple[list[int], _core.SweepRun]] = []  # running or finished, not collected
+
+    def prepared() -> tuple[list[int], _core.SweepRun] | None:
+        points = next(pending, None)
+        return None if points is None else (points, _prepare(make(points)))
+
+    try:
+        upcoming = prepared()
+        if upcoming is None:
+            return False
+        upcoming[1].start()
+        started.append(upcoming)
+        upcoming = prepared()
+        while started:
+            points, run = started[0]
+            reported = 0
+            while not run.wait(0.1):
+                reported = _advance(bar, run.finished, reported)
+            _advance(bar, run.finished, reported)
+            if upcoming is not None:
+                upcoming[1].start()
+                started.append(upcoming)
+            raw = run.result()
+            started.pop(0)
+            finished_chunk(frame(points, raw))
+            upcoming = prepared()
+    except KeyboardInterrupt:
+        for _, run in started:
+            run.cancel()
+        for points, run in started:
+            run.wait(None)
+            finished_chunk(frame(points, run.result()))
+        return True
+    return False
+
+
+def _advance(bar: Any, finished: int, reported: int) -> int:
+    if finished > reported:
+        bar.update(finished - reported)
+    return max(finished, reported)
+
+
+def _run_executor(
+    executor: cf.Executor,
+    chunks: list[list[int]],
+    make: Callable[[list[int]], _Chunk],
+    frame: Callable[[list[int], dict[str, Any]], pl.DataFrame],
+    finished_chunk: Callable[[pl.DataFrame], None],
+    bar: Any,
+) -> bool:
+    """Submits chunks with a bounded number in flight (memory stays bounded); results are
+    flushed as they complete. Returns True when interrupted (Ctrl-C)."""
+    workers = _executor_workers(executor)
+    limit = max(2, 2 * workers)
+    queue = iter(chunks)
+    in_flight: dict[cf.Future[dict[str, Any]], list[int]] = {}
+    try:
+        while True:
+            while len(in_flight) < limit:
+                points = next(queue, None)
+                if points is None:
+                    break
+                in_flight[executor.submit(_run_chunk, make(points))] = points
+            if not in_flight:
+                return False
+            done, _ = cf.wait(list(in_flight), timeout=0.2, return_when=cf.FIRST_COMPLETED)
+            for fut in done:
+                points = in_flight.pop(fut)
+                finished_chunk(frame(points, fut.result()))
+                bar.update(len(points))
+    except KeyboardInterrupt:
+        for fut in in_flight:
+            fut.cancel()
+        for fut, points in in_flight.items():
+            if fut.done() and not fut.cancelled() and fut.exception() is None:
+                finished_chunk(frame(points, fut.result()))
+        return True
+    except BaseException:
+        for fut in in_flight:
+            fut.cancel()
+        raise
+
+
+# ------------------------------------------------------------------------------ plotting
+
+
+def plot(df: pl.DataFrame, x: str, y: str | Sequence[str], hue: str | None = None, path: str | os.PathLike[str] | None = None, ax: Any = None) -> Figure:
+    """Lines of ``y`` against ``x`` (one per value of ``hue``) from the ``ok`` rows of a sweep
+    result; saved as PNG when ``path`` is given."""
+    import matplotlib.pyplot as plt
+
+    ys = [y] if isinstance(y, str) else list(y)
+    for c in [x, *ys, *([hue] if hue else [])]:
+        if c not in df.columns:
+            raise invalid("plot", repr(c), "a column of the sweep result: " + ", ".join(df.columns))
+    ok = df.filter(pl.col("status") == "ok") if "status" in df.columns else df
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(6, 4), layout="constrained")
+    else:
+        fig = ax.figure
+    groups = ok.partition_by(hue, maintain_order=True) if hue else [ok]
+    for g in groups:
+        g = g.sort(x)
+        for col in ys:
+            parts = []
+            if hue:
+                v = g[hue][0]
+                parts.append(f"{hue} = {v:g}" if isinstance(v, float | int) else f"{hue} = {v}")
+            if len(ys) > 1:
+                parts.append(col)
+            ax.plot(g[x].to_numpy(), g[col].to_numpy(), marker="o", ms=3, label=", ".join(parts) or None)
+    ax.set_xlabel(x)
+    ax.set_ylabel(ys[0] if len(ys) == 1 else "value")
+    ax.grid(alpha=0.3)
+    if hue or len(ys) > 1:
+        ax.legend(fontsize=8)
+    if path is not None:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        fig.savefig(path, dpi=150)
+    return fig

@@ -1,0 +1,173 @@
+"""``paritysim sweep study.toml --out runs/``: a parameter sweep described in TOML.
+
+A study file names the device and the grid::
+
+    spec = "hmf.toml"                      # a device spec, relative to this file (or a [spec] table)
+    metrics = ["left_stroke_amplitude"]    # optional: default all
+    keep_cycle = false                     # optional: true or a list of trajectory columns
+
+    [options]                              # optional overrides of the spec's options
+    max_cycles = 60
+
+    [grid]                                 # path = list, or {start, stop, num[, log]} (linspace)
+    "actuator.frequency_hz" = { start = 20.0, stop = 200.0, num = 37 }
+    "actuator.voltage_v" = [50.0, 100.0]
+
+    [plot]                                 # optional: a PNG of y against x, one line per hue
+    x = "actuator.frequency_hz"
+    y = "left_stroke_amplitude"
+    hue = "actuator.voltage_v"
+
+The results go to ``<out>/<stem>.parquet``, which is also the checkpoint: re-running the command
+after an interruption resumes where it stopped.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import shutil
+import sys
+import time
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import polars as pl
+
+from ._errors import invalid
+from .spec import Simulation, load_spec
+
+__all__ = ["Study", "add_parser", "load_study", "run_study"]
+
+_KEYS = ("spec", "metrics", "keep_cycle", "options", "grid", "plot", "threads", "chunk_size")
+
+
+@dataclass(frozen=True)
+class Study:
+    """A parsed study file."""
+
+    spec: Simulation
+    grid: dict[str, list[Any]]
+    metrics: list[str] | None = None
+    keep_cycle: bool | list[str] = False
+    options: dict[str, Any] = field(default_factory=dict)
+    plot: dict[str, Any] | None = None
+    threads: int | None = None
+    chunk_size: int | None = None
+
+
+def _axis(name: str, value: Any) -> list[Any]:
+    if isinstance(value, list):
+        return value
+    if isinstance(value, dict):
+        unknown = sorted(set(value) - {"start", "stop", "num", "log"})
+        if unknown or not {"start", "stop", "num"} <= set(value):
+            raise invalid(f"grid.{name}", repr(value), "a list or a table {start, stop, num[, log]}")
+        start, stop, num = float(value["start"]), float(value["stop"]), value["num"]
+        if not isinstance(num, int) or num < 1:
+            raise invalid(f"grid.{name}.num", repr(num), "a positive integer")
+        if value.get("log", False):
+            if start <= 0 or stop <= 0:
+                raise invalid(f"grid.{name}", repr(value), "start and stop > 0 for a log axis")
+            return np.geomspace(start, stop, num).tolist()
+        return np.linspace(start, stop, num).tolist()
+    return [value]
+
+
+def load_study(path: str | Path) -> Study:
+    """Parses a study TOML (see the module docstring)."""
+    path = Path(path)
+    with open(path, "rb") as f:
+        data = tomllib.load(f)
+    unknown = sorted(set(data) - set(_KEYS))
+    if unknown:
+        raise invalid(unknown[0], "<unknown key>", "one of: " + ", ".join(_KEYS))
+    raw_spec = data.get("spec")
+    if isinstance(raw_spec, str):
+        spec = load_spec(path.parent / raw_spec)
+    elif isinstance(raw_spec, dict):
+        spec = Simulation.from_dict(raw_spec)
+    else:
+        raise invalid("spec", repr(raw_spec), "a spec file path (relative to the study) or a [spec] table")
+    grid = data.get("grid", {})
+    if not isinstance(grid, dict):
+        raise invalid("grid", repr(grid), "a table of parameter path = values")
+    plot = data.get("plot")
+    if plot is not None and (not isinstance(plot, dict) or not {"x", "y"} <= set(plot) or set(plot) - {"x", "y", "hue"}):
+        raise invalid("plot", repr(plot), "a table with x, y and optionally hue")
+    return Study(
+        spec=spec,
+        grid={k: _axis(k, v) for k, v in grid.items()},
+        metrics=data.get("metrics"),
+        keep_cycle=data.get("keep_cycle", False),
+        options=dict(data.get("options", {})),
+        plot=plot,
+        threads=data.get("threads"),
+        chunk_size=data.get("chunk_size"),
+    )
+
+
+def run_study(study: Study, out: str | Path, stem: str, threads: int | None = None, progress: bool = True, fresh: bool = False) -> tuple[pl.DataFrame, dict[str, Path]]:
+    """Runs a study; writes ``<stem>.parquet`` (and ``<stem>.png`` with a [plot] table).
+    Returns the result and the written paths. ``fresh`` discards earlier results first."""
+    from .sweep import plot, sweep
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    table = out / f"{stem}.parquet"
+    if fresh:
+        table.unlink(missing_ok=True)
+        parts = table.with_name(table.name + ".parts")
+        if parts.is_dir():
+            shutil.rmtree(parts)
+    df = sweep(
+        study.spec,
+        study.grid,
+        metrics=study.metrics,
+        keep_cycle=study.keep_cycle,
+        threads=threads if threads is not None else study.threads,
+        progress=progress,
+        checkpoint=table,
+        chunk_size=study.chunk_size,
+        options=study.options,
+    )
+    written = {"table": table}
+    if study.plot is not None:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        fig = plot(df, study.plot["x"], study.plot["y"], hue=study.plot.get("hue"), path=out / f"{stem}.png")
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+        written["plot"] = out / f"{stem}.png"
+    return df, written
+
+
+def _main(args: argparse.Namespace) -> int:
+    study = load_study(args.study)
+    stem = Path(args.study).stem
+    start = time.perf_counter()
+    df, written = run_study(study, args.out, stem, threads=args.threads, progress=not args.quiet, fresh=args.fresh)
+    expected = math.prod(len(v) for v in study.grid.values())
+    if df.height < expected:
+        print(f"{stem}: interrupted after {df.height} of {expected} points; re-run the same command to resume", file=sys.stderr)
+        return 130
+    if not args.quiet:
+        n_err = df.filter(pl.col("status") == "error").height
+        print(f"{stem}: {df.height} points ({n_err} failed) in {time.perf_counter() - start:.2f} s -> " + ", ".join(str(p) for p in written.values()))
+    return 0
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    """Adds ``paritysim sweep``."""
+    p = sub.add_parser("sweep", help="run a parameter sweep described in a study TOML (device + grid)")
+    p.add_argument("study", help="study file, e.g. examples/sweep_resonance.toml")
+    p.add_argument("--out", default="runs", help="output directory (default: runs/)")
+    p.add_argument("--threads", type=int, default=None, help="engine threads (default: $PARITYSIM_THREADS or all cores)")
+    p.add_argument("--fresh", action="store_true", help="discard earlier results and checkpoints of this study and recompute everything")
+    p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
+    p.set_defaults(func=_main)

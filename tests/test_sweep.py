@@ -1,0 +1,399 @@
+"""Parameter sweeps: order and bit-identity across threads, error rows, validation before any
+work, checkpoints that survive a kill, cancellation, executors (Dask, process pools), CLI."""
+
+from __future__ import annotations
+
+import _thread
+import concurrent.futures as cf
+import dataclasses
+import importlib
+import math
+import multiprocessing
+import os
+import pickle
+import signal
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import polars as pl
+import pytest
+
+import paritysim as ps
+from paritysim import _core
+from paritysim.cli import main
+from paritysim.sweep import grid, sweep, valid_paths
+
+# The module (``paritysim.sweep`` may be re-exported as the function of the same name).
+sweep_module = importlib.import_module("paritysim.sweep")
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+FAST = {"max_cycles": 5, "samples_per_cycle": 40, "record_cycles": 1}
+
+
+@pytest.fixture(scope="module")
+def parity() -> ps.Simulation:
+    spec = ps.load_spec(EXAMPLES / "drag_parity.toml")
+    return spec.replace(options=dataclasses.replace(spec.options, **FAST))
+
+
+@pytest.fixture(scope="module")
+def hmf() -> ps.Simulation:
+    spec = ps.load_spec(EXAMPLES / "hmf.toml")
+    return spec.replace(options=dataclasses.replace(spec.options, **FAST))
+
+
+def _bits(df: pl.DataFrame) -> dict[str, Any]:
+    """Columns as comparable values; floats by their bit patterns (NaN-safe, exact)."""
+    out: dict[str, Any] = {}
+    for name in df.columns:
+        s = df[name]
+        if s.dtype == pl.Float64:
+            out[name] = (s.is_null().to_list(), s.fill_null(0.0).to_numpy().view(np.uint64).tolist())
+        else:
+            out[name] = s.to_list()
+    return out
+
+
+def assert_same(a: pl.DataFrame, b: pl.DataFrame) -> None:
+    assert a.columns == b.columns
+    assert a.schema == b.schema
+    assert _bits(a) == _bits(b)
+
+
+GRID = {"drivetrain.k2": [1.0, 5.0], "wings[*].aero.omega1": [25.0, 31.3], "actuator.frequency_hz": [100.0, 110.0, 120.0]}
+
+
+# ----------------------------------------------------------------------------- grid and paths
+
+
+def test_grid_is_a_cartesian_product_first_axis_slowest() -> None:
+    g = grid({"a": [1, 2], "b": np.array([10.0, 20.0, 30.0])})
+    assert g.columns == ["a", "b"] and g.height == 6
+    assert g.row(0) == (1, 10.0) and g.row(2) == (1, 30.0) and g.row(3) == (2, 10.0)
+    with pytest.raises(ps.InvalidParameterError, match="at least one value"):
+        grid({"a": []})
+
+
+def test_results_are_in_input_order_and_bit_identical_for_1_and_2_threads(parity: ps.Simulation) -> None:
+    one = sweep(parity, GRID, threads=1, progress=False)
+    two = sweep(parity, GRID, threads=2, progress=False, chunk_size=5)  # chunk boundaries too
+    assert_same(one, two)
+    assert one["point"].to_list() == list(range(12))
+    assert one.select(list(GRID)).rows() == grid(GRID).rows()
+    assert (one["status"] == "ok").all()
+    # each row is exactly `simulate` of that point
+    for i in (0, 7, 11):
+        k2, omega, f = grid(GRID).row(i)
+        spec = parity.replace(
+            drivetrain=dataclasses.replace(parity.drivetrain, balance_stiffness=k2),
+            wings=tuple(dataclasses.replace(w, aero=dataclasses.replace(w.aero, omega1=omega)) for w in parity.wings),
+            actuator=dataclasses.replace(parity.actuator, waveform=dataclasses.replace(parity.actuator.waveform, frequency_hz=f)),
+        )
+        direct = ps.simulate(spec).metrics
+        for name, value in direct.items():
+            assert np.float64(one[name][i]).tobytes() == np.float64(value).tobytes(), (name, i)
+
+
+def test_aliases_mean_their_canonical_fields(parity: ps.Simulation) -> None:
+    a = sweep(parity, {"wings.left.omega_ratio": [0.8], "drivetrain.k2": [5.0], "actuator.voltage_v": [80.0]}, progress=False)
+    b = sweep(parity, {"wings[0].aero.omega1": [0.8 * 31.3], "drivetrain.balance_stiffness": [5.0], "actuator.waveform.amplitude_v": [80.0]}, progress=False)
+    metrics = [c for c in a.columns if c.endswith(("_amplitude", "_peak"))]
+    assert_same(a.select(metrics), b.select(metrics))
+    both = sweep(parity, {"wings[*].aero.omega1": [20.0]}, metrics=["left_stroke_amplitude", "right_stroke_amplitude"], progress=False)
+    assert both["left_stroke_amplitude"][0] == both["right_stroke_amplitude"][0]
+    paths = valid_paths(parity)
+    for p in ("wings[1].springs[5].cubic", "wings[0].inertia[2][2]", "options.max_cycles", "drivetrain.k2", "wings.left.omega_ratio"):
+        assert p in paths
+
+
+def test_unknown_paths_and_names_are_rejected_before_any_work(parity: ps.Simulation, monkeypatch: pytest.MonkeyPatch) -> None:
+    def no_work(*_: Any, **__: Any) -> None:
+        raise AssertionError("a point was prepared before validation finished")
+
+    monkeypatch.setattr(sweep_module, "_prepare", no_work)
+    with pytest.raises(ps.InvalidParameterError, match=r"drivetrain\.k3.*valid paths:.*drivetrain\.\{kind") as info:
+        sweep(parity, {"drivetrain.k2": [1.0], "drivetrain.k3": [1.0]}, progress=False)
+    assert info.value.field == "drivetrain.k3"
+    with pytest.raises(ps.InvalidParameterError, match=r"wings\[2\]"):
+        sweep(parity, {"wings[2].aero.omega1": [1.0]}, progress=False)
+    hmf_one_wing = parity.replace(wings=parity.wings[:1], drivetrain=None, actuator=None, configuration=ps.Configuration(name=None))
+    with pytest.raises(ps.InvalidParameterError, match="wings.left"):
+        sweep(hmf_one_wing, {"wings.left.omega_ratio": [1.0]}, progress=False)
+    with pytest.raises(ps.InvalidParameterError, match="same field"):
+        sweep(parity, {"drivetrain.k2": [1.0], "drivetrain.balance_stiffness": [2.0]}, progress=False)
+    with pytest.raises(ps.InvalidParameterError, match="metrics.*left_stroke_amplitude"):
+        sweep(parity, GRID, metrics=["left_stroke_amplitud"], progress=False)
+    with pytest.raises(ps.InvalidParameterError, match="keep_cycle"):
+        sweep(parity, GRID, keep_cycle=["left_phee"], progress=False)
+    with pytest.raises(ps.InvalidParameterError, match="threads"):
+        sweep(parity, GRID, threads=0, progress=False)
+    with pytest.raises(ps.InvalidParameterError, match="options"):
+        sweep(parity, GRID, options={"max_cycle": 3}, progress=False)
+    with pytest.raises(ps.InvalidParameterError, match="options.method"):
+        sweep(parity, GRID, options={"method": "euler"}, progress=False)
+    with pytest.raises(ps.InvalidParameterError, match="chunk_size"):
+        sweep(parity, GRID, chunk_size=0, progress=False)
+    with pytest.raises(ps.InvalidParameterError, match=r"wings\[0\]\.inertia"):  # an invalid base spec
+        bad = dataclasses.replace(parity.wings[0], inertia=((1.0, 0, 0), (0, -1.0, 0), (0, 0, 1.0)))
+        sweep(parity.replace(wings=(bad, parity.wings[1])), GRID, progress=False)
+
+
+def test_failing_points_become_error_rows_and_the_rest_is_kept(parity: ps.Simulation) -> None:
+    rows = pl.DataFrame(
+        {
+            "drivetrain.k2": [1.0, -1.0, 1.0, 5.0, None],
+            "actuator.voltage_v": [100.0, 100.0, 5000.0, 80.0, 90.0],
+            "options.max_cycles": [5, 5, 5, 0, 5],
+        }
+    )
+    df = sweep(parity, rows, metrics=["left_stroke_amplitude"], progress=False)
+    assert df["status"].to_list() == ["ok", "error", "error", "error", "ok"]
+    assert df["error_kind"].to_list() == [None, "InvalidParameter", "Integration", "InvalidParameter", None]
+    assert "drivetrain.balance_stiffness" in df["error"][1] and ">= 0" in df["error"][1]
+    assert "integration failed" in df["error"][2]
+    assert "max_cycles" in df["error"][3]
+    assert df["left_stroke_amplitude"].null_count() == 3 and df["cycles_run"].null_count() == 3
+    # a null keeps the base value (K2 = 1); the last row equals the base design at 90 V
+    base = ps.simulate(parity.replace(actuator=dataclasses.replace(parity.actuator, waveform=dataclasses.replace(parity.actuator.waveform, amplitude_v=90.0))))
+    assert df["left_stroke_amplitude"][4] == base.metrics["left_stroke_amplitude"]
+
+
+def test_option_paths_run_per_point(parity: ps.Simulation) -> None:
+    df = sweep(parity, {"options.max_cycles": [1, 2], "options.min_cycles": [1]}, options={"steady_tol": 1e-30}, progress=False)
+    assert df["cycles_run"].to_list() == [1, 2]
+    assert df["converged"].to_list() == [False, False]
+
+
+def test_no_grid_runs_the_base_design_and_an_empty_table_runs_nothing(parity: ps.Simulation) -> None:
+    df = sweep(parity, progress=False, metrics=["q2_amplitude"])
+    assert df.height == 1 and df["q2_amplitude"][0] == ps.simulate(parity).metrics["q2_amplitude"]
+    empty = sweep(parity, pl.DataFrame({"drivetrain.k2": []}, schema={"drivetrain.k2": pl.Float64}), metrics=["q2_amplitude"], progress=False)
+    assert empty.height == 0
+    assert empty.columns == ["point", "drivetrain.k2", "q2_amplitude", "converged", "cycles_run", "status", "error", "error_kind"]
+
+
+def test_keep_cycle_returns_the_last_cycle_as_list_columns(hmf: ps.Simulation) -> None:
+    df = sweep(hmf, {"actuator.frequency_hz": [90.0, 120.0]}, keep_cycle=["left_phi"], options={"record_cycles": 2}, progress=False)
+    assert [c for c in df.columns if c.startswith("cycle_")] == ["cycle_time_ms", "cycle_left_phi"]
+    spec = hmf.replace(
+        actuator=dataclasses.replace(hmf.actuator, waveform=dataclasses.replace(hmf.actuator.waveform, frequency_hz=120.0)),
+        options=dataclasses.replace(hmf.options, record_cycles=2),
+    )
+    cycle = ps.simulate(spec).cycle
+    assert df["cycle_left_phi"][1].to_list() == cycle["left_phi"].to_list()
+    assert df["cycle_time_ms"][1].to_list() == cycle["time_ms"].to_list()
+    everything = sweep(hmf, None, keep_cycle=True, progress=False)
+    assert len([c for c in everything.columns if c.startswith("cycle_")]) == 1 + len(_core.sweep_trajectory_columns(hmf.device_dict()))
+
+
+# ----------------------------------------------------------------------------- progress and cancel
+
+
+def test_run_handle_reports_progress_and_cancel_keeps_finished_points(parity: ps.Simulation) -> None:
+    device, options = parity.device_dict(), parity.options_dict()
+    run = _core.SweepRun([device] * 400, options, ["left_stroke_amplitude"], False, 2)
+    assert (run.total, run.finished, run.threads) == (400, 0, 2)
+    run.start()
+    while run.finished < 10:
+        time.sleep(0.001)
+    run.cancel()
+    assert run.wait(None)
+    res = run.result()
+    done = int(res["finished"].sum())
+    assert run.cancelled and 10 <= done < 400 and done == run.finished
+    assert res["ok"][res["finished"]].all() and not res["ok"][~res["finished"]].any()
+    values = res["metrics"][res["finished"], 0]
+    assert np.all(values == values[0])  # the same device everywhere
+    assert np.isnan(res["metrics"][~res["finished"], 0]).all()
+    with pytest.raises(RuntimeError, match="already started"):
+        run.start()
+
+
+def test_ctrl_c_cancels_and_returns_the_finished_rows(parity: ps.Simulation) -> None:
+    table = grid({"drivetrain.k2": np.linspace(1.0, 2.0, 10_000).tolist()})
+    timer = threading.Timer(0.4, _thread.interrupt_main)
+    timer.start()
+    try:
+        with pytest.warns(RuntimeWarning, match="cancelled"):
+            partial = sweep(parity, table, metrics=["q2_amplitude", "left_stroke_amplitude"], threads=2, chunk_size=64, progress=False)
+    finally:
+        timer.cancel()
+    assert 0 < partial.height < table.height
+    assert partial["point"].is_sorted() and (partial["status"] == "ok").all()
+    again = sweep(parity, table[partial["point"].to_list()], metrics=["q2_amplitude", "left_stroke_amplitude"], progress=False)
+    assert_same(partial.drop("point"), again.drop("point"))
+
+
+def test_thread_count_comes_from_the_environment() -> None:
+    code = "import paritysim._core as c; print(c.sweep_resolve_threads())"
+    env = {**os.environ, _core.SWEEP_THREADS_ENV: "3"}
+    assert subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout.strip() == "3"
+    env[_core.SWEEP_THREADS_ENV] = "zero"
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert out.returncode != 0 and "PARITYSIM_THREADS" in out.stderr and "InvalidParameterError" in out.stderr
+
+
+# ----------------------------------------------------------------------------- checkpoints
+
+KILL_SCRIPT = textwrap.dedent(
+    """
+    import importlib, sys, time
+    sw = importlib.import_module("paritysim.sweep")
+    from test_sweep_inputs import spec, table
+
+    real_flush = sw._Checkpoint.flush
+    def slow_flush(self, df):
+        real_flush(self, df)
+        time.sleep(0.3)      # leave time to kill us between chunks
+    sw._Checkpoint.flush = slow_flush
+    sw.sweep(spec(), table(), threads=1, chunk_size=4, checkpoint=sys.argv[1], progress=False)
+    print("finished")
+    """
+)
+
+INPUTS = textwrap.dedent(
+    f"""
+    import dataclasses
+    import paritysim as ps
+    from paritysim.sweep import grid
+
+    def spec():
+        s = ps.load_spec({str(EXAMPLES / "drag_parity.toml")!r})
+        return s.replace(options=dataclasses.replace(s.options, **{FAST!r}))
+
+    def table():
+        return grid({{"drivetrain.k2": [1.0, 2.0, 3.0, 4.0, 5.0], "actuator.voltage_v": [60.0, 80.0, 100.0, 5000.0]}})
+    """
+)
+
+
+def test_checkpoint_resumes_a_killed_sweep_and_matches_an_uninterrupted_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    (tmp_path / "test_sweep_inputs.py").write_text(INPUTS)
+    (tmp_path / "kill_me.py").write_text(KILL_SCRIPT)
+    checkpoint = tmp_path / "runs" / "study.parquet"
+    parts = checkpoint.with_name("study.parquet.parts")
+    proc = subprocess.Popen([sys.executable, str(tmp_path / "kill_me.py"), str(checkpoint)], cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(tmp_path)})
+    try:
+        deadline = time.monotonic() + 60
+        while len(list(parts.glob("part-*.parquet"))) < 2:
+            assert proc.poll() is None, "the sweep ended before it could be killed"
+            assert time.monotonic() < deadline, "no chunk was flushed"
+            time.sleep(0.02)
+        proc.send_signal(signal.SIGKILL)
+    finally:
+        proc.wait()
+    assert not checkpoint.exists()
+    flushed = pl.concat([pl.read_parquet(p) for p in parts.glob("part-*.parquet")])
+    assert 8 <= flushed.height < 20
+
+    sys.path.insert(0, str(tmp_path))
+    try:
+        from test_sweep_inputs import spec, table  # type: ignore[import-not-found]
+    finally:
+        sys.path.remove(str(tmp_path))
+    ran: list[int] = []
+    real = sweep_module._prepare
+
+    def counting(chunk: Any) -> Any:
+        ran.extend(chunk.points)
+        return real(chunk)
+
+    monkeypatch.setattr(sweep_module, "_prepare", counting)
+    resumed = sweep(spec(), table(), threads=2, chunk_size=4, checkpoint=checkpoint, progress=False)
+    assert sorted(ran) == sorted(set(range(20)) - set(flushed["point"].to_list())), "only unfinished points run"
+    assert checkpoint.exists() and not parts.exists()
+    monkeypatch.setattr(sweep_module, "_prepare", real)
+    fresh = sweep(spec(), table(), threads=2, progress=False)
+    assert_same(resumed, fresh)
+    assert (fresh["status"] == "error").sum() == 5  # 5 kV rows are kept as errors, and resumed as such
+    assert_same(pl.read_parquet(checkpoint), fresh)
+
+    # a complete checkpoint answers a re-run without running anything; a longer grid reuses it
+    ran.clear()
+    monkeypatch.setattr(sweep_module, "_prepare", counting)
+    assert_same(sweep(spec(), table(), checkpoint=checkpoint, progress=False), fresh)
+    assert ran == []
+    longer = grid({"drivetrain.k2": [1.0, 2.0, 3.0, 4.0, 5.0, 6.0], "actuator.voltage_v": [60.0, 80.0, 100.0, 5000.0]})
+    extended = sweep(spec(), longer, checkpoint=checkpoint, progress=False)
+    assert sorted(ran) == [20, 21, 22, 23] and extended.height == 24
+    assert_same(extended.head(20), fresh)
+
+
+def test_a_checkpoint_from_another_sweep_is_refused(parity: ps.Simulation, tmp_path: Path) -> None:
+    path = tmp_path / "study.parquet"
+    sweep(parity, {"drivetrain.k2": [1.0]}, checkpoint=path, progress=False)
+    other = parity.replace(actuator=dataclasses.replace(parity.actuator, stiffness=400.0))
+    with pytest.raises(ps.InvalidParameterError, match="checkpoint"):
+        sweep(other, {"drivetrain.k2": [1.0]}, checkpoint=path, progress=False)
+
+
+# ----------------------------------------------------------------------------- executors
+
+
+def test_specs_and_chunks_pickle(parity: ps.Simulation) -> None:
+    parity.device_dict()  # with its cached dicts
+    assert pickle.loads(pickle.dumps(parity)) == parity
+    for name in ("hmf", "drag_parity"):
+        spec = ps.load_spec(EXAMPLES / f"{name}.toml")
+        assert pickle.loads(pickle.dumps(spec)) == spec
+
+
+def test_process_pool_executor_matches_local(parity: ps.Simulation) -> None:
+    local = sweep(parity, GRID, progress=False)
+    with cf.ProcessPoolExecutor(max_workers=2, mp_context=multiprocessing.get_context("spawn")) as pool:
+        remote = sweep(parity, GRID, executor=pool, chunk_size=5, progress=False)
+    assert_same(local, remote)
+
+
+def test_dask_local_cluster_matches_local(parity: ps.Simulation) -> None:
+    distributed = pytest.importorskip("distributed")
+    local = sweep(parity, GRID, progress=False)
+    with distributed.LocalCluster(processes=True, n_workers=2, threads_per_worker=1, dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        remote = sweep(parity, GRID, executor=client.get_executor(), chunk_size=3, progress=False)
+    assert_same(local, remote)
+
+
+# ----------------------------------------------------------------------------- CLI
+
+
+def test_cli_runs_a_study_file(tmp_path: Path) -> None:
+    study = tmp_path / "study.toml"
+    study.write_text(
+        textwrap.dedent(
+            f"""
+            spec = {str(EXAMPLES / "hmf.toml")!r}
+            metrics = ["left_stroke_amplitude"]
+            [options]
+            max_cycles = 5
+            samples_per_cycle = 40
+            [grid]
+            "actuator.frequency_hz" = {{ start = 80.0, stop = 140.0, num = 4 }}
+            "actuator.voltage_v" = [50.0, 100.0]
+            [plot]
+            x = "actuator.frequency_hz"
+            y = "left_stroke_amplitude"
+            hue = "actuator.voltage_v"
+            """
+        )
+    )
+    assert main(["sweep", str(study), "--out", str(tmp_path / "runs"), "--threads", "2", "--quiet"]) == 0
+    df = pl.read_parquet(tmp_path / "runs" / "study.parquet")
+    assert df.height == 8 and (df["status"] == "ok").all()
+    assert df["actuator.frequency_hz"].to_list()[:4] == [80.0, 80.0, 100.0, 100.0]
+    assert (tmp_path / "runs" / "study.png").stat().st_size > 1000
+    bad = tmp_path / "bad.toml"
+    bad.write_text(study.read_text().replace("actuator.voltage_v", "actuator.voltage"))
+    assert main(["sweep", str(bad), "--out", str(tmp_path / "runs"), "--quiet"]) == 1
+
+
+def test_plot_draws_one_line_per_hue(hmf: ps.Simulation) -> None:
+    df = sweep(hmf, {"actuator.voltage_v": [50.0, 100.0], "actuator.frequency_hz": [90.0, 110.0, 130.0]}, progress=False)
+    fig = sweep_module.plot(df, "actuator.frequency_hz", "left_stroke_amplitude", hue="actuator.voltage_v")
+    assert len(fig.axes[0].lines) == 2
+    assert math.isfinite(fig.axes[0].lines[0].get_ydata()[0])
