@@ -27,6 +27,7 @@ import numpy as np
 import polars as pl
 
 from .. import aero
+from ._io import write_trial
 from ..simulation import SimulationResult, simulate
 from ..spec import Actuator, Aero, Configuration, Drivetrain, Options, Simulation, Waveform, Wing
 
@@ -349,41 +350,31 @@ def _plot_fig2_12(df: pl.DataFrame, ratio: float):  # type: ignore[no-untyped-de
     return fig
 
 
-def _write(df: pl.DataFrame, out: Path, name: str, fig) -> list[Path]:  # type: ignore[no-untyped-def]
-    from .. import plots
-
-    written = [out / f"{name}.parquet", out / f"{name}.csv"]
-    df.write_parquet(written[0])
-    df.write_csv(written[1])
-    written.append(plots.save(fig, out / f"{name}.png"))
-    return written
-
-
 def _cli_table(out: Path) -> list[Path]:
     df = table_3_2()
-    return _write(df, out, "table3_2", _plot_table(df))
+    return write_trial(df, out, "table3_2", _plot_table(df))
 
 
 def _cli_fig3_2(out: Path) -> list[Path]:
     df = fig3_2()
-    return _write(df, out, "fig3_2", _plot_fig3_2(df))
+    return write_trial(df, out, "fig3_2", _plot_fig3_2(df))
 
 
 def _cli_fig3_3(out: Path) -> list[Path]:
     df = fig3_3()
-    return _write(df, out, "fig3_3", _plot_fig3_3(df))
+    return write_trial(df, out, "fig3_3", _plot_fig3_3(df))
 
 
 def _cli_fig3_4(out: Path) -> list[Path]:
     curves, recovery = fig3_4()
-    written = _write(curves, out, "fig3_4", _plot_fig3_4(curves, recovery))
+    written = write_trial(curves, out, "fig3_4", _plot_fig3_4(curves, recovery))
     recovery.write_csv(out / "fig3_4_recovery.csv")
     return [*written, out / "fig3_4_recovery.csv"]
 
 
 def _cli_fig2_12(out: Path) -> list[Path]:
     df, ratio = fig2_12()
-    return _write(df, out, "fig2_12", _plot_fig2_12(df, ratio))
+    return write_trial(df, out, "fig2_12", _plot_fig2_12(df, ratio))
 
 
 CLI_TRIALS = {"table3.2": _cli_table, "fig3.2": _cli_fig3_2, "fig3.3": _cli_fig3_3, "fig3.4": _cli_fig3_4, "fig2.12": _cli_fig2_12}

@@ -26,6 +26,7 @@ import numpy as np
 import polars as pl
 
 from .. import aero
+from ._io import write_trial
 from ..simulation import SimulationResult, simulate
 from ..spec import Actuator, Aero, Configuration, Drivetrain, Options, Simulation, Spring, Waveform, Wing
 
@@ -222,16 +223,6 @@ def _fig3_13(df: pl.DataFrame):  # type: ignore[no-untyped-def]
     return fig
 
 
-def _write(df: pl.DataFrame, out: Path, name: str, fig) -> list[Path]:  # type: ignore[no-untyped-def]
-    from .. import plots
-
-    written = [out / f"{name}.parquet", out / f"{name}.csv"]
-    df.write_parquet(written[0])
-    df.write_csv(written[1])
-    written.append(plots.save(fig, out / f"{name}.png"))
-    return written
-
-
 def _cli_table(out: Path) -> list[Path]:
     import matplotlib.pyplot as plt
 
@@ -244,22 +235,22 @@ def _cli_table(out: Path) -> list[Path]:
     ax.set_ylabel("stroke peak-to-peak (deg)")
     ax.legend(fontsize=8)
     ax.set_title("Table 3.3 trials: stroke amplitudes as the right wing is cut")
-    return _write(df, out, "table3_3", fig)
+    return write_trial(df, out, "table3_3", fig)
 
 
 def _cli_fig3_11(out: Path) -> list[Path]:
     df = trajectories()
-    return _write(df, out, "fig3_11", _fig(df, "roll", tuple(TRIALS), "Fig. 3.11: roll torque imparted by each wing, HMF vs PARITY", "roll torque (mN·mm)"))
+    return write_trial(df, out, "fig3_11", _fig(df, "roll", tuple(TRIALS), "Fig. 3.11: roll torque imparted by each wing, HMF vs PARITY", "roll torque (mN·mm)"))
 
 
 def _cli_fig3_12(out: Path) -> list[Path]:
     df = trajectories().filter(pl.col("trial") == "1-Cut")
-    return _write(df, out, "fig3_12", _fig(df, "yaw", ("1-Cut",), "Fig. 3.12: yaw torque in the 1-Cut trial", "yaw torque (mN·mm)"))
+    return write_trial(df, out, "fig3_12", _fig(df, "yaw", ("1-Cut",), "Fig. 3.12: yaw torque in the 1-Cut trial", "yaw torque (mN·mm)"))
 
 
 def _cli_fig3_13(out: Path) -> list[Path]:
     df = trajectories()
-    return _write(df, out, "fig3_13", _fig3_13(df))
+    return write_trial(df, out, "fig3_13", _fig3_13(df))
 
 
 CLI_TRIALS = {"table3.3": _cli_table, "fig3.11": _cli_fig3_11, "fig3.12": _cli_fig3_12, "fig3.13": _cli_fig3_13}
