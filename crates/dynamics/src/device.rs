@@ -498,10 +498,7 @@ impl Device {
         let p_ddot = Vec6::new(phi_ddot.x, 0.0, 0.0, phi_ddot.y, 0.0, 0.0);
         let mut wings = [empty_terms(); 2];
         for (k, wing) in self.spec.wings.iter().enumerate() {
-            wings[k] = wing.terms(
-                &Vector3::new(p[3 * k], 0.0, 0.0),
-                &Vector3::new(p_dot[3 * k], 0.0, 0.0),
-            )?;
+            wings[k] = wing.stroke_terms(p[3 * k], p_dot[3 * k]);
         }
         let actuator = self.spec.actuator.as_ref();
         let force = actuator.map_or(0.0, |a| a.force(t));

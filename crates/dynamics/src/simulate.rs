@@ -175,6 +175,17 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
     let period = device.period();
     let (window, n_samples) = match period {
         Some(period) => {
+            // Cycles before the first convergence check run in one integrator call (no restarts).
+            let warm_up = options
+                .min_cycles
+                .saturating_sub(1)
+                .min(options.max_cycles.saturating_sub(1));
+            if warm_up > 0 {
+                let t_end = warm_up as f64 * period;
+                y = integrator.integrate(device, 0.0, &y, t_end, &[t_end])?[0];
+                t = t_end;
+                cycles_run = warm_up;
+            }
             while cycles_run < options.max_cycles {
                 let next = integrator.integrate(device, t, &y, t + period, &[t + period])?[0];
                 let change = state_change(&next, &y);

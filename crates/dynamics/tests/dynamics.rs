@@ -824,3 +824,41 @@ fn tunable_hinge_forces_are_the_gradient_of_its_energy() {
     }
     assert!(worst < 1e-8, "relative energy drift {worst:e}");
 }
+
+/// The closed-form stroke-only wing terms equal the general shoulder terms at θ = ψ = 0.
+#[test]
+fn stroke_terms_equal_general_terms_on_the_stroke_plane() {
+    for (a2, a3) in [(90.0, 0.0), (90.0, 30.0), (90.0, 60.0)] {
+        let blade = paritysim_aero::BladeElementModel::new(
+            paritysim_aero::Omegas::new(46.8, 0.59, 17.5, 0.71).unwrap(),
+            paritysim_aero::CoefficientSet::default(),
+        )
+        .unwrap();
+        let wing = Wing::new(
+            shoulder(a2, a3),
+            full_inertia(),
+            springs([3.0, 0.0, 0.0, 2.0, 0.0, 1.0]),
+            WingAero::BladeElement(blade),
+        )
+        .unwrap();
+        for (phi, rate) in [(0.3, 0.7), (-0.9, -0.2), (1.2, 0.05), (0.0, 0.0)] {
+            let fast = wing.stroke_terms(phi, rate);
+            let general = wing
+                .terms(&Vector3::new(phi, 0.0, 0.0), &Vector3::new(rate, 0.0, 0.0))
+                .unwrap();
+            let tol = 1e-12;
+            assert_relative_eq!(fast.mass, general.mass, epsilon = tol);
+            assert_relative_eq!(fast.coriolis, general.coriolis, epsilon = tol);
+            assert_relative_eq!(fast.spring, general.spring, epsilon = tol);
+            assert_relative_eq!(fast.aero, general.aero, epsilon = tol);
+            assert_relative_eq!(fast.aero_frame6, general.aero_frame6, epsilon = tol);
+            assert_relative_eq!(fast.j6, general.j6, epsilon = tol);
+            assert_relative_eq!(fast.omega, general.omega, epsilon = tol);
+            assert_relative_eq!(fast.jdot_pdot, general.jdot_pdot, epsilon = tol);
+            assert_relative_eq!(fast.rotation, general.rotation, epsilon = tol);
+            assert_relative_eq!(fast.potential, general.potential, epsilon = tol);
+            assert_relative_eq!(fast.kinetic, general.kinetic, epsilon = tol);
+            assert!(general.theta_w.abs() < tol);
+        }
+    }
+}
