@@ -145,6 +145,9 @@ pub struct Device {
     n_dof: usize,
     formulation: Formulation,
     stroke_only: Option<StrokeOnly>,
+    /// Wings whose deviation C holds at zero on an α2 = 90° shoulder: their terms are closed form
+    /// ([`Wing::stroke_plane_terms`]).
+    stroke_plane: [bool; 2],
 }
 
 /// The drivetrain state recovered from the stroke angles.
@@ -241,6 +244,16 @@ impl Device {
                 (b, Vec6::zeros(), n_coords)
             }
         };
+        let mut stroke_plane = [false; 2];
+        if formulation != Formulation::Projection {
+            let c = &spec.constraints;
+            for (w, wing) in spec.wings.iter().enumerate() {
+                let row = 3 * w + 1;
+                let theta_held = (0..c.n_free()).all(|k| c.null_basis()[(row, k)].abs() <= 1e-12)
+                    && c.particular()[row] == 0.0;
+                stroke_plane[w] = theta_held && wing.has_closed_form_stroke_plane();
+            }
+        }
         Ok(Self {
             spec,
             n_coords,
@@ -249,6 +262,7 @@ impl Device {
             n_dof,
             formulation,
             stroke_only,
+            stroke_plane,
         })
     }
 
@@ -397,7 +411,11 @@ impl Device {
             let k = 3 * w;
             let pw = Vector3::new(p[k], p[k + 1], p[k + 2]);
             let vw = Vector3::new(p_dot[k], p_dot[k + 1], p_dot[k + 2]);
-            let terms = wing.terms(&pw, &vw)?;
+            let terms = if self.stroke_plane[w] {
+                wing.stroke_plane_terms(&pw, &vw)
+            } else {
+                wing.terms(&pw, &vw)?
+            };
             mass.fixed_view_mut::<3, 3>(k, k).copy_from(&terms.mass);
             let f = terms.aero - terms.coriolis - terms.spring;
             force.fixed_view_mut::<3, 1>(k, 0).copy_from(&f);

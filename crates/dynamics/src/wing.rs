@@ -293,6 +293,55 @@ impl Wing {
         &self.aero
     }
 
+    /// [`Self::terms`] on the stroke plane (θ = θ̇ = 0) of an α2 = 90° shoulder, in closed form:
+    /// with γ5 ≡ 0, γ3 = 0, γ2 = φ and ∂γ5/∂θ = cos φ (any α3), `R_6^1 = R_x(φ) R_z(ψ)`,
+    /// `J6 = [(cψ, −sψ, 0), cos φ (sψ, cψ, 0), ẑ]` and `J̇6 ṗ = φ̇ ψ̇ (−sψ, −cψ, 0)`. Valid without
+    /// springs on joints 2, 3, 5; tested against [`Self::terms`].
+    pub fn stroke_plane_terms(&self, p: &Vector3<f64>, p_dot: &Vector3<f64>) -> WingTerms {
+        let (phi, psi) = (p.x, p.z);
+        let (sp, cp) = phi.sin_cos();
+        let (ss, cs) = psi.sin_cos();
+        let rotation = Matrix3::new(1.0, 0.0, 0.0, 0.0, cp, -sp, 0.0, sp, cp)
+            * Matrix3::new(cs, -ss, 0.0, ss, cs, 0.0, 0.0, 0.0, 1.0);
+        let j6 = Matrix3::new(cs, cp * ss, 0.0, -ss, cp * cs, 0.0, 0.0, 0.0, 1.0);
+        let omega = j6 * p_dot;
+        let jdot_pdot = Vector3::new(-ss, -cs, 0.0) * (p_dot.x * p_dot.z);
+        let i_omega = self.inertia * omega;
+        let sp_ = &self.springs;
+        let mut spring = Vector3::new(sp_[0].torque(phi), sp_[3].torque(0.0), sp_[5].torque(psi));
+        let mut potential = sp_[0].energy(phi) + sp_[3].energy(0.0) + sp_[5].energy(psi);
+        if let Some(h) = &self.tunable_hinge {
+            let k = h.stiffness(0.0);
+            spring.z += k * psi;
+            spring.y += 0.5 * h.k1 * psi * psi;
+            potential += 0.5 * k * psi * psi;
+        }
+        let aero_frame6 = self.aero.torque(p_dot, &omega, &rotation);
+        WingTerms {
+            mass: j6.transpose() * self.inertia * j6,
+            coriolis: j6.transpose() * (self.inertia * jdot_pdot + omega.cross(&i_omega)),
+            spring,
+            aero: j6.transpose() * aero_frame6,
+            aero_frame6,
+            j6,
+            omega,
+            jdot_pdot,
+            rotation,
+            theta_w: 0.0,
+            potential,
+            kinetic: 0.5 * omega.dot(&i_omega),
+        }
+    }
+
+    /// Whether [`Self::stroke_plane_terms`] applies to this wing (α2 = 90°, no springs on
+    /// joints 2, 3, 5).
+    pub fn has_closed_form_stroke_plane(&self) -> bool {
+        (self.shoulder.alpha2() - std::f64::consts::FRAC_PI_2).abs() <= 1e-15
+            && [1, 2, 4]
+                .iter()
+                .all(|&j| self.springs[j] == JointSpring::default())
+    }
+
     /// [`Self::terms`] for a wing that only strokes (θ = ψ = 0, θ̇ = ψ̇ = 0) on an α2 = 90°
     /// shoulder, in closed form. There the velocity closure gives γ5 ≡ 0, γ3 = 0, γ2 = φ and
     /// ∂γ5/∂θ = cos φ for any α3, so `J6 = [x̂, cos φ ŷ, ẑ]`, `ω = φ̇ x̂`, `J̇6 ṗ = 0` and

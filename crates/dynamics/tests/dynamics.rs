@@ -862,3 +862,44 @@ fn stroke_terms_equal_general_terms_on_the_stroke_plane() {
         }
     }
 }
+
+/// The closed-form stroke-plane terms (θ = θ̇ = 0) equal the general shoulder terms.
+#[test]
+fn stroke_plane_terms_equal_general_terms() {
+    use paritysim_dynamics::TunableHinge;
+    for (a2, a3) in [(90.0, 0.0), (90.0, 40.0)] {
+        let blade = paritysim_aero::BladeElementModel::new(
+            paritysim_aero::Omegas::new(46.8, 0.59, 17.5, 0.71).unwrap(),
+            paritysim_aero::CoefficientSet::default(),
+        )
+        .unwrap();
+        let wing = Wing::new(
+            shoulder(a2, a3),
+            full_inertia(),
+            springs([3.0, 0.0, 0.0, 2.0, 0.0, 1.5]),
+            WingAero::BladeElement(blade),
+        )
+        .unwrap()
+        .with_tunable_hinge(TunableHinge::new(2.0, 0.5, 3.0).unwrap());
+        assert!(wing.has_closed_form_stroke_plane());
+        for (phi, psi, rate, spin) in [
+            (0.3, 0.7, 0.6, -0.4),
+            (-0.9, -1.1, -0.2, 1.3),
+            (1.2, 0.1, 0.05, 0.0),
+        ] {
+            let (p, v) = (Vector3::new(phi, 0.0, psi), Vector3::new(rate, 0.0, spin));
+            let fast = wing.stroke_plane_terms(&p, &v);
+            let general = wing.terms(&p, &v).unwrap();
+            let tol = 1e-12;
+            assert_relative_eq!(fast.mass, general.mass, epsilon = tol);
+            assert_relative_eq!(fast.coriolis, general.coriolis, epsilon = tol);
+            assert_relative_eq!(fast.spring, general.spring, epsilon = tol);
+            assert_relative_eq!(fast.aero, general.aero, epsilon = tol);
+            assert_relative_eq!(fast.j6, general.j6, epsilon = tol);
+            assert_relative_eq!(fast.jdot_pdot, general.jdot_pdot, epsilon = tol);
+            assert_relative_eq!(fast.rotation, general.rotation, epsilon = tol);
+            assert_relative_eq!(fast.potential, general.potential, epsilon = tol);
+            assert_relative_eq!(fast.kinetic, general.kinetic, epsilon = tol);
+        }
+    }
+}
