@@ -68,3 +68,10 @@ def test_reproduce_laminate_writes_section(tmp_path: Path) -> None:
     assert row["linkage sublaminate cure curvature (max)"] < 1e-12
     assert "Laminate design layer" in (tmp_path / "laminate.md").read_text()
     assert (tmp_path / "laminate.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_trial_functions_are_exported() -> None:
+    for name in ("fig2_9", "table_3_2", "fig3_2", "fig3_3", "fig3_4", "fig2_12", "section_3_4", "lift_dual_parity", "laminate_summary"):
+        assert callable(getattr(ps.trials, name)), name
+    expected = {"fig2.9", "table3.2", "fig3.2", "fig3.3", "fig3.4", "fig2.12", "table3.3", "fig3.11", "fig3.12", "fig3.13", "lift-dual", "laminate", "fig2.13", "sec2.7", "floquet"}
+    assert expected <= set(ps.trials.REGISTRY)

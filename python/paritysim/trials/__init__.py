@@ -15,8 +15,22 @@ from pathlib import Path
 
 from .laminate_design import laminate_summary
 from .section_2_3 import fig2_9
+from .section_2_5 import lift_dual_parity
+from .section_3_3 import fig2_12, fig3_2, fig3_3, fig3_4, table_3_2
+from .section_3_4 import section_3_4
 
-__all__ = ["REGISTRY", "fig2_9", "laminate_summary"]
+__all__ = [
+    "REGISTRY",
+    "fig2_9",
+    "fig2_12",
+    "fig3_2",
+    "fig3_3",
+    "fig3_4",
+    "laminate_summary",
+    "lift_dual_parity",
+    "section_3_4",
+    "table_3_2",
+]
 
 
 def _discover() -> dict[str, Callable[[Path], list[Path]]]:

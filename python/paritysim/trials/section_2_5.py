@@ -11,6 +11,7 @@ Baselines: #1 (HMF) and #3 (Drag PARITY) with θ fixed.
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import math
 from pathlib import Path
 from typing import Any
@@ -21,7 +22,8 @@ import polars as pl
 from .. import aero
 from ..simulation import simulate
 from ..spec import Configuration, Spring, TunableHinge, Wing
-from . import section_3_4 as s34
+# The package exports the function `section_3_4` under the module's name: load the module itself.
+s34 = importlib.import_module("paritysim.trials.section_3_4")
 
 #: (configuration name, Table 3.1 number, wings rotate?)
 CONFIGURATIONS = [

@@ -189,7 +189,10 @@ def floquet_devices() -> pl.DataFrame:
     K2 = 1 and 500, also with the 1-Cut wing of Table 3.2 (ERRATA 11's ratio), the linear map of
     eq. 2.15 at K2 = 0 and 1) and of the §3.4 rotating-wing
     devices (Table 3.3 wings, hinge pinned to ±60° rotation, K2 = 0; see trials.section_3_4)."""
-    from . import section_3_4 as s34
+    import importlib
+
+    # the package attribute `section_3_4` is the function; load the module itself
+    s34 = importlib.import_module("paritysim.trials.section_3_4")
 
     p34 = s34.params()
     cases = {
