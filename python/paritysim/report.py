@@ -1,6 +1,6 @@
 """The reproduction report: ``paritysim reproduce --all --out DIR`` writes ``DIR/report.md``.
 
-Each trial module may define ``report_section(out_dir) -> str`` (or ``report_section() -> str``);
+Each trial module may define ``report_section(out_dir) -> str``;
 sections appear in thesis order. Every number the thesis states is listed with ours, the
 difference and a verdict; figures written by the trials are embedded.
 """
@@ -8,7 +8,6 @@ difference and a verdict; figures written by the trials are embedded.
 from __future__ import annotations
 
 import importlib
-import inspect
 import pkgutil
 from pathlib import Path
 
@@ -39,8 +38,7 @@ def write_report(out: Path) -> Path:
         section = getattr(module, "report_section", None)
         if section is None:
             continue
-        n_args = len(inspect.signature(section).parameters)
-        parts.append(section(out) if n_args >= 1 else section())
+        parts.append(section(out))
         parts.append("")
     path = out / "report.md"
     path.write_text("\n".join(parts))

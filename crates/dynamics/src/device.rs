@@ -103,16 +103,8 @@ fn stroke_only(spec: &DeviceSpec) -> std::result::Result<StrokeOnly, String> {
     }
     let mut stroke_inertia = [0.0; 2];
     for (k, wing) in spec.wings.iter().enumerate() {
-        if (wing.shoulder().alpha2() - std::f64::consts::FRAC_PI_2).abs() > 1e-15 {
-            return Err(
-                "the shoulders must have alpha2 = 90 deg (theta_w = 0 at theta = 0)".into(),
-            );
-        }
-        if [1, 2, 4]
-            .iter()
-            .any(|&j| wing.springs()[j] != crate::wing::JointSpring::default())
-        {
-            return Err("joint springs 2, 3 and 5 must be absent".into());
+        if !wing.has_closed_form_stroke_plane() {
+            return Err("the shoulders must have alpha2 = 90 deg (theta_w = 0 at theta = 0) and no springs on joints 2, 3 and 5".into());
         }
         stroke_inertia[k] = wing.inertia()[(0, 0)];
     }
@@ -303,10 +295,8 @@ impl Device {
     #[inline]
     pub fn coordinates(&self, y: &State) -> Result<(Vec6, Vec6)> {
         if self.stroke_only.is_some() {
-            let dt = self.drivetrain();
-            let q = Vector2::new(y[0], if self.n_dof == 2 { y[1] } else { 0.0 });
-            let q_dot = Vector2::new(y[6], if self.n_dof == 2 { y[7] } else { 0.0 });
-            let e = dt.evaluate(q.x, q.y)?;
+            let (q, q_dot) = self.drive_coordinates(y);
+            let e = self.drivetrain().evaluate(q.x, q.y)?;
             let phi_dot = e.jacobian * q_dot;
             let p = Vec6::new(e.stroke.x, 0.0, 0.0, e.stroke.y, 0.0, 0.0);
             let p_dot = Vec6::new(phi_dot.x, 0.0, 0.0, phi_dot.y, 0.0, 0.0);
@@ -328,6 +318,30 @@ impl Device {
             .as_ref()
             .expect("validated: stroke-only devices have a drivetrain")
             .kinematics
+    }
+
+    /// `(q, q̇)` of a drivetrain-coordinate state (`q2 ≡ 0` for a 1-DOF drivetrain).
+    fn drive_coordinates(&self, y: &State) -> (Vector2<f64>, Vector2<f64>) {
+        let two = self.n_dof == 2;
+        (
+            Vector2::new(y[0], if two { y[1] } else { 0.0 }),
+            Vector2::new(y[6], if two { y[7] } else { 0.0 }),
+        )
+    }
+
+    /// Actuator force `F(t)`, drivetrain load `Q = (F − K1 q1, −K2 q2)` and its spring energy
+    /// `½K1q1² + ½K2q2²`.
+    fn drive_load(&self, t: f64, q: &Vector2<f64>) -> (f64, Vector2<f64>, f64) {
+        let actuator = self.spec.actuator.as_ref();
+        let force = actuator.map_or(0.0, |a| a.force(t));
+        let k1 = actuator.map_or(0.0, |a| a.stiffness());
+        let k2 = self
+            .spec
+            .transmission
+            .as_ref()
+            .map_or(0.0, |tr| tr.balance_stiffness);
+        let load = Vector2::new(force - k1 * q.x, -k2 * q.y);
+        (force, load, 0.5 * k1 * q.x * q.x + 0.5 * k2 * q.y * q.y)
     }
 
     /// An integrator state from `(p, ṗ)` after checking `C p = c0`, `C ṗ = 0`.
@@ -364,41 +378,31 @@ impl Device {
             return Ok(DriveState::default());
         };
         let dt = &tr.kinematics;
-        let k1 = self.spec.actuator.as_ref().map_or(0.0, |a| a.stiffness());
-        let force = self.spec.actuator.as_ref().map_or(0.0, |a| a.force(t));
-        let k2 = tr.balance_stiffness;
         if dt.dof() == 1 {
-            let target = p[0];
-            let (q1, slope) = invert_1dof(dt, target)?;
-            let q1_dot = p_dot[0] / slope;
-            let generalized = force - k1 * q1;
+            let (q1, slope) = invert_1dof(dt, p[0])?;
+            let q = Vector2::new(q1, 0.0);
+            let (force, load, potential) = self.drive_load(t, &q);
             return Ok(DriveState {
-                q: Vector2::new(q1, 0.0),
-                q_dot: Vector2::new(q1_dot, 0.0),
+                q,
+                q_dot: Vector2::new(p_dot[0] / slope, 0.0),
                 actuator_force: force,
-                // Acts through φL only; C ties φR to it.
-                stroke_torque: Vector2::new(generalized / slope, 0.0),
-                potential: 0.5 * k1 * q1 * q1,
+                stroke_torque: stroke_torque(1, &Matrix2::new(slope, 0.0, slope, 0.0), &q, &load)?,
+                potential,
             });
         }
         let target = Vector2::new(p[0], p[3]);
         let (q, jac) = invert_2dof(dt, &target)?;
-        let lu = jac.lu();
-        let q_dot = lu
+        let q_dot = jac
+            .lu()
             .solve(&Vector2::new(p_dot[0], p_dot[3]))
             .ok_or_else(|| singular_drive(&q))?;
-        let generalized = Vector2::new(force - k1 * q.x, -k2 * q.y);
-        let stroke_torque = jac
-            .transpose()
-            .lu()
-            .solve(&generalized)
-            .ok_or_else(|| singular_drive(&q))?;
+        let (force, load, potential) = self.drive_load(t, &q);
         Ok(DriveState {
             q,
             q_dot,
             actuator_force: force,
-            stroke_torque,
-            potential: 0.5 * k1 * q.x * q.x + 0.5 * k2 * q.y * q.y,
+            stroke_torque: stroke_torque(2, &jac, &q, &load)?,
+            potential,
         })
     }
 
@@ -501,47 +505,27 @@ impl Device {
             let (p, p_dot) = self.coordinates(y)?;
             return self.evaluate(t, &p, &p_dot);
         };
-        let dt = self.drivetrain();
-        let two = self.n_dof == 2;
-        let q = Vector2::new(y[0], if two { y[1] } else { 0.0 });
-        let q_dot = Vector2::new(y[6], if two { y[7] } else { 0.0 });
-        let mut dydt = [0.0; STATE_LEN];
-        self.rhs_drivetrain(fast, t, y, &mut dydt)?;
-        let q_ddot = Vector2::new(dydt[6], if two { dydt[7] } else { 0.0 });
-        let e = dt.evaluate(q.x, q.y)?;
-        let phi_dot = e.jacobian * q_dot;
-        let phi_ddot = e.jacobian * q_ddot + e.velocity_product(&q_dot);
+        let step = self.drivetrain_step(fast, t, y)?;
+        let e = &step.eval;
+        let phi_dot = e.jacobian * step.q_dot;
+        let phi_ddot = e.jacobian * step.q_ddot + e.velocity_product(&step.q_dot);
         let p = Vec6::new(e.stroke.x, 0.0, 0.0, e.stroke.y, 0.0, 0.0);
         let p_dot = Vec6::new(phi_dot.x, 0.0, 0.0, phi_dot.y, 0.0, 0.0);
         let p_ddot = Vec6::new(phi_ddot.x, 0.0, 0.0, phi_ddot.y, 0.0, 0.0);
         let mut wings = [empty_terms(); 2];
         for (k, wing) in self.spec.wings.iter().enumerate() {
-            wings[k] = wing.stroke_terms(p[3 * k], p_dot[3 * k]);
+            let (pk, vk) = (
+                Vector3::new(p[3 * k], 0.0, 0.0),
+                Vector3::new(p_dot[3 * k], 0.0, 0.0),
+            );
+            wings[k] = wing.stroke_plane_terms(&pk, &vk);
         }
-        let actuator = self.spec.actuator.as_ref();
-        let force = actuator.map_or(0.0, |a| a.force(t));
-        let k1 = actuator.map_or(0.0, |a| a.stiffness());
-        let k2 = self
-            .spec
-            .transmission
-            .as_ref()
-            .map_or(0.0, |tr| tr.balance_stiffness);
-        let generalized = Vector2::new(force - k1 * q.x, -k2 * q.y);
-        let stroke_torque = if two {
-            e.jacobian
-                .transpose()
-                .lu()
-                .solve(&generalized)
-                .ok_or_else(|| singular_drive(&q))?
-        } else {
-            Vector2::new(generalized.x / e.jacobian[(0, 0)], 0.0)
-        };
         let drive = DriveState {
-            q,
-            q_dot,
-            actuator_force: force,
-            stroke_torque,
-            potential: 0.5 * k1 * q.x * q.x + 0.5 * k2 * q.y * q.y,
+            q: step.q,
+            q_dot: step.q_dot,
+            actuator_force: step.force,
+            stroke_torque: stroke_torque(self.n_dof, &e.jacobian, &step.q, &step.load)?,
+            potential: step.potential,
         };
         Ok(Evaluation {
             p,
@@ -552,50 +536,56 @@ impl Device {
         })
     }
 
-    /// Right-hand side in drivetrain coordinates (see [`Formulation::DrivetrainCoordinates`]).
-    fn rhs_drivetrain(&self, fast: &StrokeOnly, t: f64, y: &State, dydt: &mut State) -> Result<()> {
-        let dt = self.drivetrain();
-        let two = self.n_dof == 2;
-        let q = Vector2::new(y[0], if two { y[1] } else { 0.0 });
-        let q_dot = Vector2::new(y[6], if two { y[7] } else { 0.0 });
-        let e = dt.evaluate(q.x, q.y)?;
-        let phi_dot = e.jacobian * q_dot;
-        let h = e.velocity_product(&q_dot);
-        let actuator = self.spec.actuator.as_ref();
-        let force = actuator.map_or(0.0, |a| a.force(t));
-        let k1 = actuator.map_or(0.0, |a| a.stiffness());
-        let k2 = self
-            .spec
-            .transmission
-            .as_ref()
-            .map_or(0.0, |tr| tr.balance_stiffness);
+    /// The equations of [`Formulation::DrivetrainCoordinates`]:
+    /// `M_q q̈ = Σ_k J_kᵀ (τ_k − I_k h_k) + Q` with `M_q = Σ_k I_k J_kᵀ J_k`.
+    fn drivetrain_step(&self, fast: &StrokeOnly, t: f64, y: &State) -> Result<DrivetrainStep> {
+        let (q, q_dot) = self.drive_coordinates(y);
+        let eval = self.drivetrain().evaluate(q.x, q.y)?;
+        let phi_dot = eval.jacobian * q_dot;
+        let h = eval.velocity_product(&q_dot);
+        let (force, load, potential) = self.drive_load(t, &q);
         let mut mass = Matrix2::zeros();
-        let mut generalized = Vector2::new(force - k1 * q.x, -k2 * q.y);
+        let mut generalized = load;
         let mut aero_power = 0.0;
         for k in 0..2 {
             let wing = &self.spec.wings[k];
-            let row = e.jacobian.row(k).transpose();
+            let row = eval.jacobian.row(k).transpose();
             let inertia = fast.stroke_inertia[k];
             let tau_aero = wing.aero().stroke_torque(phi_dot[k]);
-            let tau = tau_aero - wing.springs()[0].torque(e.stroke[k]) - inertia * h[k];
+            let tau = tau_aero - wing.springs()[0].torque(eval.stroke[k]) - inertia * h[k];
             mass += row * row.transpose() * inertia;
             generalized += row * tau;
             aero_power += tau_aero * phi_dot[k];
         }
-        let q_ddot = if two {
+        let q_ddot = if self.n_dof == 2 {
             mass.lu()
                 .solve(&generalized)
                 .ok_or_else(|| singular_drive(&q))?
         } else {
             Vector2::new(generalized.x / mass[(0, 0)], 0.0)
         };
+        Ok(DrivetrainStep {
+            eval,
+            q,
+            q_dot,
+            q_ddot,
+            force,
+            load,
+            potential,
+            aero_power,
+        })
+    }
+
+    /// Right-hand side in drivetrain coordinates (see [`Formulation::DrivetrainCoordinates`]).
+    fn rhs_drivetrain(&self, fast: &StrokeOnly, t: f64, y: &State, dydt: &mut State) -> Result<()> {
+        let step = self.drivetrain_step(fast, t, y)?;
         dydt.fill(0.0);
         for i in 0..self.n_dof {
-            dydt[i] = q_dot[i];
-            dydt[6 + i] = q_ddot[i];
+            dydt[i] = step.q_dot[i];
+            dydt[6 + i] = step.q_ddot[i];
         }
-        dydt[12] = force * q_dot.x;
-        dydt[13] = aero_power;
+        dydt[12] = step.force * step.q_dot.x;
+        dydt[13] = step.aero_power;
         Ok(())
     }
 
@@ -608,6 +598,35 @@ impl Device {
             .sum::<f64>()
             + e.drive.potential
     }
+}
+
+/// One evaluation of the drivetrain-coordinate equations.
+struct DrivetrainStep {
+    eval: paritysim_kinematics::DrivetrainEval,
+    q: Vector2<f64>,
+    q_dot: Vector2<f64>,
+    q_ddot: Vector2<f64>,
+    force: f64,
+    load: Vector2<f64>,
+    potential: f64,
+    aero_power: f64,
+}
+
+/// Generalised torques on `(φL, φR)` from the drivetrain load: `τ_φ = J⁻ᵀ Q`; a 1-DOF drivetrain
+/// acts through φL only (C ties φR to it).
+fn stroke_torque(
+    dof: usize,
+    jac: &Matrix2<f64>,
+    q: &Vector2<f64>,
+    load: &Vector2<f64>,
+) -> Result<Vector2<f64>> {
+    if dof == 1 {
+        return Ok(Vector2::new(load.x / jac[(0, 0)], 0.0));
+    }
+    jac.transpose()
+        .lu()
+        .solve(load)
+        .ok_or_else(|| singular_drive(q))
 }
 
 fn singular_drive(q: &Vector2<f64>) -> Error {

@@ -342,38 +342,6 @@ impl Wing {
                 .all(|&j| self.springs[j] == JointSpring::default())
     }
 
-    /// [`Self::terms`] for a wing that only strokes (θ = ψ = 0, θ̇ = ψ̇ = 0) on an α2 = 90°
-    /// shoulder, in closed form. There the velocity closure gives γ5 ≡ 0, γ3 = 0, γ2 = φ and
-    /// ∂γ5/∂θ = cos φ for any α3, so `J6 = [x̂, cos φ ŷ, ẑ]`, `ω = φ̇ x̂`, `J̇6 ṗ = 0` and
-    /// `R_6^1 = R_x(φ)`. Only valid without springs on joints 2, 3, 5 and without a tunable hinge
-    /// (the drivetrain-coordinate formulation checks this); tested against [`Self::terms`].
-    pub fn stroke_terms(&self, phi: f64, phi_dot: f64) -> WingTerms {
-        let (sp, cp) = phi.sin_cos();
-        let rotation = Matrix3::new(1.0, 0.0, 0.0, 0.0, cp, -sp, 0.0, sp, cp);
-        let j6 = Matrix3::new(1.0, 0.0, 0.0, 0.0, cp, 0.0, 0.0, 0.0, 1.0);
-        let omega = Vector3::new(phi_dot, 0.0, 0.0);
-        let i_omega = self.inertia * omega;
-        let s = &self.springs;
-        let spring = Vector3::new(s[0].torque(phi), s[3].torque(0.0), s[5].torque(0.0));
-        let potential = s[0].energy(phi) + s[3].energy(0.0) + s[5].energy(0.0);
-        let p_dot = Vector3::new(phi_dot, 0.0, 0.0);
-        let aero_frame6 = self.aero.torque(&p_dot, &omega, &rotation);
-        WingTerms {
-            mass: j6.transpose() * self.inertia * j6,
-            coriolis: j6.transpose() * omega.cross(&i_omega),
-            spring,
-            aero: j6.transpose() * aero_frame6,
-            aero_frame6,
-            j6,
-            omega,
-            jdot_pdot: Vector3::zeros(),
-            rotation,
-            theta_w: 0.0,
-            potential,
-            kinetic: 0.5 * omega.dot(&i_omega),
-        }
-    }
-
     /// Mass matrix, Coriolis, spring and aero terms at `(p, ṗ)`.
     ///
     /// # Errors

@@ -842,7 +842,8 @@ fn stroke_terms_equal_general_terms_on_the_stroke_plane() {
         )
         .unwrap();
         for (phi, rate) in [(0.3, 0.7), (-0.9, -0.2), (1.2, 0.05), (0.0, 0.0)] {
-            let fast = wing.stroke_terms(phi, rate);
+            let fast = wing
+                .stroke_plane_terms(&Vector3::new(phi, 0.0, 0.0), &Vector3::new(rate, 0.0, 0.0));
             let general = wing
                 .terms(&Vector3::new(phi, 0.0, 0.0), &Vector3::new(rate, 0.0, 0.0))
                 .unwrap();

@@ -2,8 +2,8 @@
 
 Each function returns Polars DataFrames computed by the model; nothing is copied from the
 thesis. A module may define ``CLI_TRIALS: dict[str, Callable[[Path], list[Path]]]`` (name ->
-runner writing files into an output directory) and ``REPORT_SECTIONS`` (name -> callable
-returning markdown); :data:`REGISTRY` collects them for ``paritysim reproduce``.
+runner writing files into an output directory) and ``report_section(out_dir) -> str``
+(markdown for ``report.md``); :data:`REGISTRY` collects the runners for ``paritysim reproduce``.
 """
 
 from __future__ import annotations

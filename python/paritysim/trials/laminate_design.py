@@ -61,18 +61,15 @@ def report_markdown(df: pl.DataFrame) -> str:
 def _cli_laminate(out: Path) -> list[Path]:
     import matplotlib.pyplot as plt
 
-    from .. import plots
+    from ._io import write_trial
 
     df, _bimorph, stack = laminate_summary()
-    written = [out / "laminate.parquet", out / "laminate.csv", out / "laminate.md"]
-    df.write_parquet(written[0])
-    df.write_csv(written[1])
-    written[2].write_text(report_markdown(df))
     fig, ax = plt.subplots(figsize=(8, 6), constrained_layout=True)
     stack.plot(ax=ax)
     ax.set_title("Fig. 4.27: the Mobee 18-layer PC-MEMS stack (computed thickness and layers)")
-    written.append(plots.save(fig, out / "laminate.png"))
-    return written
+    written = write_trial(df, out, "laminate", fig)
+    (out / "laminate.md").write_text(report_markdown(df))
+    return [*written, out / "laminate.md"]
 
 
 CLI_TRIALS = {"laminate": _cli_laminate}

@@ -60,13 +60,10 @@ def fig2_9(step_deg: float = 1.0, limit_deg: float = 90.0) -> pl.DataFrame:
 
 def _cli_fig2_9(out: Path) -> list[Path]:
     from .. import plots
+    from ._io import write_trial
 
     df = fig2_9()
-    written = [out / "fig2_9.parquet", out / "fig2_9.csv"]
-    df.write_parquet(written[0])
-    df.write_csv(written[1])
-    written.append(plots.save(plots.fig2_9(df), out / "fig2_9.png"))
-    return written
+    return write_trial(df, out, "fig2_9", plots.fig2_9(df))
 
 
 CLI_TRIALS = {"fig2.9": _cli_fig2_9}

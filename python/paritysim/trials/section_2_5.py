@@ -124,15 +124,12 @@ def _plot(df: pl.DataFrame, settle: pl.DataFrame):  # type: ignore[no-untyped-de
 
 
 def _cli(out: Path) -> list[Path]:
-    from .. import plots
+    from ._io import write_trial
 
     df = lift_dual_parity()
     settle = deviation_settling()
-    written = [out / "lift_dual.parquet", out / "lift_dual.csv"]
-    df.write_parquet(written[0])
-    df.write_csv(written[1])
+    written = write_trial(df, out, "lift_dual", _plot(df, settle))
     settle.write_csv(out / "lift_dual_settling.csv")
-    written.append(plots.save(_plot(df, settle), out / "lift_dual.png"))
     return [*written, out / "lift_dual_settling.csv"]
 
 

@@ -259,7 +259,7 @@ CLI_TRIALS = {"fig2.13": _cli_fig2_13, "sec2.7": _cli_sec2_7, "floquet": _cli_fl
 # ------------------------------------------------------------------ report
 
 
-def report_section() -> str:
+def report_section(out: Path | None = None) -> str:
     """Markdown for report.md: each thesis equation of §2.6-2.7 checked, the errata found and the
     numbers of the full nonlinear model (all computed now)."""
     from scipy.special import i0
@@ -343,4 +343,3 @@ T = 9.09 ms; multipliers below ~1e-6 are at the resolution of the finite differe
 """
 
 
-REPORT_SECTIONS = {"section_2_6": report_section}
