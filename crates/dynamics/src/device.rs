@@ -311,6 +311,7 @@ impl Device {
         Ok((self.offset + self.basis * x, self.basis * xd))
     }
 
+    #[inline]
     fn drivetrain(&self) -> &Drivetrain {
         &self
             .spec
@@ -321,6 +322,7 @@ impl Device {
     }
 
     /// `(q, q̇)` of a drivetrain-coordinate state (`q2 ≡ 0` for a 1-DOF drivetrain).
+    #[inline]
     fn drive_coordinates(&self, y: &State) -> (Vector2<f64>, Vector2<f64>) {
         let two = self.n_dof == 2;
         (
@@ -331,6 +333,7 @@ impl Device {
 
     /// Actuator force `F(t)`, drivetrain load `Q = (F − K1 q1, −K2 q2)` and its spring energy
     /// `½K1q1² + ½K2q2²`.
+    #[inline]
     fn drive_load(&self, t: f64, q: &Vector2<f64>) -> (f64, Vector2<f64>, f64) {
         let actuator = self.spec.actuator.as_ref();
         let force = actuator.map_or(0.0, |a| a.force(t));
@@ -538,6 +541,8 @@ impl Device {
 
     /// The equations of [`Formulation::DrivetrainCoordinates`]:
     /// `M_q q̈ = Σ_k J_kᵀ (τ_k − I_k h_k) + Q` with `M_q = Σ_k I_k J_kᵀ J_k`.
+    // Always inlined: it sits in the right-hand side and returns a large struct.
+    #[inline(always)]
     fn drivetrain_step(&self, fast: &StrokeOnly, t: f64, y: &State) -> Result<DrivetrainStep> {
         let (q, q_dot) = self.drive_coordinates(y);
         let eval = self.drivetrain().evaluate(q.x, q.y)?;
