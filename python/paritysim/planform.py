@@ -180,6 +180,41 @@ class Planform:
         """Shifted by ``dz`` (spanwise) and ``dx`` (toward the leading edge; moves the hinge line by ``-dx``)."""
         return Planform(self.points + np.array([float(dz), float(dx)]))
 
+    def cut(self, fraction: float, where: str = "tip", *, measure: str = "span") -> Planform:
+        """The membrane left after cutting part of it away along a straight line.
+
+        ``where="tip"`` removes the outboard part (``z`` beyond the cut line), as the 1-Cut and
+        2-Cut wings of §3.4 (Fig. 3.10, "planform area removed from the distal extent");
+        ``where="trailing"`` removes the rear part (``x`` behind the cut line).
+
+        ``measure="span"``: ``fraction`` of the spanwise extent (tip) or of the chordwise extent
+        (trailing) is removed. ``measure="area"``: the line is placed so that ``fraction`` of
+        the *area* is removed (§3.3 states its cuts as area kept: 84.3 %, 56.8 %), solved by
+        bracketing root finding to 1e-12 of the area. The result is a polygon, so its Ω1..Ω4
+        and inertia integrals stay exact.
+
+        Raises ``InvalidParameterError`` (``fraction``: ``0 <= fraction < 1``; ``where``;
+        ``measure``) and ``GeometryError`` if the line would split the membrane in pieces.
+        """
+        if measure not in ("span", "area"):
+            raise invalid("measure", measure, '"span" or "area"')
+        f = float(fraction)
+        if not (math.isfinite(f) and 0.0 <= f < 1.0):
+            raise invalid("fraction", fraction, "in [0, 1)")
+        if measure == "span" or f == 0.0:
+            return Planform(_core.aero_planform_cut(self.points, f, str(where)))
+        from scipy.optimize import brentq
+
+        target = (1.0 - f) * self.area
+
+        def excess(s: float) -> float:
+            kept = _core.aero_planform_properties(_core.aero_planform_cut(self.points, s, str(where)), AIR_DENSITY, None)
+            return float(kept["area"]) - target
+
+        # Kept area falls continuously and monotonically from the full area (s = 0) to 0 (s -> 1).
+        s = brentq(excess, 0.0, 1.0 - 1e-12, xtol=1e-14, rtol=1e-14)
+        return Planform(_core.aero_planform_cut(self.points, float(s), str(where)))
+
     # ------------------------------------------------------------------ parameters
     def omegas(self, rho: float = AIR_DENSITY) -> dict[str, float]:
         """Ω1..Ω4 of eqs. 3.12-3.15 (mg·mm²) and ``force`` = ½ρ∬z²dA (mg·mm).

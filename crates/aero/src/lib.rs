@@ -3,6 +3,8 @@
 //! * [`planform`]: a wing outline polygon in the frame of Fig. 3.1 (`z` spanwise along the
 //!   hinge from the spherical centre, `x` chordwise, positive toward the leading edge), with
 //!   exact area, chord `c(z)`, leading edge `l(z)` and the parameters Ω1..Ω4 of eqs. 3.12–3.15.
+//! * [`cut`]: [`Planform::cut`] trims a membrane at the tip or trailing edge (the 1-Cut /
+//!   2-Cut wings of §3.3–3.4); the result is a polygon, so its Ω stay exact.
 //! * [`inertia`]: the wing inertia tensor about the spherical centre (frame of Fig. 3.10) from a
 //!   membrane areal density, line masses (spars) and point masses; exact for polygons.
 //! * [`coefficients`]: lift/drag coefficient models behind [`CoefficientModel`]: the Dickinson
@@ -29,6 +31,7 @@
 
 pub mod blade;
 pub mod coefficients;
+pub mod cut;
 pub mod inertia;
 pub mod planform;
 
@@ -41,6 +44,7 @@ pub use coefficients::{
     WhitneyWood2010, center_of_pressure, checked_coefficients, from_normal_tangential,
     to_normal_tangential,
 };
+pub use cut::CutEdge;
 pub use inertia::{LineMass, MassDistribution, PointMass, WingInertia};
 pub use paritysim_error::{Error, Result};
 pub use planform::{DEFAULT_AIR_DENSITY, Planform, PlanformIntegrals};

@@ -6,7 +6,7 @@
 use nalgebra::Vector3;
 use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
 use paritysim_aero::{
-    BladeElementModel, CoefficientModel, CoefficientSet, LineMass, MassDistribution,
+    BladeElementModel, CoefficientModel, CoefficientSet, CutEdge, LineMass, MassDistribution,
     NormalForceLaw, Omegas, Planform, PointMass, WingState, center_of_pressure,
 };
 use paritysim_error::Error;
@@ -136,6 +136,22 @@ fn aero_planform_hmf_like<'py>(
     segments: usize,
 ) -> PyResult<Bound<'py, PyAny>> {
     let p = Planform::hmf_like(tip_radius, segments).py_err()?;
+    vertices(py, &p)
+}
+
+/// Vertices `(m, 2)` of the membrane left after cutting `fraction` of its span at the tip
+/// (`where = "tip"`) or of its chordwise extent at the trailing edge (`"trailing"`).
+#[pyfunction]
+fn aero_planform_cut<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    fraction: f64,
+    edge: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let edge = CutEdge::from_name(edge).py_err()?;
+    let p = planform(&points, None)
+        .and_then(|p| p.cut(fraction, edge))
+        .py_err()?;
     vertices(py, &p)
 }
 
@@ -400,6 +416,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(aero_planform_semi_ellipse, m)?)?;
     m.add_function(wrap_pyfunction!(aero_planform_hmf_like, m)?)?;
     m.add_function(wrap_pyfunction!(aero_planform_chord, m)?)?;
+    m.add_function(wrap_pyfunction!(aero_planform_cut, m)?)?;
     m.add_function(wrap_pyfunction!(aero_planform_inertia, m)?)?;
     m.add_function(wrap_pyfunction!(aero_coefficients, m)?)?;
     m.add_function(wrap_pyfunction!(aero_moments, m)?)?;
