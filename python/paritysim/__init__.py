@@ -6,14 +6,21 @@ Angles are radians unless an argument name says otherwise (``*_deg``).
 Quick start::
 
     import paritysim as ps
-    spec = ps.load_spec("examples/drag_parity.toml")   # build a model
-    result = ps.simulate(spec)                          # run it (Rust, GIL released)
-    result.plot("drag_parity.png")                      # plot it; result.trajectory is Polars
+    spec = ps.devices.load("sreetharan2012_3_3_parity")  # a named device (ps.devices.list())
+    result = ps.simulate(spec)                            # run it (Rust, GIL released)
+    result.plot("drag_parity.png")                        # plot it; result.trajectory is Polars
+    df = ps.sweep(spec, {"wings.left.omega_ratio": [1.0, 0.8, 0.6]})  # a design study
+
+Submodules load on first use (``import paritysim`` stays fast and never touches matplotlib's
+backend). Log messages go to the ``"paritysim"`` :mod:`logging` logger.
 """
 
 from __future__ import annotations
 
-from . import aero, kinematics, laminate, planform, plots, spec, stability, trials
+import importlib
+import logging
+from typing import TYPE_CHECKING, Any
+
 from ._core import (
     CancelledError,
     ConstraintError,
@@ -26,50 +33,85 @@ from ._core import (
     SingularError,
     __version__,
 )
-from .calibration import CalibrationResult, calibrate
-from .planform import Planform
-from .simulation import SimulationResult, simulate
 
-# `paritysim.sweep` is the function (the module stays importable as paritysim.sweep via importlib).
-from .sweep import grid, sweep  # noqa: E402
-from .spec import Actuator, Aero, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, TunableHinge, Waveform, Wing, load_spec
+logging.getLogger(__name__).addHandler(logging.NullHandler())
+
+if TYPE_CHECKING:  # what type checkers see; at run time the names below load lazily
+    from . import aero, devices, kinematics, laminate, planform, plots, spec, stability, trials
+    from .calibration import CalibrationResult, calibrate
+    from .planform import Planform
+    from .simulation import SimulationResult, simulate
+    from .spec import Actuator, Aero, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, TunableHinge, Waveform, Wing, load_spec
+    from .sweep import grid, sweep
+
+#: Lazily loaded submodules.
+_SUBMODULES = ("aero", "calibration", "devices", "kinematics", "laminate", "planform", "plots", "simulation", "spec", "stability", "sweep", "trials")
+#: Lazily loaded names -> the submodule defining them.
+_NAMES = {
+    "CalibrationResult": "calibration",
+    "calibrate": "calibration",
+    "Planform": "planform",
+    "SimulationResult": "simulation",
+    "simulate": "simulation",
+    "grid": "sweep",
+    **{n: "spec" for n in ("Actuator", "Aero", "Configuration", "Drivetrain", "Options", "Shoulder", "Simulation", "Spring", "TunableHinge", "Waveform", "Wing", "load_spec")},
+}
+
+
+def __getattr__(name: str) -> Any:
+    # `paritysim.sweep` is the sweep module, callable as the sweep function (see sweep.py).
+    if name in _SUBMODULES:
+        module = importlib.import_module(f"{__name__}.{name}")
+        globals()[name] = module
+        return module
+    if name in _NAMES:
+        value = getattr(importlib.import_module(f"{__name__}.{_NAMES[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_SUBMODULES) | set(_NAMES))
+
 
 __all__ = [
     "Actuator",
     "Aero",
     "CalibrationResult",
-    "Planform",
-    "calibrate",
-    "aero",
-    "laminate",
-    "planform",
-    "Configuration",
-    "Options",
-    "Shoulder",
-    "Simulation",
-    "SimulationResult",
-    "Spring",
-    "TunableHinge",
-    "Waveform",
-    "Wing",
-    "load_spec",
-    "simulate",
-    "stability",
-    "grid",
-    "sweep",
-    "spec",
     "CancelledError",
+    "Configuration",
     "ConstraintError",
     "Drivetrain",
     "GeometryError",
     "IntegrationError",
     "InvalidParameterError",
+    "Options",
     "OutOfDomainError",
     "ParitysimError",
+    "Planform",
     "ShapeError",
+    "Shoulder",
+    "Simulation",
+    "SimulationResult",
     "SingularError",
+    "Spring",
+    "TunableHinge",
+    "Waveform",
+    "Wing",
     "__version__",
+    "aero",
+    "calibrate",
+    "devices",
+    "grid",
     "kinematics",
+    "laminate",
+    "load_spec",
+    "planform",
     "plots",
+    "simulate",
+    "spec",
+    "stability",
+    "sweep",
     "trials",
 ]

@@ -97,7 +97,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``paritysim`` console script."""
+    """Entry point of the ``paritysim`` console script (also ``python -m paritysim``)."""
+    import matplotlib
+
+    matplotlib.use("Agg")  # the CLI only writes files
     args = build_parser().parse_args(argv)
     try:
         return int(args.func(args))

@@ -4,10 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")  # headless by default; a user's interactive backend still works via pyplot
-import matplotlib.pyplot as plt
+import matplotlib.pyplot as plt  # the backend stays the user's (the CLI picks Agg)
 import numpy as np
 import polars as pl
 from matplotlib.figure import Figure

@@ -3,9 +3,13 @@
 ::
 
     import paritysim as ps
-    spec = ps.load_spec("examples/drag_parity.toml")
-    df = ps.sweep(spec, {"drivetrain.k2": [0.5, 1, 2], "wings.left.omega_ratio": [0.6, 0.8, 1.0]},
+    spec = ps.devices.load("sreetharan2012_3_3_parity")   # §3.3 Drag PARITY (eq. 2.15)
+    df = ps.sweep(spec, {"drivetrain.k2": [0.0, 1.0, 2.0], "wings.left.omega_ratio": [1.0, 0.8, 0.6]},
                   metrics=["left_roll_aero_peak", "right_roll_aero_peak"])
+
+``paritysim.sweep`` is this module and, called, the :func:`sweep` function (``ps.sweep(...)``).
+The rod-crank linkage device (``sreetharan2012_3_3_parity_linkage``, ``examples/drag_parity.toml``)
+fails on cut wings: its whippletree mode is unstable at small K2 (docs/findings.md §3).
 
 Each point is the base spec with some fields overridden, run to periodic steady state by the
 Rust engine on a local thread pool (GIL released). The result has one row per point in input
@@ -31,6 +35,16 @@ Aliases: ``wings.left`` / ``wings.right`` for ``wings[0]`` / ``wings[1]`` of a t
 waveform fields; ``wings[i].omega_ratio`` multiplies that wing's ``aero.omega1`` by the value
 (a cut wing of Table 3.2: ``wings.left.omega_ratio = 0.6``).
 
+Indices are 0-based: ``wings[0]`` is the left wing (eq. 3.21), ``springs[j]`` is joint ``j + 1``
+of the shoulder, so ``springs[0]`` is the stroke φ (γ1), ``springs[3]`` the deviation θ (γ4)
+and ``springs[5]`` the wing-rotation (ψ) hinge (γ6, eq. 2.1).
+
+Label columns
+-------------
+Columns named in ``labels=`` are not parameters: they are carried, unchanged, into the result
+(e.g. a ``cut_fraction`` column next to the Ω columns computed from
+:meth:`paritysim.Planform.cut`), so results need no join.
+
 Threads, progress, checkpoints, clusters
 ----------------------------------------
 ``threads=None`` uses ``$PARITYSIM_THREADS`` if set, else every core. ``progress=True`` shows a
@@ -52,10 +66,12 @@ import dataclasses
 import hashlib
 import itertools
 import json
+import logging
 import math
 import os
 import uuid
 import warnings
+from collections import Counter
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -72,6 +88,8 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 __all__ = ["THREADS_ENV", "grid", "plot", "sweep", "valid_paths"]
+
+logger = logging.getLogger(__name__)
 
 #: Environment variable giving the default thread count (a positive integer).
 THREADS_ENV: str = _core.SWEEP_THREADS_ENV
@@ -432,6 +450,7 @@ def sweep(
     executor: cf.Executor | None = None,
     chunk_size: int | None = None,
     options: Mapping[str, Any] | None = None,
+    labels: Sequence[str] = (),
 ) -> pl.DataFrame:
     """Run ``spec`` over a table of parameter overrides; one row per point, in input order.
 
@@ -466,12 +485,17 @@ def sweep(
         executor, at most 256).
     options:
         Overrides of ``spec.options`` for every point, e.g. ``{"max_cycles": 50}``.
+    labels:
+        Grid columns that are not parameter paths (e.g. ``"cut_fraction"``): passed through
+        to the result unchanged, never applied to the spec.
 
     Returns
     -------
     polars.DataFrame
         ``point``, the parameter columns, the metrics, ``converged``, ``cycles_run``,
         ``status`` (``"ok"``/``"error"``), ``error``, ``error_kind`` (and ``cycle_*``).
+        When more than half of the points fail, a ``RuntimeWarning`` names the most common
+        error (and the ``"paritysim"`` logger records it).
 
     Raises
     ------
@@ -489,8 +513,13 @@ def sweep(
         except TypeError as exc:
             raise invalid("options", repr(dict(options)), f"fields of paritysim.Options ({exc})") from None
     table = _table(grid)
+    label_names = [labels] if isinstance(labels, str) else list(labels)
+    for name in label_names:
+        if name not in table.columns:
+            raise invalid("labels", repr(name), "columns of the grid: " + ", ".join(table.columns))
+    param_table = table.drop(label_names) if label_names else table
     schema = _schema(spec)
-    params = tuple(_resolve(spec, name, schema) for name in table.columns)
+    params = tuple(_resolve(spec, name, schema) for name in param_table.columns)
     seen: dict[tuple[str, tuple[str | int, ...]], str] = {}
     for p in params:
         for t in p.targets:
@@ -516,7 +545,7 @@ def sweep(
     if chunk_size is not None and (not isinstance(chunk_size, int) or isinstance(chunk_size, bool) or chunk_size < 1):
         raise invalid("chunk_size", repr(chunk_size), "a positive integer")
 
-    rows = table.rows() if table.width else [()]
+    rows = param_table.rows() if param_table.width else [()] * max(table.height, 1)
     n = len(rows)
     store = _Checkpoint(checkpoint, _fingerprint(device, opts, table.columns, metric_names, cycle_columns)) if checkpoint is not None else None
     done: list[pl.DataFrame] = []
@@ -524,7 +553,7 @@ def sweep(
     if store is not None:
         previous = store.load()
         if previous is not None and previous.height:
-            done_frame, todo = _reuse(previous, table, rows)
+            done_frame, todo = _reuse(previous, table, table.rows() if table.width else rows)
             done.append(done_frame)
 
     if chunk_size is None:
@@ -567,7 +596,40 @@ def sweep(
         )
     elif store is not None:
         store.finish(result)
+    _report_failures(result)
     return result
+
+
+def _report_failures(result: pl.DataFrame) -> None:
+    """Logs a summary; warns when more than half of the points failed, naming the most common error."""
+    if not result.height or "status" not in result.columns:
+        return
+    failed = result.filter(pl.col("status") == "error")
+    logger.info("sweep: %d points, %d failed", result.height, failed.height)
+    if 2 * failed.height <= result.height:
+        return
+    kinds = Counter(zip(failed["error_kind"].fill_null("?").to_list(), failed["error"].fill_null("").to_list(), strict=True))
+    by_kind = Counter(k for k, _ in kinds.elements())
+    kind, count = by_kind.most_common(1)[0]
+    example = next(msg for (k, msg) in kinds if k == kind)
+    message = (
+        f"{failed.height} of {result.height} sweep points failed; most common error ({count} points): {kind}: {example}. "
+        "Failed rows have status = 'error' (see the 'error' column)"
+    )
+    logger.warning(message)
+    warnings.warn(message, RuntimeWarning, stacklevel=_caller_stacklevel())
+
+
+def _caller_stacklevel() -> int:
+    """The ``stacklevel`` (seen from the caller of this function) of the first frame outside
+    the paritysim package, so warnings point at the user's line however sweep was reached."""
+    import sys
+
+    package = os.path.dirname(os.path.abspath(__file__))
+    frame, level = sys._getframe(1), 1
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package):
+        frame, level = frame.f_back, level + 1  # type: ignore[assignment]
+    return level
 
 
 def _cycle_columns(device: dict[str, Any], keep_cycle: bool | Sequence[str]) -> list[str]:
@@ -763,3 +825,9 @@ def plot(df: pl.DataFrame, x: str, y: str | Sequence[str], hue: str | None = Non
         Path(path).parent.mkdir(parents=True, exist_ok=True)
         fig.savefig(path, dpi=150)
     return fig
+
+
+# `paritysim.sweep` is this module; calling it calls `sweep` (``ps.sweep(spec, grid)``).
+from ._callable_module import make_callable  # noqa: E402
+
+make_callable(__name__, "sweep")

@@ -300,3 +300,9 @@ def report_section(out: Path | None = None) -> str:
         "",
     ]
     return "\n".join(lines)
+
+
+# `from paritysim.trials import section_3_4` gives this module; calling it runs the study.
+from .._callable_module import make_callable  # noqa: E402
+
+make_callable(__name__, "section_3_4")

@@ -1,0 +1,90 @@
+"""Named devices: every thesis device and trial as a shipped TOML spec, with its provenance.
+
+Like PyBaMM's parameter sets: pick a device by name, get a :class:`paritysim.Simulation`::
+
+    import paritysim as ps
+    ps.devices.list()                                    # names
+    spec = ps.devices.load("sreetharan2012_3_3_parity")  # §3.3 Drag PARITY, Control trial
+    ps.devices.info("sreetharan2012_3_3_parity")         # what the thesis states, what we chose
+
+Names are ``sreetharan2012_<section>_<drivetrain>[_<trial>]``. Each file is a plain spec
+(:func:`paritysim.load_spec` reads :func:`path`); its header and :func:`info` list which values
+the thesis states (with § or table) and which are our choices, and why.
+
+``cut_wings`` in :func:`info` says whether the device survives cut-wing sweeps
+(``wings.left.omega_ratio`` < 1). ``sreetharan2012_3_3_parity_linkage`` (the rod-crank linkage,
+``examples/drag_parity.toml``) does not: its whippletree mode is unstable below K2 ≈ 377
+mN·mm/rad (docs/findings.md §3), so asymmetric wings drive it out of the linkage's domain.
+"""
+
+from __future__ import annotations
+
+import builtins
+import functools
+import tomllib
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from ..spec import Simulation
+
+__all__ = ["DeviceInfo", "info", "list", "load", "path"]
+
+
+@dataclass(frozen=True)
+class DeviceInfo:
+    """Provenance of a shipped device."""
+
+    name: str
+    title: str
+    section: str
+    stated: tuple[str, ...]
+    choices: tuple[str, ...]
+    cut_wings: bool
+
+    def __str__(self) -> str:
+        lines = [f"{self.name}: {self.title} ({self.section})", "Stated in the thesis:"]
+        lines += [f"  - {s}" for s in self.stated]
+        lines += ["Our choices and why:"]
+        lines += [f"  - {c}" for c in self.choices]
+        lines.append(f"Survives cut-wing sweeps: {'yes' if self.cut_wings else 'no'}")
+        return "\n".join(lines)
+
+
+@functools.cache
+def _index() -> dict[str, dict[str, Any]]:
+    text = resources.files(__name__).joinpath("index.toml").read_text(encoding="utf-8")
+    return tomllib.loads(text)
+
+
+def list() -> builtins.list[str]:  # noqa: A001  (the PyBaMM-style name is the point)
+    """Names of every shipped device, sorted."""
+    return sorted(_index())
+
+
+def _check(name: str) -> str:
+    if name not in _index():
+        from .._errors import invalid
+
+        raise invalid("name", repr(name), "a shipped device: " + ", ".join(list()))
+    return name
+
+
+def path(name: str) -> Path:
+    """The TOML file of device ``name`` (raises ``InvalidParameterError`` for an unknown name)."""
+    return Path(str(resources.files(__name__).joinpath(f"{_check(name)}.toml")))
+
+
+def info(name: str) -> DeviceInfo:
+    """The provenance of device ``name``: thesis statements, our choices, cut-wing robustness."""
+    e = _index()[_check(name)]
+    return DeviceInfo(name, e["title"], e["section"], tuple(e["stated"]), tuple(e["choices"]), bool(e["cut_wings"]))
+
+
+def load(name: str) -> Simulation:
+    """Device ``name`` as a :class:`paritysim.Simulation` (see :func:`list`)."""
+    from ..spec import load_spec
+
+    return load_spec(path(name))

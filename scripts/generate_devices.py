@@ -1,0 +1,185 @@
+"""Regenerates python/paritysim/devices/*.toml and index.toml from the trial constructors.
+
+Run after changing a trial's device or the spec format:
+    .venv/bin/python scripts/generate_devices.py
+Each TOML is a plain spec (``ps.load_spec`` reads it); its provenance (what the thesis states,
+with section or table, and what we chose and why) is in index.toml and in the file's header.
+tests/test_devices.py checks that the shipped files still equal what the trials build.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from pathlib import Path
+from typing import Any
+
+import tomli_w
+
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "python" / "paritysim" / "devices"
+
+S33_STATED = [
+    "Right-wing drag parameter Ω^R = 31.3 mg·mm² (§3.3.2, Table 3.2)",
+    "Wing inertia about the stroke axis 29.0 mg·mm² (§3.3.2)",
+    "Actuator: 120 mN blocked force at 100 V, i.e. 1.2 mN/V, and stiffness 467 mN/mm (§3.3.1)",
+    "Drive: 100 V amplitude sine at 110 Hz, no DC part (§3.3.1)",
+    "Transmission '±200 µm → ±35°' (§3.3.2) gives T = 35° / 0.2 mm of eq. 2.15",
+]
+S33_CHOICES = [
+    "Drivetrain: eq. 2.15 (linear differential), the model §2.6 proves stable; the rod-crank linkage of Fig. 2.7a is not given (ERRATA 14) and its whippletree mode is unstable at small K2 (docs/findings.md §3)",
+    "Whippletree arm L = L1 = 2.5 mm (half the 5 mm whippletree): not stated",
+    "Balance-beam spring K2 = 0 (ERRATA 14: not given; §2.6.3's κ2 = 0 case)",
+    "Drag law τ = Ω C_N(90°) φ̇² with C_N from eqs. 3.5-3.6 (ERRATA 12; 1.0 would be eq. 2.16)",
+    "Izz = 0.05 × Ixx: a fixed wing only uses Ixx; any positive value keeps the tensor valid",
+]
+S34_STATED = [
+    "Wing inertia tensors Ixx, Iyy, Izz, Ixz and Ω1..Ω4 of each wing (Table 3.3)",
+    "Drive V(t) = 100 V + 100 V sin(2π·110 Hz·t) (eq. 3.24)",
+    "Configuration #3 Drag PARITY / #1 HMF with a free ψ hinge (Table 3.1, §3.4)",
+    "Actuator 1.2 mN/V and 467 mN/mm (§3.3.1)",
+]
+S34_CHOICES = [
+    "Hinge stiffness (springs[5], the ψ hinge, joint 6; 0-based index 5) pinned so the Uncut PARITY right wing rotates ±60°, the amplitude §3.4 reports: {hinge:.6g} mN·mm/rad (root finding on the model; not stated, ERRATA 14)",
+    "dc_offset = 'ignore': the 100 V DC part biases the piezo without a net force (taken as a force it would hold a 45° stroke offset)",
+    "Transmission: eq. 2.15 with '±200 µm → ±35°' as in §3.3; whippletree arm 2.5 mm; K2 = 0",
+    "Coefficients: Dickinson et al. 1999 fits (eqs. 3.5-3.6); C_rd the aero crate's cited default; α sign convention of the aero crate (ERRATA 5)",
+]
+
+
+def trial_module(name: str) -> Any:
+    return importlib.import_module(f"paritysim.trials.{name}")
+
+
+def catalogue() -> dict[str, dict[str, Any]]:
+    """name -> {spec, title, section, stated, choices, cut_wings}."""
+    s33, s34, s25, s26 = (trial_module(n) for n in ("section_3_3", "section_3_4", "section_2_5", "section_2_6"))
+    out: dict[str, dict[str, Any]] = {}
+    p33 = s33.params()
+    for drivetrain in ("PARITY", "HMF"):
+        for trial, ratio in s33.TRIALS.items():
+            suffix = "" if trial == "Control" else "_" + trial.replace("-", "").lower()
+            name = f"sreetharan2012_3_3_{drivetrain.lower()}{suffix}"
+            stated = [*S33_STATED, f"Left wing Ω^L = {ratio:g} Ω^R ({trial} trial, §3.3.2; ERRATA 11: the ratios define the trials)"]
+            out[name] = dict(
+                spec=s33.device(p33, drivetrain, ratio * p33.omega_r).replace(name=name),
+                title=f"§3.3 {'Drag PARITY' if drivetrain == 'PARITY' else 'HMF'} with fixed wings, {trial} trial (Table 3.2)",
+                section="§3.3, Table 3.2",
+                stated=stated,
+                choices=S33_CHOICES if drivetrain == "PARITY" else [c for c in S33_CHOICES if "K2" not in c and "Drivetrain" not in c] + ["Drivetrain: eq. 2.15 for both wings (the four-bar linearised like the PARITY)"],
+                cut_wings=True,
+            )
+    out["sreetharan2012_3_3_parity_linkage"] = dict(
+        spec=s26.drag_parity_spec(k2=1.0).replace(name="sreetharan2012_3_3_parity_linkage"),
+        title="§3.3 Drag PARITY on the nonlinear rod-crank linkage (examples/drag_parity.toml)",
+        section="§3.3.2, Fig. 2.7a",
+        stated=[S33_STATED[0], S33_STATED[1], S33_STATED[2], S33_STATED[3], "Link lengths of §3.3.2: crank 0.4 mm, rod 0.8 mm, whippletree 5 mm"],
+        choices=[
+            "Linkage topology: a whippletree driving two rod-cranks perpendicular at rest (Fig. 2.7a is not in the text; ERRATA 14)",
+            "K2 = 1 mN·mm/rad (not given). With this linkage the whippletree mode is UNSTABLE below K2 ≈ 377 mN·mm/rad (Floquet multiplier 1.78 at K2 = 0, docs/findings.md §3): cut-wing points run out of the linkage's domain. Use sreetharan2012_3_3_parity for cut wings",
+            "Drag law C_N(90°) φ̇² (ERRATA 12); Izz = 1 (unused by fixed wings)",
+        ],
+        cut_wings=False,
+    )
+    out["sreetharan2012_3_3_hmf_four_bar"] = dict(
+        spec=s26.hmf_spec().replace(name="sreetharan2012_3_3_hmf_four_bar"),
+        title="§3.3 HMF on its nonlinear four-bar (examples/hmf.toml)",
+        section="§2.3.1, §3.3",
+        stated=[S33_STATED[0], S33_STATED[1], S33_STATED[2], S33_STATED[3], "HMF four-bar: 400 µm crank → 60° (§2.3.1)"],
+        choices=["Rod 0.8 mm (not stated)", "Drag law C_N(90°) φ̇² (ERRATA 12); Izz = 1 (unused by fixed wings)"],
+        cut_wings=True,
+    )
+    p34 = s34.params()
+    hinge = s34.hinge_stiffness(p34)
+    for drivetrain in ("PARITY", "HMF"):
+        for trial in s34.TRIALS:
+            suffix = "" if trial == "Uncut" else "_" + trial.replace("-", "").lower()
+            name = f"sreetharan2012_3_4_{drivetrain.lower()}{suffix}"
+            out[name] = dict(
+                spec=s34.device(p34, drivetrain, trial, hinge=hinge).replace(name=name),
+                title=f"§3.4 {'Drag PARITY' if drivetrain == 'PARITY' else 'HMF'} with rotating wings, {trial} trial (Table 3.3)",
+                section="§3.4, Table 3.3",
+                stated=[*S34_STATED, f"Right wing: the {trial} wing of Table 3.3; left wing the same in every trial (§3.4)"],
+                choices=[c.format(hinge=hinge) for c in S34_CHOICES],
+                cut_wings=True,
+            )
+    for config in ("lift_parity", "dual_parity"):
+        name = f"sreetharan2012_2_5_{config}_1cut"
+        out[name] = dict(
+            spec=s25.device(config, "1-Cut", hinge_k2=20.0).replace(name=name),
+            title=f"§2.5 {config.replace('_', ' ').title()} exploration on the §3.4 1-Cut wings",
+            section="§2.5, Table 3.1 #5/#7",
+            stated=["Configuration (Table 3.1) and the §2.5.1 tunable hinge, stiffer with deviation", *S34_STATED[:2]],
+            choices=[
+                "Tunable hinge V = ½ (k0 + k2 θ²) ψ² with k0 the §3.4 hinge and k2 = 20 mN·mm/rad³ (the law and k2 are ours; §2.5 gives no numbers)",
+                "Deviation spring (springs[3], joint 4) 10 mN·mm/rad: not stated",
+                *[c.format(hinge=hinge) for c in S34_CHOICES[1:]],
+            ],
+            cut_wings=True,
+        )
+    out["sreetharan2012_2_6_parity_linear"] = dict(
+        spec=s26.drag_parity_spec(k2=1.0, linear=True).replace(name="sreetharan2012_2_6_parity_linear"),
+        title="§2.6 Drag PARITY linearised (eq. 2.15, T = L = 2.5), the Floquet-stable reference",
+        section="§2.6, eq. 2.15",
+        stated=[S33_STATED[0], S33_STATED[1], S33_STATED[2], S33_STATED[3], "Eq. 2.15 (linear differential) of §2.6"],
+        choices=["T = 1/L3 = 2.5 rad/mm and L = L0/2 = 2.5 mm: the rest gain of the §3.3.2 linkage (docs/findings.md §2)", "K2 = 1 mN·mm/rad (not given)", "Drag law C_N(90°) φ̇² (ERRATA 12)"],
+        cut_wings=True,
+    )
+    return out
+
+
+def _value(v: Any) -> str:
+    if isinstance(v, list | tuple):
+        return "[" + ", ".join(_value(x) for x in v) + "]"
+    return tomli_w.dumps({"v": v})[4:].strip()
+
+
+JOINTS = ("γ1 = φ stroke", "γ2 shoulder link", "γ3 shoulder link", "γ4 = θ deviation", "γ5 shoulder link", "γ6 = ψ hinge (wing rotation)")
+
+
+def _springs(springs: list[dict[str, Any]]) -> str:
+    rows = [f"    {{{', '.join(f'{k} = {_value(v)}' for k, v in s.items())}}},  # [{i}] joint {i + 1}: {JOINTS[i]}" for i, s in enumerate(springs)]
+    return "springs = [  # 0-based: springs[5] is the ψ hinge (eq. 2.1: p = (γ1, γ4, γ6))\n" + "\n".join(rows) + "\n]"
+
+
+def dumps(data: dict[str, Any], prefix: str = "") -> str:
+    """TOML with numeric arrays inline (tomli_w puts every element on its own line)."""
+    scalars = {k: v for k, v in data.items() if k == "springs" or (not isinstance(v, dict) and not (isinstance(v, list) and v and isinstance(v[0], dict)))}
+    lines = [_springs(v) if k == "springs" else f"{k} = {_value(v)}" for k, v in scalars.items()]
+    out = "\n".join(lines) + ("\n" if lines else "")
+    for k, v in data.items():
+        if k in scalars:
+            continue
+        key = f"{prefix}{k}"
+        if isinstance(v, dict):
+            out += f"\n[{key}]\n" + dumps(v, key + ".")
+        else:
+            for item in v:
+                out += f"\n[[{key}]]\n" + dumps(item, key + ".")
+    return out
+
+
+def header(name: str, entry: dict[str, Any]) -> str:
+    lines = [f"# {name}: {entry['title']}", "# Units: mg, mm, ms, rad, V.  Load: ps.devices.load(" + repr(name) + ")", "#", "# Stated in the thesis:"]
+    lines += [f"#   - {s}" for s in entry["stated"]]
+    lines += ["# Our choices (not stated, or ambiguous) and why:"]
+    lines += [f"#   - {c}" for c in entry["choices"]]
+    lines += ["#", "# Generated by scripts/generate_devices.py from paritysim.trials; edit there.", ""]
+    return "\n".join(lines) + "\n"
+
+
+def main() -> int:
+    OUT.mkdir(parents=True, exist_ok=True)
+    cat = catalogue()
+    index: dict[str, Any] = {}
+    for name, entry in cat.items():
+        data = entry["spec"].to_dict()
+        (OUT / f"{name}.toml").write_text(header(name, entry) + dumps(data))
+        index[name] = {k: entry[k] for k in ("title", "section", "stated", "choices", "cut_wings")}
+    (OUT / "index.toml").write_text("# Provenance of every shipped device (generated by scripts/generate_devices.py).\n" + tomli_w.dumps(index))
+    print(f"wrote {len(cat)} devices to {OUT}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
