@@ -244,9 +244,12 @@ class Planform:
         point_masses:
             Rows ``[z, x, mass]`` (mm, mg).
 
-        Returns ``mass``, ``center_of_mass`` ``[z, x]``, ``ixx = ∫z²dm``, ``izz = ∫x²dm``,
-        ``iyy = ixx + izz``, ``ixz = -∫xz dm`` (tensor element; positive for a wing behind
-        its hinge, as in Table 3.3) and ``tensor`` (3, 3).
+        Returns
+        -------
+        dict
+            ``mass``, ``center_of_mass`` ``[z, x]``, ``ixx = ∫z²dm``, ``izz = ∫x²dm``,
+            ``iyy = ixx + izz``, ``ixz = -∫xz dm`` (tensor element; positive for a wing behind
+            its hinge, as in Table 3.3) and ``tensor`` (3, 3).
         """
         out: dict[str, Any] = _core.aero_planform_inertia(
             self.points,
