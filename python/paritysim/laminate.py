@@ -367,41 +367,62 @@ class Layup:
         return _core.laminate_ply_stresses(self._dicts, _vec3(n), _vec3(m), float(delta_t), v)
 
     # -- drawing
-    def plot(self, ax: Axes | None = None, to_scale: bool = False) -> Axes:
+    def plot(self, ax: Axes | None = None, to_scale: bool = True) -> Axes:
         """Draw the stack like Fig. 4.27c: one band per layer, bottom to top, coloured by
-        material, labelled with the layer name and thickness in µm. With ``to_scale=False``
-        every layer gets the same height (thin adhesive and film layers stay visible)."""
+        material, labelled with the layer name and thickness in µm, with the total thickness
+        dimensioned on the left.
+
+        ``to_scale=True`` (default) draws every layer at its real thickness (µm axis); labels
+        sit in evenly spaced slots joined to their layer by leader lines, so thin adhesive and
+        film layers stay readable. ``to_scale=False`` gives every layer the same height."""
         import matplotlib.pyplot as plt
         from matplotlib.patches import Patch, Rectangle
 
         if ax is None:
             _, ax = plt.subplots(figsize=(6.0, 0.35 * len(self) + 1.2))
+        total = sum(layer.thickness for layer in self._layers) * 1e3
+        heights = [layer.thickness * 1e3 if to_scale else total / len(self) for layer in self._layers]
+        slot = total / len(self)
         y = 0.0
         seen: dict[str, str] = {}
-        for layer in self._layers:
-            h = layer.thickness * 1e3 if to_scale else 1.0
+        for k, (layer, h) in enumerate(zip(self._layers, heights, strict=True)):
             colour = _COLOURS.get(layer.category, "#cccccc")
             lname = layer.plies[0].material.name.lower()
             for key, c in _METAL_COLOURS.items():
                 if layer.category == "metal" and key in lname:
                     colour = c
-            ax.add_patch(Rectangle((0.0, y), 1.0, h, facecolor=colour, edgecolor="k", linewidth=0.5))
-            label = f"{layer.name}  ({layer.thickness * 1e3:.1f} µm)"
-            ax.text(1.03, y + h / 2, label, va="center", fontsize=8)
+            ax.add_patch(Rectangle((0.0, y), 1.0, h, facecolor=colour, edgecolor="k", linewidth=0.4))
+            label_y = (k + 0.5) * slot
+            ax.annotate(
+                f"{layer.name}  ({layer.thickness * 1e3:.1f} µm)",
+                xy=(1.0, y + h / 2),
+                xytext=(1.12, label_y),
+                va="center",
+                fontsize=7,
+                arrowprops={"arrowstyle": "-", "color": "0.5", "lw": 0.5, "shrinkA": 0, "shrinkB": 0},
+            )
             seen.setdefault(layer.plies[0].material.name, colour)
             y += h
-        ax.set_xlim(0.0, 1.6)
+        # Total thickness, dimensioned beside the stack.
+        ax.annotate("", xy=(-0.06, 0.0), xytext=(-0.06, y), arrowprops={"arrowstyle": "<->", "lw": 1.0})
+        ax.text(-0.09, y / 2, f"total {total:.1f} µm", rotation=90, ha="right", va="center", fontsize=8)
+        ax.set_xlim(-0.3, 1.75)
         ax.set_ylim(0.0, y)
         ax.set_xticks([])
         if to_scale:
-            ax.set_ylabel("z from bottom (µm)")
+            ax.set_ylabel("z from bottom (µm, to scale)")
+            ax.yaxis.set_label_position("right")
+            ax.yaxis.tick_right()
         else:
             ax.set_yticks([])
-        ax.set_title(f"{len(self)}-layer stack, {1e3 * self.total_thickness_mm:.1f} µm, {self.areal_mass:.3f} mg/mm²")
+        for side in ("top", "bottom", "left"):
+            ax.spines[side].set_visible(False)
+        ax.set_title(f"{len(self)}-layer stack, {total:.1f} µm, {self.areal_mass:.3f} mg/mm²", fontsize=10)
         ax.legend(
             handles=[Patch(facecolor=c, edgecolor="k", label=n) for n, c in seen.items()],
             loc="upper left",
-            bbox_to_anchor=(1.0, -0.02),
+            bbox_to_anchor=(0.0, -0.01),
+            ncol=2,
             fontsize=7,
             frameon=False,
         )

@@ -3,13 +3,65 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import matplotlib.pyplot as plt  # the backend stays the user's (the CLI picks Agg)
 import numpy as np
 import polars as pl
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-__all__ = ["fig2_9", "save", "simulation"]
+__all__ = ["COINCIDENCE_TOLERANCE", "fig2_9", "label_with_unit", "pair", "save", "simulation"]
+
+#: Two curves closer than this fraction of their peak are "coincident" for :func:`pair`.
+COINCIDENCE_TOLERANCE = 0.01
+
+
+def pair(ax: Axes, x: Any, under: Any, over: Any, labels: tuple[str, str], color: str | tuple[str, str] = "C0", linestyle: str = "-") -> bool:
+    """Two compared curves that may lie on top of each other, both visible.
+
+    ``under`` is drawn wide and translucent, ``over`` thin and dashed on top of it (with sparse
+    markers), so a curve hidden exactly under another still shows. When they coincide (max
+    difference below :data:`COINCIDENCE_TOLERANCE` of the peak, computed) the legend says so.
+    Returns whether they coincide.
+    """
+    u, o = np.asarray(under, dtype=float), np.asarray(over, dtype=float)
+    scale = max(float(np.nanmax(np.abs(u))), float(np.nanmax(np.abs(o))), 1e-300)
+    coincide = bool(np.nanmax(np.abs(u - o)) <= COINCIDENCE_TOLERANCE * scale)
+    cu, co = (color, color) if isinstance(color, str) else color
+    note = " (coincides with the next)" if coincide else ""
+    ax.plot(x, u, linestyle=linestyle, color=cu, lw=4.0, alpha=0.35, solid_capstyle="butt", label=labels[0] + note)
+    every = max(1, len(o) // 12)
+    ax.plot(x, o, linestyle=(0, (4, 2)) if linestyle == "-" else linestyle, color=co, lw=1.2, marker="o", ms=3, markevery=every, label=labels[1])
+    return coincide
+
+
+_UNITS = {
+    "stroke": "rad", "rotation": "rad", "phi": "rad", "psi": "rad", "theta": "rad", "roll": "mN·mm", "yaw": "mN·mm",
+    "pitch": "mN·mm", "torque": "mN·mm", "tau": "mN·mm", "power": "mW", "work": "µJ", "energy": "µJ", "force": "mN",
+    "omega1": "mg·mm²", "omega2": "mg·mm²", "omega3": "mg·mm²", "omega4": "mg·mm²", "inertia": "mg·mm²",
+    "balance_stiffness": "mN·mm/rad", "k2": "mN·mm/rad", "springs": "mN·mm/rad", "q1": "mm", "q2": "rad",
+    "transmission_ratio": "rad/mm", "force_per_volt": "mN/V", "actuator.stiffness": "mN/mm", "time_ms": "ms",
+}
+
+
+def label_with_unit(column: str) -> str:
+    """An axis label for a sweep or trajectory column: the name and its unit (mg-mm-ms-rad-V),
+    e.g. ``left_roll_aero_peak (mN·mm)``, ``actuator.waveform.frequency_hz (Hz)``; ratios,
+    counts and names without a known unit get none (``omega_ratio`` is dimensionless)."""
+    name = column.lower()
+    suffixes = {"_hz": "Hz", "_v": "V", "_mm": "mm", "_ms": "ms", "_deg": "deg", "_pct": "%", "_ratio": "-"}
+    for suffix, unit in suffixes.items():
+        if name.endswith(suffix):
+            return column if unit == "-" else f"{column} ({unit})"
+    if name.endswith(("cycles_run", "point", "_phase_lag")):
+        return f"{column} (rad)" if name.endswith("_phase_lag") else column
+    if name.startswith("wings") and ".springs[" in name:
+        return f"{column} (mN·mm/rad{'³' if name.endswith('cubic') else ''})" if not name.endswith("rest_angle") else f"{column} (rad)"
+    for key, unit in _UNITS.items():
+        if key in name:
+            return f"{column} ({unit})"
+    return column
 
 
 def fig2_9(df: pl.DataFrame) -> Figure:

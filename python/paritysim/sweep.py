@@ -793,8 +793,11 @@ def _run_executor(
 
 def plot(df: pl.DataFrame, x: str, y: str | Sequence[str], hue: str | None = None, path: str | os.PathLike[str] | None = None, ax: Any = None) -> Figure:
     """Lines of ``y`` against ``x`` (one per value of ``hue``) from the ``ok`` rows of a sweep
-    result; saved as PNG when ``path`` is given."""
+    result; saved as PNG when ``path`` is given. Axis and legend labels carry units
+    (:func:`paritysim.plots.label_with_unit`)."""
     import matplotlib.pyplot as plt
+
+    from .plots import label_with_unit
 
     ys = [y] if isinstance(y, str) else list(y)
     for c in [x, *ys, *([hue] if hue else [])]:
@@ -812,12 +815,14 @@ def plot(df: pl.DataFrame, x: str, y: str | Sequence[str], hue: str | None = Non
             parts = []
             if hue:
                 v = g[hue][0]
-                parts.append(f"{hue} = {v:g}" if isinstance(v, float | int) else f"{hue} = {v}")
+                unit = label_with_unit(hue)[len(hue) :].strip(" ()")
+                parts.append(f"{hue} = {v:g}{' ' + unit if unit else ''}" if isinstance(v, float | int) else f"{hue} = {v}")
             if len(ys) > 1:
-                parts.append(col)
+                parts.append(label_with_unit(col))
             ax.plot(g[x].to_numpy(), g[col].to_numpy(), marker="o", ms=3, label=", ".join(parts) or None)
-    ax.set_xlabel(x)
-    ax.set_ylabel(ys[0] if len(ys) == 1 else "value")
+    ax.set_xlabel(label_with_unit(x))
+    units = {label_with_unit(c)[len(c) :] for c in ys}
+    ax.set_ylabel(label_with_unit(ys[0]) if len(ys) == 1 else "value" + (units.pop() if len(units) == 1 else ""))
     ax.grid(alpha=0.3)
     if hue or len(ys) > 1:
         ax.legend(fontsize=8)

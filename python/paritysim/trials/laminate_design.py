@@ -64,9 +64,9 @@ def _cli_laminate(out: Path) -> list[Path]:
     from ._io import write_trial
 
     df, _bimorph, stack = laminate_summary()
-    fig, ax = plt.subplots(figsize=(8, 6), constrained_layout=True)
-    stack.plot(ax=ax)
-    ax.set_title("Fig. 4.27: the Mobee 18-layer PC-MEMS stack (computed thickness and layers)")
+    fig, ax = plt.subplots(figsize=(8, 7), constrained_layout=True)
+    stack.plot(ax=ax, to_scale=True)
+    fig.suptitle(f"Fig. 4.27: the Mobee PC-MEMS stack to scale, total {1e3 * stack.total_thickness_mm:.1f} µm")
     written = write_trial(df, out, "laminate", fig)
     (out / "laminate.md").write_text(report_markdown(df))
     return [*written, out / "laminate.md"]

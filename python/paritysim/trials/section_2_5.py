@@ -106,13 +106,25 @@ def _plot(df: pl.DataFrame, settle: pl.DataFrame):  # type: ignore[no-untyped-de
     import matplotlib.pyplot as plt
 
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(13, 4.5), constrained_layout=True)
-    ok = df.filter(pl.col("status") == "ok")
-    labels, values = [], []
-    for r in ok.filter(pl.col("trial") == "1-Cut").iter_rows(named=True):
-        labels.append(f"#{r['number']} {r['configuration']}\nk2={r['hinge_k2']:g}")
-        values.append(abs(r["yaw_mean"]))
-    ax.bar(range(len(values)), values)
+    ok = df.filter((pl.col("status") == "ok") & (pl.col("trial") == "1-Cut"))
+    # One bar per configuration and hinge k2; a k2 > 0 bar that changes nothing (θ fixed, so
+    # the tunable hinge never stiffens; computed, not assumed) is dropped and the label says so.
+    labels, values, colours = [], [], []
+    for (config, number), g in ok.group_by("configuration", "number", maintain_order=True):
+        base = g.filter(pl.col("hinge_k2") == 0.0)["yaw_mean"]
+        for r in g.sort("hinge_k2").iter_rows(named=True):
+            same = r["hinge_k2"] != 0.0 and len(base) and math.isclose(r["yaw_mean"], base[0], rel_tol=1e-9, abs_tol=1e-12)
+            if same:
+                labels[-1] += f"\n(= k2 {r['hinge_k2']:g}: no effect)"
+                continue
+            labels.append(f"#{number} {config}\nk2={r['hinge_k2']:g}")
+            values.append(abs(r["yaw_mean"]))
+            colours.append("C0" if r["hinge_k2"] == 0.0 else "C1")
+    ax.bar(range(len(values)), values, color=colours)
     ax.set_xticks(range(len(values)), labels, rotation=60, fontsize=7)
+    from matplotlib.patches import Patch
+
+    ax.legend(handles=[Patch(color="C0", label="hinge k2 = 0"), Patch(color="C1", label="tunable hinge k2 > 0")], fontsize=7)
     ax.set_ylabel("|mean net yaw torque| (mN·mm)")
     ax.set_title("1-Cut: average yaw (lift-aligned) imbalance")
     ax2.plot(settle["cycle"], settle["theta_mean_deg"], "o-", ms=3)

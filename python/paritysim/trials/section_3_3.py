@@ -338,11 +338,12 @@ def _plot_fig3_4(curves: pl.DataFrame, recovery: pl.DataFrame):  # type: ignore[
 def _plot_fig2_12(df: pl.DataFrame, ratio: float):  # type: ignore[no-untyped-def]
     import matplotlib.pyplot as plt
 
+    from ..plots import pair
+
     fig, ax = plt.subplots(figsize=(8, 4.5), constrained_layout=True)
-    for label, style in (("balanced", ":"), ("biased", "-")):
+    for label, colors in (("balanced", ("C0", "C1")), ("biased", ("C2", "C3"))):
         sub = df.filter(pl.col("drivetrain") == label)
-        ax.plot(sub["time_ms"], -sub["tau_left"].to_numpy(), style, label=f"{label}: left (−)")
-        ax.plot(sub["time_ms"], sub["tau_right"], style, label=f"{label}: right")
+        pair(ax, sub["time_ms"], -sub["tau_left"].to_numpy(), sub["tau_right"].to_numpy(), (f"{label}: left (−)", f"{label}: right"), colors)
     ax.set_xlabel("time (ms)")
     ax.set_ylabel("roll torque (mN·mm)")
     ax.legend(fontsize=8)

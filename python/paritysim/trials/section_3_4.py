@@ -189,12 +189,13 @@ def trajectories(cycles: int = 3, **overrides: Any) -> pl.DataFrame:
 def _fig(df: pl.DataFrame, quantity: str, trials: tuple[str, ...], title: str, ylabel: str):  # type: ignore[no-untyped-def]
     import matplotlib.pyplot as plt
 
+    from ..plots import pair
+
     fig, axes = plt.subplots(1, len(trials), figsize=(5 * len(trials), 4.2), sharey=True, constrained_layout=True, squeeze=False)
     for ax, trial in zip(axes[0], trials, strict=True):
-        for d, style in (("HMF", "--"), ("PARITY", "-")):
+        for d, colors in (("HMF", ("C0", "C1")), ("PARITY", ("C2", "C3"))):
             sub = df.filter((pl.col("trial") == trial) & (pl.col("drivetrain") == d))
-            ax.plot(sub["time_ms"], -sub[f"left_{quantity}"].to_numpy(), style, label=f"{d} left (−)")
-            ax.plot(sub["time_ms"], sub[f"right_{quantity}"], style, label=f"{d} right")
+            pair(ax, sub["time_ms"], -sub[f"left_{quantity}"].to_numpy(), sub[f"right_{quantity}"].to_numpy(), (f"{d} left (−)", f"{d} right"), colors)
         ax.set_title(trial)
         ax.set_xlabel("time (ms)")
         ax.legend(fontsize=7)
@@ -224,17 +225,48 @@ def _fig3_13(df: pl.DataFrame):  # type: ignore[no-untyped-def]
 
 
 def _cli_table(out: Path) -> list[Path]:
+    df = section_3_4()
+    return write_trial(df, out, "table3_3", _plot_table(df))
+
+
+#: What §3.4 states, drawn as markers in table3_3.png (comparison only, never a result).
+THESIS_MARKERS = {"stroke_p2p_deg": 100.0, "rotation_amplitude_deg": 60.0, "yaw_reduction_pct": {"Uncut": 0.0, "1-Cut": 71.0, "2-Cut": 72.0}}
+
+
+def _plot_table(df: pl.DataFrame):  # type: ignore[no-untyped-def]
     import matplotlib.pyplot as plt
 
-    df = section_3_4()
-    fig, ax = plt.subplots(figsize=(8, 4.2), constrained_layout=True)
-    for d in DRIVETRAINS:
-        sub = df.filter(pl.col("drivetrain") == d)
-        ax.plot(list(TRIALS), sub["right_stroke_p2p_deg"], "o-", label=f"{d} right stroke p2p")
-        ax.plot(list(TRIALS), sub["left_stroke_p2p_deg"], "s--", label=f"{d} left stroke p2p")
-    ax.set_ylabel("stroke peak-to-peak (deg)")
-    ax.legend(fontsize=8)
-    ax.set_title("Table 3.3 trials: stroke amplitudes as the right wing is cut")
+    from ..plots import pair
+
+    trials = list(TRIALS)
+    x = np.arange(len(trials))
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2), constrained_layout=True)
+    thesis = {"marker": "*", "ms": 13, "color": "k", "ls": "none", "mfc": "gold"}
+    for (ax, quantity, ylabel, key) in (
+        (axes[0], "stroke_p2p_deg", "stroke peak-to-peak (deg)", "stroke_p2p_deg"),
+        (axes[1], "rotation_amplitude_deg", "rotation amplitude (deg)", "rotation_amplitude_deg"),
+    ):
+        for d, colours in (("HMF", ("C0", "C1")), ("PARITY", ("C2", "C3"))):
+            sub = df.filter(pl.col("drivetrain") == d)
+            pair(ax, x, sub[f"left_{quantity}"].to_numpy(), sub[f"right_{quantity}"].to_numpy(), (f"{d} left", f"{d} right"), colours)
+        ax.plot(x, [THESIS_MARKERS[key]] * len(x), **thesis, label=f"thesis ≈ {THESIS_MARKERS[key]:g}° (§3.4)")
+        ax.set_xticks(x, trials)
+        ax.set_ylabel(ylabel)
+        ax.legend(fontsize=7)
+        ax.grid(alpha=0.3)
+    axes[0].set_title("stroke amplitude as the right wing is cut")
+    axes[1].set_title("wing rotation ψ amplitude")
+    par = df.filter(pl.col("drivetrain") == "PARITY")
+    axes[2].bar(x, 100 * par["yaw_mean_reduction_vs_hmf"].to_numpy(), 0.5, color="C2", label="paritysim: PARITY vs HMF")
+    marks = THESIS_MARKERS["yaw_reduction_pct"]
+    axes[2].plot([trials.index(t) for t in marks], list(marks.values()), **thesis, label="thesis: no reduction (Uncut), 71 %, 72 % (§3.4.2)")
+    axes[2].set_xticks(x, trials)
+    axes[2].set_ylabel("mean yaw imbalance reduction (%)")
+    axes[2].set_title("average yaw imbalance, reduction by the PARITY")
+    axes[2].legend(fontsize=7)
+    axes[2].grid(alpha=0.3, axis="y")
+    fig.suptitle("Table 3.3 trials (§3.4): paritysim lines and bars, thesis statements as stars")
+    return fig
     return write_trial(df, out, "table3_3", fig)
 
 

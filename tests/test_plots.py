@@ -1,0 +1,31 @@
+"""Figure helpers: coincident compared curves stay visible, sweep labels carry units."""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from paritysim import plots
+
+
+def test_pair_draws_both_curves_and_detects_coincidence() -> None:
+    t = np.linspace(0.0, 1.0, 50)
+    fig, ax = plt.subplots()
+    assert plots.pair(ax, t, np.sin(t), np.sin(t) * (1 + 1e-6), ("left", "right"))
+    assert not plots.pair(ax, t, np.sin(t), 1.1 * np.sin(t), ("a", "b"))
+    lines = ax.get_lines()
+    assert len(lines) == 4
+    under, over = lines[0], lines[1]
+    assert under.get_linewidth() > 2 * over.get_linewidth()  # the hidden curve is the wide one
+    assert over.get_linestyle() != "-" and over.get_marker() == "o"
+    assert "coincides" in under.get_label() and "coincides" not in lines[2].get_label()
+    plt.close(fig)
+
+
+def test_labels_carry_units() -> None:
+    assert plots.label_with_unit("left_roll_aero_peak") == "left_roll_aero_peak (mN·mm)"
+    assert plots.label_with_unit("actuator.frequency_hz") == "actuator.frequency_hz (Hz)"
+    assert plots.label_with_unit("drivetrain.k2") == "drivetrain.k2 (mN·mm/rad)"
+    assert plots.label_with_unit("wings[1].springs[5].stiffness") == "wings[1].springs[5].stiffness (mN·mm/rad)"
+    assert plots.label_with_unit("wings.left.omega_ratio") == "wings.left.omega_ratio"  # dimensionless
+    assert plots.label_with_unit("mean_actuator_power") == "mean_actuator_power (mW)"
