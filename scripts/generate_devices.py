@@ -107,7 +107,7 @@ def catalogue() -> dict[str, dict[str, Any]]:
         name = f"sreetharan2012_2_5_{config}_1cut"
         out[name] = dict(
             spec=s25.device(config, "1-Cut", hinge_k2=20.0).replace(name=name),
-            title=f"§2.5 {config.replace('_', ' ').title()} exploration on the §3.4 1-Cut wings",
+            title=f"§2.5 {'Lift' if config.startswith('lift') else 'Dual'} PARITY exploration on the §3.4 1-Cut wings",
             section="§2.5, Table 3.1 #5/#7",
             stated=["Configuration (Table 3.1) and the §2.5.1 tunable hinge, stiffer with deviation", *S34_STATED[:2]],
             choices=[

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import logging
+from pathlib import Path
 import subprocess
 import sys
 import warnings
@@ -79,3 +80,14 @@ def test_healthy_sweep_does_not_warn() -> None:
 def test_python_dash_m_runs_the_cli() -> None:
     out = subprocess.run([sys.executable, "-m", "paritysim", "--version"], capture_output=True, text=True, check=True)
     assert out.stdout.startswith("paritysim ")
+
+
+def test_cli_lists_devices_and_runs_one_by_name(tmp_path: Path) -> None:
+    listing = subprocess.run([sys.executable, "-m", "paritysim", "devices"], capture_output=True, text=True, check=True).stdout
+    assert "sreetharan2012_3_4_parity_1cut" in listing
+    assert "sreetharan2012_3_3_parity_linkage" in listing and "[fails on cut wings]" in listing
+    out = subprocess.run([sys.executable, "-m", "paritysim", "run", "sreetharan2012_3_3_parity", "--out", str(tmp_path)], capture_output=True, text=True, check=True)
+    assert "converged" in out.stdout
+    assert (tmp_path / "sreetharan2012_3_3_parity_metrics.csv").exists()
+    bad = subprocess.run([sys.executable, "-m", "paritysim", "devices", "nope"], capture_output=True, text=True)
+    assert bad.returncode == 1 and "InvalidParameterError" in bad.stderr and "Traceback" not in bad.stderr

@@ -49,10 +49,24 @@ def _reproduce(args: argparse.Namespace) -> int:
     return 0
 
 
-def _run(args: argparse.Namespace) -> int:
-    from . import load_spec, simulate
+def _devices(args: argparse.Namespace) -> int:
+    from . import devices
 
-    spec = load_spec(args.spec)
+    if args.name:
+        print(devices.info(args.name))
+        print(f"file: {devices.path(args.name)}")
+        return 0
+    for name in devices.list():
+        info = devices.info(name)
+        print(f"{name:40s} {info.title}{'' if info.cut_wings else '  [fails on cut wings]'}")
+    return 0
+
+
+def _run(args: argparse.Namespace) -> int:
+    from . import devices, load_spec, simulate
+
+    # A named device of the library, or a TOML path.
+    spec = devices.load(args.spec) if args.spec in devices.list() and not Path(args.spec).exists() else load_spec(args.spec)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     stem = Path(args.spec).stem
@@ -83,10 +97,13 @@ def build_parser() -> argparse.ArgumentParser:
     rep.add_argument("--quiet", action="store_true", help="no progress output")
     rep.set_defaults(func=_reproduce)
     run = sub.add_parser("run", help="simulate a device spec (TOML) and write trajectory, metrics and a plot")
-    run.add_argument("spec", help="device spec, e.g. examples/drag_parity.toml")
+    run.add_argument("spec", help="device spec (TOML path, e.g. examples/hmf.toml) or a named device (see `paritysim devices`)")
     run.add_argument("--out", default="results", help="output directory (default: results/)")
     run.add_argument("--quiet", action="store_true", help="no summary output")
     run.set_defaults(func=_run)
+    dev = sub.add_parser("devices", help="list the named thesis devices (or show one's provenance)")
+    dev.add_argument("name", nargs="?", help="a device name: print what the thesis states and what we chose")
+    dev.set_defaults(func=_devices)
     try:  # `paritysim sweep` lives with the sweep engine (issue 8)
         from .sweep_cli import add_parser as add_sweep_parser
     except ImportError:

@@ -42,6 +42,16 @@ impl Planform {
     /// `x_c = x_min + fraction·(x_max − x_min)` (keep `x ≥ x_c`). A rectangle cut at the tip is
     /// the shorter rectangle, so its Ω_k follow in closed form (tested).
     ///
+    /// ```
+    /// use paritysim_aero::{CutEdge, DEFAULT_AIR_DENSITY, Planform};
+    ///
+    /// let wing = Planform::rectangle(16.0, 3.2, 0.0, 0.4)?;
+    /// let cut = wing.cut(0.25, CutEdge::Tip)?; // a 12 mm long membrane is left
+    /// let omega1 = 0.5 * DEFAULT_AIR_DENSITY * 3.2 * 12.0_f64.powi(4) / 4.0; // eq. 3.12
+    /// assert!((cut.omegas(DEFAULT_AIR_DENSITY)?.omega1 - omega1).abs() < 1e-12 * omega1);
+    /// # Ok::<(), paritysim_aero::Error>(())
+    /// ```
+    ///
     /// # Errors
     /// * [`Error::InvalidParameter`] (`fraction`) unless `0 ≤ fraction < 1`.
     /// * [`Error::Geometry`] if the line splits the membrane into several pieces (the outline
