@@ -91,3 +91,13 @@ def test_cli_lists_devices_and_runs_one_by_name(tmp_path: Path) -> None:
     assert (tmp_path / "sreetharan2012_3_3_parity_metrics.csv").exists()
     bad = subprocess.run([sys.executable, "-m", "paritysim", "devices", "nope"], capture_output=True, text=True)
     assert bad.returncode == 1 and "InvalidParameterError" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def test_design_study_example_runs(tmp_path: Path) -> None:
+    root = Path(__file__).resolve().parents[1]
+    out = subprocess.run([sys.executable, str(root / "examples" / "design_study_3_4.py"), "--out", str(tmp_path), "--cuts", "3"], capture_output=True, text=True, check=True)
+    assert "(0 failed)" in out.stdout
+    import polars as pl
+
+    df = pl.read_parquet(tmp_path / "design_study_3_4.parquet")
+    assert df.height == 2 * 3 * 5 and set(df["cut_fraction"]) == {0.0, 0.15, 0.3}
