@@ -3,16 +3,18 @@
 Units everywhere: mg-mm-ms-rad-V (force mN, torque mN·mm, inertia mg·mm², energy µJ).
 Angles are radians unless an argument name says otherwise (``*_deg``).
 
-Quick start::
+Quick start:
 
-    import paritysim as ps
-    spec = ps.devices.load("sreetharan2012_3_3_parity")  # a named device (ps.devices.list())
-    result = ps.simulate(spec)                            # run it (Rust, GIL released)
-    result.plot("drag_parity.png")                        # plot it; result.trajectory is Polars
-    df = ps.sweep(spec, {"wings.left.omega_ratio": [1.0, 0.8, 0.6]})  # a design study
+```python
+import paritysim as ps
+spec = ps.devices.load("sreetharan2012_3_3_parity")  # a named device (ps.devices.list())
+result = ps.simulate(spec)                            # run it (Rust, GIL released)
+result.plot("drag_parity.png")                        # plot it; result.trajectory is Polars
+df = ps.sweep(spec, {"wings.left.omega_ratio": [1.0, 0.8, 0.6]})  # a design study
+```
 
 Submodules load on first use (``import paritysim`` stays fast and never touches matplotlib's
-backend). Log messages go to the ``"paritysim"`` :mod:`logging` logger.
+backend). Log messages go to the ``"paritysim"`` `logging` logger.
 """
 
 from __future__ import annotations

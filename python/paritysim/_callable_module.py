@@ -1,7 +1,7 @@
 """Modules that can be called like their main function (``ps.sweep(...)``, ``trials.section_3_4()``).
 
 ``paritysim.sweep`` is both the module (``import paritysim.sweep``, ``help(paritysim.sweep)``
-shows the parameter paths) and, called, the :func:`paritysim.sweep.sweep` function, so
+shows the parameter paths) and, called, the `paritysim.sweep.sweep` function, so
 existing ``ps.sweep(spec, grid)`` code keeps working.
 """
 

@@ -1,13 +1,13 @@
 """Parameter sweeps: thousands of simulations of one design, in parallel, as one DataFrame.
 
-::
+```python
+import paritysim as ps
+spec = ps.devices.load("sreetharan2012_3_3_parity")   # §3.3 Drag PARITY (eq. 2.15)
+df = ps.sweep(spec, {"drivetrain.k2": [0.0, 1.0, 2.0], "wings.left.omega_ratio": [1.0, 0.8, 0.6]},
+              metrics=["left_roll_aero_peak", "right_roll_aero_peak"])
+```
 
-    import paritysim as ps
-    spec = ps.devices.load("sreetharan2012_3_3_parity")   # §3.3 Drag PARITY (eq. 2.15)
-    df = ps.sweep(spec, {"drivetrain.k2": [0.0, 1.0, 2.0], "wings.left.omega_ratio": [1.0, 0.8, 0.6]},
-                  metrics=["left_roll_aero_peak", "right_roll_aero_peak"])
-
-``paritysim.sweep`` is this module and, called, the :func:`sweep` function (``ps.sweep(...)``).
+``paritysim.sweep`` is this module and, called, the `sweep` function (``ps.sweep(...)``).
 The rod-crank linkage device (``sreetharan2012_3_3_parity_linkage``, ``examples/drag_parity.toml``)
 fails on cut wings: its whippletree mode is unstable at small K2 (docs/findings.md §3).
 
@@ -20,7 +20,7 @@ and class of a failing point; every other row is kept).
 Parameter paths
 ---------------
 Dotted paths into the spec, checked before anything runs (an unknown path raises
-``InvalidParameterError`` listing the valid ones; :func:`valid_paths` lists them too):
+``InvalidParameterError`` listing the valid ones; `valid_paths` lists them too):
 
 * ``wings[i].inertia[r][c]``, ``wings[i].shoulder.alpha2``, ``wings[i].springs[j].stiffness``
   (``cubic``, ``rest_angle``), ``wings[i].aero.omega1`` (and every other ``Aero`` field);
@@ -43,7 +43,7 @@ Label columns
 -------------
 Columns named in ``labels=`` are not parameters: they are carried, unchanged, into the result
 (e.g. a ``cut_fraction`` column next to the Ω columns computed from
-:meth:`paritysim.Planform.cut`), so results need no join.
+`paritysim.Planform.cut`), so results need no join.
 
 Threads, progress, checkpoints, clusters
 ----------------------------------------
@@ -207,7 +207,7 @@ def _describe(spec: Simulation, schema: dict[str, _Target]) -> str:
 
 
 def valid_paths(spec: Simulation, aliases: bool = True) -> list[str]:
-    """Every parameter path :func:`sweep` accepts for ``spec`` (canonical, then aliases)."""
+    """Every parameter path `sweep` accepts for ``spec`` (canonical, then aliases)."""
     schema = _schema(spec)
     out = list(schema)
     if aliases:
@@ -259,7 +259,7 @@ def _point_dicts(device: dict[str, Any], options: dict[str, Any], params: Sequen
 
 def grid(axes: Mapping[str, Iterable[Any]]) -> pl.DataFrame:
     """The Cartesian product of ``axes`` as a DataFrame (first axis slowest, like
-    ``itertools.product``); pass it, filtered or not, as :func:`sweep`'s ``grid``.
+    ``itertools.product``); pass it, filtered or not, as `sweep`'s ``grid``.
 
     >>> grid({"drivetrain.k2": [1, 2], "actuator.frequency_hz": [100.0, 110.0, 120.0]}).height
     6
@@ -457,14 +457,14 @@ def sweep(
     Parameters
     ----------
     spec:
-        The base design (:class:`paritysim.Simulation`).
+        The base design (`paritysim.Simulation`).
     grid:
-        A mapping ``{path: values}`` (Cartesian product, see :func:`grid`), a Polars DataFrame
+        A mapping ``{path: values}`` (Cartesian product, see `grid`), a Polars DataFrame
         whose columns are paths and rows are points, or a list of ``{path: value}`` rows.
-        Paths are listed in the module docstring and by :func:`valid_paths`. None runs the
+        Paths are listed in the module docstring and by `valid_paths`. None runs the
         base design once.
     metrics:
-        Metric names to keep (default: all that :func:`paritysim.simulate` reports).
+        Metric names to keep (default: all that `paritysim.simulate` reports).
     keep_cycle:
         True keeps the last recorded cycle of each point as list columns ``cycle_time_ms``,
         ``cycle_<column>`` for every trajectory column; a list of trajectory column names keeps
@@ -794,7 +794,7 @@ def _run_executor(
 def plot(df: pl.DataFrame, x: str, y: str | Sequence[str], hue: str | None = None, path: str | os.PathLike[str] | None = None, ax: Any = None) -> Figure:
     """Lines of ``y`` against ``x`` (one per value of ``hue``) from the ``ok`` rows of a sweep
     result; saved as PNG when ``path`` is given. Axis and legend labels carry units
-    (:func:`paritysim.plots.label_with_unit`)."""
+    (`paritysim.plots.label_with_unit`)."""
     import matplotlib.pyplot as plt
 
     from .plots import label_with_unit

@@ -1,17 +1,19 @@
 """Named devices: every thesis device and trial as a shipped TOML spec, with its provenance.
 
-Like PyBaMM's parameter sets: pick a device by name, get a :class:`paritysim.Simulation`::
+Like PyBaMM's parameter sets: pick a device by name, get a `paritysim.Simulation`:
 
-    import paritysim as ps
-    ps.devices.list()                                    # names
-    spec = ps.devices.load("sreetharan2012_3_3_parity")  # §3.3 Drag PARITY, Control trial
-    ps.devices.info("sreetharan2012_3_3_parity")         # what the thesis states, what we chose
+```python
+import paritysim as ps
+ps.devices.list()                                    # names
+spec = ps.devices.load("sreetharan2012_3_3_parity")  # §3.3 Drag PARITY, Control trial
+ps.devices.info("sreetharan2012_3_3_parity")         # what the thesis states, what we chose
+```
 
 Names are ``sreetharan2012_<section>_<drivetrain>[_<trial>]``. Each file is a plain spec
-(:func:`paritysim.load_spec` reads :func:`path`); its header and :func:`info` list which values
+(`paritysim.load_spec` reads `path`); its header and `info` list which values
 the thesis states (with § or table) and which are our choices, and why.
 
-``cut_wings`` in :func:`info` says whether the device survives cut-wing sweeps
+``cut_wings`` in `info` says whether the device survives cut-wing sweeps
 (``wings.left.omega_ratio`` < 1). ``sreetharan2012_3_3_parity_linkage`` (the rod-crank linkage,
 ``examples/drag_parity.toml``) does not: its whippletree mode is unstable below K2 ≈ 377
 mN·mm/rad (docs/findings.md §3), so asymmetric wings drive it out of the linkage's domain.
@@ -84,7 +86,7 @@ def info(name: str) -> DeviceInfo:
 
 
 def load(name: str) -> Simulation:
-    """Device ``name`` as a :class:`paritysim.Simulation` (see :func:`list`)."""
+    """Device ``name`` as a `paritysim.Simulation` (see `list`)."""
     from ..spec import load_spec
 
     return load_spec(path(name))
