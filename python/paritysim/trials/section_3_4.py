@@ -265,6 +265,7 @@ def _plot_table(df: pl.DataFrame):  # type: ignore[no-untyped-def]
     axes[2].set_title("average yaw imbalance, reduction by the PARITY")
     axes[2].legend(fontsize=7)
     axes[2].grid(alpha=0.3, axis="y")
+    axes[2].set_ylim(bottom=-8.0)  # keep the thesis star at 0 % (Uncut) off the axis line
     fig.suptitle("Table 3.3 trials (§3.4): paritysim lines and bars, thesis statements as stars")
     return fig
     return write_trial(df, out, "table3_3", fig)
