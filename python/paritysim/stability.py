@@ -57,6 +57,8 @@ __all__ = [
 
 #: Region names of Fig. 2.13 by index.
 REGIONS = {1: "I", 2: "II", 3: "III", 4: "IV"}
+#: ``region_name`` of points whose largest multiplier is within its error of the unit circle.
+MARGINAL = "marginal"
 
 
 def _f64(x: Any, name: str) -> np.ndarray:
@@ -87,8 +89,9 @@ def hill_floquet(beta0: float, kappa: float) -> dict[str, Any]:
     """Floquet analysis of eq. 2.25 at one point.
 
     Returns a dict: ``monodromy`` (at t0 = -π/2), ``a`` (half trace), ``b`` (determinant),
-    ``multipliers`` (complex, eq. 2.37), ``spectral_radius``, ``region`` (1-4, Fig. 2.13) and
-    ``stable`` (Region I).
+    ``multipliers`` (complex, eq. 2.37), ``spectral_radius``, ``region`` (1-4, Fig. 2.13),
+    ``multiplier_error`` and ``marginal`` (see :func:`stability_chart`) and ``stable``
+    (Region I and not marginal).
     """
     return _core.stability_hill_floquet(float(beta0), float(kappa))
 
@@ -106,14 +109,20 @@ def stability_chart(beta0: Any, kappa: Any, *, brockett: bool = True) -> pl.Data
     """Floquet stability over the grid ``beta0 × kappa`` (computed in parallel in Rust).
 
     Returns one row per point (β0 outer, κ inner): ``beta0, kappa, a, b, spectral_radius,
-    region`` (1-4), ``region_name`` (I-IV), ``stable`` and, with ``brockett=True``,
-    ``brockett_bounded`` (Brockett's guarantee of eqs. 2.57-2.58; false where it does not
-    apply, κ <= 0).
+    region`` (1-4, of the computed ``a``, ``b``), ``stable`` (Region I and not marginal),
+    ``multiplier_error`` (error estimate of the multipliers' moduli: round-off of the
+    monodromy and its Liouville residual, eq. 2.45), ``marginal`` (``|max|ρ| − 1|`` within
+    that error: the undamped line β0 = 0 and the κ = 0 line), ``region_name`` (I-IV, or
+    ``marginal``) and, with ``brockett=True``, ``brockett_bounded`` (Brockett's guarantee of
+    eqs. 2.57-2.58; false where it does not apply, κ <= 0).
     """
     raw = _core.stability_chart(_f64(beta0, "beta0"), _f64(kappa, "kappa"))
     df = pl.DataFrame(raw).with_columns(
         pl.col("region").cast(pl.Int8),
-        pl.col("region").replace_strict(REGIONS, return_dtype=pl.String).alias("region_name"),
+        pl.when(pl.col("marginal"))
+        .then(pl.lit(MARGINAL))
+        .otherwise(pl.col("region").replace_strict(REGIONS, return_dtype=pl.String))
+        .alias("region_name"),
     )
     if brockett:
         beta = raw["beta0"]

@@ -266,11 +266,19 @@ pub struct HillFloquet {
     pub b: f64,
     /// The Floquet multipliers (eq. 2.37), larger modulus first.
     pub multipliers: [Complex<f64>; 2],
-    /// Region of Fig. 2.13.
+    /// Region of Fig. 2.13 (of the computed `a`, `b`; see [`Self::is_marginal`]).
     pub region: Region,
+    /// Error estimate of the multipliers' moduli ([`multiplier_error`]).
+    pub multiplier_error: f64,
 }
 
 impl HillFloquet {
+    /// Whether `max |ρ|` is within [`Self::multiplier_error`] of 1: the computed multipliers
+    /// cannot tell stable from unstable (the undamped line β0 = 0, the κ = 0 line of eq. 2.50).
+    pub fn is_marginal(&self) -> bool {
+        (self.spectral_radius() - 1.0).abs() <= self.multiplier_error
+    }
+
     /// `max |ρ|`.
     pub fn spectral_radius(&self) -> f64 {
         self.multipliers[0].norm().max(self.multipliers[1].norm())
@@ -282,11 +290,42 @@ impl HillFloquet {
     }
 }
 
-/// Monodromy, multipliers and region of eq. 2.25 at `(β0, κ)`.
+/// Safety factor of [`multiplier_error`] over its first-order round-off estimate.
+pub const MULTIPLIER_ERROR_SAFETY: f64 = 4.0;
+
+/// Error estimate of the multipliers' moduli for the computed monodromy `m` of eq. 2.25
+/// (`steps` Taylor steps, exact determinant `e^{−2β0}` by eq. 2.45).
+///
+/// Entries: round-off accumulated over the steps, `δM = steps · ε · max(1, max|M_ij|)`.
+/// Determinant: the larger of the Liouville residual `|det M − e^{−2β0}|` (a measured error)
+/// and `δM Σ|M_ij|`. The roots `ρ = a ± √(a² − b)` of eq. 2.36 then move by at most
+/// `δa + min(δΔ / (2√|Δ|), √δΔ)` with `Δ = a² − b`, `δΔ = 2|a|δa + δb` (the square root's
+/// first-order and Hölder bounds), times [`MULTIPLIER_ERROR_SAFETY`].
+pub fn multiplier_error(m: &Matrix2<f64>, beta0: f64, steps: usize) -> f64 {
+    let entry = steps as f64 * f64::EPSILON * m.amax().max(1.0);
+    let a = 0.5 * m.trace();
+    let b = m.determinant();
+    let abs_sum = m.iter().map(|v| v.abs()).sum::<f64>();
+    let db = (b - (-2.0 * beta0).exp()).abs().max(entry * abs_sum);
+    let disc = (a * a - b).abs();
+    let ddisc = 2.0 * a.abs() * entry + db;
+    let root = if disc > 0.0 {
+        (ddisc / (2.0 * disc.sqrt())).min(ddisc.sqrt())
+    } else {
+        ddisc.sqrt()
+    };
+    MULTIPLIER_ERROR_SAFETY * (entry + root)
+}
+
+/// Monodromy, multipliers and region of eq. 2.25 at `(β0, κ)`, with the multipliers' error
+/// estimate ([`multiplier_error`]; [`HillFloquet::is_marginal`] uses it).
 pub fn hill_floquet(beta0: f64, kappa: f64) -> Result<HillFloquet> {
     let m = hill_monodromy(beta0, kappa, -FRAC_PI_2)?;
     let a = 0.5 * m.trace();
     let b = m.determinant();
+    // [−π/2, π/2] is one smooth piece of |cos t|: the step count of `hill_solution_matrix`.
+    let lambda = 1.0f64.max(beta0.abs()).max(kappa.abs().sqrt());
+    let steps = (PI * lambda / STEP).ceil().max(1.0) as usize;
     Ok(HillFloquet {
         beta0,
         kappa,
@@ -295,6 +334,7 @@ pub fn hill_floquet(beta0: f64, kappa: f64) -> Result<HillFloquet> {
         b,
         multipliers: multipliers(a, b),
         region: region(a, b)?,
+        multiplier_error: multiplier_error(&m, beta0, steps),
     })
 }
 
@@ -313,6 +353,10 @@ pub struct StabilityChart {
     pub spectral_radius: Vec<f64>,
     /// Region of Fig. 2.13.
     pub region: Vec<Region>,
+    /// [`HillFloquet::multiplier_error`].
+    pub multiplier_error: Vec<f64>,
+    /// [`HillFloquet::is_marginal`].
+    pub marginal: Vec<bool>,
 }
 
 /// Largest number of points of one [`stability_chart`] call.
@@ -352,6 +396,8 @@ pub fn stability_chart(beta0: &[f64], kappa: &[f64]) -> Result<StabilityChart> {
         b: Vec::with_capacity(n),
         spectral_radius: Vec::with_capacity(n),
         region: Vec::with_capacity(n),
+        multiplier_error: Vec::with_capacity(n),
+        marginal: Vec::with_capacity(n),
     };
     for p in points {
         chart.beta0.push(p.beta0);
@@ -360,6 +406,8 @@ pub fn stability_chart(beta0: &[f64], kappa: &[f64]) -> Result<StabilityChart> {
         chart.b.push(p.b);
         chart.spectral_radius.push(p.spectral_radius());
         chart.region.push(p.region);
+        chart.multiplier_error.push(p.multiplier_error);
+        chart.marginal.push(p.is_marginal());
     }
     Ok(chart)
 }

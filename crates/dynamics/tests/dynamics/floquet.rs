@@ -878,3 +878,37 @@ fn shooting_finds_an_unstable_asymmetric_orbit_that_simulation_cannot_reach() {
         long.map(|r| r.converged)
     );
 }
+
+#[test]
+fn undamped_and_unsprung_lines_are_marginal_within_the_multiplier_error() {
+    // β0 = 0: ẍ + κx = 0, multipliers e^{±iπ√κ} on the unit circle; the computed det M is
+    // 1 + O(1e-16), which without a tolerance lands in Region II for about half the points.
+    for j in 0..51 {
+        let k = 0.05 + 3.95 * j as f64 / 50.0;
+        let f = hill_floquet(0.0, k).unwrap();
+        assert!(
+            f.is_marginal(),
+            "beta0 = 0, kappa = {k}: {:?}",
+            f.multipliers
+        );
+        assert!(f.multiplier_error < 1e-12, "{k}: {}", f.multiplier_error);
+    }
+    // κ = 0 (eq. 2.50): a multiplier exactly 1 for any damping.
+    for b0 in [0.3, 1.0, 2.5] {
+        assert!(hill_floquet(b0, 0.0).unwrap().is_marginal(), "{b0}");
+    }
+    // Away from |ρ| = 1 the error estimate is far below the distance to the unit circle.
+    for (b0, k) in [
+        (0.5, 1.0),
+        (1.0, 0.05),
+        (-0.2, 1.0),
+        (0.1, 1.0),
+        (2.0, 10.0),
+    ] {
+        let f = hill_floquet(b0, k).unwrap();
+        assert!(!f.is_marginal(), "{b0} {k}: {}", f.spectral_radius());
+        assert!(f.multiplier_error < 1e-3 * (f.spectral_radius() - 1.0).abs());
+    }
+    let chart = stability_chart(&[0.0, 0.5], &[0.5, 2.0]).unwrap();
+    assert_eq!(chart.marginal, vec![true, true, false, false]);
+}
