@@ -171,6 +171,27 @@ def test_dickinson_fits_in_degrees_at_0_45_90() -> None:
     np.testing.assert_allclose(c["center_of_pressure"], aero.center_of_pressure(np.radians(deg)))
 
 
+def test_dickinson_past_90_degrees_mirrors_the_printed_fit() -> None:
+    """docs/errata.md#P2: past α = 90° (leading edge trailing) the printed eqs. 3.5-3.6 are not
+    used; the coefficients are the flat-plate mirror image of the printed fit at π − α:
+    C_L(α) = −C_L,fit(π − α), C_D(α) = C_D,fit(π − α). The printed fit itself is evaluated here
+    independently (degrees, as published)."""
+    deg = np.linspace(90.5, 180.0, 180)
+    c = aero.coefficients(np.radians(deg))
+    mirror = 180.0 - deg
+    cd = 1.92 - 1.55 * np.cos(np.radians(2.04 * mirror - 9.82))
+    cl = 0.225 + 1.58 * np.sin(np.radians(2.13 * mirror - 7.20))
+    np.testing.assert_allclose(c["drag"], cd, rtol=1e-12)
+    np.testing.assert_allclose(c["lift"], -cl, rtol=1e-12, atol=1e-14)
+    # a departure, not the print: the fit evaluated as printed past 90° differs
+    printed_cl = 0.225 + 1.58 * np.sin(np.radians(2.13 * deg - 7.20))
+    assert np.abs(printed_cl - c["lift"]).max() > 0.5
+    # C_N is continuous at 90°, C_L jumps by 2 C_L,fit(90°) = 0.20 (the fit has C_L(90°) = 0.10 ≠ 0)
+    at = aero.coefficients(np.radians([90.0 - 1e-9, 90.0 + 1e-9]))
+    assert abs(at["normal"][1] - at["normal"][0]) < 1e-8
+    assert at["lift"][0] - at["lift"][1] == pytest.approx(2 * (0.225 + 1.58 * np.sin(np.radians(2.13 * 90 - 7.20))), rel=1e-6)
+
+
 @pytest.mark.parametrize("model", aero.MODELS)
 def test_normal_tangential_transform_inverts(model: str) -> None:
     a = np.linspace(0.0, np.pi, 181).reshape(181, 1)

@@ -13,7 +13,7 @@ Quick start::
 
 from __future__ import annotations
 
-from . import aero, dynamics, kinematics, laminate, planform, plots, spec, stability, trials
+from . import aero, claims, dynamics, kinematics, laminate, planform, plots, spec, stability, trials
 from ._core import (
     CancelledError,
     ConstraintError,
@@ -41,6 +41,7 @@ __all__ = [
     "Planform",
     "calibrate",
     "aero",
+    "claims",
     "dynamics",
     "laminate",
     "planform",

@@ -6,10 +6,10 @@
 //!   pieces where `|cos t|` is smooth (truncation at round-off level; closed forms of eqs.
 //!   2.45, 2.50 and 2.54 hold to 1e-9 or better in `tests/dynamics/floquet.rs`); its
 //!   half trace `a`, determinant `b` (eq. 2.36), multipliers (eq. 2.37) and region of Fig. 2.13
-//!   ([`Region`], with the corrected Region III bound of ERRATA item 9) follow. A
+//!   ([`Region`], with the corrected Region III bound of docs/errata.md#9) follow. A
 //!   [`stability_chart`] over a (β0, κ) grid is computed in parallel with rayon. [`brockett`]
 //!   is the criterion of eqs. 2.57–2.58 and [`PhysicalParameters::hill`] maps a device to
-//!   (β0, κ1, κ2) with the factors of ERRATA item 7.
+//!   (β0, κ1, κ2) with the factors of docs/errata.md#7.
 //! * **Disturbance rejection (§2.7).** [`LtiModel`] is eq. 2.59; [`linearise`] derives its
 //!   `β*` (cycle-averaged aerodynamic damping of the whippletree mode) and `κ0` from a device
 //!   and its periodic orbit, and [`disturbance_response`] measures the same transfer on the
@@ -21,7 +21,7 @@
 //!   coordinates and rates the device integrates (work integrals excluded) and returns the
 //!   Floquet multipliers; [`balance_stiffness_sweep`] repeats that over K2 in parallel.
 //!
-//! Errata (ERRATA.md next to the thesis) relied on here, each verified numerically in
+//! Errata (docs/errata.md) relied on here, each verified numerically in
 //! `tests/dynamics/floquet.rs`: item 7 (the drag forces of eqs. 2.17–2.19 carry `T³`, so
 //! `β0 = 2ΩΦ/I`), item 8 (eq. 2.27's coefficient is `−¼β0²cos²t`), item 9 (Region I is
 //! `b ≤ 1, |a| ≤ (1 + b)/2`), item 10 (eq. 2.52 is `M = exp(TQ)`, eq. 2.53 is `M^(n+1)`, eq. 2.54
@@ -186,11 +186,11 @@ pub fn hill_monodromy(beta0: f64, kappa: f64, t0: f64) -> Result<Matrix2<f64>> {
 /// A region of the trace-determinant plane of Fig. 2.13.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Region {
-    /// Stable: `b ≤ 1` and `|a| ≤ (1 + b)/2` (the Schur–Cohn triangle, ERRATA item 9).
+    /// Stable: `b ≤ 1` and `|a| ≤ (1 + b)/2` (the Schur–Cohn triangle, docs/errata.md#9).
     I,
     /// Complex multipliers with `|ρ| = √b > 1` (`b > a²`, `b > 1`).
     II,
-    /// Real multipliers, `a > 0`, one of them above 1: `a > (1 + b)/2` (ERRATA item 9: the
+    /// Real multipliers, `a > 0`, one of them above 1: `a > (1 + b)/2` (docs/errata.md#9: the
     /// printed bound `(b − 1)/2` is wrong) or `b > 1`.
     III,
     /// Real multipliers, `a < 0`, one of them below −1: `a < −(1 + b)/2` or `b > 1`.
@@ -216,7 +216,7 @@ impl Region {
 
 /// The region of Fig. 2.13 for half trace `a` and determinant `b` of a 2×2 monodromy matrix.
 ///
-/// Region I is `b ≤ 1, |a| ≤ (1 + b)/2` (ERRATA item 9): the roots of `ρ² − 2aρ + b` (eq. 2.36)
+/// Region I is `b ≤ 1, |a| ≤ (1 + b)/2` (docs/errata.md#9): the roots of `ρ² − 2aρ + b` (eq. 2.36)
 /// have `|ρ| ≤ 1` exactly there. Outside it, complex roots with `b > 1` are Region II and real
 /// roots are Region III (`a > 0`) or IV (`a < 0`).
 ///
@@ -500,7 +500,7 @@ pub fn brockett_hill(beta0: f64, kappa: f64) -> Result<Brockett> {
 pub struct PhysicalParameters {
     /// Wing inertia about the stroke axis I (mg·mm²).
     pub inertia: f64,
-    /// Drag parameter Ω of eq. 2.16 (mg·mm²; `Ω1 C_N(90°)` for eq. 3.8, ERRATA item 12).
+    /// Drag parameter Ω of eq. 2.16 (mg·mm²; `Ω1 C_N(90°)` for eq. 3.8, docs/errata.md#12).
     pub drag: f64,
     /// Transmission ratio T (rad/mm).
     pub transmission_ratio: f64,
@@ -519,7 +519,7 @@ pub struct PhysicalParameters {
 /// The non-dimensional parameters of eqs. 2.23–2.24.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HillParameters {
-    /// `β0 = 2ΩTA/I = 2ΩΦ/I` (ERRATA item 7; the printed `2ΩA/I` lacks T).
+    /// `β0 = 2ΩTA/I = 2ΩΦ/I` (docs/errata.md#7; the printed `2ΩA/I` lacks T).
     pub beta0: f64,
     /// `κ1 = K1/(2 I T² ω0²)`.
     pub kappa1: f64,
@@ -551,7 +551,7 @@ impl PhysicalParameters {
         2.0 * PI * self.frequency_hz * 1e-3
     }
 
-    /// (β0, κ1, κ2) of §2.6.1 with the factors corrected by ERRATA item 7: the drag force on q2
+    /// (β0, κ1, κ2) of §2.6.1 with the factors corrected by docs/errata.md#7: the drag force on q2
     /// is `−4ΩT³L²|q̇1|q̇2`, so linearising about `q1 = A sin ω0t` and dividing by the modal
     /// inertia `2IT²L²` gives the damping `2ΩTA ω0 |cos τ|/I` per unit ω0.
     ///
@@ -1307,7 +1307,7 @@ pub struct DeviceLinearisation {
     /// `L = (hL + hR)/2`; drag = `−τ(φ̇ = 1 rad/ms)`, i.e. `Ω1 C` for stroke drag; Φ the mean
     /// stroke amplitude of the orbit).
     pub physical: PhysicalParameters,
-    /// (β0, κ1, κ2) of eq. 2.23–2.24 (ERRATA item 7).
+    /// (β0, κ1, κ2) of eq. 2.23–2.24 (docs/errata.md#7).
     pub hill: HillParameters,
     /// Eq. 2.59 as §2.7 builds it: the cycle averages over the orbit of the whippletree mode's
     /// aerodynamic damping rate and spring stiffness per unit modal inertia,

@@ -195,7 +195,7 @@ fn stability_brockett_hill<'py>(
     brockett_dict(py, &b)
 }
 
-/// (β0, κ1, κ2) of §2.6.1 with ERRATA item 7's factors, and eq. 2.59's `beta_star` (1/ms),
+/// (β0, κ1, κ2) of §2.6.1 with docs/errata.md#7's factors, and eq. 2.59's `beta_star` (1/ms),
 /// `kappa0` (1/ms²) for sinusoidal flapping.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]

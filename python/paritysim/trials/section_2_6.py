@@ -17,7 +17,7 @@ from ..claims import Claim, render
 from ._io import write_claims
 from ..spec import Actuator, Aero, Configuration, Drivetrain, Simulation, Waveform, Wing
 
-#: C_N(90°) of eqs. 3.5-3.6, as in examples/drag_parity.toml (ERRATA item 12).
+#: C_N(90°) of eqs. 3.5-3.6, as in examples/drag_parity.toml (docs/errata.md#12).
 CN90 = 3.4609
 #: Fixed §3.3 wing: stroke inertia 29.0 mg·mm² (§3.3.2).
 INERTIA = ((29.0, 0.0, 0.0), (0.0, 29.0, 0.0), (0.0, 0.0, 1.0))
@@ -252,7 +252,7 @@ def critical_k2(spec_for: object = None, lo: float = 100.0, hi: float = 1000.0, 
 
 def floquet_devices() -> pl.DataFrame:
     """Floquet multipliers of the §3.3 devices (examples/hmf.toml, examples/drag_parity.toml at
-    K2 = 1 and 500, also with the 1-Cut wing of Table 3.2 (ERRATA 11's ratio), the linear map of
+    K2 = 1 and 500, also with the 1-Cut wing of Table 3.2 (docs/errata.md#11's ratio), the linear map of
     eq. 2.15 at K2 = 0 and 1) and of the §3.4 rotating-wing
     devices (Table 3.3 wings, hinge pinned to ±60° rotation, K2 = 0; see trials.section_3_4)."""
     import importlib
@@ -365,6 +365,8 @@ carry `T³`, so `β0 = 2ΩΦ/I` (docs/errata.md#7).
 
 {render(linearised)}
 
+![Fig. 2.13](fig2_13.png)
+
 Disturbance rejection (eq. 2.59), §3.3 device (examples/drag_parity.toml), β* from the
 cycle-averaged aerodynamic damping of its simulated orbit: K2 = 1 gives β* = {h1['beta_star']:.3f} /ms,
 κ0 = {h1['kappa0']:.3g} /ms²; K2 = 500 gives |H(300 Hz)| = {h500['h300']:.3g}. The rod-crank linkage adds a
@@ -372,6 +374,8 @@ geometric stiffness of {h500['geometric_stiffness']:.0f} mN·mm/rad to the whipp
 ignores (see `sec2_7.csv` for the nonlinear response against the LTI estimate).
 
 {render(rejection)}
+
+![§2.7 transfer functions](sec2_7.png)
 
 Full nonlinear model (shooting + finite-difference monodromy, multipliers per drive period
 T = 9.09 ms; multipliers below ~1e-6 are at the resolution of the finite differences):
@@ -381,6 +385,8 @@ T = 9.09 ms; multipliers below ~1e-6 are at the resolution of the finite differe
 {rows}
 
 {render(nonlinear)}
+
+![Floquet multipliers vs K2](floquet.png)
 
 The §3.4 rotating-wing PARITY (eq. 2.15, K2 = 0) has the same cyclic q2 direction as the K2 = 0
 linear map (a multiplier 1); see the table above for the computed labels.

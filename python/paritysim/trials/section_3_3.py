@@ -4,7 +4,7 @@ whippletree (Fig. 2.12).
 Every number here is computed by the model from :class:`Params`; the thesis' statements are kept
 in :data:`THESIS_TABLE_3_2` only to compare against in the report.
 
-Unspecified by the thesis (ERRATA items 12-14), each an argument with a documented default:
+Unspecified by the thesis (docs/errata.md#12 to #14), each an argument with a documented default:
 
 * ``drivetrain = "linear"``: eq. 2.15 with ``T`` from "±200 µm → ±35°" (§3.3.2) and ``L = L1 =
   2.5 mm``. The nonlinear rod-crank linkage (``"linkage"``) makes the whippletree mode unstable
@@ -33,7 +33,7 @@ from ..simulation import SimulationResult, simulate
 from ..spec import Actuator, Aero, Configuration, Drivetrain, Options, Simulation, Waveform, Wing
 
 #: Trials of §3.3.2: the left wing's drag parameter as a fraction of the right wing's
-#: (ERRATA item 11: the printed Ω^L = 18.8, 13.2 are rounded; the ratios define the trials).
+#: (docs/errata.md#11: the printed Ω^L = 18.8, 13.2 are rounded; the ratios define the trials).
 TRIALS: dict[str, float] = {"Control": 1.0, "1-Cut": 0.599, "2-Cut": 0.420}
 
 #: What Table 3.2 prints (for comparison in the report; never used as a result).
@@ -87,7 +87,7 @@ class Params:
 
     @property
     def drag_coefficient(self) -> float:
-        """The coefficient multiplying Ω φ̇² (ERRATA item 12)."""
+        """The coefficient multiplying Ω φ̇² (docs/errata.md#12)."""
         if self.drag_law == "unit":
             base = 1.0
         elif self.drag_law == "cn90":
@@ -248,13 +248,14 @@ def recovery_time_constant(t: np.ndarray, e: np.ndarray, floor: float = RECOVERY
         return float(-1.0 / slope) if slope < 0 else float("inf")
 
     below = np.flatnonzero(a < level)
-    if below.size and below[0] >= 3:
-        first = np.arange(below[0])
-        window = e[: below[0] + 3]  # a zero crossing right at the level is an oscillation
+    end = int(below[0]) if below.size else a.size  # a decay still above the floor at the end: all of it
+    if end >= 3:
+        first = np.arange(end)
+        window = e[: end + 3]  # a zero crossing right at the level is an oscillation
         if (np.sign(window) == np.sign(e[0])).all() and _log_linearity(t[first], a[first]) >= MONOTONE_R2:
             return fit(first)
     envelope = np.maximum.accumulate(a[::-1])[::-1]
-    interior = np.r_[True, a[1:-1] >= np.maximum(a[:-2], a[2:]), a[-1] > a[-2]]
+    interior = np.r_[False, a[1:-1] >= np.maximum(a[:-2], a[2:]), False]  # true local maxima only
     peaks = np.flatnonzero(interior & (a >= envelope) & (a > level))
     return fit(peaks)
 
@@ -558,7 +559,7 @@ def _range(recovery: list[dict[str, Any]], key: str) -> str:
 
 
 def reconciliation(table: list[Claim], stated: list[Claim], fitted: list[Claim], cal: dict[str, Any], stated_recovery: list[dict[str, Any]]) -> str:
-    """The ERRATA 13 paragraph (docs/errata.md#13), written from the computed claims only."""
+    """The docs/errata.md#13 paragraph, written from the computed claims only."""
     parity = [c for c in table if " PARITY " in c.statement]
     n_ok = sum(bool(c.ok) for c in parity)
     targets = [c for c in fitted if c.statement.startswith("calibrated")]
@@ -595,7 +596,7 @@ def reconciliation(table: list[Claim], stated: list[Claim], fitted: list[Claim],
 
 def report_section(out: Path) -> str:
     """Markdown for the reproduction report from the files the §3.3 trials wrote into ``out``:
-    Table 3.2 cell by cell, Figs. 3.2-3.4 and 2.12, and the ERRATA 13 calibration."""
+    Table 3.2 cell by cell, Figs. 3.2-3.4 and 2.12, and the docs/errata.md#13 calibration."""
     from ._io import results
 
     p = Params()

@@ -3,14 +3,14 @@
 Wings of Table 3.3 (full inertia tensors, Ω1..Ω4) on compliant hinges (ψ free), configuration
 #3 (Drag PARITY) against #1 (HMF), drive V(t) = 100 V + 100 V sin(2π·110 t) (eq. 3.24).
 
-Not given by the thesis (ERRATA items 5, 14), each an argument:
+Not given by the thesis (docs/errata.md#5, #14), each an argument:
 
 * ``hinge_stiffness`` (mN·mm/rad): ``None`` pins it so the Uncut PARITY right wing rotates ±60°,
   the amplitude §3.4 reports (root finding on the model);
 * ``dc_offset = "ignore"``: the 100 V DC part biases the piezo without a net force (taken as a
   force it would hold q1 at 120/467 mm, a 45° stroke offset under the §3.3 transmission);
 * transmission: eq. 2.15 with "±200 µm → ±35°" as in §3.3; C_rd and the coefficient model:
-  the aero crate's cited defaults; the α sign convention: the aero crate's (ERRATA 5).
+  the aero crate's cited defaults; the α sign convention: the aero crate's (docs/errata.md#5).
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 //! floquet tests (submodule of the one dynamics integration binary).
 //!
 //! §2.6: the eq. 2.25 monodromy against Liouville (eq. 2.45), the κ = 0 closed form (eq. 2.50)
-//! and an independent adaptive integrator; ERRATA items 7–10 each checked numerically. Full
+//! and an independent adaptive integrator; docs/errata.md#7 to #10 each checked numerically. Full
 //! model: shooting against long simulation, multipliers against independent differences of the
 //! stroboscopic map and against kick growth in `simulate`, and a Liouville identity for the
 //! whippletree block. §2.7: eq. 2.59 against the nonlinear disturbance response.
@@ -186,7 +186,7 @@ fn monodromy_matches_an_independent_adaptive_integrator() {
 #[test]
 fn errata_8_hill_form_coefficient_is_minus_one_quarter() {
     // y = x exp(½β0∫|cos|) (eq. 2.26) satisfies ÿ + (κ − ¼β0²cos²t − ½β0 d|cos t|/dt) y = 0
-    // (ERRATA item 8), not the printed +½β0²cos²t of eq. 2.27. Checked by second differences
+    // (docs/errata.md#8), not the printed +½β0²cos²t of eq. 2.27. Checked by second differences
     // of y built from the integrated solution on the smooth piece t in (−π/2, π/2).
     let (beta0, kappa, t0) = (0.8, 1.3, -FRAC_PI_2);
     let y = |t: f64| {
@@ -250,7 +250,7 @@ fn errata_10_eqs_2_52_to_2_54() {
     for beta0 in [0.3, 0.9, 2.0] {
         let m = hill_monodromy(beta0, 0.0, -FRAC_PI_2).unwrap();
         let i0 = bessel_i0(beta0);
-        // Eq. 2.52 gives Q with M = exp(πQ), not log (ERRATA item 10).
+        // Eq. 2.52 gives Q with M = exp(πQ), not log (docs/errata.md#10).
         let q = Matrix2::new(
             0.0,
             -2.0 * i0 * beta0 * beta0.exp() / (1.0 - (2.0 * beta0).exp()),
@@ -370,13 +370,13 @@ fn brockett_guarantee_implies_floquet_stability() {
     assert!(guaranteed > 50, "{guaranteed}");
 }
 
-// ------------------------------------------------------------------ ERRATA 7: physical mapping
+// ------------------------------------------------------------------ docs/errata.md#7: physical mapping
 
 #[test]
 fn errata_7_drag_generalised_forces_carry_t_cubed() {
     // Eq. 2.15 device: M_q = diag(2IT², 2IT²L²). From the right-hand side, the drag part of the
     // generalised force is −2ΩT³ sgn(q̇1)(q̇1² + L²q̇2²) on q1 and −4ΩT³L²|q̇1|q̇2 on q2
-    // (ERRATA item 7; eqs. 2.17–2.19 print ΩT²) whenever L|q̇2| < |q̇1|.
+    // (docs/errata.md#7; eqs. 2.17–2.19 print ΩT²) whenever L|q̇2| < |q̇1|.
     let (i, omega, t, l, k1, k2) = (29.0, 31.3, 2.5, 2.5, 467.0, 20.0);
     let device = eq_2_16_device(linear_map(), k2);
     let actuator = device.spec().actuator.clone().unwrap();
@@ -431,7 +431,7 @@ fn errata_7_whippletree_block_determinant_is_exp_minus_four_beta0() {
     // (q2, p2): its determinant is exp(−∮ c22/m22 dt) = exp(−(2Ω/I)∮|φ̇|dt) = exp(−8ΩΦ/I) for a
     // single-hump stroke of amplitude Φ, for the linear map and the nonlinear linkage alike.
     // One drive period is two periods of eq. 2.25, so this is b² = e^{−4β0} (eq. 2.45) with
-    // β0 = 2ΩΦ/I (ERRATA item 7; the printed 2ΩA/I would give e^{−4β0/T}).
+    // β0 = 2ΩΦ/I (docs/errata.md#7; the printed 2ΩA/I would give e^{−4β0/T}).
     for drivetrain in [
         linear_map(),
         Drivetrain::LinkageDifferential(LinkageDifferential::thesis()),
