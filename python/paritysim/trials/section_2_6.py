@@ -150,7 +150,7 @@ def linearised_claims(chart: pl.DataFrame) -> list[Claim]:
             computed=f"{weak.filter(pl.col('beta0') > 0)['stable'].sum()} of {weak.filter(pl.col('beta0') > 0).height} chart points with β0 > 0, "
             f"0 < κ ≤ 0.1 asymptotically stable; {weak.filter(pl.col('beta0') < 0)['stable'].sum()} with β0 < 0",
             criterion="all with β0 > 0 stable, none with β0 < 0",
-            note=f"{unstable_positive} chart points with β0, κ > 0 (κ up to {chart['kappa'].max():g}) have max|ρ| > 1 beyond its error",
+            note=f"{unstable_positive} chart points with β0, κ > 0 (κ up to {float(chart['kappa'].max()):g}) have max|ρ| > 1 beyond its error",
         ),
         Claim.holds(
             "eqs. 2.57-2.58: where Brockett's criterion guarantees boundedness, the Floquet multipliers agree",

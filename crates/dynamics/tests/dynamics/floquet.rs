@@ -891,7 +891,13 @@ fn undamped_and_unsprung_lines_are_marginal_within_the_multiplier_error() {
             "beta0 = 0, kappa = {k}: {:?}",
             f.multipliers
         );
-        assert!(f.multiplier_error < 1e-12, "{k}: {}", f.multiplier_error);
+        // √(round-off) near the double roots ρ = ±1 at κ = n², round-off elsewhere
+        let bound = if (k.sqrt() - k.sqrt().round()).abs() < 0.05 {
+            1e-6
+        } else {
+            1e-12
+        };
+        assert!(f.multiplier_error < bound, "{k}: {}", f.multiplier_error);
     }
     // κ = 0 (eq. 2.50): a multiplier exactly 1 for any damping.
     for b0 in [0.3, 1.0, 2.5] {
