@@ -117,3 +117,23 @@ def test_theta_and_psi_accelerations_integrate_to_the_rates() -> None:
             scale = np.abs(rate).max()
             assert scale > 1e-3, (wing, angle)
             np.testing.assert_allclose(cumulative_trapezoid(accel, t, initial=0.0), rate - rate[0], atol=2e-4 * scale, err_msg=f"{wing}_{angle}")
+
+
+def test_recorded_accelerations_satisfy_the_euler_lagrange_equations() -> None:
+    """A.13 at every sample of a free (unconstrained, undriven, vacuum) wing: the trajectory's
+    (φ̈, θ̈, ψ̈) and ``wing_terms`` at the recorded (p, ṗ) give M p̈ + c + ∇V = 0."""
+    spec = ps.Simulation(
+        wings=(WING,),
+        configuration=ps.Configuration(name=None),
+        options=ps.Options(duration_ms=3.0, initial_p=(0.3, 0.2, -0.4), initial_p_dot=(0.1, -0.06, 0.24), samples_per_cycle=100, rtol=1e-11, atol=1e-13),
+    )
+    df = ps.simulate(spec).trajectory
+    assert np.ptp(df["wing_theta"].to_numpy()) > 0.1 and np.abs(df["wing_theta_ddot"].to_numpy()).max() > 0.01
+    angles = ("phi", "theta", "psi")
+    for row in df.iter_rows(named=True):
+        p = np.array([row[f"wing_{a}"] for a in angles])
+        v = np.array([row[f"wing_{a}_dot"] for a in angles])
+        acc = np.array([row[f"wing_{a}_ddot"] for a in angles])
+        t = ps.dynamics.wing_terms(WING, p, v)
+        residual = t.mass @ acc + t.coriolis + t.spring_gradient - t.aero
+        assert np.abs(residual).max() <= 1e-12 * np.abs(t.spring_gradient).max(), (row["time_ms"], residual)

@@ -66,14 +66,17 @@ class Claim:
     # ------------------------------------------------------------------ constructors
 
     @classmethod
-    def near(cls, statement: str, value: float, thesis: float, tol: float, *, unit: str = "", fmt: str = ".4g", rel: bool = False, note: str = "") -> Claim:
-        """``|value − thesis| ≤ tol`` (``rel=True``: ``≤ tol·|thesis|``). NaN never matches."""
+    def near(
+        cls, statement: str, value: float, thesis: float, tol: float, *, unit: str = "", fmt: str = ".4g", rel: bool = False, note: str = "", thesis_text: str | None = None
+    ) -> Claim:
+        """``|value − thesis| ≤ tol`` (``rel=True``: ``≤ tol·|thesis|``). NaN never matches.
+        ``thesis_text`` replaces the displayed thesis value (e.g. "exact" for a residual)."""
         bound = tol * abs(thesis) if rel else tol
         ok = bool(math.isfinite(value) and abs(value - thesis) <= bound)
         u = f" {unit}" if unit else ""
         crit = f"|Δ| ≤ {tol:g}·|thesis|" if rel else f"|Δ| ≤ {tol:g}{u}"
         shown = f"{_fmt(value, fmt)}{u} (Δ = {_fmt(value - thesis, '+' + fmt)})" if math.isfinite(value) else str(value)
-        return cls(statement, f"{thesis:g}{u}", shown, crit, ok, float(value), note)
+        return cls(statement, thesis_text if thesis_text is not None else f"{thesis:g}{u}", shown, crit, ok, float(value), note)
 
     @classmethod
     def between(cls, statement: str, value: float, lo: float, hi: float, *, thesis: str, unit: str = "", fmt: str = ".3g", note: str = "") -> Claim:

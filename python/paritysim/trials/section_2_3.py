@@ -76,7 +76,7 @@ def fig2_9_claims(df: pl.DataFrame) -> list[Claim]:
     closed = np.degrees(np.arctan(np.cos(phi) * np.tan(theta)))
     closed_error = float(np.abs(a["theta_w_deg"].to_numpy() - closed).max())
     return [
-        Claim.near("(90°, 45°): on the box edges θ ∈ {0°, 45°}, |φ| ≤ 60° the shoulder is perfectly decoupled (θ_w = θ)", edge_error, 0.0, 1e-9, unit="°", fmt=".1e"),
+        Claim.near("(90°, 45°): on the box edges θ ∈ {0°, 45°}, |φ| ≤ 60° the shoulder is perfectly decoupled (θ_w = θ)", edge_error, 0.0, 1e-9, unit="°", fmt=".1e", thesis_text="exact (residual 0)"),
         Claim.holds(
             "(90°, 0°): ∂θ_w/∂θ ≈ 1 over a wide range (Fig. 2.9a)",
             slope_error <= 0.15,
@@ -84,7 +84,7 @@ def fig2_9_claims(df: pl.DataFrame) -> list[Claim]:
             criterion="≤ 0.15 for |φ|, |θ| ≤ 30°",
             note="∂θ_w/∂θ = cos φ at θ = 0: the range ends near |φ| = 30° (docs/errata.md#6)",
         ),
-        Claim.near("(90°, 0°): tan θ_w = cos φ tan θ exactly (docs/errata.md#6)", closed_error, 0.0, 1e-9, unit="°", fmt=".1e", note="eqs. 2.11-2.14 as printed"),
+        Claim.near("(90°, 0°): tan θ_w = cos φ tan θ exactly (docs/errata.md#6)", closed_error, 0.0, 1e-9, unit="°", fmt=".1e", thesis_text="exact (residual 0)", note="eqs. 2.11-2.14 as printed"),
     ]
 
 
