@@ -50,28 +50,24 @@ def test_cli_unknown_trial_fails_clearly(capsys: pytest.CaptureFixture[str]) -> 
     assert "available" in capsys.readouterr().err
 
 
-def test_console_script_runs(tmp_path: Path) -> None:
+def test_console_script_runs() -> None:
+    """The installed ``paritysim`` entry point (a subprocess); the full ``reproduce --all`` runs
+    once per session in the ``reproduced`` fixture (conftest.py)."""
     exe = Path(sys.executable).with_name("paritysim")
-    res = subprocess.run([str(exe), "reproduce", "--all", "--out", str(tmp_path), "--quiet"], capture_output=True, text=True, check=False)
+    res = subprocess.run([str(exe), "reproduce", "--list"], capture_output=True, text=True, check=False)
     assert res.returncode == 0, res.stderr
-    assert (tmp_path / "fig2_9.parquet").exists()
+    assert set(res.stdout.split()) == set(ps.trials.REGISTRY)
 
 
 def test_reproduce_laminate_writes_section(tmp_path: Path) -> None:
     assert main(["reproduce", "laminate", "--out", str(tmp_path), "--quiet"]) == 0
-    df = pl.read_csv(tmp_path / "laminate.csv")
-    assert df.columns == ["quantity", "value", "unit", "thesis", "note"]
-    row = dict(zip(df["quantity"], df["value"], strict=True))
-    # the designed actuator reproduces the thesis' constants (solved, then re-evaluated)
-    assert row["actuator stiffness"] == pytest.approx(467.0, rel=1e-6)
-    assert row["actuator force per volt"] == pytest.approx(1.2, rel=1e-6)
-    assert row["linkage sublaminate cure curvature (max)"] < 1e-12
     assert "Laminate design layer" in (tmp_path / "laminate.md").read_text()
-    assert (tmp_path / "laminate.png").read_bytes()[:4] == b"\x89PNG"
+    claims, _ = ps.claims.load(tmp_path / "laminate.claims.json")
+    assert all(c.ok for c in claims), [c.computed for c in claims]
 
 
 def test_trial_functions_are_exported() -> None:
     for name in ("fig2_9", "table_3_2", "fig3_2", "fig3_3", "fig3_4", "fig2_12", "section_3_4", "lift_dual_parity", "laminate_summary"):
         assert callable(getattr(ps.trials, name)), name
-    expected = {"fig2.9", "table3.2", "fig3.2", "fig3.3", "fig3.4", "fig2.12", "table3.3", "fig3.11", "fig3.12", "fig3.13", "lift-dual", "laminate", "fig2.13", "sec2.7", "floquet"}
+    expected = {"fig2.9", "table3.2", "fig3.2", "fig3.3", "fig3.4", "fig2.12", "calibration3.2", "table3.3", "fig3.11", "fig3.12", "fig3.13", "lift-dual", "laminate", "fig2.13", "sec2.7", "floquet"}
     assert expected <= set(ps.trials.REGISTRY)

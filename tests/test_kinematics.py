@@ -58,22 +58,6 @@ def test_joint_limit_eq_2_10_matches_the_mask() -> None:
     assert out["theta_w"].shape == phi.shape
 
 
-def test_erratum_6_relation_from_python() -> None:
-    phi, theta = np.meshgrid(np.linspace(-1.4, 1.4, 30), np.linspace(-1.4, 1.4, 30))
-    out = kin.shoulder_map(np.pi / 2, 0.0, phi, theta)
-    assert out["reachable"].all()
-    np.testing.assert_allclose(np.tan(out["theta_w"]), np.cos(phi) * np.tan(theta), atol=1e-10)
-
-
-def test_box_edges_are_exactly_decoupled_at_90_45() -> None:
-    """§2.3.3: along theta = 0 and theta = 45° the (90°, 45°) shoulder gives theta_w = theta."""
-    phi = np.radians(np.linspace(-60, 60, 121))
-    for edge in (0.0, np.pi / 4):
-        out = kin.shoulder_map(np.pi / 2, np.pi / 4, phi, edge)
-        assert out["reachable"].all()
-        np.testing.assert_allclose(out["theta_w"], edge, atol=1e-12)
-
-
 def test_partials_match_numpy_finite_differences() -> None:
     a2, a3, phi, theta = 2 * np.pi / 3, np.pi / 3, 0.4, -0.3
     p = kin.shoulder_partials(a2, a3, phi, theta)

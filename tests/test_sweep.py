@@ -15,7 +15,6 @@ import signal
 import subprocess
 import sys
 import textwrap
-import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -215,16 +214,26 @@ def test_run_handle_reports_progress_and_cancel_keeps_finished_points(parity: ps
         run.start()
 
 
-def test_ctrl_c_cancels_and_returns_the_finished_rows(parity: ps.Simulation) -> None:
+def test_ctrl_c_cancels_and_returns_the_finished_rows(parity: ps.Simulation, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Ctrl-C (SIGINT via ``_thread.interrupt_main``) once 128 points have finished: a count, not
+    a timer, so the outcome does not depend on the machine's load."""
     table = grid({"drivetrain.k2": np.linspace(1.0, 2.0, 10_000).tolist()})
-    timer = threading.Timer(0.4, _thread.interrupt_main)
-    timer.start()
-    try:
-        with pytest.warns(RuntimeWarning, match="cancelled"):
-            partial = sweep(parity, table, metrics=["q2_amplitude", "left_stroke_amplitude"], threads=2, chunk_size=64, progress=False)
-    finally:
-        timer.cancel()
-    assert 0 < partial.height < table.height
+    after = 128
+    advance = sweep_module._advance
+    done = [0]  # points finished so far, over all chunks (`finished` counts within a chunk)
+    fired = []
+
+    def advance_then_interrupt(bar: Any, finished: int, reported: int) -> int:
+        done[0] += max(finished - reported, 0)
+        if done[0] >= after and not fired:
+            fired.append(done[0])
+            _thread.interrupt_main()
+        return advance(bar, finished, reported)
+
+    monkeypatch.setattr(sweep_module, "_advance", advance_then_interrupt)
+    with pytest.warns(RuntimeWarning, match="cancelled"):
+        partial = sweep(parity, table, metrics=["q2_amplitude", "left_stroke_amplitude"], threads=2, chunk_size=64, progress=False)
+    assert fired and after <= partial.height < table.height
     assert partial["point"].is_sorted() and (partial["status"] == "ok").all()
     again = sweep(parity, table[partial["point"].to_list()], metrics=["q2_amplitude", "left_stroke_amplitude"], progress=False)
     assert_same(partial.drop("point"), again.drop("point"))

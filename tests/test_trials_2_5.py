@@ -2,13 +2,9 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
-import polars as pl
 
 import paritysim as ps
-from paritysim.cli import main
 from paritysim.trials import section_2_5 as s25
 
 FAST = dict(hinge_stiffness=2.5, max_cycles=60)
@@ -39,11 +35,3 @@ def test_hinge_validation_is_typed() -> None:
         spec = s25.device("lift_parity", "Uncut", hinge_k2=1.0, **FAST)
         bad = ps.Wing.from_moments(49, 50.5, 1.56, 4.2, aero=spec.wings[0].aero, tunable_hinge=ps.TunableHinge(1.0, 5.0, 1.0))
         ps.simulate(spec.replace(wings=(bad, bad)))
-
-
-def test_cli_lift_dual_writes_files(tmp_path: Path) -> None:
-    assert main(["reproduce", "lift-dual", "--out", str(tmp_path), "--quiet"]) == 0
-    df = pl.read_csv(tmp_path / "lift_dual.csv")
-    assert {"configuration", "number", "trial", "hinge_k2", "yaw_mean", "status"} <= set(df.columns)
-    assert set(df["number"].to_list()) == {1, 3, 5, 6, 7, 8}
-    assert (tmp_path / "lift_dual.png").read_bytes()[:4] == b"\x89PNG"

@@ -39,7 +39,7 @@ from ._core import (
 logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 if TYPE_CHECKING:  # what type checkers see; at run time the names below load lazily
-    from . import aero, devices, kinematics, laminate, planform, plots, spec, stability, trials
+    from . import aero, claims, devices, dynamics, kinematics, laminate, planform, plots, spec, stability, trials
     from .calibration import CalibrationResult, calibrate
     from .planform import Planform
     from .simulation import SimulationResult, simulate
@@ -47,7 +47,7 @@ if TYPE_CHECKING:  # what type checkers see; at run time the names below load la
     from .sweep import grid, sweep
 
 #: Lazily loaded submodules.
-_SUBMODULES = ("aero", "calibration", "devices", "kinematics", "laminate", "planform", "plots", "simulation", "spec", "stability", "sweep", "trials")
+_SUBMODULES = ("aero", "calibration", "claims", "devices", "dynamics", "kinematics", "laminate", "planform", "plots", "simulation", "spec", "stability", "sweep", "trials")
 #: Lazily loaded names -> the submodule defining them.
 _NAMES = {
     "CalibrationResult": "calibration",
@@ -104,7 +104,9 @@ __all__ = [
     "__version__",
     "aero",
     "calibrate",
+    "claims",
     "devices",
+    "dynamics",
     "grid",
     "kinematics",
     "laminate",

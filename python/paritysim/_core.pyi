@@ -1,6 +1,7 @@
 # Type stubs of the native module paritysim._core.
 # Checked against the built module by `python -m mypy.stubtest paritysim._core` in the tests.
 
+from collections.abc import Sequence
 from typing import Any, final
 
 import numpy as np
@@ -48,6 +49,7 @@ class Drivetrain:
 # --- dynamics ---
 def validate_device(spec: dict[str, Any]) -> tuple[int, int]: ...
 def simulate(spec: dict[str, Any], options: dict[str, Any]) -> dict[str, Any]: ...
+def dynamics_wing_terms(device: dict[str, Any], wing: int, p: Sequence[float], p_dot: Sequence[float]) -> dict[str, Any]: ...
 
 # --- aero (begin) ---
 AERO_AIR_DENSITY: float

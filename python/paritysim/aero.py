@@ -4,7 +4,7 @@ Conventions (see the Rust crate ``paritysim-aero`` for the derivations):
 
 * ``alpha`` in [0, pi] rad is the angle between the chord (toward the leading edge) and the
   wing's velocity: < pi/2 while the leading edge leads. ``alpha = pi/2 + psi_rw*sgn(phi_dot_rw)``,
-  i.e. eq. 3.4 with the sign of ``psi_rw`` flipped (ERRATA item 5), so that passive rotation
+  i.e. eq. 3.4 with the sign of ``psi_rw`` flipped (docs/errata.md#5), so that passive rotation
   (psi lagging phi by ~90°) gives alpha = 90° - |psi|.
 * ``C_N = C_L cos a + C_D sin a`` (normal), ``C_T = C_D cos a - C_L sin a`` (chordwise, toward
   the trailing edge).
@@ -108,7 +108,7 @@ def moments(
     phi_dot, theta_dot, psi_dot:
         Their rates (rad/ms).
     normal_force_law:
-        ``"coefficient"`` (eq. 3.8, Ω1 C_N φ̇²) or ``"unit"`` (eq. 2.16, Ω φ̇²; ERRATA item 12).
+        ``"coefficient"`` (eq. 3.8, Ω1 C_N φ̇²) or ``"unit"`` (eq. 2.16, Ω φ̇²; docs/errata.md#12).
 
     Returns
     -------

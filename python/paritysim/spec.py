@@ -62,7 +62,7 @@ class Aero:
 
     ``kind = "stroke_drag"``: ``tau = -omega1 * coefficient * sgn(phi_dot) phi_dot^2`` about the
     stroke axis; ``coefficient = 1`` is eq. 2.16, ``coefficient = C_N(90°)`` is eq. 3.8 for a
-    fixed wing (ERRATA item 12).
+    fixed wing (docs/errata.md#12).
 
     ``kind = "blade_element"``: the quasi-steady model of §3.2.4 (eqs. 3.8-3.11) with
     ``omega1..omega4`` (e.g. from :meth:`paritysim.Planform.omegas` or Table 3.3), coefficient
@@ -193,7 +193,7 @@ class Waveform:
 @dataclass(frozen=True)
 class Actuator:
     """Zeroth-order piezo actuator (§3.2.2): force = force_per_volt (mN/V) × V(t), in parallel
-    with ``stiffness`` (mN/mm). ``dc_offset``: ``as_force`` or ``ignore`` (ERRATA item 14)."""
+    with ``stiffness`` (mN/mm). ``dc_offset``: ``as_force`` or ``ignore`` (docs/errata.md#14)."""
 
     waveform: Waveform = field(default_factory=Waveform)
     force_per_volt: float = 1.2

@@ -4,9 +4,9 @@ of the full nonlinear model.
 Linearised model (§2.6)
     :func:`hill_monodromy`, :func:`hill_floquet`, :func:`region` and :func:`stability_chart`
     analyse ``x'' + β0|cos t| x' + κ x = 0`` (eq. 2.25, period π) and place points in the
-    regions of Fig. 2.13 (Region I with the corrected bound of ERRATA item 9);
+    regions of Fig. 2.13 (Region I with the corrected bound of docs/errata.md#9);
     :func:`brockett` and :func:`brockett_hill` are eqs. 2.57-2.58; :func:`hill_parameters`
-    maps physical parameters to (β0, κ1, κ2) with the factors of ERRATA item 7.
+    maps physical parameters to (β0, κ1, κ2) with the factors of docs/errata.md#7.
 Disturbance rejection (§2.7)
     :func:`lti_transfer` is eq. 2.59; :func:`linearise` derives β* and κ0 from a device's
     periodic orbit; :func:`disturbance_response` measures the same transfer on the nonlinear
@@ -57,6 +57,8 @@ __all__ = [
 
 #: Region names of Fig. 2.13 by index.
 REGIONS = {1: "I", 2: "II", 3: "III", 4: "IV"}
+#: ``region_name`` of points whose largest multiplier is within its error of the unit circle.
+MARGINAL = "marginal"
 
 
 def _f64(x: Any, name: str) -> np.ndarray:
@@ -87,8 +89,9 @@ def hill_floquet(beta0: float, kappa: float) -> dict[str, Any]:
     """Floquet analysis of eq. 2.25 at one point.
 
     Returns a dict: ``monodromy`` (at t0 = -π/2), ``a`` (half trace), ``b`` (determinant),
-    ``multipliers`` (complex, eq. 2.37), ``spectral_radius``, ``region`` (1-4, Fig. 2.13) and
-    ``stable`` (Region I).
+    ``multipliers`` (complex, eq. 2.37), ``spectral_radius``, ``region`` (1-4, Fig. 2.13),
+    ``multiplier_error`` and ``marginal`` (see :func:`stability_chart`) and ``stable``
+    (Region I and not marginal).
     """
     return _core.stability_hill_floquet(float(beta0), float(kappa))
 
@@ -96,7 +99,7 @@ def hill_floquet(beta0: float, kappa: float) -> dict[str, Any]:
 def region(a: Any, b: Any) -> np.ndarray:
     """Region (1-4) of Fig. 2.13 for half trace ``a`` and determinant ``b`` (arrays).
 
-    Region I is ``b <= 1, |a| <= (1 + b)/2`` (ERRATA item 9; the printed Region III bound
+    Region I is ``b <= 1, |a| <= (1 + b)/2`` (docs/errata.md#9; the printed Region III bound
     ``a > (b - 1)/2`` would mark stable systems unstable).
     """
     return _core.stability_region(_f64(a, "a"), _f64(b, "b"))
@@ -106,14 +109,20 @@ def stability_chart(beta0: Any, kappa: Any, *, brockett: bool = True) -> pl.Data
     """Floquet stability over the grid ``beta0 × kappa`` (computed in parallel in Rust).
 
     Returns one row per point (β0 outer, κ inner): ``beta0, kappa, a, b, spectral_radius,
-    region`` (1-4), ``region_name`` (I-IV), ``stable`` and, with ``brockett=True``,
-    ``brockett_bounded`` (Brockett's guarantee of eqs. 2.57-2.58; false where it does not
-    apply, κ <= 0).
+    region`` (1-4, of the computed ``a``, ``b``), ``stable`` (Region I and not marginal),
+    ``multiplier_error`` (error estimate of the multipliers' moduli: round-off of the
+    monodromy and its Liouville residual, eq. 2.45), ``marginal`` (``|max|ρ| − 1|`` within
+    that error: the undamped line β0 = 0 and the κ = 0 line), ``region_name`` (I-IV, or
+    ``marginal``) and, with ``brockett=True``, ``brockett_bounded`` (Brockett's guarantee of
+    eqs. 2.57-2.58; false where it does not apply, κ <= 0).
     """
     raw = _core.stability_chart(_f64(beta0, "beta0"), _f64(kappa, "kappa"))
     df = pl.DataFrame(raw).with_columns(
         pl.col("region").cast(pl.Int8),
-        pl.col("region").replace_strict(REGIONS, return_dtype=pl.String).alias("region_name"),
+        pl.when(pl.col("marginal"))
+        .then(pl.lit(MARGINAL))
+        .otherwise(pl.col("region").replace_strict(REGIONS, return_dtype=pl.String))
+        .alias("region_name"),
     )
     if brockett:
         beta = raw["beta0"]
@@ -148,7 +157,7 @@ def hill_parameters(
     stroke_amplitude: float,
     frequency_hz: float,
 ) -> dict[str, float]:
-    """(β0, κ1, κ2) of §2.6.1 from physical parameters, with ERRATA item 7's factors.
+    """(β0, κ1, κ2) of §2.6.1 from physical parameters, with docs/errata.md#7's factors.
 
     ``β0 = 2 Ω Φ / I`` (Φ = T·A the stroke amplitude in rad; the printed ``2ΩA/I`` lacks T),
     ``κ1 = K1/(2 I T² ω0²)``, ``κ2 = K2/(2 I T² L² ω0²)``. Also returns eq. 2.59's
@@ -304,7 +313,7 @@ def linearise(spec: Simulation | dict[str, Any], samples: int = 2000, **options:
     """Places a fixed-wing Drag PARITY device on the charts of §2.6-2.7 from its periodic orbit.
 
     Returns ``physical`` (inertia, drag Ω·C, T, L, K1, K2, stroke amplitude Φ, frequency),
-    ``hill`` (β0, κ1, κ2; ERRATA item 7), and three eq. 2.59 models (``beta_star`` in 1/ms,
+    ``hill`` (β0, κ1, κ2; docs/errata.md#7), and three eq. 2.59 models (``beta_star`` in 1/ms,
     ``kappa0`` in 1/ms²): ``lti`` (cycle-averaged aerodynamic damping and K2 of the
     whippletree mode, as §2.7 builds it), ``lti_sinusoidal`` (the same for sinusoidal
     flapping) and ``lti_averaged`` (cycle average of the full model's variational equation,
@@ -370,7 +379,7 @@ _REGION_COLOURS = {1: "#4daf4a", 2: "#e41a1c", 3: "#377eb8", 4: "#984ea3"}
 def plot_fig2_13(chart: pl.DataFrame | None = None, points: dict[str, tuple[float, float]] | None = None) -> Figure:
     """Fig. 2.13: the (a, b) plane of the monodromy matrix with Regions I-IV.
 
-    Boundaries: ``b = 1``, ``a = ±(1 + b)/2`` (ERRATA item 9; the printed ``(b - 1)/2`` dashed
+    Boundaries: ``b = 1``, ``a = ±(1 + b)/2`` (docs/errata.md#9; the printed ``(b - 1)/2`` dashed
     for comparison) and the double-root parabola ``b = a²``. ``chart`` (from
     :func:`stability_chart`) is scattered coloured by region; ``points`` maps labels to (a, b).
     """
@@ -384,7 +393,7 @@ def plot_fig2_13(chart: pl.DataFrame | None = None, points: dict[str, tuple[floa
     cmap = ListedColormap([_REGION_COLOURS[i] for i in (1, 2, 3, 4)])
     ax.pcolormesh(a, b_grid, reg, cmap=cmap, vmin=0.5, vmax=4.5, alpha=0.18, shading="auto")
     ax.axhline(1.0, color="k", lw=1.0)
-    ax.plot((1 + b_grid) / 2, b_grid, "k", lw=1.0, label="$a = \\pm(1+b)/2$ (ERRATA 9)")
+    ax.plot((1 + b_grid) / 2, b_grid, "k", lw=1.0, label="$a = \\pm(1+b)/2$ (docs/errata.md#9)")
     ax.plot(-(1 + b_grid) / 2, b_grid, "k", lw=1.0)
     ax.plot((b_grid - 1) / 2, b_grid, "k--", lw=0.8, label="printed $a = (b-1)/2$")
     ax.plot(a, a**2, "k:", lw=1.0, label="double root $b = a^2$")

@@ -5,7 +5,7 @@
 //! The wing angles `(φ, θ, ψ)` are the wing's intrinsic x-y-z Euler angles (stroke, deviation,
 //! rotation: `φ_w, θ_w, ψ_w` of §3.2.3), so the wing frame 6 is
 //! `R_6^1 = R_x(φ) R_y(θ) R_z(ψ)` (eqs. 2.2–2.5 with `γ5 = θ_w`; for the (α2, α3) = (90°, 0°)
-//! shoulder `θ_w ≈ θ` near mid-stroke, ERRATA item 6). The ground/body frame 1 is the shoulder
+//! shoulder `θ_w ≈ θ` near mid-stroke, docs/errata.md#6). The ground/body frame 1 is the shoulder
 //! ground. In the wing frame: `x̂` chordwise toward the leading edge, `ẑ` spanwise along the
 //! hinge, `ŷ = ẑ × x̂` the wing normal. The wing's angular velocity in the wing frame is
 //!
@@ -18,7 +18,7 @@
 //! translational depends on `(ω_x, ω_y)` only, and the model can be evaluated from `ω` alone
 //! ([`BladeElementModel::moments_omega`]; `ω = J6 ṗ` with the Jacobian of eq. A.9).
 //!
-//! # Wind-relative coordinates and α (eq. 3.4, ERRATA item 5)
+//! # Wind-relative coordinates and α (eq. 3.4, docs/errata.md#5)
 //! In the hinge frame the element velocity is `z (θ̇, −φ̇ cos θ, 0)`. Write it as
 //! `−z φ̇_rw (−sin δ, cos δ, 0)`: `φ̇_rw = sgn(φ̇ cos θ) √((φ̇ cos θ)² + θ̇²)` is the
 //! **wind-relative stroke velocity** and `δ = atan(θ̇ / (φ̇ cos θ))` the tilt of the relative
@@ -35,7 +35,7 @@
 //! α = π/2 + ψ_rw sgn(φ̇_rw)        (|ψ_rw| <= π/2; in general α = acos(−sgn(φ̇_rw) sin ψ_rw))
 //! ```
 //!
-//! i.e. eq. 3.4 with the sign of `ψ_rw` flipped (ERRATA item 5). The leading edge leads when
+//! i.e. eq. 3.4 with the sign of `ψ_rw` flipped (docs/errata.md#5). The leading edge leads when
 //! `ψ` has the opposite sign of `φ̇`: passive rotation makes `ψ` lag `φ` by ~90° and gives
 //! `α = 90° − |ψ|` (α ≈ 30° mid-stroke at |ψ| = 60°, α = 90° at stroke reversal).
 //!
@@ -54,12 +54,12 @@
 //! with that definition the derivation gives no `sgn(φ̇_rw)` in `M_T`: a chordwise drag pushes
 //! toward the trailing edge on both half-strokes, so its moment about the wing normal keeps its
 //! sign in the wing frame. The printed eq. 3.9 carries `sgn(φ̇_rw)`, which is only consistent
-//! with a `C_T` signed by the stroke direction. Not an ERRATA item yet; flagged in the tests.
+//! with a `C_T` signed by the stroke direction. Not yet an item of docs/errata.md; flagged in the tests.
 //!
 //! Power checks (tested): `(M_N, M_T)·(ω_x, ω_y) = −Ω1 |W|³ C_D(α) <= 0` and
 //! `M_rd ω_z = −Ω2 C_rd |ω_z|³ <= 0`. All four moments are odd in `ω`.
 //!
-//! ERRATA item 12 (drag torque `Ω φ̇²` of eq. 2.16 vs `Ω C_N φ̇²` of eq. 3.8) is exposed as
+//! docs/errata.md#12 (drag torque `Ω φ̇²` of eq. 2.16 vs `Ω C_N φ̇²` of eq. 3.8) is exposed as
 //! [`NormalForceLaw`].
 
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -138,7 +138,7 @@ impl Omegas {
     }
 }
 
-/// Which coefficient multiplies `Ω1 φ̇_rw²` in the normal moment (ERRATA item 12).
+/// Which coefficient multiplies `Ω1 φ̇_rw²` in the normal moment (docs/errata.md#12).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum NormalForceLaw {
     /// `M_N = −Ω1 sgn(φ̇_rw) φ̇_rw² C_N(α)`, eqs. 3.8–3.11 as printed (default).
@@ -401,7 +401,7 @@ impl<C: CoefficientModel> BladeElementModel<C> {
         Ok(self)
     }
 
-    /// Replaces the normal-force law (ERRATA item 12).
+    /// Replaces the normal-force law (docs/errata.md#12).
     pub fn with_normal_force_law(mut self, law: NormalForceLaw) -> Self {
         self.law = law;
         self

@@ -4,7 +4,7 @@
 //! `α ∈ [0, π]` is the geometric angle between the chord, pointing to the **leading edge**, and
 //! the wing's velocity through the air: `α < π/2` while the leading edge leads, `α = π/2` with
 //! the wing broadside to the flow, `α > π/2` when the leading edge trails (see
-//! [`crate::blade`] for how α follows from the wing state and ERRATA item 5).
+//! [`crate::blade`] for how α follows from the wing state and docs/errata.md#5).
 //!
 //! In the plane of the chord and the velocity `û`: drag acts along `−û`, lift along the unit
 //! vector `ℓ̂ ⟂ û` on the leading-edge side (`ℓ̂·ĉ >= 0`, `ĉ` the chord toward the leading edge).
@@ -37,7 +37,7 @@ use paritysim_error::{Error, Result, bail};
 /// J. P. Whitney & R. J. Wood, "Aeromechanics of passive rotation in flapping flight",
 /// J. Fluid Mech. 660, 197–220 (2010), who base it on tumbling-plate experiments
 /// (Andersen, Pesavento & Wang 2005), the sources the thesis cites as refs. 1 and 39.
-/// The thesis gives no value for §3.4 (ERRATA item 14); this is a documented default.
+/// The thesis gives no value for §3.4 (docs/errata.md#14); this is a documented default.
 pub const DEFAULT_ROTATIONAL_DAMPING: f64 = 5.0;
 
 /// Lift, drag, normal and tangential force coefficients at one angle of attack.

@@ -592,7 +592,7 @@ impl Planform {
     /// ```
     ///
     /// No force coefficient is folded in: the moments multiply by `C_N(α)`, `C_T(α)`, `C_rd`
-    /// and `d̂_cp(α)` at run time (eqs. 3.8–3.11). See ERRATA item 12 for the `Ω φ̇²` form.
+    /// and `d̂_cp(α)` at run time (eqs. 3.8–3.11). See docs/errata.md#12 for the `Ω φ̇²` form.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] (`density`) unless `density` is finite and > 0.

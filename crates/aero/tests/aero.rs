@@ -596,7 +596,7 @@ fn wind_relative_reduces_to_plain_coordinates_without_deviation() {
         assert_relative_eq!(w.phi_dot_rw, phi_dot, max_relative = 1e-15);
         assert_relative_eq!(w.psi_rw, psi, max_relative = 1e-15);
         assert_relative_eq!(w.psi_dot_rw, psi_dot, max_relative = 1e-15);
-        // α = π/2 + ψ sgn φ̇ (eq. 3.4 with ERRATA item 5's sign).
+        // α = π/2 + ψ sgn φ̇ (eq. 3.4 with docs/errata.md#5's sign).
         assert_relative_eq!(
             w.alpha,
             FRAC_PI_2 + psi * phi_dot.signum(),
@@ -721,7 +721,7 @@ fn rotational_moment_drives_leading_edge_forward() {
 /// Prescribed stroke `φ = Φ sin ωt` (±50°, 110 Hz) and the hinge equation
 /// `Izz ψ̈ = −k ψ + M_r + M_rd` (wing inertial coupling omitted: this isolates the aerodynamic
 /// moment). ψ must lag φ by about 90°, with α ≈ 90° at stroke reversal and well below 90° with
-/// the leading edge leading at mid-stroke (ERRATA item 5; §3.4: α = 90° at the extents, ≈ 30°
+/// the leading edge leading at mid-stroke (docs/errata.md#5; §3.4: α = 90° at the extents, ≈ 30°
 /// mid-stroke).
 #[test]
 fn passive_rotation_lags_stroke_by_about_90_degrees() {
@@ -834,7 +834,7 @@ fn normal_force_law_exposes_errata_item_12() {
     let o33 = Omegas::new(31.3, 0.0, 0.0, 0.0).unwrap();
     let m = dickinson_model(o33).moments(&WingState::planar(0.0, 0.0, phi_dot, 0.0).unwrap());
     println!(
-        "ERRATA 12 at Ω = 31.3, ±35°, 110 Hz: Ω φ̇² = {:.2} mN·mm, Ω C_N(90°) φ̇² = {:.2} mN·mm \
+        "docs/errata.md#12 at Ω = 31.3, ±35°, 110 Hz: Ω φ̇² = {:.2} mN·mm, Ω C_N(90°) φ̇² = {:.2} mN·mm \
          (Table 3.2 peak: 12.42)",
         -drag_torque_eq_2_16(31.3, phi_dot),
         -m.normal

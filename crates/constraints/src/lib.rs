@@ -7,7 +7,7 @@
 //!
 //! * **null space** (default): `p = p_part + N z` with `N` an orthonormal basis of `ker C` and
 //!   `C p_part = c0`; the reduced coordinates `z` cannot drift off the constraint;
-//! * **projection** (eq. 3.20 with the `Cᵀ` restored, ERRATA item 4):
+//! * **projection** (eq. 3.20 with the `Cᵀ` restored, docs/errata.md#4):
 //!   `p̈ = M⁻¹ (I − Cᵀ (C M⁻¹ Cᵀ)⁻¹ C M⁻¹) (f + τ)`, see [`Constraints::project`].
 
 use nalgebra::{DMatrix, SMatrix, SVector};
@@ -244,7 +244,7 @@ impl Constraints {
         Ok(())
     }
 
-    /// Constrained accelerations by eq. 3.20 with the `Cᵀ` of ERRATA item 4:
+    /// Constrained accelerations by eq. 3.20 with the `Cᵀ` of docs/errata.md#4:
     /// `p̈ = M⁻¹ (I − Cᵀ (C M⁻¹ Cᵀ)⁻¹ C M⁻¹) (f + τ)`, given `M⁻¹` and the force `f + τ`.
     ///
     /// # Errors

@@ -5,7 +5,7 @@
 
 use paritysim_error::{Error, Result, bail, check_finite, check_non_negative, check_positive};
 
-/// How the DC part of the drive voltage enters (ERRATA item 14: not specified by the thesis).
+/// How the DC part of the drive voltage enters (docs/errata.md#14: not specified by the thesis).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum DcOffset {
     /// The offset produces a static force (shifts the equilibrium of `q1`).

@@ -24,7 +24,7 @@ pub struct Transmission {
 }
 
 impl Transmission {
-    /// `balance_stiffness` K2 on `q2` in mN·mm/rad (>= 0; ERRATA item 14: not given by the
+    /// `balance_stiffness` K2 on `q2` in mN·mm/rad (>= 0; docs/errata.md#14: not given by the
     /// thesis).
     pub fn new(kinematics: Drivetrain, balance_stiffness: f64) -> Result<Self> {
         Ok(Self {
@@ -53,7 +53,7 @@ pub enum Formulation {
     Auto,
     /// Reduced coordinates `p = p_part + N z` (cannot drift).
     NullSpace,
-    /// Lagrange-multiplier projection of eq. 3.20 (with ERRATA item 4's `Cᵀ`) on the full `p`.
+    /// Lagrange-multiplier projection of eq. 3.20 (with docs/errata.md#4's `Cᵀ`) on the full `p`.
     Projection,
     /// Fixed wings only stroking (θ = ψ = 0 imposed by `C`, α2 = 90° shoulders so θ_w ≡ 0, no
     /// springs on joints 2, 3, 5): integrate the drivetrain coordinates `q` directly with

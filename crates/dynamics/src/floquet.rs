@@ -6,10 +6,10 @@
 //!   pieces where `|cos t|` is smooth (truncation at round-off level; closed forms of eqs.
 //!   2.45, 2.50 and 2.54 hold to 1e-9 or better in `tests/dynamics/floquet.rs`); its
 //!   half trace `a`, determinant `b` (eq. 2.36), multipliers (eq. 2.37) and region of Fig. 2.13
-//!   ([`Region`], with the corrected Region III bound of ERRATA item 9) follow. A
+//!   ([`Region`], with the corrected Region III bound of docs/errata.md#9) follow. A
 //!   [`stability_chart`] over a (β0, κ) grid is computed in parallel with rayon. [`brockett`]
 //!   is the criterion of eqs. 2.57–2.58 and [`PhysicalParameters::hill`] maps a device to
-//!   (β0, κ1, κ2) with the factors of ERRATA item 7.
+//!   (β0, κ1, κ2) with the factors of docs/errata.md#7.
 //! * **Disturbance rejection (§2.7).** [`LtiModel`] is eq. 2.59; [`linearise`] derives its
 //!   `β*` (cycle-averaged aerodynamic damping of the whippletree mode) and `κ0` from a device
 //!   and its periodic orbit, and [`disturbance_response`] measures the same transfer on the
@@ -21,7 +21,7 @@
 //!   coordinates and rates the device integrates (work integrals excluded) and returns the
 //!   Floquet multipliers; [`balance_stiffness_sweep`] repeats that over K2 in parallel.
 //!
-//! Errata (ERRATA.md next to the thesis) relied on here, each verified numerically in
+//! Errata (docs/errata.md) relied on here, each verified numerically in
 //! `tests/dynamics/floquet.rs`: item 7 (the drag forces of eqs. 2.17–2.19 carry `T³`, so
 //! `β0 = 2ΩΦ/I`), item 8 (eq. 2.27's coefficient is `−¼β0²cos²t`), item 9 (Region I is
 //! `b ≤ 1, |a| ≤ (1 + b)/2`), item 10 (eq. 2.52 is `M = exp(TQ)`, eq. 2.53 is `M^(n+1)`, eq. 2.54
@@ -186,11 +186,11 @@ pub fn hill_monodromy(beta0: f64, kappa: f64, t0: f64) -> Result<Matrix2<f64>> {
 /// A region of the trace-determinant plane of Fig. 2.13.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Region {
-    /// Stable: `b ≤ 1` and `|a| ≤ (1 + b)/2` (the Schur–Cohn triangle, ERRATA item 9).
+    /// Stable: `b ≤ 1` and `|a| ≤ (1 + b)/2` (the Schur–Cohn triangle, docs/errata.md#9).
     I,
     /// Complex multipliers with `|ρ| = √b > 1` (`b > a²`, `b > 1`).
     II,
-    /// Real multipliers, `a > 0`, one of them above 1: `a > (1 + b)/2` (ERRATA item 9: the
+    /// Real multipliers, `a > 0`, one of them above 1: `a > (1 + b)/2` (docs/errata.md#9: the
     /// printed bound `(b − 1)/2` is wrong) or `b > 1`.
     III,
     /// Real multipliers, `a < 0`, one of them below −1: `a < −(1 + b)/2` or `b > 1`.
@@ -216,7 +216,7 @@ impl Region {
 
 /// The region of Fig. 2.13 for half trace `a` and determinant `b` of a 2×2 monodromy matrix.
 ///
-/// Region I is `b ≤ 1, |a| ≤ (1 + b)/2` (ERRATA item 9): the roots of `ρ² − 2aρ + b` (eq. 2.36)
+/// Region I is `b ≤ 1, |a| ≤ (1 + b)/2` (docs/errata.md#9): the roots of `ρ² − 2aρ + b` (eq. 2.36)
 /// have `|ρ| ≤ 1` exactly there. Outside it, complex roots with `b > 1` are Region II and real
 /// roots are Region III (`a > 0`) or IV (`a < 0`).
 ///
@@ -266,11 +266,19 @@ pub struct HillFloquet {
     pub b: f64,
     /// The Floquet multipliers (eq. 2.37), larger modulus first.
     pub multipliers: [Complex<f64>; 2],
-    /// Region of Fig. 2.13.
+    /// Region of Fig. 2.13 (of the computed `a`, `b`; see [`Self::is_marginal`]).
     pub region: Region,
+    /// Error estimate of the multipliers' moduli ([`multiplier_error`]).
+    pub multiplier_error: f64,
 }
 
 impl HillFloquet {
+    /// Whether `max |ρ|` is within [`Self::multiplier_error`] of 1: the computed multipliers
+    /// cannot tell stable from unstable (the undamped line β0 = 0, the κ = 0 line of eq. 2.50).
+    pub fn is_marginal(&self) -> bool {
+        (self.spectral_radius() - 1.0).abs() <= self.multiplier_error
+    }
+
     /// `max |ρ|`.
     pub fn spectral_radius(&self) -> f64 {
         self.multipliers[0].norm().max(self.multipliers[1].norm())
@@ -282,11 +290,42 @@ impl HillFloquet {
     }
 }
 
-/// Monodromy, multipliers and region of eq. 2.25 at `(β0, κ)`.
+/// Safety factor of [`multiplier_error`] over its first-order round-off estimate.
+pub const MULTIPLIER_ERROR_SAFETY: f64 = 4.0;
+
+/// Error estimate of the multipliers' moduli for the computed monodromy `m` of eq. 2.25
+/// (`steps` Taylor steps, exact determinant `e^{−2β0}` by eq. 2.45).
+///
+/// Entries: round-off accumulated over the steps, `δM = steps · ε · max(1, max|M_ij|)`.
+/// Determinant: the larger of the Liouville residual `|det M − e^{−2β0}|` (a measured error)
+/// and `δM Σ|M_ij|`. The roots `ρ = a ± √(a² − b)` of eq. 2.36 then move by at most
+/// `δa + min(δΔ / (2√|Δ|), √δΔ)` with `Δ = a² − b`, `δΔ = 2|a|δa + δb` (the square root's
+/// first-order and Hölder bounds), times [`MULTIPLIER_ERROR_SAFETY`].
+pub fn multiplier_error(m: &Matrix2<f64>, beta0: f64, steps: usize) -> f64 {
+    let entry = steps as f64 * f64::EPSILON * m.amax().max(1.0);
+    let a = 0.5 * m.trace();
+    let b = m.determinant();
+    let abs_sum = m.iter().map(|v| v.abs()).sum::<f64>();
+    let db = (b - (-2.0 * beta0).exp()).abs().max(entry * abs_sum);
+    let disc = (a * a - b).abs();
+    let ddisc = 2.0 * a.abs() * entry + db;
+    let root = if disc > 0.0 {
+        (ddisc / (2.0 * disc.sqrt())).min(ddisc.sqrt())
+    } else {
+        ddisc.sqrt()
+    };
+    MULTIPLIER_ERROR_SAFETY * (entry + root)
+}
+
+/// Monodromy, multipliers and region of eq. 2.25 at `(β0, κ)`, with the multipliers' error
+/// estimate ([`multiplier_error`]; [`HillFloquet::is_marginal`] uses it).
 pub fn hill_floquet(beta0: f64, kappa: f64) -> Result<HillFloquet> {
     let m = hill_monodromy(beta0, kappa, -FRAC_PI_2)?;
     let a = 0.5 * m.trace();
     let b = m.determinant();
+    // [−π/2, π/2] is one smooth piece of |cos t|: the step count of `hill_solution_matrix`.
+    let lambda = 1.0f64.max(beta0.abs()).max(kappa.abs().sqrt());
+    let steps = (PI * lambda / STEP).ceil().max(1.0) as usize;
     Ok(HillFloquet {
         beta0,
         kappa,
@@ -295,6 +334,7 @@ pub fn hill_floquet(beta0: f64, kappa: f64) -> Result<HillFloquet> {
         b,
         multipliers: multipliers(a, b),
         region: region(a, b)?,
+        multiplier_error: multiplier_error(&m, beta0, steps),
     })
 }
 
@@ -313,6 +353,10 @@ pub struct StabilityChart {
     pub spectral_radius: Vec<f64>,
     /// Region of Fig. 2.13.
     pub region: Vec<Region>,
+    /// [`HillFloquet::multiplier_error`].
+    pub multiplier_error: Vec<f64>,
+    /// [`HillFloquet::is_marginal`].
+    pub marginal: Vec<bool>,
 }
 
 /// Largest number of points of one [`stability_chart`] call.
@@ -352,6 +396,8 @@ pub fn stability_chart(beta0: &[f64], kappa: &[f64]) -> Result<StabilityChart> {
         b: Vec::with_capacity(n),
         spectral_radius: Vec::with_capacity(n),
         region: Vec::with_capacity(n),
+        multiplier_error: Vec::with_capacity(n),
+        marginal: Vec::with_capacity(n),
     };
     for p in points {
         chart.beta0.push(p.beta0);
@@ -360,6 +406,8 @@ pub fn stability_chart(beta0: &[f64], kappa: &[f64]) -> Result<StabilityChart> {
         chart.b.push(p.b);
         chart.spectral_radius.push(p.spectral_radius());
         chart.region.push(p.region);
+        chart.multiplier_error.push(p.multiplier_error);
+        chart.marginal.push(p.is_marginal());
     }
     Ok(chart)
 }
@@ -452,7 +500,7 @@ pub fn brockett_hill(beta0: f64, kappa: f64) -> Result<Brockett> {
 pub struct PhysicalParameters {
     /// Wing inertia about the stroke axis I (mg·mm²).
     pub inertia: f64,
-    /// Drag parameter Ω of eq. 2.16 (mg·mm²; `Ω1 C_N(90°)` for eq. 3.8, ERRATA item 12).
+    /// Drag parameter Ω of eq. 2.16 (mg·mm²; `Ω1 C_N(90°)` for eq. 3.8, docs/errata.md#12).
     pub drag: f64,
     /// Transmission ratio T (rad/mm).
     pub transmission_ratio: f64,
@@ -471,7 +519,7 @@ pub struct PhysicalParameters {
 /// The non-dimensional parameters of eqs. 2.23–2.24.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HillParameters {
-    /// `β0 = 2ΩTA/I = 2ΩΦ/I` (ERRATA item 7; the printed `2ΩA/I` lacks T).
+    /// `β0 = 2ΩTA/I = 2ΩΦ/I` (docs/errata.md#7; the printed `2ΩA/I` lacks T).
     pub beta0: f64,
     /// `κ1 = K1/(2 I T² ω0²)`.
     pub kappa1: f64,
@@ -503,7 +551,7 @@ impl PhysicalParameters {
         2.0 * PI * self.frequency_hz * 1e-3
     }
 
-    /// (β0, κ1, κ2) of §2.6.1 with the factors corrected by ERRATA item 7: the drag force on q2
+    /// (β0, κ1, κ2) of §2.6.1 with the factors corrected by docs/errata.md#7: the drag force on q2
     /// is `−4ΩT³L²|q̇1|q̇2`, so linearising about `q1 = A sin ω0t` and dividing by the modal
     /// inertia `2IT²L²` gives the damping `2ΩTA ω0 |cos τ|/I` per unit ω0.
     ///
@@ -1259,7 +1307,7 @@ pub struct DeviceLinearisation {
     /// `L = (hL + hR)/2`; drag = `−τ(φ̇ = 1 rad/ms)`, i.e. `Ω1 C` for stroke drag; Φ the mean
     /// stroke amplitude of the orbit).
     pub physical: PhysicalParameters,
-    /// (β0, κ1, κ2) of eq. 2.23–2.24 (ERRATA item 7).
+    /// (β0, κ1, κ2) of eq. 2.23–2.24 (docs/errata.md#7).
     pub hill: HillParameters,
     /// Eq. 2.59 as §2.7 builds it: the cycle averages over the orbit of the whippletree mode's
     /// aerodynamic damping rate and spring stiffness per unit modal inertia,

@@ -324,6 +324,8 @@ pub fn record(device: &Device, times: &[f64], states: &[State]) -> Result<Trajec
         "theta_dot",
         "psi_dot",
         "phi_ddot",
+        "theta_ddot",
+        "psi_ddot",
         "theta_w",
         "tau_aero_phi",
         "tau_aero_theta",
@@ -380,7 +382,9 @@ pub fn record(device: &Device, times: &[f64], states: &[State]) -> Result<Trajec
             for i in 0..3 {
                 push(p_dot[k + i]);
             }
-            push(e.p_ddot[k]);
+            for i in 0..3 {
+                push(e.p_ddot[k + i]); // φ̈, θ̈, ψ̈ (Appendix A's p̈)
+            }
             push(terms.theta_w);
             for i in 0..3 {
                 push(terms.aero[i]);

@@ -6,7 +6,7 @@
 //!
 //! ```text
 //! M(p) = J6ᵀ I J6                                  (A.36)
-//! c(p, ṗ) = J6ᵀ (I (J̇6 ṗ) + ω × I ω)               (replaces A.37–A.38, see ERRATA items 1–2)
+//! c(p, ṗ) = J6ᵀ (I (J̇6 ṗ) + ω × I ω)               (replaces A.37–A.38, see docs/errata.md#1, #2)
 //! ```
 //!
 //! `J̇6 ṗ` is assembled from link angular velocities (no second partials of the printed
@@ -106,7 +106,7 @@ pub enum WingAero {
     /// No aerodynamics (vacuum).
     None,
     /// Quadratic drag about the stroke axis, `τ = −Ω C sgn(φ̇) φ̇²`, the fixed-wing model of
-    /// §2.6.1 (eq. 2.16, `C = 1`) or eq. 3.8 at α = 90° (`C = C_N(90°)`); ERRATA item 12.
+    /// §2.6.1 (eq. 2.16, `C = 1`) or eq. 3.8 at α = 90° (`C = C_N(90°)`); docs/errata.md#12.
     StrokeDrag {
         /// Drag parameter Ω1 (mg·mm²).
         omega1: f64,

@@ -13,8 +13,8 @@
 //! is `R_6^1 = R_x(φ) R_y(γ5) R_z(ψ)`, so the wing angles are the intrinsic x-y-z Euler angles
 //! `(φ_w, θ_w, ψ_w) = (φ, γ5, ψ)`.
 //!
-//! Partial derivatives: instead of the overdetermined 3×2 systems A.18–A.28 (see ERRATA items
-//! 1–3, which this module does not inherit), we use the angular-velocity closure of link 4 via
+//! Partial derivatives: instead of the overdetermined 3×2 systems A.18–A.28 (see docs/errata.md#1
+//! to #3, which this module does not inherit), we use the angular-velocity closure of link 4 via
 //! both chains, `φ̇ x̂ + γ̇5 ŷ3 = θ̇ ŷ + γ̇2 ŝ2¹ + γ̇3 ŝ3¹`, a square 3×3 system
 //! `A (γ2, γ3, γ5)' = (x̂ | −ŷ)` whose derivative gives the second partials as
 //! `A g'' = −A' g'`. The integration tests cross-check this against finite differences and

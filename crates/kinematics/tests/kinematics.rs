@@ -77,7 +77,7 @@ proptest! {
     }
 }
 
-/// ERRATA item 6: for (α2, α3) = (90°, 0°), tan θ_w = cos φ tan θ exactly.
+/// docs/errata.md#6: for (α2, α3) = (90°, 0°), tan θ_w = cos φ tan θ exactly.
 #[test]
 fn erratum_6_exact_relation_at_90_0() {
     let sh = shoulder(90.0, 0.0);
@@ -215,8 +215,8 @@ fn partials_match_finite_differences() {
 }
 
 /// The thesis' overdetermined form (A.18/A.19/A.26–A.28), solved by least squares (A.15).
-/// `joint2_axis_as_printed` uses x̂2 (the printed text) instead of ŝ2¹ (ERRATA item 2);
-/// `a28_as_printed` multiplies A.28 by the θ-partials (ERRATA item 1).
+/// `joint2_axis_as_printed` uses x̂2 (the printed text) instead of ŝ2¹ (docs/errata.md#2);
+/// `a28_as_printed` multiplies A.28 by the θ-partials (docs/errata.md#1).
 struct ThesisForm {
     g2: Vector2<f64>,
     g5: Vector2<f64>,
@@ -260,7 +260,7 @@ fn thesis_form(
             dsy3_phi * s3 + skew(&y3) * ds3_phi,
         ]) * g_phi;
     let pp = lsq(b, rhs_pp);
-    // A.28, with the column separators restored (ERRATA item 3).
+    // A.28, with the column separators restored (docs/errata.md#3).
     let cols = nalgebra::Matrix3x2::from_columns(&[
         -(dsx2_theta * s3 + skew(&axis2) * ds3_theta),
         skew(&y3) * ds3_theta,
@@ -277,7 +277,7 @@ fn thesis_form(
     }
 }
 
-/// ERRATA items 1–3: the corrected A.18/A.26/A.28 agree with our closure formulation for all
+/// docs/errata.md#1 to #3: the corrected A.18/A.26/A.28 agree with our closure formulation for all
 /// (α2, α3); the printed x̂2 fails unless α2 = 90°; the printed A.28 fails everywhere.
 #[test]
 fn errata_1_to_3_appendix_partials() {

@@ -272,7 +272,7 @@ fn aero_coefficients<'py>(
 /// Blade-element moments (eqs. 3.8–3.11) over paired state arrays.
 ///
 /// `omegas` is `[Ω1, Ω2, Ω3, Ω4]` (mg·mm²); `force` (mg·mm, `½ρ∬z²dA`) enables the lift/drag
-/// outputs. `normal_force_law` is `"coefficient"` (eq. 3.8) or `"unit"` (eq. 2.16, ERRATA 12).
+/// outputs. `normal_force_law` is `"coefficient"` (eq. 3.8) or `"unit"` (eq. 2.16, docs/errata.md#12).
 /// Returns `normal`, `tangential`, `rotational`, `rotational_damping`, `alpha`, `phi_dot_rw`,
 /// `psi_rw`, `psi_dot_rw` (n,), `torque_wing (n, 3)`, and with `force`: `lift`, `drag`,
 /// `lift_torque`, `drag_torque`, `torque_body` (n, 3) in body axes `[roll, yaw, pitch]`.

@@ -14,6 +14,7 @@ mod kinematics;
 mod laminate;
 mod stability;
 mod sweep;
+mod wing_terms;
 
 /// The native module.
 #[pymodule]
@@ -26,5 +27,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     laminate::register(m)?;
     stability::register(m)?;
     sweep::register(m)?;
+    wing_terms::register(m)?;
     Ok(())
 }

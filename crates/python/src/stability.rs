@@ -76,13 +76,16 @@ fn hill_dict<'py>(py: Python<'py>, f: &HillFloquet) -> PyResult<Bound<'py, PyDic
     )?;
     out.set_item("spectral_radius", f.spectral_radius())?;
     out.set_item("region", f.region.index())?;
-    out.set_item("stable", f.region.is_stable())?;
+    out.set_item("stable", f.region.is_stable() && !f.is_marginal())?;
+    out.set_item("marginal", f.is_marginal())?;
+    out.set_item("multiplier_error", f.multiplier_error)?;
     Ok(out)
 }
 
 /// Floquet analysis of eq. 2.25: `monodromy` (at t0 = -π/2), half trace `a`, determinant `b`,
-/// `multipliers` (complex), `spectral_radius`, `region` (1-4 of Fig. 2.13, ERRATA item 9),
-/// `stable`.
+/// `multipliers` (complex), `spectral_radius`, `region` (1-4 of Fig. 2.13, docs/errata.md#9),
+/// `multiplier_error`, `marginal` (`|max|ρ| − 1| <= multiplier_error`) and `stable` (Region I
+/// and not marginal).
 #[pyfunction]
 fn stability_hill_floquet<'py>(
     py: Python<'py>,
@@ -94,7 +97,8 @@ fn stability_hill_floquet<'py>(
 }
 
 /// The (β0, κ) grid `beta0 × kappa` (row-major, β0 outer) computed in parallel: flat arrays
-/// `beta0, kappa, a, b, spectral_radius, region` (int 1-4), `stable` (bool).
+/// `beta0, kappa, a, b, spectral_radius, region` (int 1-4), `multiplier_error`, `marginal`
+/// and `stable` (Region I and not marginal).
 #[pyfunction]
 fn stability_chart<'py>(
     py: Python<'py>,
@@ -107,7 +111,12 @@ fn stability_chart<'py>(
         .py_err()?;
     let out = PyDict::new(py);
     let region: Vec<i64> = chart.region.iter().map(|r| i64::from(r.index())).collect();
-    let stable: Vec<bool> = chart.region.iter().map(|r| r.is_stable()).collect();
+    let stable: Vec<bool> = chart
+        .region
+        .iter()
+        .zip(&chart.marginal)
+        .map(|(r, &marginal)| r.is_stable() && !marginal)
+        .collect();
     out.set_item("beta0", PyArray1::from_vec(py, chart.beta0))?;
     out.set_item("kappa", PyArray1::from_vec(py, chart.kappa))?;
     out.set_item("a", PyArray1::from_vec(py, chart.a))?;
@@ -118,11 +127,16 @@ fn stability_chart<'py>(
     )?;
     out.set_item("region", PyArray1::from_vec(py, region))?;
     out.set_item("stable", PyArray1::from_vec(py, stable))?;
+    out.set_item(
+        "multiplier_error",
+        PyArray1::from_vec(py, chart.multiplier_error),
+    )?;
+    out.set_item("marginal", PyArray1::from_vec(py, chart.marginal))?;
     Ok(out)
 }
 
 /// Region (1-4) of Fig. 2.13 for paired arrays of half trace `a` and determinant `b`
-/// (ERRATA item 9: Region I is `b <= 1, |a| <= (1 + b)/2`).
+/// (docs/errata.md#9: Region I is `b <= 1, |a| <= (1 + b)/2`).
 #[pyfunction]
 fn stability_region<'py>(
     py: Python<'py>,
@@ -181,7 +195,7 @@ fn stability_brockett_hill<'py>(
     brockett_dict(py, &b)
 }
 
-/// (β0, κ1, κ2) of §2.6.1 with ERRATA item 7's factors, and eq. 2.59's `beta_star` (1/ms),
+/// (β0, κ1, κ2) of §2.6.1 with docs/errata.md#7's factors, and eq. 2.59's `beta_star` (1/ms),
 /// `kappa0` (1/ms²) for sinusoidal flapping.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]

@@ -2,8 +2,10 @@
 
 Each function returns Polars DataFrames computed by the model; nothing is copied from the
 thesis. A module may define ``CLI_TRIALS: dict[str, Callable[[Path], list[Path]]]`` (name ->
-runner writing files into an output directory) and ``report_section(out_dir) -> str``
-(markdown for ``report.md``); :data:`REGISTRY` collects the runners for ``paritysim reproduce``.
+runner writing files into an output directory, including ``<stem>.claims.json``: the thesis
+claims with computed verdicts, :mod:`paritysim.claims`) and ``report_section(out_dir) -> str``
+(markdown for ``report.md``, built from those files); :data:`REGISTRY` collects the runners for
+``paritysim reproduce``.
 """
 
 from __future__ import annotations

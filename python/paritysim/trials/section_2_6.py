@@ -13,9 +13,11 @@ import numpy as np
 import polars as pl
 
 from .. import stability as st
+from ..claims import Claim, render
+from ._io import write_claims
 from ..spec import Actuator, Aero, Configuration, Drivetrain, Simulation, Waveform, Wing
 
-#: C_N(90°) of eqs. 3.5-3.6, as in examples/drag_parity.toml (ERRATA item 12).
+#: C_N(90°) of eqs. 3.5-3.6, as in examples/drag_parity.toml (docs/errata.md#12).
 CN90 = 3.4609
 #: Fixed §3.3 wing: stroke inertia 29.0 mg·mm² (§3.3.2).
 INERTIA = ((29.0, 0.0, 0.0), (0.0, 29.0, 0.0), (0.0, 0.0, 1.0))
@@ -95,7 +97,68 @@ def _cli_fig2_13(out: Path) -> list[Path]:
     bk = {f"§3.3, K2 = {r['k2']:g}": (r["beta0"], r["kappa2"]) for r in pts.iter_rows(named=True)}
     written.append(plots.save(st.plot_fig2_13(chart.filter(pl.col("beta0") >= 0.0).gather_every(7), ab), out / "fig2_13.png"))
     written.append(plots.save(st.plot_chart_map(chart, bk), out / "fig2_13_map.png"))
+    written.append(write_claims(out, "fig2.13", linearised_claims(chart), {"devices": pts.to_dicts()}))
     return written
+
+
+def linearised_claims(chart: pl.DataFrame) -> list[Claim]:
+    """The §2.6 closed forms (with docs/errata.md#7 to #10) checked on the eq. 2.25 solver,
+    and Fig. 2.13's statements checked on ``chart``."""
+    from scipy.special import i0
+
+    rng = np.random.default_rng(0)
+    worst_det = 0.0
+    for beta0, kappa in zip(rng.uniform(-1, 5, 50), rng.uniform(-1, 8, 50), strict=True):
+        m = st.hill_monodromy(beta0, kappa, rng.uniform(-3, 3))
+        scale = max(math.exp(-2 * beta0), abs(m[0, 0] * m[1, 1]) + abs(m[0, 1] * m[1, 0]))
+        worst_det = max(worst_det, abs(np.linalg.det(m) - math.exp(-2 * beta0)) / scale)
+    beta0 = 0.9
+    m = st.hill_monodromy(beta0, 0.0)
+    err_250 = abs(m[0, 1] / (math.pi * math.exp(-beta0) * i0(beta0)) - 1)
+    far = st.hill_solution(beta0, 0.0, [-math.pi / 2 + 40 * math.pi])[0]
+    limit = math.pi * i0(beta0) * math.exp(-beta0) / (1 - math.exp(-2 * beta0))
+    err_254 = abs(far[0, 1] / limit - 1)
+    printed_254 = abs(far[0, 1] / (limit / math.pi) - 1)
+    w = st.hill_floquet(1.0, 0.05)
+    undamped = st.stability_chart([0.0], np.linspace(0.05, 4.0, 51), brockett=False)
+    n_marginal = int((undamped["region_name"] == "marginal").sum())
+    guaranteed = chart.filter(pl.col("brockett_bounded"))
+    brockett_ok = bool((guaranteed["spectral_radius"] <= 1 + guaranteed["multiplier_error"] + 1e-12).all())
+    weak = chart.filter((pl.col("kappa") > 0) & (pl.col("kappa") <= 0.1) & (pl.col("beta0") != 0))
+    unstable_positive = chart.filter((pl.col("beta0") > 0) & (pl.col("kappa") > 0) & (pl.col("spectral_radius") > 1 + pl.col("multiplier_error"))).height
+    return [
+        Claim.near("eq. 2.45: det M = e^(-2β0), 50 random (β0, κ, t0)", worst_det, 0.0, 1e-9, fmt=".1e", thesis_text="exact (residual 0)", note="error relative to the products of entries"),
+        Claim.near("eq. 2.50: κ = 0 monodromy entry π e^(-β0) I0(β0), β0 = 0.9", err_250, 0.0, 1e-9, fmt=".1e", thesis_text="exact (residual 0)", note="relative error"),
+        Claim.near("eq. 2.54 with the factor π restored (docs/errata.md#10)", err_254, 0.0, 1e-9, fmt=".1e", thesis_text="exact (residual 0)",
+                   note=f"relative error; the printed form (without π) is off by {printed_254:.3g}"),
+        Claim.holds(
+            "Fig. 2.13: Region I is b ≤ 1, |a| ≤ (1+b)/2 (docs/errata.md#9)",
+            w["region"] == 1 and w["spectral_radius"] < 1 and w["a"] > (w["b"] - 1) / 2,
+            computed=f"β0 = 1, κ = 0.05: a = {w['a']:.3f}, b = {w['b']:.3f}, max|ρ| = {w['spectral_radius']:.3f}, Region {st.REGIONS[w['region']]}",
+            criterion="stable point that the printed bound a > (b−1)/2 calls Region III",
+            thesis="a > (b − 1)/2 bounds Region III",
+        ),
+        Claim.holds(
+            "undamped (β0 = 0): multipliers on the unit circle, neither stable nor unstable",
+            n_marginal == undamped.height,
+            computed=f"{n_marginal} of {undamped.height} points marginal",
+            criterion="every point labelled marginal (|ρ| = 1 within the multipliers' error)",
+        ),
+        Claim.holds(
+            "eq. 2.51: for a weak spring (κ ≪ 1) the system is stable exactly when β0 ≥ 0",
+            bool(weak.filter(pl.col("beta0") > 0)["stable"].all()) and not bool(weak.filter(pl.col("beta0") < 0)["stable"].any()),
+            computed=f"{weak.filter(pl.col('beta0') > 0)['stable'].sum()} of {weak.filter(pl.col('beta0') > 0).height} chart points with β0 > 0, "
+            f"0 < κ ≤ 0.1 asymptotically stable; {weak.filter(pl.col('beta0') < 0)['stable'].sum()} with β0 < 0",
+            criterion="all with β0 > 0 stable, none with β0 < 0",
+            note=f"{unstable_positive} chart points with β0, κ > 0 (κ up to {float(chart['kappa'].max()):g}) have max|ρ| > 1 beyond its error",
+        ),
+        Claim.holds(
+            "eqs. 2.57-2.58: where Brockett's criterion guarantees boundedness, the Floquet multipliers agree",
+            brockett_ok,
+            computed=f"{guaranteed.height} guaranteed points",
+            criterion="max|ρ| ≤ 1 + its error at each",
+        ),
+    ]
 
 
 # ------------------------------------------------------------------ §2.7
@@ -165,7 +228,10 @@ def _cli_sec2_7(out: Path) -> list[Path]:
             curves[f"{label}, with geometric stiffness"] = (f, st.lti_transfer(avg["beta_star"], avg["kappa0"], f))
     measured = {d: df.filter(pl.col("device") == d) for d in df["device"].unique(maintain_order=True)}
     written.append(plots.save(st.plot_bode(curves, measured), out / "sec2_7.png"))
-    return written
+    h1, h500 = h_300(1.0), h_300(500.0)
+    claim = Claim.near("§2.7: |H(300 Hz)| = 0.003 (eq. 2.59, §3.3 device, K2 = 1 as in examples/drag_parity.toml)", h1["h300"], THESIS_H300, 0.5, rel=True,
+                       fmt=".2g", note=f"K2 is not given (docs/errata.md#14); the thesis' value needs K2 ≈ {h1['k2_for_thesis_h300']:.0f} mN·mm/rad")
+    return [*written, write_claims(out, "sec2.7", [claim], {"h300": {"1": h1, "500": h500}})]
 
 
 # ------------------------------------------------------------------ the nonlinear model
@@ -186,7 +252,7 @@ def critical_k2(spec_for: object = None, lo: float = 100.0, hi: float = 1000.0, 
 
 def floquet_devices() -> pl.DataFrame:
     """Floquet multipliers of the §3.3 devices (examples/hmf.toml, examples/drag_parity.toml at
-    K2 = 1 and 500, also with the 1-Cut wing of Table 3.2 (ERRATA 11's ratio), the linear map of
+    K2 = 1 and 500, also with the 1-Cut wing of Table 3.2 (docs/errata.md#11's ratio), the linear map of
     eq. 2.15 at K2 = 0 and 1) and of the §3.4 rotating-wing
     devices (Table 3.3 wings, hinge pinned to ±60° rotation, K2 = 0; see trials.section_3_4)."""
     import importlib
@@ -250,6 +316,19 @@ def _cli_floquet(out: Path) -> list[Path]:
     devices.with_columns(pl.col("multipliers").list.join(" ")).write_csv(written[3])
     frames = {d: sweep.filter((pl.col("drivetrain") == d) & (pl.col("k2") > 0)) for d in sweep["drivetrain"].unique(maintain_order=True)}
     written.append(plots.save(st.plot_k2_sweep(frames), out / "floquet.png"))
+    stability = dict(zip(devices["device"], devices["stability"], strict=True))
+    linear = sweep.filter((pl.col("drivetrain") == "eq. 2.15") & (pl.col("k2") > 0))["stability"].to_list()
+    k_crit = critical_k2()
+    claims = [
+        Claim.holds("§2.6.3: Drag PARITY on eq. 2.15 is stable for every K2 > 0", set(linear) == {"asymptotic"},
+                    computed=f"{linear.count('asymptotic')} of {len(linear)} K2 values in (0, 10⁴] asymptotically stable", criterion="all asymptotic"),
+        Claim.holds("§2.6.3: κ = 0 (K2 = 0) is the marginal case", stability["eq. 2.15 (§3.3 drag), K2 = 0"] == "marginal",
+                    computed=stability["eq. 2.15 (§3.3 drag), K2 = 0"], criterion="a multiplier 1 within its error"),
+        Claim.holds("§2.6.3: \"all implementations will be stable\": the §3.3 device (rod-crank linkage of examples/drag_parity.toml, K2 = 1)",
+                    stability["drag_parity (§3.3), K2 = 1"] == "asymptotic", computed=stability["drag_parity (§3.3), K2 = 1"],
+                    criterion="all multipliers inside the unit circle", note=f"unstable below K2 ≈ {k_crit:.0f} mN·mm/rad (docs/findings.md item 3)"),
+    ]
+    written.append(write_claims(out, "floquet", claims, {"devices": devices.drop("multipliers").to_dicts(), "critical_k2": k_crit}))
     return written
 
 
@@ -259,70 +338,44 @@ CLI_TRIALS = {"fig2.13": _cli_fig2_13, "sec2.7": _cli_sec2_7, "floquet": _cli_fl
 # ------------------------------------------------------------------ report
 
 
-def report_section(out: Path | None = None) -> str:
-    """Markdown for report.md: each thesis equation of §2.6-2.7 checked, the errata found and the
-    numbers of the full nonlinear model (all computed now)."""
-    from scipy.special import i0
+def report_section(out: Path) -> str:
+    """Markdown for report.md from the claims the ``fig2.13``, ``sec2.7`` and ``floquet`` trials
+    wrote into ``out``."""
+    from ._io import results
 
-    # eq. 2.45 over a grid
-    rng = np.random.default_rng(0)
-    worst_det = 0.0
-    for beta0, kappa in zip(rng.uniform(-1, 5, 50), rng.uniform(-1, 8, 50), strict=True):
-        m = st.hill_monodromy(beta0, kappa, rng.uniform(-3, 3))
-        scale = max(math.exp(-2 * beta0), abs(m[0, 0] * m[1, 1]) + abs(m[0, 1] * m[1, 0]))
-        worst_det = max(worst_det, abs(np.linalg.det(m) - math.exp(-2 * beta0)) / scale)
-    # eq. 2.50 and eq. 2.54
-    beta0 = 0.9
-    m = st.hill_monodromy(beta0, 0.0)
-    err_250 = abs(m[0, 1] / (math.pi * math.exp(-beta0) * i0(beta0)) - 1)
-    far = st.hill_solution(beta0, 0.0, [-math.pi / 2 + 40 * math.pi])[0]
-    limit = math.pi * i0(beta0) * math.exp(-beta0) / (1 - math.exp(-2 * beta0))
-    err_254 = abs(far[0, 1] / limit - 1)
-    # ERRATA 9 witness
-    w = st.hill_floquet(1.0, 0.05)
-    # Brockett
-    b = st.brockett(0.5, 2.4, 1.0)
-    # devices
-    dev = floquet_devices()
-    h1, h500 = h_300(1.0), h_300(500.0)
-    k_crit = critical_k2()
+    linearised, _ = results(out, "fig2.13")
+    rejection, sec27 = results(out, "sec2.7")
+    nonlinear, flo = results(out, "floquet")
+    h1, h500 = sec27["h300"]["1"], sec27["h300"]["500"]
+
     def fmt(v: float | None) -> str:
         return "-" if v is None else f"{v:.4g}"
 
     rows = "\n".join(
         f"| {r['device']} | {fmt(r['spectral_radius'])} | {fmt(r['whippletree_radius'])} | {r['stability']} "
         f"| {fmt(r['slowest_decay_ms'])} | {fmt(r['growth_time_ms'])} |"
-        for r in dev.iter_rows(named=True)
+        for r in flo["devices"]
     )
-    sweep = floquet_k2(np.array([0.0, 1.0, 10.0, 100.0, 1000.0, 10000.0]))
-    linear_stable = sweep.filter((pl.col("drivetrain") == "eq. 2.15") & (pl.col("k2") > 0))["stability"].to_list()
     return f"""## §2.6-2.7: stability and disturbance rejection
 
-Linearised model (eq. 2.25, `paritysim.stability`), computed with a Taylor-series integrator
-and checked against an independent adaptive integrator:
+Linearised model (eq. 2.25, `paritysim.stability`), computed with a Taylor-series integrator.
+Also verified in tests: eq. 2.52 is `M = exp(π Q)` and eq. 2.53 is `M^(n+1)` (docs/errata.md#10),
+eq. 2.27's coefficient is `-¼β0² cos² t` (docs/errata.md#8), the drag forces of eqs. 2.17-2.19
+carry `T³`, so `β0 = 2ΩΦ/I` (docs/errata.md#7).
 
-| equation | check | result |
-|---|---|---|
-| 2.45 `det M = e^(-2β0)` | 50 random (β0, κ, t0), error relative to the products of entries | {worst_det:.1e} |
-| 2.50 κ = 0 monodromy, `π e^(-β0) I0(β0)` | β0 = {beta0} | rel. error {err_250:.1e} |
-| 2.52 | `M = exp(π Q)` holds; the printed `log` does not (**ERRATA 10**) | verified in tests |
-| 2.53 | the printed matrix is `M^(n+1)` (**ERRATA 10**) | verified in tests |
-| 2.54 | `x(∞) = x0 + ẋ0 π I0 e^(-β0)/(1 - e^(-2β0))`: the factor π is missing in print (**ERRATA 10**) | rel. error {err_254:.1e} |
-| 2.27 | the Hill-form coefficient is `-¼β0² cos² t`, not `+½` (**ERRATA 8**) | verified in tests |
-| Fig. 2.13 | Region I is `b ≤ 1, |a| ≤ (1+b)/2`; the printed Region III bound `a > (b-1)/2` is wrong (**ERRATA 9**): e.g. β0 = 1, κ = 0.05 has a = {w['a']:.3f}, b = {w['b']:.3f}, real multipliers, max|ρ| = {w['spectral_radius']:.3f} (stable) | Region {st.REGIONS[w['region']]} |
-| 2.17-2.19, 2.22 | the drag forces carry `T³` (**ERRATA 7**), so `β0 = 2ΩΦ/I`: the whippletree block of the full model's monodromy has `det = e^(-4β0)` per drive period | verified in tests |
-| 2.57-2.58 | Brockett's criterion; δ = 0.5, T = 2.4: n = {b['n']}, bounded = {b['bounded']}; wherever it guarantees boundedness, Floquet agrees | verified in tests |
+{render(linearised)}
+
+![Fig. 2.13](fig2_13.png)
 
 Disturbance rejection (eq. 2.59), §3.3 device (examples/drag_parity.toml), β* from the
-cycle-averaged aerodynamic damping of its simulated orbit:
+cycle-averaged aerodynamic damping of its simulated orbit: K2 = 1 gives β* = {h1['beta_star']:.3f} /ms,
+κ0 = {h1['kappa0']:.3g} /ms²; K2 = 500 gives |H(300 Hz)| = {h500['h300']:.3g}. The rod-crank linkage adds a
+geometric stiffness of {h500['geometric_stiffness']:.0f} mN·mm/rad to the whippletree mode, which eq. 2.59
+ignores (see `sec2_7.csv` for the nonlinear response against the LTI estimate).
 
-- K2 = 1 mN·mm/rad (the example): β* = {h1['beta_star']:.3f} /ms, κ0 = {h1['kappa0']:.3g} /ms²,
-  **|H(300 Hz)| = {h1['h300']:.2g}** (thesis: {THESIS_H300}); the thesis' value would need
-  K2 ≈ {h1['k2_for_thesis_h300']:.0f} mN·mm/rad (K2 is not given, ERRATA 14).
-- K2 = 500: |H(300 Hz)| = {h500['h300']:.3g}. The rod-crank linkage adds a geometric stiffness of
-  {h500['geometric_stiffness']:.0f} mN·mm/rad to the whippletree mode, which eq. 2.59 ignores;
-  with the linear map of eq. 2.15 the LTI estimate and the nonlinear response agree within
-  10 % (30-300 Hz, tested), with the linkage they do not (see `sec2_7.csv`).
+{render(rejection)}
+
+![§2.7 transfer functions](sec2_7.png)
 
 Full nonlinear model (shooting + finite-difference monodromy, multipliers per drive period
 T = 9.09 ms; multipliers below ~1e-6 are at the resolution of the finite differences):
@@ -331,15 +384,10 @@ T = 9.09 ms; multipliers below ~1e-6 are at the resolution of the finite differe
 |---|---|---|---|---|---|
 {rows}
 
-- The whippletree mode of the §3.3 linkage is unstable below K2 ≈ {k_crit:.0f} mN·mm/rad
-  (docs/findings.md item 3: 1.78× per cycle at K2 = 1); eq. 2.59's LTI model cannot show this.
-  With the 1-Cut wing of Table 3.2 the asymmetric orbit (found by shooting; simulation from
-  rest runs away) is unstable even at K2 = 500.
-- With the linear map of eq. 2.15 and the same drag it is {"stable" if set(linear_stable) == {"asymptotic"} else "NOT always stable"}
-  for K2 = 1 ... 10⁴ and marginal (a multiplier 1, the κ = 0 case of §2.6.3) at K2 = 0, as
-  the thesis' linearised analysis predicts.
-- The §3.4 rotating-wing PARITY (eq. 2.15, K2 = 0) is marginal for the same reason (the q2
-  direction is cyclic), also with a cut wing; the §3.4 HMF is asymptotically stable.
+{render(nonlinear)}
+
+![Floquet multipliers vs K2](floquet.png)
+
+The §3.4 rotating-wing PARITY (eq. 2.15, K2 = 0) has the same cyclic q2 direction as the K2 = 0
+linear map (a multiplier 1); see the table above for the computed labels.
 """
-
-

@@ -3,14 +3,14 @@
 Wings of Table 3.3 (full inertia tensors, Ω1..Ω4) on compliant hinges (ψ free), configuration
 #3 (Drag PARITY) against #1 (HMF), drive V(t) = 100 V + 100 V sin(2π·110 t) (eq. 3.24).
 
-Not given by the thesis (ERRATA items 5, 14), each an argument:
+Not given by the thesis (docs/errata.md#5, #14), each an argument:
 
 * ``hinge_stiffness`` (mN·mm/rad): ``None`` pins it so the Uncut PARITY right wing rotates ±60°,
   the amplitude §3.4 reports (root finding on the model);
 * ``dc_offset = "ignore"``: the 100 V DC part biases the piezo without a net force (taken as a
   force it would hold q1 at 120/467 mm, a 45° stroke offset under the §3.3 transmission);
 * transmission: eq. 2.15 with "±200 µm → ±35°" as in §3.3; C_rd and the coefficient model:
-  the aero crate's cited defaults; the α sign convention: the aero crate's (ERRATA 5).
+  the aero crate's cited defaults; the α sign convention: the aero crate's (docs/errata.md#5).
 """
 
 from __future__ import annotations
@@ -26,7 +26,8 @@ import numpy as np
 import polars as pl
 
 from .. import aero
-from ._io import write_trial
+from ..claims import Claim, render
+from ._io import write_claims, write_trial
 from ..simulation import SimulationResult, simulate
 from ..spec import Actuator, Aero, Configuration, Drivetrain, Options, Simulation, Spring, Waveform, Wing
 
@@ -155,8 +156,13 @@ def section_3_4(**overrides: Any) -> pl.DataFrame:
 
 
 def trajectories(cycles: int = 3, **overrides: Any) -> pl.DataFrame:
-    """Long-format trajectories over ``cycles`` steady cycles for every trial and drivetrain."""
-    p = params(**overrides)
+    """Long-format trajectories over ``cycles`` steady cycles for every trial and drivetrain
+    (computed once per parameter set: Figs. 3.11-3.13 share them)."""
+    return _trajectories(params(**overrides), cycles)
+
+
+@functools.lru_cache(maxsize=4)
+def _trajectories(p: Params, cycles: int) -> pl.DataFrame:
     k = hinge_stiffness(p)
     frames = []
     for trial in TRIALS:
@@ -224,9 +230,41 @@ def _fig3_13(df: pl.DataFrame):  # type: ignore[no-untyped-def]
     return fig
 
 
+def section_3_4_claims(df: pl.DataFrame) -> list[Claim]:
+    """Each §3.4 statement, evaluated on :func:`section_3_4`'s table ``df``."""
+    par = {r["trial"]: r for r in df.filter(pl.col("drivetrain") == "PARITY").iter_rows(named=True)}
+    hmf = {r["trial"]: r for r in df.filter(pl.col("drivetrain") == "HMF").iter_rows(named=True)}
+    u = par["Uncut"]
+    rs = [par[t]["right_stroke_p2p_deg"] for t in TRIALS]
+    ls = [par[t]["left_stroke_p2p_deg"] for t in TRIALS]
+    rot = [par[t]["right_rotation_amplitude_deg"] for t in TRIALS]
+    roll_ratio = [par[t]["roll_imbalance_rms"] / hmf[t]["roll_imbalance_rms"] for t in TRIALS]
+    arrow = lambda v: " → ".join(f"{x:.1f}°" for x in v)  # noqa: E731
+    reduction = {t: 100 * par[t]["yaw_mean_reduction_vs_hmf"] for t in ("1-Cut", "2-Cut")}
+    return [
+        Claim.between("stroke ≈ 100° peak-to-peak (Uncut, right wing)", u["right_stroke_p2p_deg"], 70.0, 130.0, thesis="≈ 100°", unit="°", fmt=".1f",
+                      note=f"left wing {u['left_stroke_p2p_deg']:.1f}°"),
+        Claim.given("rotation ±60°", computed=f"{u['right_rotation_amplitude_deg']:.1f}°", thesis="±60°", note="pins the hinge stiffness (docs/errata.md#14)"),
+        Claim.between("rotation lags stroke by ~90°", u["right_rotation_lag_deg"], 60.0, 120.0, thesis="~90°", unit="°", fmt=".1f",
+                      note=f"left wing {u['left_rotation_lag_deg']:.1f}°"),
+        Claim.near("α ≈ 90° at stroke reversal", u["right_alpha_reversal_deg"], 90.0, 20.0, unit="°", fmt=".1f", note="α convention: docs/errata.md#5"),
+        Claim.near("α ≈ 30° mid-stroke", u["right_alpha_midstroke_deg"], 30.0, 15.0, unit="°", fmt=".1f"),
+        Claim.holds("right stroke grows as the membrane is cut", rs[0] < rs[1] < rs[2], computed=arrow(rs), criterion="strictly increasing Uncut → 2-Cut"),
+        Claim.holds("left stroke shrinks as the membrane is cut", ls[0] > ls[1] > ls[2], computed=arrow(ls), criterion="strictly decreasing Uncut → 2-Cut"),
+        Claim.holds("rotation amplitudes decrease as the membrane is cut", rot[0] > rot[1] > rot[2], computed=arrow(rot), criterion="strictly decreasing Uncut → 2-Cut"),
+        Claim.holds("PARITY balances roll torques (Fig. 3.11)", all(v < 0.5 for v in roll_ratio[1:]),
+                    computed=", ".join(f"{t}: {v:.3f}" for t, v in zip(TRIALS, roll_ratio, strict=True)), criterion="rms net roll PARITY/HMF < 0.5 for the cut wings"),
+        Claim.near("average yaw imbalance reduced 71 % (1-Cut)", reduction["1-Cut"], 71.0, 15.0, unit="%", fmt=".0f"),
+        Claim.near("average yaw imbalance reduced 72 % (2-Cut)", reduction["2-Cut"], 72.0, 15.0, unit="%", fmt=".0f"),
+        Claim.holds("... and not reduced in the Uncut trial", par["Uncut"]["yaw_mean_reduction_vs_hmf"] < 0.3,
+                    computed=f"{100 * par['Uncut']['yaw_mean_reduction_vs_hmf']:.0f} %", criterion="reduction < 30 %"),
+    ]
+
+
 def _cli_table(out: Path) -> list[Path]:
     df = section_3_4()
-    return write_trial(df, out, "table3_3", _plot_table(df))
+    written = write_trial(df, out, "table3_3", _plot_table(df))
+    return [*written, write_claims(out, "table3.3", section_3_4_claims(df), {"hinge_stiffness": float(df["hinge_stiffness"][0])})]
 
 
 #: What §3.4 states, drawn as markers in table3_3.png (comparison only, never a result).
@@ -268,7 +306,6 @@ def _plot_table(df: pl.DataFrame):  # type: ignore[no-untyped-def]
     axes[2].set_ylim(bottom=-8.0)  # keep the thesis star at 0 % (Uncut) off the axis line
     fig.suptitle("Table 3.3 trials (§3.4): paritysim lines and bars, thesis statements as stars")
     return fig
-    return write_trial(df, out, "table3_3", fig)
 
 
 def _cli_fig3_11(out: Path) -> list[Path]:
@@ -289,41 +326,18 @@ def _cli_fig3_13(out: Path) -> list[Path]:
 CLI_TRIALS = {"table3.3": _cli_table, "fig3.11": _cli_fig3_11, "fig3.12": _cli_fig3_12, "fig3.13": _cli_fig3_13}
 
 
-def report_section(out: Path | None = None) -> str:
-    """Markdown: each §3.4 statement beside the model's number and a verdict."""
-    df = section_3_4()
-    k = df["hinge_stiffness"][0]
-    par = {r["trial"]: r for r in df.filter(pl.col("drivetrain") == "PARITY").iter_rows(named=True)}
-    hmf = {r["trial"]: r for r in df.filter(pl.col("drivetrain") == "HMF").iter_rows(named=True)}
-    u = par["Uncut"]
+def report_section(out: Path) -> str:
+    """Markdown: each §3.4 claim (computed by the ``table3.3`` trial) and the figures."""
+    from ._io import results
 
-    def row(statement: str, ours: str, ok: bool, why: str = "") -> str:
-        return f"| {statement} | {ours} | {'matches' if ok else 'differs'}{': ' + why if why else ''} |"
-
-    rs = [par[t]["right_stroke_p2p_deg"] for t in TRIALS]
-    ls = [par[t]["left_stroke_p2p_deg"] for t in TRIALS]
-    rot = [par[t]["right_rotation_amplitude_deg"] for t in TRIALS]
-    roll_ratio = [par[t]["roll_imbalance_rms"] / hmf[t]["roll_imbalance_rms"] for t in TRIALS]
+    claims, values = results(out, "table3.3")
     lines = [
         "## §3.4 Drag PARITY with rotating wings (Table 3.3, Figs. 3.11-3.13)",
         "",
-        f"Hinge stiffness pinned by the stated ±60° rotation (Uncut, PARITY): k = {k:.4f} mN·mm/rad. DC part of eq. 3.24: "
-        "`ignore` (piezo bias). Transmission as §3.3 (eq. 2.15). Blade-element aero with the Dickinson fits.",
+        f"Hinge stiffness pinned by the stated ±60° rotation (Uncut, PARITY): k = {values['hinge_stiffness']:.4f} mN·mm/rad. DC part of eq. 3.24: "
+        "`ignore` (piezo bias). Transmission as §3.3 (eq. 2.15). Blade-element aero with the Dickinson fits (mirrored past α = 90°, docs/errata.md#P2).",
         "",
-        "| thesis statement | paritysim | verdict |",
-        "|---|---|---|",
-        row("stroke ≈ 100° peak-to-peak", f"{u['right_stroke_p2p_deg']:.1f}° (right), {u['left_stroke_p2p_deg']:.1f}° (left)", 70 <= u["right_stroke_p2p_deg"] <= 130),
-        row("rotation ±60°", f"{u['right_rotation_amplitude_deg']:.1f}°", True, "used to pin the hinge stiffness"),
-        row("rotation lags stroke by ~90°", f"{u['right_rotation_lag_deg']:.1f}° (right), {u['left_rotation_lag_deg']:.1f}° (left)", 60 <= u["right_rotation_lag_deg"] <= 120),
-        row("α ≈ 90° at stroke reversal", f"{u['right_alpha_reversal_deg']:.1f}°", abs(u["right_alpha_reversal_deg"] - 90) <= 20),
-        row("α ≈ 30° mid-stroke", f"{u['right_alpha_midstroke_deg']:.1f}°", abs(u["right_alpha_midstroke_deg"] - 30) <= 15),
-        row("right stroke grows as membrane is cut", " → ".join(f"{v:.1f}°" for v in rs), rs[0] < rs[1] < rs[2]),
-        row("left stroke shrinks as membrane is cut", " → ".join(f"{v:.1f}°" for v in ls), ls[0] > ls[1] > ls[2]),
-        row("rotation amplitudes decrease as membrane is cut", " → ".join(f"{v:.1f}°" for v in rot), rot[0] > rot[1] > rot[2]),
-        row("PARITY balances roll torques (rms net roll, PARITY/HMF)", ", ".join(f"{t}: {v:.3f}" for t, v in zip(TRIALS, roll_ratio, strict=True)), all(v < 0.5 for v in roll_ratio[1:])),
-        row("average yaw imbalance reduced 71 % (1-Cut), 72 % (2-Cut)", f"1-Cut: {100 * par['1-Cut']['yaw_mean_reduction_vs_hmf']:.0f} %, 2-Cut: {100 * par['2-Cut']['yaw_mean_reduction_vs_hmf']:.0f} %",
-            all(abs(100 * par[t]["yaw_mean_reduction_vs_hmf"] - v) <= 15 for t, v in (("1-Cut", 71), ("2-Cut", 72)))),
-        row("... and not reduced in the Uncut trial", f"Uncut: {100 * par['Uncut']['yaw_mean_reduction_vs_hmf']:.0f} %", par["Uncut"]["yaw_mean_reduction_vs_hmf"] < 0.3),
+        render(claims),
         "",
         "![Fig. 3.11](fig3_11.png)",
         "",

@@ -1,7 +1,7 @@
 //! floquet tests (submodule of the one dynamics integration binary).
 //!
 //! §2.6: the eq. 2.25 monodromy against Liouville (eq. 2.45), the κ = 0 closed form (eq. 2.50)
-//! and an independent adaptive integrator; ERRATA items 7–10 each checked numerically. Full
+//! and an independent adaptive integrator; docs/errata.md#7 to #10 each checked numerically. Full
 //! model: shooting against long simulation, multipliers against independent differences of the
 //! stroboscopic map and against kick growth in `simulate`, and a Liouville identity for the
 //! whippletree block. §2.7: eq. 2.59 against the nonlinear disturbance response.
@@ -186,7 +186,7 @@ fn monodromy_matches_an_independent_adaptive_integrator() {
 #[test]
 fn errata_8_hill_form_coefficient_is_minus_one_quarter() {
     // y = x exp(½β0∫|cos|) (eq. 2.26) satisfies ÿ + (κ − ¼β0²cos²t − ½β0 d|cos t|/dt) y = 0
-    // (ERRATA item 8), not the printed +½β0²cos²t of eq. 2.27. Checked by second differences
+    // (docs/errata.md#8), not the printed +½β0²cos²t of eq. 2.27. Checked by second differences
     // of y built from the integrated solution on the smooth piece t in (−π/2, π/2).
     let (beta0, kappa, t0) = (0.8, 1.3, -FRAC_PI_2);
     let y = |t: f64| {
@@ -250,7 +250,7 @@ fn errata_10_eqs_2_52_to_2_54() {
     for beta0 in [0.3, 0.9, 2.0] {
         let m = hill_monodromy(beta0, 0.0, -FRAC_PI_2).unwrap();
         let i0 = bessel_i0(beta0);
-        // Eq. 2.52 gives Q with M = exp(πQ), not log (ERRATA item 10).
+        // Eq. 2.52 gives Q with M = exp(πQ), not log (docs/errata.md#10).
         let q = Matrix2::new(
             0.0,
             -2.0 * i0 * beta0 * beta0.exp() / (1.0 - (2.0 * beta0).exp()),
@@ -370,13 +370,13 @@ fn brockett_guarantee_implies_floquet_stability() {
     assert!(guaranteed > 50, "{guaranteed}");
 }
 
-// ------------------------------------------------------------------ ERRATA 7: physical mapping
+// ------------------------------------------------------------------ docs/errata.md#7: physical mapping
 
 #[test]
 fn errata_7_drag_generalised_forces_carry_t_cubed() {
     // Eq. 2.15 device: M_q = diag(2IT², 2IT²L²). From the right-hand side, the drag part of the
     // generalised force is −2ΩT³ sgn(q̇1)(q̇1² + L²q̇2²) on q1 and −4ΩT³L²|q̇1|q̇2 on q2
-    // (ERRATA item 7; eqs. 2.17–2.19 print ΩT²) whenever L|q̇2| < |q̇1|.
+    // (docs/errata.md#7; eqs. 2.17–2.19 print ΩT²) whenever L|q̇2| < |q̇1|.
     let (i, omega, t, l, k1, k2) = (29.0, 31.3, 2.5, 2.5, 467.0, 20.0);
     let device = eq_2_16_device(linear_map(), k2);
     let actuator = device.spec().actuator.clone().unwrap();
@@ -431,7 +431,7 @@ fn errata_7_whippletree_block_determinant_is_exp_minus_four_beta0() {
     // (q2, p2): its determinant is exp(−∮ c22/m22 dt) = exp(−(2Ω/I)∮|φ̇|dt) = exp(−8ΩΦ/I) for a
     // single-hump stroke of amplitude Φ, for the linear map and the nonlinear linkage alike.
     // One drive period is two periods of eq. 2.25, so this is b² = e^{−4β0} (eq. 2.45) with
-    // β0 = 2ΩΦ/I (ERRATA item 7; the printed 2ΩA/I would give e^{−4β0/T}).
+    // β0 = 2ΩΦ/I (docs/errata.md#7; the printed 2ΩA/I would give e^{−4β0/T}).
     for drivetrain in [
         linear_map(),
         Drivetrain::LinkageDifferential(LinkageDifferential::thesis()),
@@ -877,4 +877,44 @@ fn shooting_finds_an_unstable_asymmetric_orbit_that_simulation_cannot_reach() {
         "{:?}",
         long.map(|r| r.converged)
     );
+}
+
+#[test]
+fn undamped_and_unsprung_lines_are_marginal_within_the_multiplier_error() {
+    // β0 = 0: ẍ + κx = 0, multipliers e^{±iπ√κ} on the unit circle; the computed det M is
+    // 1 + O(1e-16), which without a tolerance lands in Region II for about half the points.
+    for j in 0..51 {
+        let k = 0.05 + 3.95 * j as f64 / 50.0;
+        let f = hill_floquet(0.0, k).unwrap();
+        assert!(
+            f.is_marginal(),
+            "beta0 = 0, kappa = {k}: {:?}",
+            f.multipliers
+        );
+        // √(round-off) near the double roots ρ = ±1 at κ = n², round-off elsewhere
+        let bound = if (k.sqrt() - k.sqrt().round()).abs() < 0.05 {
+            1e-6
+        } else {
+            1e-12
+        };
+        assert!(f.multiplier_error < bound, "{k}: {}", f.multiplier_error);
+    }
+    // κ = 0 (eq. 2.50): a multiplier exactly 1 for any damping.
+    for b0 in [0.3, 1.0, 2.5] {
+        assert!(hill_floquet(b0, 0.0).unwrap().is_marginal(), "{b0}");
+    }
+    // Away from |ρ| = 1 the error estimate is far below the distance to the unit circle.
+    for (b0, k) in [
+        (0.5, 1.0),
+        (1.0, 0.05),
+        (-0.2, 1.0),
+        (0.1, 1.0),
+        (2.0, 10.0),
+    ] {
+        let f = hill_floquet(b0, k).unwrap();
+        assert!(!f.is_marginal(), "{b0} {k}: {}", f.spectral_radius());
+        assert!(f.multiplier_error < 1e-3 * (f.spectral_radius() - 1.0).abs());
+    }
+    let chart = stability_chart(&[0.0, 0.5], &[0.5, 2.0]).unwrap();
+    assert_eq!(chart.marginal, vec![true, true, false, false]);
 }

@@ -1,0 +1,64 @@
+"""Appendix A's dynamics terms of one wing, from the Rust model (``Wing::terms``).
+
+:func:`wing_terms` returns the mass matrix ``M(p)`` (A.36), the Coriolis/centrifugal vector
+``c(p, ṗ)`` (replacing A.37-A.38, docs/errata.md#1 and #2), the spring gradient ``∇V`` (A.6)
+and the Jacobian ``J6`` (A.9) of the Euler-Lagrange form A.13,
+``M p̈ + c + ∇V = τ_aero + τ_drive``, so that Appendix A can be checked from Python.
+Units: mg·mm², mN·mm, rad, rad/ms.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from . import _core
+from ._errors import invalid
+from .spec import Configuration, Simulation, Wing
+
+__all__ = ["WingTerms", "wing_terms"]
+
+
+@dataclass(frozen=True)
+class WingTerms:
+    """The terms of :func:`wing_terms` (numpy arrays; units mg·mm², mN·mm, µJ)."""
+
+    mass: np.ndarray
+    coriolis: np.ndarray
+    spring_gradient: np.ndarray
+    aero: np.ndarray
+    j6: np.ndarray
+    omega: np.ndarray
+    jdot_pdot: np.ndarray
+    rotation: np.ndarray
+    theta_w: float
+    kinetic: float
+    potential: float
+
+
+def _vec3(x: Any, name: str) -> list[float]:
+    a = np.asarray(x, dtype=float)
+    if a.shape != (3,):
+        raise invalid(name, f"shape {a.shape}", "3 values (phi, theta, psi)")
+    return [float(v) for v in a]
+
+
+def wing_terms(wing: Wing | Simulation, p: Any, p_dot: Any, *, index: int = 0) -> WingTerms:
+    """``M``, ``c``, ``∇V``, ``J6`` (and ``ω = J6 ṗ``, ``J̇6 ṗ``, the aerodynamic generalised
+    torque, energies) of ``wing`` at ``p = (φ, θ, ψ)`` (rad) and ``ṗ`` (rad/ms).
+
+    ``wing`` is a :class:`paritysim.Wing`, or a :class:`paritysim.Simulation` whose wing
+    ``index`` is used. Always the general Appendix A terms (the Rust ``Wing::terms``).
+
+    Raises
+    ------
+    InvalidParameterError
+        For a bad wing, index or non-finite ``p``/``p_dot`` (the message names the field).
+    OutOfDomainError, SingularError
+        Outside the shoulder's joint limit or at a singular pose.
+    """
+    spec = wing if isinstance(wing, Simulation) else Simulation(wings=(wing,), configuration=Configuration(name=None))
+    raw = _core.dynamics_wing_terms(spec.device_dict(), int(index), _vec3(p, "p"), _vec3(p_dot, "p_dot"))
+    return WingTerms(**raw)
