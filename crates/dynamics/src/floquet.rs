@@ -35,7 +35,7 @@ use paritysim_error::{Error, Result, bail, check_finite, check_positive};
 use rayon::prelude::*;
 
 use crate::device::{Device, DeviceSpec, Formulation, Transmission};
-use crate::integrate::{Integrator, Method, OdeSystem, RungeKutta, STATE_LEN, State};
+use crate::integrate::{Integrator, Method, OdeSystem, RungeKutta, State};
 
 // ============================================================================================
 // §2.6: the linearised (Hill-type) equation 2.25
@@ -644,7 +644,7 @@ impl ShootingOptions {
                 format!("{}, {}", self.warmup_cycles, self.fallback_cycles), "<= 100000");
         }
         if let Some(y) = &self.initial {
-            paritysim_error::check_all_finite("initial", y)?;
+            paritysim_error::check_all_finite("initial", &y.to_vec())?;
         }
         RungeKutta::new(self.method, self.rtol, self.atol, self.max_steps)
     }
@@ -679,14 +679,17 @@ pub struct PeriodicOrbit {
 }
 
 fn compact(n: usize, y: &State) -> DVector<f64> {
-    DVector::from_fn(2 * n, |i, _| if i < n { y[i] } else { y[6 + i - n] })
+    DVector::from_fn(
+        2 * n,
+        |i, _| if i < n { y.coords[i] } else { y.rates[i - n] },
+    )
 }
 
 fn expand(n: usize, v: &DVector<f64>) -> State {
-    let mut y = [0.0; STATE_LEN];
+    let mut y = State::default();
     for i in 0..n {
-        y[i] = v[i];
-        y[6 + i] = v[n + i];
+        y.coords[i] = v[i];
+        y.rates[i] = v[n + i];
     }
     y
 }
@@ -711,20 +714,18 @@ pub fn stroboscopic_map(
     period: f64,
     y: &State,
 ) -> Result<State> {
-    let mut start = *y;
-    start[12] = 0.0;
-    start[13] = 0.0;
-    let mut out = integrator.integrate(system, t0, &start, t0 + period, &[t0 + period])?[0];
-    out[12] = 0.0;
-    out[13] = 0.0;
-    Ok(out)
+    let integrator = integrator.with_work(false);
+    let out = integrator.advance(system, t0, &y.without_work(), t0 + period)?;
+    Ok(out.without_work())
 }
 
 fn residual_norm(n: usize, y: &State, py: &State) -> f64 {
     let (mut num, mut den): (f64, f64) = (0.0, 0.0);
-    for i in (0..n).chain(6..6 + n) {
-        num = num.max((py[i] - y[i]).abs());
-        den = den.max(y[i].abs());
+    let pairs =
+        (py.coords[..n].iter().zip(&y.coords[..n])).chain(py.rates[..n].iter().zip(&y.rates[..n]));
+    for (a, b) in pairs {
+        num = num.max((a - b).abs());
+        den = den.max(b.abs());
     }
     num / (1.0 + den)
 }
@@ -732,8 +733,8 @@ fn residual_norm(n: usize, y: &State, py: &State) -> f64 {
 /// Finite-difference steps: `fd_step ×` the largest |coordinate| (resp. |rate|) of `y`, with a
 /// floor so that a coordinate at zero (e.g. `q2` of a symmetric orbit) is still perturbed.
 fn fd_steps(n: usize, y: &State, fd_step: f64) -> Vec<f64> {
-    let pos = (0..n).map(|i| y[i].abs()).fold(1e-2, f64::max);
-    let vel = (0..n).map(|i| y[6 + i].abs()).fold(1e-2, f64::max);
+    let pos = y.coords[..n].iter().map(|v| v.abs()).fold(1e-2, f64::max);
+    let vel = y.rates[..n].iter().map(|v| v.abs()).fold(1e-2, f64::max);
     (0..2 * n)
         .map(|i| fd_step * if i < n { pos } else { vel })
         .collect()
@@ -793,8 +794,7 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
         Some(y) => y,
         None => device.state_from(device.spec().constraints.particular(), &Vec6::zeros())?,
     };
-    y[12] = 0.0;
-    y[13] = 0.0;
+    y = y.without_work();
     let mut cycles = 0;
     let mut py = stroboscopic_map(device, &integrator, t0, period, &y)?;
     let mut res = residual_norm(n, &y, &py);
@@ -1187,13 +1187,13 @@ impl<'a> RollDisturbance<'a> {
     /// Body roll torque (mN·mm) at an integrator state: `Σ_k m_k (τ_aero,k − I_k φ̈_k + d_k)`
     /// with `m = (−1, +1)` (left mirrored), the wings' momentum balance.
     pub fn body_roll(&self, t: f64, y: &State) -> Result<f64> {
-        let mut dydt = [0.0; STATE_LEN];
+        let mut dydt = State::default();
         self.rhs(t, y, &mut dydt)?;
         let dt = self.stroke.transmission().kinematics();
         let two = self.stroke.device.n_dof() == 2;
-        let q_dot = Vector2::new(y[6], if two { y[7] } else { 0.0 });
-        let q_ddot = Vector2::new(dydt[6], if two { dydt[7] } else { 0.0 });
-        let e = dt.evaluate(y[0], if two { y[1] } else { 0.0 })?;
+        let q_dot = Vector2::new(y.rates[0], if two { y.rates[1] } else { 0.0 });
+        let q_ddot = Vector2::new(dydt.rates[0], if two { dydt.rates[1] } else { 0.0 });
+        let e = dt.evaluate(y.coords[0], if two { y.coords[1] } else { 0.0 })?;
         let phi_dot = e.jacobian * q_dot;
         let phi_ddot = e.jacobian * q_ddot + e.velocity_product(&q_dot);
         let d = self.stroke_torques(t);
@@ -1221,7 +1221,7 @@ impl OdeSystem for RollDisturbance<'_> {
             .stroke
             .transmission()
             .kinematics()
-            .evaluate(y[0], if two { y[1] } else { 0.0 })?;
+            .evaluate(y.coords[0], if two { y.coords[1] } else { 0.0 })?;
         let tau = self.stroke_torques(t);
         let mut mass = Matrix2::zeros();
         let mut force = Vector2::zeros();
@@ -1234,15 +1234,15 @@ impl OdeSystem for RollDisturbance<'_> {
             let extra = mass.lu().solve(&force).ok_or_else(|| {
                 Error::Singular(format!(
                     "drivetrain mass matrix is singular at q = ({}, {})",
-                    y[0], y[1]
+                    y.coords[0], y.coords[1]
                 ))
             })?;
-            dydt[6] += extra.x;
-            dydt[7] += extra.y;
+            dydt.rates[0] += extra.x;
+            dydt.rates[1] += extra.y;
         } else {
-            dydt[6] += force.x / mass[(0, 0)];
+            dydt.rates[0] += force.x / mass[(0, 0)];
         }
-        // The disturbance's work is neither actuator nor aerodynamic work: slots 12, 13 as is.
+        // The disturbance's work is neither actuator nor aerodynamic work: powers as is.
         Ok(())
     }
 
@@ -1369,8 +1369,8 @@ pub fn linearise(
     ];
     let (mut rate, mut inv_m22, mut dq2, mut dq2_dot) = (0.0, 0.0, 0.0, 0.0);
     for (t, y) in times.iter().zip(&states) {
-        let e = tr.kinematics().evaluate(y[0], y[1])?;
-        let phi_dot = e.jacobian * Vector2::new(y[6], y[7]);
+        let e = tr.kinematics().evaluate(y.coords[0], y.coords[1])?;
+        let phi_dot = e.jacobian * Vector2::new(y.rates[0], y.rates[1]);
         let (mut c, mut m) = (0.0, 0.0);
         for k in 0..2 {
             strokes[k].push(e.stroke[k]);
@@ -1385,15 +1385,21 @@ pub fn linearise(
         rate += c / m;
         inv_m22 += 1.0 / m;
         // Whippletree row of the variational equation (central differences of the RHS).
-        for (slot, acc) in [(1, &mut dq2), (7, &mut dq2_dot)] {
-            let h = 1e-6 * (1.0 + y[slot].abs());
+        for (rate, acc) in [(false, &mut dq2), (true, &mut dq2_dot)] {
+            let value = if rate { y.rates[1] } else { y.coords[1] };
+            let h = 1e-6 * (1.0 + value.abs());
             let (mut plus, mut minus) = (*y, *y);
-            plus[slot] += h;
-            minus[slot] -= h;
-            let (mut fp, mut fm) = ([0.0; STATE_LEN], [0.0; STATE_LEN]);
+            if rate {
+                plus.rates[1] += h;
+                minus.rates[1] -= h;
+            } else {
+                plus.coords[1] += h;
+                minus.coords[1] -= h;
+            }
+            let (mut fp, mut fm) = (State::default(), State::default());
             device.rhs(*t, &plus, &mut fp)?;
             device.rhs(*t, &minus, &mut fm)?;
-            *acc += (fp[7] - fm[7]) / (2.0 * h);
+            *acc += (fp.rates[1] - fm.rates[1]) / (2.0 * h);
         }
     }
     let count = states.len() as f64;

@@ -13,7 +13,7 @@ use paritysim_constraints::Vec6;
 use paritysim_error::{Error, Result, bail, check_positive};
 
 use crate::device::{Device, Evaluation};
-use crate::integrate::{Integrator, Method, RungeKutta, STATE_LEN, State};
+use crate::integrate::{Integrator, Method, RungeKutta, State};
 use crate::metrics;
 
 /// An instantaneous velocity change.
@@ -144,9 +144,14 @@ fn validate(options: &SimulationOptions) -> Result<()> {
 fn state_change(a: &State, b: &State) -> f64 {
     let mut num: f64 = 0.0;
     let mut den: f64 = 1e-12;
-    for i in 0..12 {
-        num = num.max((a[i] - b[i]).abs());
-        den = den.max(a[i].abs());
+    for (x, y) in a
+        .coords
+        .iter()
+        .chain(&a.rates)
+        .zip(b.coords.iter().chain(&b.rates))
+    {
+        num = num.max((x - y).abs());
+        den = den.max(x.abs());
     }
     num / den
 }
@@ -215,8 +220,7 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
         }
     };
     // Work integrals restart in the recorded window.
-    y[12] = 0.0;
-    y[13] = 0.0;
+    y = y.without_work();
     let t_start = t;
     // The last sample is exactly the window's end: t_start + window·k/n can round one ulp past
     // it, and the solver would then return one sample short.
@@ -284,8 +288,8 @@ fn apply_kick(device: &Device, t: f64, y: &State, kick: Perturbation) -> Result<
         }
     }
     let mut out = device.state_from(&p, &p_dot)?;
-    out[12] = y[12];
-    out[13] = y[13];
+    out.work_actuator = y.work_actuator;
+    out.work_aero = y.work_aero;
     Ok(out)
 }
 
@@ -410,8 +414,8 @@ pub fn record(device: &Device, times: &[f64], states: &[State]) -> Result<Trajec
         push(voltage);
         push(e.drive.actuator_force);
         push(e.drive.actuator_force * e.drive.q_dot.x);
-        push(y[12]);
-        push(y[13]);
+        push(y.work_actuator);
+        push(y.work_aero);
         push(device.energy(&e));
         push(total.x);
         push(total.y);
@@ -425,7 +429,6 @@ pub fn record(device: &Device, times: &[f64], states: &[State]) -> Result<Trajec
             reason: "non-finite derived quantity".into(),
         });
     }
-    let _ = STATE_LEN;
     Ok(Trajectory {
         time: times.to_vec(),
         columns: names.into_iter().zip(data).collect(),

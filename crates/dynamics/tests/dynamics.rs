@@ -604,7 +604,7 @@ fn drivetrain_coordinates_agree_with_null_space() {
                 let y = rk
                     .integrate(d, 0.0, &y0, cycles * period, &[cycles * period])
                     .unwrap()[0];
-                (d.coordinates(&y).unwrap(), y[12], y[13])
+                (d.coordinates(&y).unwrap(), y.work_actuator, y.work_aero)
             };
             let (((pa, va), wa, aa), ((pb, vb), wb, ab)) = (end(&fast), end(&general));
             let rel = |a: f64, b: f64| (a - b).abs() / (1e-3 + b.abs());
@@ -744,7 +744,7 @@ fn right_hand_side_does_not_allocate() {
                 &Vec6::new(0.3, 0.0, 0.0, 0.25, 0.0, 0.0),
             )
             .unwrap();
-        let mut dydt = [0.0; paritysim_dynamics::STATE_LEN];
+        let mut dydt = paritysim_dynamics::State::default();
         let (result, allocations) = allocation::count(|| {
             (0..100).try_for_each(|k| device.rhs(0.1 * k as f64, &y, &mut dydt))
         });
