@@ -63,7 +63,8 @@ use paritysim_error::{Error, Result, bail};
 
 use crate::device::Device;
 use crate::metrics;
-use crate::simulate::{SimulationOptions, Trajectory, record, simulate};
+use crate::simulate::{SimulationOptions, Trajectory, simulate};
+use crate::trajectory::column_table;
 
 /// Environment variable read by [`resolve_threads`] when no thread count is given:
 /// a positive integer (`PARITYSIM_THREADS=4`).
@@ -187,18 +188,13 @@ where
 
 /// The metric names [`simulate`](crate::simulate()) reports for this device, in order.
 pub fn metric_names(device: &Device) -> Vec<String> {
-    metrics::compute(device, &Trajectory::default(), device.period())
-        .into_iter()
-        .map(|(name, _)| name)
-        .collect()
+    metrics::names(device)
 }
 
 /// The trajectory column names [`simulate`](crate::simulate()) records for this device
 /// (without `time_ms`), in order.
 pub fn trajectory_columns(device: &Device) -> Vec<String> {
-    record(device, &[], &[])
-        .map(|t| t.columns.into_iter().map(|(name, _)| name).collect())
-        .unwrap_or_default()
+    column_table(device).into_iter().map(|c| c.name).collect()
 }
 
 /// Checks requested names against the allowed ones; `None` selects them all.
@@ -228,7 +224,8 @@ pub struct SweepSettings {
     pub threads: Option<usize>,
     /// Metric names to keep, in this order (`None`: all of [`metric_names`]).
     pub metrics: Option<Vec<String>>,
-    /// Keep the last recorded cycle of each point.
+    /// Keep the last recorded cycle of each point (Δτ and the imbalance percentages are metrics
+    /// now; this is only for the waveforms themselves).
     pub keep_cycle: bool,
 }
 
@@ -255,7 +252,16 @@ pub fn run_point(
     metric_names: &[String],
     keep_cycle: bool,
 ) -> Result<PointOutput> {
-    let result = simulate(device, options)?;
+    let result = if keep_cycle {
+        simulate(device, options)?
+    } else {
+        // Metrics only: no trajectory column is built.
+        let options = SimulationOptions {
+            columns: Some(Vec::new()),
+            ..options.clone()
+        };
+        simulate(device, &options)?
+    };
     let metrics = metric_names
         .iter()
         .map(|name| {

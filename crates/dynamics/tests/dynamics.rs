@@ -3,6 +3,8 @@
 
 #[path = "dynamics/floquet.rs"]
 mod floquet;
+#[path = "dynamics/metrics.rs"]
+mod metrics;
 #[path = "dynamics/sweep.rs"]
 mod sweep;
 

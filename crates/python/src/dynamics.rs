@@ -498,6 +498,7 @@ pub(crate) fn parse_options(
             None => None,
             Some(_) => Some(n.f64("duration_ms")?),
         },
+        ..d
     })
 }
 
