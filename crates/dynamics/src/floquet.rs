@@ -599,9 +599,10 @@ pub struct ShootingOptions {
     pub max_newton: usize,
     /// Converged when `‖P(y) − y‖∞ ≤ tol (1 + ‖y‖∞)`.
     pub tol: f64,
-    /// Relative finite-difference step (scaled by the size of the coordinates or of the rates).
-    /// The monodromy is also computed with 4× this step to estimate its error
-    /// ([`NonlinearFloquet::monodromy_uncertainty`]).
+    /// Relative finite-difference step (scaled by the size of the coordinates or of the rates)
+    /// of the independent check of the monodromy
+    /// ([`NonlinearFloquet::monodromy_uncertainty`]); Newton and the multipliers use the
+    /// variational equations.
     pub fd_step: f64,
     /// Cycles of the fallback simulation when Newton fails.
     pub fallback_cycles: usize,
@@ -676,6 +677,10 @@ pub struct PeriodicOrbit {
     pub cycles_simulated: usize,
     /// How it was found.
     pub method: OrbitMethod,
+    /// Jacobian of the stroboscopic map at `state` from the forward sensitivities of the last
+    /// Newton iterate (`None` when the orbit came from plain simulation or needed no Newton
+    /// step).
+    pub monodromy: Option<DMatrix<f64>>,
 }
 
 fn compact(n: usize, y: &State) -> DVector<f64> {
@@ -775,7 +780,7 @@ pub fn map_jacobian(
 ///
 /// Warm-up: up to `warmup_cycles` cycles of simulation (stopping at the last good state if an
 /// integration fails). Then Newton on `F(y) = P(y) − y` with
-/// the Jacobian of [`map_jacobian`]; the step solves `(DP − I)Δ = −F` by SVD in the
+/// the exact Jacobian of the computed map (forward sensitivities, [`RungeKutta::flow_with_sensitivity`]); the step solves `(DP − I)Δ = −F` by SVD in the
 /// least-squares sense, so a neutral direction (multiplier 1, e.g. K2 = 0 with the linear
 /// drivetrain, where every constant `q2` is an orbit) does not break it; steps are halved until
 /// the residual decreases. If Newton stalls, cycle-to-cycle simulation continues from the best
@@ -809,9 +814,30 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
         cycles += 1;
     }
     let mut iterations = 0;
+    let mut monodromy = None;
+    // Newton with the exact derivative of the map (forward sensitivities, same period
+    // integration as P itself).
+    let sensitivity = |y: &State| -> Result<(State, DMatrix<f64>)> {
+        let (py, phi) = integrator.with_work(false).flow_with_sensitivity(
+            device,
+            t0,
+            &y.without_work(),
+            t0 + period,
+        )?;
+        Ok((py.without_work(), phi))
+    };
+    if res > options.tol && options.max_newton > 0 {
+        match sensitivity(&y) {
+            Ok((p, phi)) => {
+                py = p;
+                monodromy = Some(phi);
+            }
+            Err(_) => monodromy = None,
+        }
+    }
     while res > options.tol && iterations < options.max_newton {
+        let Some(jac) = monodromy.clone() else { break };
         iterations += 1;
-        let jac = map_jacobian(device, n, &integrator, t0, period, &y, options.fd_step)?;
         let a = jac - DMatrix::<f64>::identity(2 * n, 2 * n);
         let f = compact(n, &py) - compact(n, &y);
         let svd = a.svd(true, true);
@@ -824,10 +850,11 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
         for _ in 0..8 {
             let trial = expand(n, &(compact(n, &y) + &delta * lambda));
             // A trial step may leave the linkage's reach: treat it as a failed step.
-            if let Ok(pt) = stroboscopic_map(device, &integrator, t0, period, &trial) {
+            if let Ok((pt, phi)) = sensitivity(&trial) {
                 let rt = residual_norm(n, &trial, &pt);
                 if rt < res {
                     (y, py, res) = (trial, pt, rt);
+                    monodromy = Some(phi);
                     accepted = true;
                     break;
                 }
@@ -847,6 +874,7 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
             newton_iterations: iterations,
             cycles_simulated: cycles,
             method: OrbitMethod::Newton,
+            monodromy,
         });
     }
     // Fallback: plain cycle-to-cycle simulation.
@@ -864,6 +892,7 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
                 newton_iterations: iterations,
                 cycles_simulated: cycles,
                 method: OrbitMethod::Simulation,
+                monodromy: None,
             });
         }
     }
@@ -912,9 +941,10 @@ pub struct NonlinearFloquet {
     /// Largest entry of the off-diagonal `(q1, q̇1)`–`(q2, q̇2)` blocks of the monodromy
     /// (zero for a symmetric orbit).
     pub whippletree_coupling: Option<f64>,
-    /// Largest entry of `|M(h) − M(4h)|` between the monodromies at `fd_step` and `4 fd_step`:
-    /// an estimate of the finite-difference error (larger for piecewise-smooth models such as
-    /// blade-element aerodynamics).
+    /// Largest entry of `|M_var − M_fd|` between the monodromy of the variational equations
+    /// and the central-difference Jacobian of the map at `fd_step` (two independent
+    /// formulations): an error estimate, larger for piecewise-smooth models such as
+    /// blade-element aerodynamics.
     pub monodromy_uncertainty: f64,
 }
 
@@ -1000,7 +1030,18 @@ pub fn floquet(device: &Device, options: &ShootingOptions) -> Result<NonlinearFl
     let orbit = periodic_orbit(device, options)?;
     let integrator = options.validate(orbit.period)?;
     let n = device.n_dof();
-    let jacobian = |step: f64| {
+    // The monodromy from the variational equations (exact derivative of the computed map);
+    // its uncertainty from the independent central-difference Jacobian of the map.
+    let variational = || -> Result<DMatrix<f64>> {
+        if let Some(m) = &orbit.monodromy {
+            return Ok(m.clone());
+        }
+        integrator
+            .with_work(false)
+            .flow_with_sensitivity(device, orbit.t0, &orbit.state, orbit.t0 + orbit.period)
+            .map(|(_, m)| m)
+    };
+    let differences = || {
         map_jacobian(
             device,
             n,
@@ -1008,13 +1049,10 @@ pub fn floquet(device: &Device, options: &ShootingOptions) -> Result<NonlinearFl
             orbit.t0,
             orbit.period,
             &orbit.state,
-            step,
+            options.fd_step,
         )
     };
-    let (monodromy, coarse) = rayon::join(
-        || jacobian(options.fd_step),
-        || jacobian(4.0 * options.fd_step),
-    );
+    let (monodromy, coarse) = rayon::join(variational, differences);
     let (monodromy, coarse) = (monodromy?, coarse?);
     let monodromy_uncertainty = (&monodromy - coarse).amax();
     let multipliers = eigenvalues(&monodromy)?;

@@ -13,6 +13,7 @@ mod dop853;
 mod dopri5;
 #[cfg(test)]
 mod tests;
+mod variational;
 
 use paritysim_error::{Error, Result, check_positive};
 
@@ -275,6 +276,7 @@ impl RungeKutta {
             atol: self.atol,
             controlled: 2 * n,
         };
+        let c0 = compress::<M>(n, y0);
         let (y, mut stats) = match self.method {
             Method::Dop853 => drive(
                 &mut dop853::Dop853::<M>::new(),
@@ -282,7 +284,7 @@ impl RungeKutta {
                 &tol,
                 self.max_steps,
                 t0,
-                y0,
+                c0,
                 t_end,
                 times,
                 sink,
@@ -294,7 +296,7 @@ impl RungeKutta {
                 &tol,
                 self.max_steps,
                 t0,
-                y0,
+                c0,
                 t_end,
                 times,
                 sink,
@@ -302,7 +304,7 @@ impl RungeKutta {
             )?,
         };
         stats.rhs_calls = rhs.calls;
-        Ok((y, stats))
+        Ok((Rhs::<M>::expand(&rhs, &y), stats))
     }
 }
 
@@ -503,20 +505,22 @@ fn drive<const M: usize, S: Stepper<M>>(
     tol: &Tolerances,
     max_steps: usize,
     t0: f64,
-    y0: &State,
+    y0: [f64; M],
     t_end: f64,
     times: &[f64],
     sink: &mut Sink<'_>,
     on_step: &mut dyn FnMut(f64, &State),
-) -> Result<(State, IntegrationStats)> {
+) -> Result<([f64; M], IntegrationStats)> {
     let mut stats = IntegrationStats::default();
-    let n = tol.controlled / 2;
-    let mut y: [f64; M] = compress(n, y0);
+    let mut y = y0;
     let mut t = t0;
     let mut next = 0;
-    while next < times.len() && times[next] <= t0 {
-        sink(next, times[next], y0)?;
-        next += 1;
+    if next < times.len() && times[next] <= t0 {
+        let state = rhs.expand(&y);
+        while next < times.len() && times[next] <= t0 {
+            sink(next, times[next], &state)?;
+            next += 1;
+        }
     }
     let mut f0 = [0.0; M];
     rhs.eval(t, &y, &mut f0)?;
@@ -586,7 +590,7 @@ fn drive<const M: usize, S: Stepper<M>>(
                 next += 1;
             }
             if last {
-                return Ok((state, stats));
+                return Ok((y, stats));
             }
             h_new = h_new.min(h_max);
             if rejected_last {
