@@ -29,5 +29,7 @@ pub use actuator::{Actuator, DcOffset, Waveform};
 pub use device::{Device, DeviceSpec, Formulation, Transmission};
 pub use integrate::{Integrator, MAX_DOF, Method, State};
 pub use paritysim_error::{Error, Result};
-pub use simulate::{Perturbation, SimulationOptions, SimulationResult, Trajectory, simulate};
+pub use simulate::{
+    Perturbation, SimulationOptions, SimulationResult, SteadyState, Trajectory, simulate,
+};
 pub use wing::{JointSpring, TunableHinge, Wing, WingAero};

@@ -31,6 +31,20 @@ pub struct Perturbation {
     pub phase: f64,
 }
 
+/// How the periodic steady state is reached.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SteadyState {
+    /// Cycle-to-cycle simulation until the change per cycle is below `steady_tol` (the
+    /// default).
+    #[default]
+    Transient,
+    /// Newton shooting on the stroboscopic map with forward sensitivities
+    /// ([`crate::floquet::periodic_orbit`]) after `min_cycles` of warm-up; residual
+    /// `≤ min(steady_tol / 100, 10 rtol)`. Falls back to [`SteadyState::Transient`] when Newton fails.
+    /// The Floquet multipliers come with the result.
+    Shooting,
+}
+
 /// Options of [`simulate`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct SimulationOptions {
@@ -60,6 +74,8 @@ pub struct SimulationOptions {
     pub duration_ms: Option<f64>,
     /// Trajectory columns to build (`None`: all of them; `Some(vec![])`: none, metrics only).
     pub columns: Option<Vec<String>>,
+    /// How the periodic steady state is found (driven devices).
+    pub steady_state: SteadyState,
 }
 
 impl Default for SimulationOptions {
@@ -78,6 +94,7 @@ impl Default for SimulationOptions {
             perturbation: None,
             duration_ms: None,
             columns: None,
+            steady_state: SteadyState::Transient,
         }
     }
 }
@@ -96,6 +113,15 @@ pub struct SimulationResult {
     pub converged: bool,
     /// Drive period (ms), NaN without an actuator.
     pub period_ms: f64,
+    /// Relative change of the state over the last cycle before recording
+    /// (`‖P(y) − y‖∞ / max(‖y‖∞, 1e-12)` for transient runs, the shooting residual
+    /// `‖P(y) − y‖∞ / (1 + ‖y‖∞)` for Newton); NaN without a drive.
+    pub residual: f64,
+    /// The state at the start of the recorded window (on the periodic orbit when converged).
+    pub steady_state: State,
+    /// Floquet multipliers of the orbit, largest modulus first (Newton shooting only; empty
+    /// otherwise).
+    pub multipliers: Vec<nalgebra::Complex<f64>>,
 }
 
 fn validate(options: &SimulationOptions) -> Result<()> {
@@ -159,29 +185,62 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
     let mut t = 0.0;
     let mut cycles_run = 0;
     let mut converged = false;
+    let mut residual = f64::NAN;
+    let mut multipliers = Vec::new();
     let period = device.period();
     let (window, n_samples) = match period {
         Some(period) => {
-            // Cycles before the first convergence check run in one integrator call (no restarts).
-            let warm_up = options
-                .min_cycles
-                .saturating_sub(1)
-                .min(options.max_cycles.saturating_sub(1));
-            if warm_up > 0 {
-                let t_end = warm_up as f64 * period;
-                y = transient.advance(device, 0.0, &y, t_end)?;
-                t = t_end;
-                cycles_run = warm_up;
-            }
-            while cycles_run < options.max_cycles {
-                let next = transient.advance(device, t, &y, t + period)?;
-                let change = state_change(&next, &y);
-                y = next;
-                t += period;
-                cycles_run += 1;
-                if cycles_run >= options.min_cycles && change < options.steady_tol {
+            let mut transient_needed = true;
+            if options.steady_state == SteadyState::Shooting {
+                let shooting = crate::floquet::ShootingOptions {
+                    method: options.method,
+                    rtol: options.rtol,
+                    atol: options.atol,
+                    max_steps: options.max_steps,
+                    t0: 0.0,
+                    warmup_cycles: options.min_cycles,
+                    warmup_tol: 1e-3,
+                    max_newton: 20,
+                    // Below the integration's own noise (~rtol) Newton cannot improve the map.
+                    tol: (1e-2 * options.steady_tol).min(10.0 * options.rtol),
+                    fallback_cycles: 0,
+                    initial: Some(y),
+                    ..Default::default()
+                };
+                if let Ok(orbit) = crate::floquet::periodic_orbit(device, &shooting) {
+                    y = orbit.state;
+                    cycles_run = orbit.cycles_simulated;
+                    t = cycles_run as f64 * period;
+                    residual = orbit.residual;
                     converged = true;
-                    break;
+                    transient_needed = false;
+                    if let Some(m) = &orbit.monodromy {
+                        multipliers = crate::floquet::eigenvalues(m).unwrap_or_default();
+                    }
+                }
+            }
+            if transient_needed {
+                // Cycles before the first convergence check run in one integrator call.
+                let warm_up = options
+                    .min_cycles
+                    .saturating_sub(1)
+                    .min(options.max_cycles.saturating_sub(1));
+                if warm_up > 0 {
+                    let t_end = warm_up as f64 * period;
+                    y = transient.advance(device, 0.0, &y, t_end)?;
+                    t = t_end;
+                    cycles_run = warm_up;
+                }
+                while cycles_run < options.max_cycles {
+                    let next = transient.advance(device, t, &y, t + period)?;
+                    residual = state_change(&next, &y);
+                    y = next;
+                    t += period;
+                    cycles_run += 1;
+                    if cycles_run >= options.min_cycles && residual < options.steady_tol {
+                        converged = true;
+                        break;
+                    }
                 }
             }
             (
@@ -220,6 +279,9 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
         cycles_run,
         converged,
         period_ms: period.unwrap_or(f64::NAN),
+        residual,
+        steady_state: y,
+        multipliers,
     })
 }
 

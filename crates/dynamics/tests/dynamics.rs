@@ -5,6 +5,8 @@
 mod floquet;
 #[path = "dynamics/metrics.rs"]
 mod metrics;
+#[path = "dynamics/steady_state.rs"]
+mod steady_state;
 #[path = "dynamics/sweep.rs"]
 mod sweep;
 
