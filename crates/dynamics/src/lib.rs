@@ -12,15 +12,15 @@
 //!   planar drivetrain with balance-beam spring, the actuator; the right-hand side.
 //! * [`integrate`]: our own Dormand–Prince pairs (DOP853 default, DOPRI5) with Hairer's dense
 //!   output, sampled through a callback; errors that carry the time and state.
-//! * [`simulate`]: periodic steady state, perturbations; the recorded window is streamed into
+//! * [`simulate`](mod@simulate): periodic steady state, perturbations; the recorded window is streamed into
 //!   [`metrics`] and, only when asked, into [`trajectory`] columns (a name/unit/getter table).
 
 pub mod actuator;
 pub mod device;
-pub mod floquet;
 pub mod integrate;
 pub mod metrics;
 pub mod simulate;
+pub mod stability;
 pub mod sweep;
 pub mod trajectory;
 pub mod wing;
@@ -32,4 +32,6 @@ pub use paritysim_error::{Error, Result};
 pub use simulate::{
     Perturbation, SimulationOptions, SimulationResult, SteadyState, Trajectory, simulate,
 };
+/// The former name of [`stability`] (kept for the bindings and existing users).
+pub use stability as floquet;
 pub use wing::{JointSpring, TunableHinge, Wing, WingAero};
