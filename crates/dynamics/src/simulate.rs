@@ -119,8 +119,10 @@ pub struct SimulationResult {
     pub residual: f64,
     /// The state at the start of the recorded window (on the periodic orbit when converged).
     pub steady_state: State,
-    /// Floquet multipliers of the orbit, largest modulus first (Newton shooting only; empty
-    /// otherwise).
+    /// Floquet multipliers, largest modulus first, of the Jacobian the shooting used (evaluated
+    /// within the warm-up tolerance of the orbit: accurate to about that; use
+    /// [`crate::stability::floquet`] for multipliers at the orbit itself). Newton shooting
+    /// only; empty otherwise.
     pub multipliers: Vec<nalgebra::Complex<f64>>,
 }
 

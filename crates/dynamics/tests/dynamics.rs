@@ -299,7 +299,10 @@ fn dense_output_conserves_energy_as_well_as_the_steps() {
         Ok(())
     })
     .unwrap();
-    assert!(worst < 1e-11, "relative energy error at dense samples {worst:e}");
+    assert!(
+        worst < 1e-11,
+        "relative energy error at dense samples {worst:e}"
+    );
 }
 
 #[test]

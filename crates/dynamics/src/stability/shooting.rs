@@ -111,10 +111,13 @@ pub struct PeriodicOrbit {
     pub cycles_simulated: usize,
     /// How it was found.
     pub method: OrbitMethod,
-    /// Jacobian of the stroboscopic map at `state` from the forward sensitivities of the last
-    /// Newton iterate (`None` when the orbit came from plain simulation or needed no Newton
-    /// step).
+    /// Jacobian of the stroboscopic map from the forward sensitivities, as used by the chord
+    /// Newton iteration: evaluated at a state `monodromy_offset` away from `state` (`None` when
+    /// the orbit came from plain simulation or needed no Newton step).
     pub monodromy: Option<DMatrix<f64>>,
+    /// `‖y_J − state‖∞` of the state `y_J` where [`Self::monodromy`] was evaluated (0: at the
+    /// orbit itself; NaN without a monodromy).
+    pub monodromy_offset: f64,
 }
 
 fn compact(n: usize, y: &State) -> DVector<f64> {
@@ -248,9 +251,10 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
         cycles += 1;
     }
     let mut iterations = 0;
-    let mut monodromy = None;
-    // Newton with the exact derivative of the map (forward sensitivities, same period
-    // integration as P itself).
+    // Chord Newton: the exact derivative of the computed map (forward sensitivities, one
+    // augmented period integration) is evaluated once and reused while it keeps the residual
+    // falling fast; trial states cost one plain period each. It is re-evaluated at the
+    // current iterate when a step stalls.
     let sensitivity = |y: &State| -> Result<(State, DMatrix<f64>)> {
         let (py, phi) = integrator.with_work(false).flow_with_sensitivity(
             device,
@@ -260,17 +264,19 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
         )?;
         Ok((py.without_work(), phi))
     };
+    let mut monodromy: Option<(DMatrix<f64>, State)> = None;
     if res > options.tol && options.max_newton > 0 {
-        match sensitivity(&y) {
-            Ok((p, phi)) => {
-                py = p;
-                monodromy = Some(phi);
-            }
-            Err(_) => monodromy = None,
+        if let Ok((p, phi)) = sensitivity(&y) {
+            py = p;
+            res = residual_norm(n, &y, &py);
+            monodromy = Some((phi, y));
         }
     }
     while res > options.tol && iterations < options.max_newton {
-        let Some(jac) = monodromy.clone() else { break };
+        let Some((jac, at)) = monodromy.clone() else {
+            break;
+        };
+        let fresh = at == y;
         iterations += 1;
         let a = jac - DMatrix::<f64>::identity(2 * n, 2 * n);
         let f = compact(n, &py) - compact(n, &y);
@@ -281,25 +287,44 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
             .map_err(|e| Error::Singular(format!("Newton step of the shooting method: {e}")))?;
         let mut lambda = 1.0;
         let mut accepted = false;
-        for _ in 0..8 {
+        for _ in 0..if fresh { 8 } else { 1 } {
             let trial = expand(n, &(compact(n, &y) + &delta * lambda));
             // A trial step may leave the linkage's reach: treat it as a failed step.
-            if let Ok((pt, phi)) = sensitivity(&trial) {
+            if let Ok(pt) = stroboscopic_map(device, &integrator, t0, period, &trial) {
                 let rt = residual_norm(n, &trial, &pt);
-                if rt < res {
+                // A stale Jacobian must still contract fast; a fresh one only needs descent.
+                if rt < if fresh { res } else { 0.3 * res } {
                     (y, py, res) = (trial, pt, rt);
-                    monodromy = Some(phi);
                     accepted = true;
                     break;
                 }
             }
             lambda *= 0.5;
         }
-        if !accepted {
+        if accepted {
+            continue;
+        }
+        if fresh {
             break;
+        }
+        // Stalled on a stale Jacobian: re-evaluate it here.
+        match sensitivity(&y) {
+            Ok((p, phi)) => {
+                py = p;
+                res = residual_norm(n, &y, &py);
+                monodromy = Some((phi, y));
+            }
+            Err(_) => break,
         }
     }
     if res <= options.tol {
+        let (monodromy, monodromy_offset) = match monodromy {
+            Some((m, at)) => {
+                let offset = (compact(n, &at) - compact(n, &y)).amax();
+                (Some(m), offset)
+            }
+            None => (None, f64::NAN),
+        };
         return Ok(PeriodicOrbit {
             state: y,
             t0,
@@ -309,6 +334,7 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
             cycles_simulated: cycles,
             method: OrbitMethod::Newton,
             monodromy,
+            monodromy_offset,
         });
     }
     // Fallback: plain cycle-to-cycle simulation.
@@ -327,6 +353,7 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
                 cycles_simulated: cycles,
                 method: OrbitMethod::Simulation,
                 monodromy: None,
+                monodromy_offset: f64::NAN,
             });
         }
     }
@@ -467,7 +494,11 @@ pub fn floquet(device: &Device, options: &ShootingOptions) -> Result<NonlinearFl
     // The monodromy from the variational equations (exact derivative of the computed map);
     // its uncertainty from the independent central-difference Jacobian of the map.
     let variational = || -> Result<DMatrix<f64>> {
-        if let Some(m) = &orbit.monodromy {
+        if let Some(m) = orbit
+            .monodromy
+            .as_ref()
+            .filter(|_| orbit.monodromy_offset == 0.0)
+        {
             return Ok(m.clone());
         }
         integrator

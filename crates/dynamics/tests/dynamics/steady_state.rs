@@ -51,7 +51,8 @@ fn shooting_reaches_the_orbit_of_a_long_transient() {
         let (a, b) = (metric(&fast, name), metric(&long, name));
         assert!((a - b).abs() <= 1e-5, "{name}: {a} vs {b}");
     }
-    // The multipliers come with the result and agree with the stability analysis.
+    // The multipliers come with the result (from the chord Jacobian, evaluated within the
+    // 1e-3 warm-up tolerance of the orbit) and agree with the stability analysis at the orbit.
     let f = floquet(
         &device,
         &ShootingOptions {
@@ -63,7 +64,7 @@ fn shooting_reaches_the_orbit_of_a_long_transient() {
     .unwrap();
     assert_eq!(fast.multipliers.len(), 4);
     for (a, b) in fast.multipliers.iter().zip(&f.multipliers) {
-        assert!((a - b).norm() < 1e-5, "{a} vs {b}");
+        assert!((a - b).norm() < 2e-3, "{a} vs {b}");
     }
 }
 
