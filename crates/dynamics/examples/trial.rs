@@ -1,7 +1,8 @@
 //! One §3.3 Drag PARITY trial (linear map eq. 2.15, T = L = 2.5, K2 = 10, 1-Cut, 120 mN) (20 wingbeats at rtol 1e-8, 4000 samples in the last cycle),
 //! repeated `N` times (first argument, default 20): a fixed workload for callgrind
 //! (`valgrind --tool=callgrind target/release/examples/trial 5`) and wall-clock comparisons
-//! against older engines. Second argument `metrics` builds no trajectory column.
+//! against older engines. Second argument `metrics` builds no trajectory column; `SAMPLES`
+//! (environment) overrides the 4000 samples.
 
 use nalgebra::{Matrix3, Vector3};
 use paritysim_constraints::Constraints;
@@ -50,7 +51,7 @@ fn main() {
         min_cycles: 19,
         max_cycles: 19,
         steady_tol: 1e-30,
-        samples_per_cycle: 4000,
+        samples_per_cycle: std::env::var("SAMPLES").ok().and_then(|s| s.parse().ok()).unwrap_or(4000),
         ..Default::default()
     };
     if metrics_only {
