@@ -51,12 +51,22 @@ fn main() {
         min_cycles: 19,
         max_cycles: 19,
         steady_tol: 1e-30,
-        samples_per_cycle: std::env::var("SAMPLES").ok().and_then(|s| s.parse().ok()).unwrap_or(4000),
+        samples_per_cycle: std::env::var("SAMPLES")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(4000),
         ..Default::default()
     };
     if metrics_only {
         // COLUMNS-LINE (absent in engines without streamed metrics)
         options.columns = Some(Vec::new());
+        // STEADY-LINE: `STEADY=shooting` uses Newton shooting (default cycles as configured).
+        if std::env::var("STEADY").is_ok_and(|s| s == "shooting") {
+            options.steady_state = paritysim_dynamics::SteadyState::Shooting;
+            options.min_cycles = 3;
+            options.max_cycles = 300;
+            options.steady_tol = 1e-7;
+        }
     }
     let start = std::time::Instant::now();
     let mut check = 0.0;
