@@ -245,6 +245,8 @@ def main() -> None:
         ref = reference[pick] if name.startswith("scipy") else reference
         rel, pct = errors(results[name], ref)
         print(f"{name:48s} {ms[name]:10.3f} {ms[name] / ours:12.1f}x {rel:11.1e} {pct:9.1e}")
+    ours_on_scipy_points = errors(results["paritysim sweep, shooting (metrics only)"][pick], reference[pick])
+    print(f"paritysim on the scipy points: torque err {ours_on_scipy_points[0]:.1e}, pct err {ours_on_scipy_points[1]:.1e}")
     if math.isfinite(jax_best):
         print(f"\nparitysim per point = {ours / jax_best:.3f} × the best JAX set-up's time")
     print(f"(medians of {args.repeat} interleaved rounds; {args.threads} paritysim threads; script peers run {args.cycles} cycles from rest)")
