@@ -27,10 +27,10 @@ S33_STATED = [
     "Transmission '±200 µm → ±35°' (§3.3.2) gives T = 35° / 0.2 mm of eq. 2.15",
 ]
 S33_CHOICES = [
-    "Drivetrain: eq. 2.15 (linear differential), the model §2.6 proves stable; the rod-crank linkage of Fig. 2.7a is not given (ERRATA 14) and its whippletree mode is unstable at small K2 (docs/findings.md §3)",
+    "Drivetrain: eq. 2.15 (linear differential), the model §2.6 proves stable; the rod-crank linkage of Fig. 2.7a is not given (docs/errata.md#14) and its whippletree mode is unstable at small K2 (docs/findings.md §3)",
     "Whippletree arm L = L1 = 2.5 mm (half the 5 mm whippletree): not stated",
-    "Balance-beam spring K2 = 0 (ERRATA 14: not given; §2.6.3's κ2 = 0 case)",
-    "Drag law τ = Ω C_N(90°) φ̇² with C_N from eqs. 3.5-3.6 (ERRATA 12; 1.0 would be eq. 2.16)",
+    "Balance-beam spring K2 = 0 (docs/errata.md#14: not given; §2.6.3's κ2 = 0 case)",
+    "Drag law τ = Ω C_N(90°) φ̇² with C_N from eqs. 3.5-3.6 (docs/errata.md#12; 1.0 would be eq. 2.16)",
     "Izz = 0.05 × Ixx: a fixed wing only uses Ixx; any positive value keeps the tensor valid",
 ]
 S34_STATED = [
@@ -40,10 +40,10 @@ S34_STATED = [
     "Actuator 1.2 mN/V and 467 mN/mm (§3.3.1)",
 ]
 S34_CHOICES = [
-    "Hinge stiffness (springs[5], the ψ hinge, joint 6; 0-based index 5) pinned so the Uncut PARITY right wing rotates ±60°, the amplitude §3.4 reports: {hinge:.6g} mN·mm/rad (root finding on the model; not stated, ERRATA 14)",
+    "Hinge stiffness (springs[5], the ψ hinge, joint 6; 0-based index 5) pinned so the Uncut PARITY right wing rotates ±60°, the amplitude §3.4 reports: {hinge:.6g} mN·mm/rad (root finding on the model; not stated, docs/errata.md#14)",
     "dc_offset = 'ignore': the 100 V DC part biases the piezo without a net force (taken as a force it would hold a 45° stroke offset)",
     "Transmission: eq. 2.15 with '±200 µm → ±35°' as in §3.3; whippletree arm 2.5 mm; K2 = 0",
-    "Coefficients: Dickinson et al. 1999 fits (eqs. 3.5-3.6); C_rd the aero crate's cited default; α sign convention of the aero crate (ERRATA 5)",
+    "Coefficients: Dickinson et al. 1999 fits (eqs. 3.5-3.6); C_rd the aero crate's cited default; α sign convention of the aero crate (docs/errata.md#5)",
 ]
 
 
@@ -60,7 +60,7 @@ def catalogue() -> dict[str, dict[str, Any]]:
         for trial, ratio in s33.TRIALS.items():
             suffix = "" if trial == "Control" else "_" + trial.replace("-", "").lower()
             name = f"sreetharan2012_3_3_{drivetrain.lower()}{suffix}"
-            stated = [*S33_STATED, f"Left wing Ω^L = {ratio:g} Ω^R ({trial} trial, §3.3.2; ERRATA 11: the ratios define the trials)"]
+            stated = [*S33_STATED, f"Left wing Ω^L = {ratio:g} Ω^R ({trial} trial, §3.3.2; docs/errata.md#11: the ratios define the trials)"]
             out[name] = dict(
                 spec=s33.device(p33, drivetrain, ratio * p33.omega_r).replace(name=name),
                 title=f"§3.3 {'Drag PARITY' if drivetrain == 'PARITY' else 'HMF'} with fixed wings, {trial} trial (Table 3.2)",
@@ -75,9 +75,9 @@ def catalogue() -> dict[str, dict[str, Any]]:
         section="§3.3.2, Fig. 2.7a",
         stated=[S33_STATED[0], S33_STATED[1], S33_STATED[2], S33_STATED[3], "Link lengths of §3.3.2: crank 0.4 mm, rod 0.8 mm, whippletree 5 mm"],
         choices=[
-            "Linkage topology: a whippletree driving two rod-cranks perpendicular at rest (Fig. 2.7a is not in the text; ERRATA 14)",
+            "Linkage topology: a whippletree driving two rod-cranks perpendicular at rest (Fig. 2.7a is not in the text; docs/errata.md#14)",
             "K2 = 1 mN·mm/rad (not given). With this linkage the whippletree mode is UNSTABLE below K2 ≈ 377 mN·mm/rad (Floquet multiplier 1.78 at K2 = 0, docs/findings.md §3): cut-wing points run out of the linkage's domain. Use sreetharan2012_3_3_parity for cut wings",
-            "Drag law C_N(90°) φ̇² (ERRATA 12); Izz = 1 (unused by fixed wings)",
+            "Drag law C_N(90°) φ̇² (docs/errata.md#12); Izz = 1 (unused by fixed wings)",
         ],
         cut_wings=False,
     )
@@ -86,7 +86,7 @@ def catalogue() -> dict[str, dict[str, Any]]:
         title="§3.3 HMF on its nonlinear four-bar (examples/hmf.toml)",
         section="§2.3.1, §3.3",
         stated=[S33_STATED[0], S33_STATED[1], S33_STATED[2], S33_STATED[3], "HMF four-bar: 400 µm crank → 60° (§2.3.1)"],
-        choices=["Rod 0.8 mm (not stated)", "Drag law C_N(90°) φ̇² (ERRATA 12); Izz = 1 (unused by fixed wings)"],
+        choices=["Rod 0.8 mm (not stated)", "Drag law C_N(90°) φ̇² (docs/errata.md#12); Izz = 1 (unused by fixed wings)"],
         cut_wings=True,
     )
     p34 = s34.params()
@@ -122,7 +122,7 @@ def catalogue() -> dict[str, dict[str, Any]]:
         title="§2.6 Drag PARITY linearised (eq. 2.15, T = L = 2.5), the Floquet-stable reference",
         section="§2.6, eq. 2.15",
         stated=[S33_STATED[0], S33_STATED[1], S33_STATED[2], S33_STATED[3], "Eq. 2.15 (linear differential) of §2.6"],
-        choices=["T = 1/L3 = 2.5 rad/mm and L = L0/2 = 2.5 mm: the rest gain of the §3.3.2 linkage (docs/findings.md §2)", "K2 = 1 mN·mm/rad (not given)", "Drag law C_N(90°) φ̇² (ERRATA 12)"],
+        choices=["T = 1/L3 = 2.5 rad/mm and L = L0/2 = 2.5 mm: the rest gain of the §3.3.2 linkage (docs/findings.md §2)", "K2 = 1 mN·mm/rad (not given)", "Drag law C_N(90°) φ̇² (docs/errata.md#12)"],
         cut_wings=True,
     )
     return out

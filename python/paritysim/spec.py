@@ -241,6 +241,8 @@ class Options:
     initial_p: tuple[float, ...] | None = None
     initial_p_dot: tuple[float, ...] | None = None
     perturbation: dict[str, Any] | None = None
+    #: "transient" (cycle-to-cycle simulation) or "shooting" (Newton on the stroboscopic map).
+    steady_state: str = "transient"
 
 
 @dataclass(frozen=True)

@@ -464,7 +464,12 @@ def sweep(
         Paths are listed in the module docstring and by `valid_paths`. None runs the
         base design once.
     metrics:
-        Metric names to keep (default: all that `paritysim.simulate` reports).
+        Metric names to keep (default: all that `paritysim.simulate` reports). They are
+        streamed by the engine from every sample of the recorded window, including Table 3.2's
+        ``delta_tau_peak``, ``tau_l_peak``, ``tau_r_peak``, ``imbalance_instantaneous_pct``,
+        ``imbalance_peak_pct`` and the cycle ``_mean`` / ``_rms`` / ``_peak`` of the roll, yaw
+        and pitch torques per wing (``left_roll_rms``) and net (``yaw_total_mean``), so
+        ``keep_cycle`` is not needed for them.
     keep_cycle:
         True keeps the last recorded cycle of each point as list columns ``cycle_time_ms``,
         ``cycle_<column>`` for every trajectory column; a list of trajectory column names keeps

@@ -61,7 +61,7 @@ fn rhs(c: &mut Criterion) {
             &Vec6::new(0.3, 0.0, 0.0, 0.25, 0.0, 0.0),
         )
         .unwrap();
-    let mut dydt = [0.0; paritysim_dynamics::STATE_LEN];
+    let mut dydt = paritysim_dynamics::State::default();
     c.bench_function("rhs_two_wing_drag_parity_fixed_null_space", |b| {
         b.iter(|| {
             device

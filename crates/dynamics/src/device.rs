@@ -13,7 +13,7 @@ use paritysim_error::{Error, Result, bail, check_non_negative};
 use paritysim_kinematics::Drivetrain;
 
 use crate::actuator::Actuator;
-use crate::integrate::{STATE_LEN, State};
+use crate::integrate::State;
 use crate::wing::{Wing, WingTerms};
 
 /// A drivetrain with its balance-beam spring.
@@ -305,8 +305,8 @@ impl Device {
         let mut x = Vec6::zeros();
         let mut xd = Vec6::zeros();
         for i in 0..self.n_dof {
-            x[i] = y[i];
-            xd[i] = y[6 + i];
+            x[i] = y.coords[i];
+            xd[i] = y.rates[i];
         }
         Ok((self.offset + self.basis * x, self.basis * xd))
     }
@@ -326,8 +326,8 @@ impl Device {
     fn drive_coordinates(&self, y: &State) -> (Vector2<f64>, Vector2<f64>) {
         let two = self.n_dof == 2;
         (
-            Vector2::new(y[0], if two { y[1] } else { 0.0 }),
-            Vector2::new(y[6], if two { y[7] } else { 0.0 }),
+            Vector2::new(y.coords[0], if two { y.coords[1] } else { 0.0 }),
+            Vector2::new(y.rates[0], if two { y.rates[1] } else { 0.0 }),
         )
     }
 
@@ -358,19 +358,19 @@ impl Device {
         self.spec.constraints.check_consistent(p, p_dot, 1e-10)?;
         if self.stroke_only.is_some() {
             let drive = self.drive(0.0, p, p_dot)?;
-            let mut y = [0.0; STATE_LEN];
+            let mut y = State::default();
             for i in 0..self.n_dof {
-                y[i] = drive.q[i];
-                y[6 + i] = drive.q_dot[i];
+                y.coords[i] = drive.q[i];
+                y.rates[i] = drive.q_dot[i];
             }
             return Ok(y);
         }
         let x = self.basis.transpose() * (p - self.offset);
         let xd = self.basis.transpose() * p_dot;
-        let mut y = [0.0; STATE_LEN];
+        let mut y = State::default();
         for i in 0..self.n_dof {
-            y[i] = x[i];
-            y[6 + i] = xd[i];
+            y.coords[i] = x[i];
+            y.rates[i] = xd[i];
         }
         Ok(y)
     }
@@ -485,10 +485,10 @@ impl Device {
         let e = self.evaluate(t, &p, &p_dot)?;
         let x_ddot = self.basis.transpose() * e.p_ddot;
         for i in 0..6 {
-            dydt[i] = if i < self.n_dof { y[6 + i] } else { 0.0 };
-            dydt[6 + i] = if i < self.n_dof { x_ddot[i] } else { 0.0 };
+            dydt.coords[i] = if i < self.n_dof { y.rates[i] } else { 0.0 };
+            dydt.rates[i] = if i < self.n_dof { x_ddot[i] } else { 0.0 };
         }
-        dydt[12] = e.drive.actuator_force * e.drive.q_dot.x;
+        dydt.work_actuator = e.drive.actuator_force * e.drive.q_dot.x;
         let mut aero_power = 0.0;
         for (w, terms) in e.wings.iter().take(self.n_wings()).enumerate() {
             aero_power += terms.aero.dot(&Vector3::new(
@@ -497,7 +497,7 @@ impl Device {
                 p_dot[3 * w + 2],
             ));
         }
-        dydt[13] = aero_power;
+        dydt.work_aero = aero_power;
         Ok(())
     }
 
@@ -584,13 +584,13 @@ impl Device {
     /// Right-hand side in drivetrain coordinates (see [`Formulation::DrivetrainCoordinates`]).
     fn rhs_drivetrain(&self, fast: &StrokeOnly, t: f64, y: &State, dydt: &mut State) -> Result<()> {
         let step = self.drivetrain_step(fast, t, y)?;
-        dydt.fill(0.0);
+        *dydt = State::default();
         for i in 0..self.n_dof {
-            dydt[i] = step.q_dot[i];
-            dydt[6 + i] = step.q_ddot[i];
+            dydt.coords[i] = step.q_dot[i];
+            dydt.rates[i] = step.q_ddot[i];
         }
-        dydt[12] = step.force * step.q_dot.x;
-        dydt[13] = step.aero_power;
+        dydt.work_actuator = step.force * step.q_dot.x;
+        dydt.work_aero = step.aero_power;
         Ok(())
     }
 

@@ -1,112 +1,260 @@
-//! Metrics over a recorded trajectory.
+//! Metrics of the recorded window, accumulated sample by sample (no trajectory is stored).
 //!
-//! Per wing (`left_`, `right_` or `wing_`): stroke amplitude (half peak-to-peak), mean and
-//! peak-to-peak; rotation amplitude and mean; phase lag of rotation behind stroke (from the
-//! fundamental Fourier components, rad in (−π, π]); peak and mean of the roll aerodynamic torque.
-//! Device: actuator and aerodynamic work per cycle, mean actuator power, peak actuator force,
-//! whippletree amplitude, peak total roll torque.
+//! Means, rms and Fourier sums use the samples of whole periods (the sample closing the window
+//! is left out); extrema use every sample. Names, per wing (`left_`, `right_` or `wing_`):
+//!
+//! * `stroke_amplitude` (half peak-to-peak), `stroke_peak_to_peak`, `stroke_mean`;
+//!   `rotation_amplitude`, `rotation_mean`; `rotation_phase_lag` of rotation behind stroke
+//!   (fundamental Fourier components, rad in (−π, π]); `roll_aero_peak`, `roll_aero_mean`;
+//! * `roll_mean`, `roll_rms`, `roll_peak` (and `yaw_*`, `pitch_*`): the wing's body reaction
+//!   torque (aerodynamic + inertial, mN·mm).
+//!
+//! Device: `work_actuator_per_cycle`, `work_aero_per_cycle`, `mean_actuator_power`,
+//! `actuator_force_peak`, `q2_amplitude`; the net body torque `roll_total_peak` and
+//! `{roll,yaw,pitch}_total_{mean,rms,peak}`. Two wings, Table 3.2 (§3.3.1, drag torques in the
+//! body roll frame): `delta_tau_peak = max |τL + τR|` (eq. 3.23), `tau_l_peak`, `tau_r_peak`,
+//! `imbalance_instantaneous_pct = 100 Δτ_peak / τR_peak`,
+//! `imbalance_peak_pct = 100 (τR_peak − τL_peak) / τR_peak`.
+
+use std::f64::consts::{PI, TAU};
 
 use crate::device::Device;
-use crate::simulate::Trajectory;
+use crate::trajectory::Sample;
 
-fn extrema(v: &[f64]) -> (f64, f64) {
-    v.iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
-            (lo.min(x), hi.max(x))
-        })
+const AXES: [&str; 3] = ["roll", "yaw", "pitch"];
+
+/// Running extrema.
+#[derive(Clone, Copy, Debug)]
+struct Range {
+    lo: f64,
+    hi: f64,
 }
 
-/// Fundamental Fourier coefficient of `v` at angular frequency `w` (uniform samples, the last
-/// sample closing the window is excluded).
-fn fundamental(time: &[f64], v: &[f64], w: f64) -> (f64, f64) {
-    let n = v.len().saturating_sub(1).max(1);
-    let (mut re, mut im) = (0.0, 0.0);
-    for i in 0..n {
-        re += v[i] * (w * time[i]).cos();
-        im -= v[i] * (w * time[i]).sin();
+impl Default for Range {
+    fn default() -> Self {
+        Self {
+            lo: f64::INFINITY,
+            hi: f64::NEG_INFINITY,
+        }
     }
-    (re, im)
 }
 
-/// Drops the sample that closes a periodic window.
-fn body(v: &[f64]) -> &[f64] {
-    if v.len() > 1 { &v[..v.len() - 1] } else { v }
+impl Range {
+    fn add(&mut self, v: f64) {
+        self.lo = self.lo.min(v);
+        self.hi = self.hi.max(v);
+    }
+    fn span(&self) -> f64 {
+        self.hi - self.lo
+    }
+    fn abs_max(&self) -> f64 {
+        self.lo.abs().max(self.hi.abs())
+    }
+}
+
+/// Extrema, sum and sum of squares.
+#[derive(Clone, Copy, Debug, Default)]
+struct Stats {
+    range: Range,
+    sum: f64,
+    sum_sq: f64,
+}
+
+impl Stats {
+    fn add(&mut self, v: f64, in_body: bool) {
+        self.range.add(v);
+        if in_body {
+            self.sum += v;
+            self.sum_sq += v * v;
+        }
+    }
+    fn mean(&self, n: f64) -> f64 {
+        self.sum / n
+    }
+    fn rms(&self, n: f64) -> f64 {
+        (self.sum_sq / n).sqrt()
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+struct WingAcc {
+    phi: Stats,
+    psi: Stats,
+    roll_aero: Stats,
+    torque: [Stats; 3],
+    /// Fundamental Fourier sums `Σ v cos ωt`, `−Σ v sin ωt` of φ and ψ.
+    phi_f: (f64, f64),
+    psi_f: (f64, f64),
+}
+
+/// Accumulates the metrics over the samples of a recorded window.
+#[derive(Clone, Debug)]
+pub struct MetricsAccumulator {
+    n_wings: usize,
+    period: Option<f64>,
+    omega: f64,
+    wings: [WingAcc; 2],
+    force: Range,
+    q2: Range,
+    total: [Stats; 3],
+    delta_tau: Range,
+    body_samples: usize,
+    first_time: Option<f64>,
+    last_time: f64,
+    work_actuator: f64,
+    work_aero: f64,
+}
+
+impl MetricsAccumulator {
+    /// An empty accumulator for `device` with drive `period` (ms).
+    pub fn new(device: &Device, period: Option<f64>) -> Self {
+        Self {
+            n_wings: device.n_wings(),
+            period,
+            omega: period.map_or(0.0, |p| TAU / p),
+            wings: [WingAcc::default(); 2],
+            force: Range::default(),
+            q2: Range::default(),
+            total: [Stats::default(); 3],
+            delta_tau: Range::default(),
+            body_samples: 0,
+            first_time: None,
+            last_time: 0.0,
+            work_actuator: 0.0,
+            work_aero: 0.0,
+        }
+    }
+
+    /// Adds a sample; `closing` marks the sample that closes the window (left out of means).
+    pub fn add(&mut self, s: &Sample, closing: bool) {
+        let body = !closing;
+        if body {
+            self.body_samples += 1;
+        }
+        self.first_time.get_or_insert(s.time);
+        self.last_time = s.time;
+        let (cos, sin) = if body && self.period.is_some() {
+            let (s_, c_) = (self.omega * s.time).sin_cos();
+            (c_, s_)
+        } else {
+            (0.0, 0.0)
+        };
+        for w in 0..self.n_wings {
+            let acc = &mut self.wings[w];
+            let phi = s.eval.p[3 * w];
+            let psi = s.eval.p[3 * w + 2];
+            acc.phi.add(phi, body);
+            acc.psi.add(psi, body);
+            acc.roll_aero.add(s.aero[w].x, body);
+            let torque = s.wing_torque(w);
+            for (k, stats) in acc.torque.iter_mut().enumerate() {
+                stats.add(torque[k], body);
+            }
+            acc.phi_f.0 += phi * cos;
+            acc.phi_f.1 -= phi * sin;
+            acc.psi_f.0 += psi * cos;
+            acc.psi_f.1 -= psi * sin;
+        }
+        if self.n_wings == 2 {
+            self.delta_tau.add(s.aero[0].x + s.aero[1].x);
+        }
+        for (k, stats) in self.total.iter_mut().enumerate() {
+            stats.add(s.total[k], body);
+        }
+        self.force.add(s.eval.drive.actuator_force);
+        self.q2.add(s.eval.drive.q.y);
+        self.work_actuator = s.state.work_actuator;
+        self.work_aero = s.state.work_aero;
+    }
+
+    /// The metrics, names as documented in the module.
+    pub fn finish(&self) -> Vec<(String, f64)> {
+        let mut out: Vec<(String, f64)> = Vec::with_capacity(64);
+        let n = self.body_samples.max(1) as f64;
+        let duration = self.last_time - self.first_time.unwrap_or(self.last_time);
+        let cycles = self.period.map_or(1.0, |p| (duration / p).round().max(1.0));
+        let prefixes: &[&str] = if self.n_wings == 2 {
+            &["left", "right"]
+        } else {
+            &["wing"]
+        };
+        for (w, p) in prefixes.iter().enumerate() {
+            let a = &self.wings[w];
+            out.push((format!("{p}_stroke_amplitude"), 0.5 * a.phi.range.span()));
+            out.push((format!("{p}_stroke_peak_to_peak"), a.phi.range.span()));
+            out.push((format!("{p}_stroke_mean"), a.phi.mean(n)));
+            out.push((format!("{p}_rotation_amplitude"), 0.5 * a.psi.range.span()));
+            out.push((format!("{p}_rotation_mean"), a.psi.mean(n)));
+            let lag = match self.period {
+                Some(_) if a.psi.range.span() > 1e-9 && self.body_samples > 1 => {
+                    wrap(a.phi_f.1.atan2(a.phi_f.0) - a.psi_f.1.atan2(a.psi_f.0))
+                }
+                _ => f64::NAN,
+            };
+            out.push((format!("{p}_rotation_phase_lag"), lag));
+            out.push((format!("{p}_roll_aero_peak"), a.roll_aero.range.abs_max()));
+            out.push((format!("{p}_roll_aero_mean"), a.roll_aero.mean(n)));
+        }
+        out.push((
+            "work_actuator_per_cycle".into(),
+            self.work_actuator / cycles,
+        ));
+        out.push(("work_aero_per_cycle".into(), self.work_aero / cycles));
+        out.push((
+            "mean_actuator_power".into(),
+            if duration > 0.0 {
+                self.work_actuator / duration
+            } else {
+                0.0
+            },
+        ));
+        out.push(("actuator_force_peak".into(), self.force.abs_max()));
+        out.push(("q2_amplitude".into(), 0.5 * self.q2.span()));
+        out.push(("roll_total_peak".into(), self.total[0].range.abs_max()));
+        // Added with the streamed engine (after the original names, which keep their order).
+        for (w, p) in prefixes.iter().enumerate() {
+            for (k, axis) in AXES.iter().enumerate() {
+                let t = &self.wings[w].torque[k];
+                out.push((format!("{p}_{axis}_mean"), t.mean(n)));
+                out.push((format!("{p}_{axis}_rms"), t.rms(n)));
+                out.push((format!("{p}_{axis}_peak"), t.range.abs_max()));
+            }
+        }
+        for (k, axis) in AXES.iter().enumerate() {
+            let t = &self.total[k];
+            out.push((format!("{axis}_total_mean"), t.mean(n)));
+            out.push((format!("{axis}_total_rms"), t.rms(n)));
+            if k > 0 {
+                out.push((format!("{axis}_total_peak"), t.range.abs_max()));
+            }
+        }
+        if self.n_wings == 2 {
+            let delta = self.delta_tau.abs_max();
+            let tau_l = self.wings[0].roll_aero.range.abs_max();
+            let tau_r = self.wings[1].roll_aero.range.abs_max();
+            out.push(("delta_tau_peak".into(), delta));
+            out.push(("tau_l_peak".into(), tau_l));
+            out.push(("tau_r_peak".into(), tau_r));
+            out.push(("imbalance_instantaneous_pct".into(), 100.0 * delta / tau_r));
+            out.push(("imbalance_peak_pct".into(), 100.0 * (tau_r - tau_l) / tau_r));
+        }
+        out
+    }
+}
+
+/// The metric names for `device`, in order.
+pub fn names(device: &Device) -> Vec<String> {
+    MetricsAccumulator::new(device, device.period())
+        .finish()
+        .into_iter()
+        .map(|(name, _)| name)
+        .collect()
 }
 
 fn wrap(a: f64) -> f64 {
-    let mut a = (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
-    if a <= -std::f64::consts::PI {
-        a += std::f64::consts::TAU;
+    let mut a = (a + PI).rem_euclid(TAU) - PI;
+    if a <= -PI {
+        a += TAU;
     }
     a
-}
-
-/// Computes the metrics; names are stable and documented above.
-pub fn compute(device: &Device, traj: &Trajectory, period: Option<f64>) -> Vec<(String, f64)> {
-    let mut out: Vec<(String, f64)> = Vec::new();
-    let prefixes: &[&str] = if device.n_wings() == 2 {
-        &["left", "right"]
-    } else {
-        &["wing"]
-    };
-    let n = traj.time.len();
-    let duration =
-        traj.time.last().copied().unwrap_or(0.0) - traj.time.first().copied().unwrap_or(0.0);
-    let cycles = period.map_or(1.0, |p| (duration / p).round().max(1.0));
-    let col = |name: &str| traj.column(name).unwrap_or(&[]);
-    for p in prefixes {
-        let phi = col(&format!("{p}_phi"));
-        let psi = col(&format!("{p}_psi"));
-        let (lo, hi) = extrema(phi);
-        out.push((format!("{p}_stroke_amplitude"), 0.5 * (hi - lo)));
-        out.push((format!("{p}_stroke_peak_to_peak"), hi - lo));
-        out.push((
-            format!("{p}_stroke_mean"),
-            body(phi).iter().sum::<f64>() / body(phi).len().max(1) as f64,
-        ));
-        let (rlo, rhi) = extrema(psi);
-        out.push((format!("{p}_rotation_amplitude"), 0.5 * (rhi - rlo)));
-        out.push((
-            format!("{p}_rotation_mean"),
-            body(psi).iter().sum::<f64>() / body(psi).len().max(1) as f64,
-        ));
-        let lag = match period {
-            Some(period) if rhi - rlo > 1e-9 && n > 2 => {
-                let w = std::f64::consts::TAU / period;
-                let (a, b) = fundamental(&traj.time, phi, w);
-                let (c, d) = fundamental(&traj.time, psi, w);
-                wrap(b.atan2(a) - d.atan2(c))
-            }
-            _ => f64::NAN,
-        };
-        out.push((format!("{p}_rotation_phase_lag"), lag));
-        let roll = col(&format!("{p}_roll_aero"));
-        let (rl, rh) = extrema(roll);
-        out.push((format!("{p}_roll_aero_peak"), rl.abs().max(rh.abs())));
-        out.push((
-            format!("{p}_roll_aero_mean"),
-            body(roll).iter().sum::<f64>() / body(roll).len().max(1) as f64,
-        ));
-    }
-    let last = |name: &str| col(name).last().copied().unwrap_or(0.0);
-    out.push((
-        "work_actuator_per_cycle".into(),
-        last("work_actuator") / cycles,
-    ));
-    out.push(("work_aero_per_cycle".into(), last("work_aero") / cycles));
-    out.push((
-        "mean_actuator_power".into(),
-        if duration > 0.0 {
-            last("work_actuator") / duration
-        } else {
-            0.0
-        },
-    ));
-    let (flo, fhi) = extrema(col("actuator_force"));
-    out.push(("actuator_force_peak".into(), flo.abs().max(fhi.abs())));
-    let (qlo, qhi) = extrema(col("q2"));
-    out.push(("q2_amplitude".into(), 0.5 * (qhi - qlo)));
-    let (tlo, thi) = extrema(col("roll_total"));
-    out.push(("roll_total_peak".into(), tlo.abs().max(thi.abs())));
-    out
 }

@@ -1,20 +1,14 @@
-//! Running a device: periodic steady state, perturbations, trajectories.
-//!
-//! Body reaction torques: the wing pushes on the body with
-//! `τ_react = R6 (τ_aero⁶ − (I ω̇ + ω × I ω))` (aerodynamic part and inertial part), expressed
-//! in the wing's shoulder ground frame. Body axes (Fig. 2.10, our reading): roll about the
-//! stroke axis x̂, yaw about ŷ (normal to the resting wing plane, the lift direction of a
-//! deviated stroke plane), pitch about ẑ (spanwise, lateral). The left wing's frame is the
-//! mirror image of the right's through the sagittal plane, so its roll and yaw components change
-//! sign: with symmetric strokes the roll torques cancel (eq. 3.23: `Δτ = τL + τR`).
+//! Running a device: periodic steady state, perturbations, streamed metrics and (when asked)
+//! trajectory columns.
 
-use nalgebra::Vector3;
 use paritysim_constraints::Vec6;
 use paritysim_error::{Error, Result, bail, check_positive};
 
-use crate::device::{Device, Evaluation};
-use crate::integrate::{Integrator, Method, RungeKutta, STATE_LEN, State};
-use crate::metrics;
+use crate::device::Device;
+use crate::integrate::{Integrator, Method, RungeKutta, State};
+use crate::metrics::MetricsAccumulator;
+use crate::trajectory::{Recorder, Sample, select_columns};
+pub use crate::trajectory::{Trajectory, record};
 
 /// An instantaneous velocity change.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,6 +29,20 @@ pub struct Perturbation {
     pub delta: f64,
     /// Fraction of the first recorded cycle at which it is applied, in [0, 1).
     pub phase: f64,
+}
+
+/// How the periodic steady state is reached.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SteadyState {
+    /// Cycle-to-cycle simulation until the change per cycle is below `steady_tol` (the
+    /// default).
+    #[default]
+    Transient,
+    /// Newton shooting on the stroboscopic map with forward sensitivities
+    /// ([`crate::floquet::periodic_orbit`]) after `min_cycles` of warm-up; residual
+    /// `≤ min(steady_tol / 100, 10 rtol)`. Falls back to [`SteadyState::Transient`] when Newton fails.
+    /// The Floquet multipliers come with the result.
+    Shooting,
 }
 
 /// Options of [`simulate`].
@@ -64,6 +72,10 @@ pub struct SimulationOptions {
     pub perturbation: Option<Perturbation>,
     /// Duration (ms) for devices without a periodic drive.
     pub duration_ms: Option<f64>,
+    /// Trajectory columns to build (`None`: all of them; `Some(vec![])`: none, metrics only).
+    pub columns: Option<Vec<String>>,
+    /// How the periodic steady state is found (driven devices).
+    pub steady_state: SteadyState,
 }
 
 impl Default for SimulationOptions {
@@ -81,35 +93,19 @@ impl Default for SimulationOptions {
             record_cycles: 1,
             perturbation: None,
             duration_ms: None,
+            columns: None,
+            steady_state: SteadyState::Transient,
         }
-    }
-}
-
-/// Sampled trajectory: time and named columns (ready for a DataFrame).
-#[derive(Clone, Debug, PartialEq, Default)]
-pub struct Trajectory {
-    /// Sample times (ms).
-    pub time: Vec<f64>,
-    /// `(name, values)` in a fixed order.
-    pub columns: Vec<(String, Vec<f64>)>,
-}
-
-impl Trajectory {
-    /// A column by name.
-    pub fn column(&self, name: &str) -> Option<&[f64]> {
-        self.columns
-            .iter()
-            .find(|(n, _)| n == name)
-            .map(|(_, v)| v.as_slice())
     }
 }
 
 /// The outcome of [`simulate`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct SimulationResult {
-    /// The recorded window.
+    /// The recorded window (only the columns of [`SimulationOptions::columns`]; no samples
+    /// when none is asked for).
     pub trajectory: Trajectory,
-    /// Metrics over the recorded window (see [`metrics::compute`]).
+    /// Metrics over the recorded window (see [`crate::metrics`]).
     pub metrics: Vec<(String, f64)>,
     /// Cycles simulated before recording.
     pub cycles_run: usize,
@@ -117,6 +113,17 @@ pub struct SimulationResult {
     pub converged: bool,
     /// Drive period (ms), NaN without an actuator.
     pub period_ms: f64,
+    /// Relative change of the state over the last cycle before recording
+    /// (`‖P(y) − y‖∞ / max(‖y‖∞, 1e-12)` for transient runs, the shooting residual
+    /// `‖P(y) − y‖∞ / (1 + ‖y‖∞)` for Newton); NaN without a drive.
+    pub residual: f64,
+    /// The state at the start of the recorded window (on the periodic orbit when converged).
+    pub steady_state: State,
+    /// Floquet multipliers, largest modulus first, of the Jacobian the shooting used (evaluated
+    /// within the warm-up tolerance of the orbit: accurate to about that; use
+    /// [`crate::stability::floquet`] for multipliers at the orbit itself). Newton shooting
+    /// only; empty otherwise.
+    pub multipliers: Vec<nalgebra::Complex<f64>>,
 }
 
 fn validate(options: &SimulationOptions) -> Result<()> {
@@ -144,9 +151,14 @@ fn validate(options: &SimulationOptions) -> Result<()> {
 fn state_change(a: &State, b: &State) -> f64 {
     let mut num: f64 = 0.0;
     let mut den: f64 = 1e-12;
-    for i in 0..12 {
-        num = num.max((a[i] - b[i]).abs());
-        den = den.max(a[i].abs());
+    for (x, y) in a
+        .coords
+        .iter()
+        .chain(&a.rates)
+        .zip(b.coords.iter().chain(&b.rates))
+    {
+        num = num.max((x - y).abs());
+        den = den.max(x.abs());
     }
     num / den
 }
@@ -159,12 +171,15 @@ fn state_change(a: &State, b: &State) -> f64 {
 /// initial state; [`Error::Integration`] (with time and state) when integration fails.
 pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<SimulationResult> {
     validate(options)?;
-    let integrator = RungeKutta::new(
+    let columns = select_columns(device, options.columns.as_deref())?;
+    let recording = RungeKutta::new(
         options.method,
         options.rtol,
         options.atol,
         options.max_steps,
     )?;
+    // The transient needs no work integrals.
+    let transient = recording.with_work(false);
     let (p0, pd0) = options
         .initial
         .unwrap_or((*device.spec().constraints.particular(), Vec6::zeros()));
@@ -172,29 +187,62 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
     let mut t = 0.0;
     let mut cycles_run = 0;
     let mut converged = false;
+    let mut residual = f64::NAN;
+    let mut multipliers = Vec::new();
     let period = device.period();
     let (window, n_samples) = match period {
         Some(period) => {
-            // Cycles before the first convergence check run in one integrator call (no restarts).
-            let warm_up = options
-                .min_cycles
-                .saturating_sub(1)
-                .min(options.max_cycles.saturating_sub(1));
-            if warm_up > 0 {
-                let t_end = warm_up as f64 * period;
-                y = integrator.integrate(device, 0.0, &y, t_end, &[t_end])?[0];
-                t = t_end;
-                cycles_run = warm_up;
-            }
-            while cycles_run < options.max_cycles {
-                let next = integrator.integrate(device, t, &y, t + period, &[t + period])?[0];
-                let change = state_change(&next, &y);
-                y = next;
-                t += period;
-                cycles_run += 1;
-                if cycles_run >= options.min_cycles && change < options.steady_tol {
+            let mut transient_needed = true;
+            if options.steady_state == SteadyState::Shooting {
+                let shooting = crate::floquet::ShootingOptions {
+                    method: options.method,
+                    rtol: options.rtol,
+                    atol: options.atol,
+                    max_steps: options.max_steps,
+                    t0: 0.0,
+                    warmup_cycles: options.min_cycles,
+                    warmup_tol: 1e-3,
+                    max_newton: 20,
+                    // Below the integration's own noise (~rtol) Newton cannot improve the map.
+                    tol: (1e-2 * options.steady_tol).min(10.0 * options.rtol),
+                    fallback_cycles: 0,
+                    initial: Some(y),
+                    ..Default::default()
+                };
+                if let Ok(orbit) = crate::floquet::periodic_orbit(device, &shooting) {
+                    y = orbit.state;
+                    cycles_run = orbit.cycles_simulated;
+                    t = cycles_run as f64 * period;
+                    residual = orbit.residual;
                     converged = true;
-                    break;
+                    transient_needed = false;
+                    if let Some(m) = &orbit.monodromy {
+                        multipliers = crate::floquet::eigenvalues(m).unwrap_or_default();
+                    }
+                }
+            }
+            if transient_needed {
+                // Cycles before the first convergence check run in one integrator call.
+                let warm_up = options
+                    .min_cycles
+                    .saturating_sub(1)
+                    .min(options.max_cycles.saturating_sub(1));
+                if warm_up > 0 {
+                    let t_end = warm_up as f64 * period;
+                    y = transient.advance(device, 0.0, &y, t_end)?;
+                    t = t_end;
+                    cycles_run = warm_up;
+                }
+                while cycles_run < options.max_cycles {
+                    let next = transient.advance(device, t, &y, t + period)?;
+                    residual = state_change(&next, &y);
+                    y = next;
+                    t += period;
+                    cycles_run += 1;
+                    if cycles_run >= options.min_cycles && residual < options.steady_tol {
+                        converged = true;
+                        break;
+                    }
                 }
             }
             (
@@ -215,11 +263,46 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
         }
     };
     // Work integrals restart in the recorded window.
-    y[12] = 0.0;
-    y[13] = 0.0;
-    let t_start = t;
+    y = y.without_work();
+    let (trajectory, metrics) = record_window(
+        device,
+        &recording,
+        t,
+        &y,
+        window,
+        n_samples,
+        period,
+        options.perturbation,
+        columns,
+    )?;
+    Ok(SimulationResult {
+        trajectory,
+        metrics,
+        cycles_run,
+        converged,
+        period_ms: period.unwrap_or(f64::NAN),
+        residual,
+        steady_state: y,
+        multipliers,
+    })
+}
+
+/// Integrates the recorded window from `(t_start, y)`, evaluating each of the `n_samples + 1`
+/// samples once: it feeds the metrics and the asked columns, nothing else is kept.
+#[allow(clippy::too_many_arguments)]
+fn record_window(
+    device: &Device,
+    integrator: &RungeKutta,
+    t_start: f64,
+    y: &State,
+    window: f64,
+    n_samples: usize,
+    period: Option<f64>,
+    perturbation: Option<Perturbation>,
+    columns: Vec<crate::trajectory::Column>,
+) -> Result<(Trajectory, Vec<(String, f64)>)> {
     // The last sample is exactly the window's end: t_start + window·k/n can round one ulp past
-    // it, and the solver would then return one sample short.
+    // it.
     let t_end = t_start + window;
     let times: Vec<f64> = (0..=n_samples)
         .map(|k| {
@@ -230,35 +313,34 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
             }
         })
         .collect();
-    let states = match options.perturbation {
-        None => integrator.integrate(device, t_start, &y, t_end, &times)?,
+    let mut metrics = MetricsAccumulator::new(device, period);
+    let mut recorder = Recorder::new(columns, times.len());
+    let mut sink = |i: usize, t: f64, y: &State| -> Result<()> {
+        let sample = Sample::new(device, t, y)?;
+        metrics.add(&sample, i == n_samples);
+        recorder.push(&sample)
+    };
+    match perturbation {
+        None => {
+            integrator.integrate_with(device, t_start, y, t_end, &times, &mut sink)?;
+        }
         Some(kick) => {
             let t_kick = t_start + kick.phase * period.unwrap_or(window);
-            let (before, after): (Vec<f64>, Vec<f64>) = times.iter().partition(|&&s| s < t_kick);
-            let mut states = if before.is_empty() {
-                Vec::new()
-            } else {
-                integrator.integrate(device, t_start, &y, t_kick, &before)?
-            };
+            let split = times.partition_point(|&s| s < t_kick);
             let y_kick = if t_kick > t_start {
-                integrator.integrate(device, t_start, &y, t_kick, &[t_kick])?[0]
+                let (before, _) = times.split_at(split);
+                integrator.integrate_with(device, t_start, y, t_kick, before, &mut sink)?
             } else {
-                y
+                *y
             };
             let y_kicked = apply_kick(device, t_kick, &y_kick, kick)?;
-            states.extend(integrator.integrate(device, t_kick, &y_kicked, t_end, &after)?);
-            states
+            let after = &times[split..];
+            // Sample indices continue after the kick.
+            let mut shifted = |i: usize, t: f64, y: &State| sink(i + split, t, y);
+            integrator.integrate_with(device, t_kick, &y_kicked, t_end, after, &mut shifted)?;
         }
-    };
-    let trajectory = record(device, &times, &states)?;
-    let metrics = metrics::compute(device, &trajectory, period);
-    Ok(SimulationResult {
-        trajectory,
-        metrics,
-        cycles_run,
-        converged,
-        period_ms: period.unwrap_or(f64::NAN),
-    })
+    }
+    Ok((recorder.finish(), metrics.finish()))
 }
 
 fn apply_kick(device: &Device, t: f64, y: &State, kick: Perturbation) -> Result<State> {
@@ -284,154 +366,7 @@ fn apply_kick(device: &Device, t: f64, y: &State, kick: Perturbation) -> Result<
         }
     }
     let mut out = device.state_from(&p, &p_dot)?;
-    out[12] = y[12];
-    out[13] = y[13];
+    out.work_actuator = y.work_actuator;
+    out.work_aero = y.work_aero;
     Ok(out)
-}
-
-/// Body reaction torques (roll, yaw, pitch) of wing `w`: (aerodynamic, inertial).
-fn body_torques(device: &Device, e: &Evaluation, w: usize) -> (Vector3<f64>, Vector3<f64>) {
-    let terms = &e.wings[w];
-    let inertia = device.spec().wings[w].inertia();
-    let k = 3 * w;
-    let p_ddot = Vector3::new(e.p_ddot[k], e.p_ddot[k + 1], e.p_ddot[k + 2]);
-    let omega_dot = terms.j6 * p_ddot + terms.jdot_pdot;
-    let inertial6 = -(inertia * omega_dot + terms.omega.cross(&(inertia * terms.omega)));
-    let aero = terms.rotation * terms.aero_frame6;
-    let inertial = terms.rotation * inertial6;
-    // Mirror the left wing (index 0 of two) through the sagittal plane.
-    let mirror = if device.n_wings() == 2 && w == 0 {
-        Vector3::new(-1.0, -1.0, 1.0)
-    } else {
-        Vector3::new(1.0, 1.0, 1.0)
-    };
-    (aero.component_mul(&mirror), inertial.component_mul(&mirror))
-}
-
-/// Evaluates every derived quantity at the samples.
-pub fn record(device: &Device, times: &[f64], states: &[State]) -> Result<Trajectory> {
-    let n_wings = device.n_wings();
-    let prefixes: &[&str] = if n_wings == 2 {
-        &["left", "right"]
-    } else {
-        &["wing"]
-    };
-    let per_wing = [
-        "phi",
-        "theta",
-        "psi",
-        "phi_dot",
-        "theta_dot",
-        "psi_dot",
-        "phi_ddot",
-        "theta_ddot",
-        "psi_ddot",
-        "theta_w",
-        "tau_aero_phi",
-        "tau_aero_theta",
-        "tau_aero_psi",
-        "tau_spring_phi",
-        "tau_spring_theta",
-        "tau_spring_psi",
-        "roll_aero",
-        "yaw_aero",
-        "pitch_aero",
-        "roll_inertial",
-        "yaw_inertial",
-        "pitch_inertial",
-        "kinetic_energy",
-    ];
-    let device_cols = [
-        "q1",
-        "q2",
-        "q1_dot",
-        "q2_dot",
-        "voltage",
-        "actuator_force",
-        "actuator_power",
-        "work_actuator",
-        "work_aero",
-        "mechanical_energy",
-        "roll_total",
-        "yaw_total",
-        "pitch_total",
-    ];
-    let mut names: Vec<String> = Vec::new();
-    for p in prefixes {
-        for c in per_wing {
-            names.push(format!("{p}_{c}"));
-        }
-    }
-    names.extend(device_cols.iter().map(|s| s.to_string()));
-    let mut data: Vec<Vec<f64>> = vec![Vec::with_capacity(times.len()); names.len()];
-    for (t, y) in times.iter().zip(states) {
-        let e = device.evaluate_state(*t, y)?;
-        let (p, p_dot) = (e.p, e.p_dot);
-        let mut col = 0;
-        let mut push = |v: f64| {
-            data[col].push(v);
-            col += 1;
-        };
-        let mut total = Vector3::zeros();
-        for w in 0..n_wings {
-            let k = 3 * w;
-            let terms = &e.wings[w];
-            for i in 0..3 {
-                push(p[k + i]);
-            }
-            for i in 0..3 {
-                push(p_dot[k + i]);
-            }
-            for i in 0..3 {
-                push(e.p_ddot[k + i]); // φ̈, θ̈, ψ̈ (Appendix A's p̈)
-            }
-            push(terms.theta_w);
-            for i in 0..3 {
-                push(terms.aero[i]);
-            }
-            for i in 0..3 {
-                push(-terms.spring[i]);
-            }
-            let (aero, inertial) = body_torques(device, &e, w);
-            for i in 0..3 {
-                push(aero[i]);
-            }
-            for i in 0..3 {
-                push(inertial[i]);
-            }
-            push(terms.kinetic);
-            total += aero + inertial;
-        }
-        let voltage = device
-            .spec()
-            .actuator
-            .as_ref()
-            .map_or(0.0, |a| a.waveform().voltage(*t));
-        push(e.drive.q.x);
-        push(e.drive.q.y);
-        push(e.drive.q_dot.x);
-        push(e.drive.q_dot.y);
-        push(voltage);
-        push(e.drive.actuator_force);
-        push(e.drive.actuator_force * e.drive.q_dot.x);
-        push(y[12]);
-        push(y[13]);
-        push(device.energy(&e));
-        push(total.x);
-        push(total.y);
-        push(total.z);
-    }
-    debug_assert!(data.iter().all(|c| c.len() == times.len()));
-    if data.iter().flatten().any(|v| !v.is_finite()) {
-        return Err(Error::Integration {
-            time: *times.last().unwrap_or(&0.0),
-            state: vec![],
-            reason: "non-finite derived quantity".into(),
-        });
-    }
-    let _ = STATE_LEN;
-    Ok(Trajectory {
-        time: times.to_vec(),
-        columns: names.into_iter().zip(data).collect(),
-    })
 }

@@ -63,7 +63,9 @@ use paritysim_error::{Error, Result, bail};
 
 use crate::device::Device;
 use crate::metrics;
-use crate::simulate::{SimulationOptions, Trajectory, record, simulate};
+use crate::simulate::{SimulationOptions, SteadyState, Trajectory, simulate};
+use crate::trajectory::column_table;
+use paritysim_constraints::Vec6;
 
 /// Environment variable read by [`resolve_threads`] when no thread count is given:
 /// a positive integer (`PARITYSIM_THREADS=4`).
@@ -187,18 +189,13 @@ where
 
 /// The metric names [`simulate`](crate::simulate()) reports for this device, in order.
 pub fn metric_names(device: &Device) -> Vec<String> {
-    metrics::compute(device, &Trajectory::default(), device.period())
-        .into_iter()
-        .map(|(name, _)| name)
-        .collect()
+    metrics::names(device)
 }
 
 /// The trajectory column names [`simulate`](crate::simulate()) records for this device
 /// (without `time_ms`), in order.
 pub fn trajectory_columns(device: &Device) -> Vec<String> {
-    record(device, &[], &[])
-        .map(|t| t.columns.into_iter().map(|(name, _)| name).collect())
-        .unwrap_or_default()
+    column_table(device).into_iter().map(|c| c.name).collect()
 }
 
 /// Checks requested names against the allowed ones; `None` selects them all.
@@ -228,7 +225,8 @@ pub struct SweepSettings {
     pub threads: Option<usize>,
     /// Metric names to keep, in this order (`None`: all of [`metric_names`]).
     pub metrics: Option<Vec<String>>,
-    /// Keep the last recorded cycle of each point.
+    /// Keep the last recorded cycle of each point (Δτ and the imbalance percentages are metrics
+    /// now; this is only for the waveforms themselves).
     pub keep_cycle: bool,
 }
 
@@ -243,6 +241,12 @@ pub struct PointOutput {
     pub cycles_run: usize,
     /// The last recorded cycle (its closing sample included), when asked for.
     pub cycle: Option<Trajectory>,
+    /// Relative change over the last cycle, or the shooting residual
+    /// ([`crate::SimulationResult::residual`]).
+    pub residual: f64,
+    /// `(p, ṗ)` at the start of the recorded window: the next point's initial guess in a
+    /// continuation chain.
+    pub steady_state: Option<(Vec6, Vec6)>,
 }
 
 /// Simulates one point and keeps what the sweep asked for.
@@ -255,7 +259,16 @@ pub fn run_point(
     metric_names: &[String],
     keep_cycle: bool,
 ) -> Result<PointOutput> {
-    let result = simulate(device, options)?;
+    let result = if keep_cycle {
+        simulate(device, options)?
+    } else {
+        // Metrics only: no trajectory column is built.
+        let options = SimulationOptions {
+            columns: Some(Vec::new()),
+            ..options.clone()
+        };
+        simulate(device, &options)?
+    };
     let metrics = metric_names
         .iter()
         .map(|name| {
@@ -289,11 +302,23 @@ pub fn run_point(
         converged: result.converged,
         cycles_run: result.cycles_run,
         cycle,
+        residual: result.residual,
+        steady_state: device.coordinates(&result.steady_state).ok(),
     })
 }
 
+/// Points per continuation chain (see [`run_points`]); fixed, so results do not depend on the
+/// thread count.
+pub const CHAIN_LENGTH: usize = 16;
+
 /// Runs prepared points: slot `i` is `(device, options)` or the error that prevented building
 /// it (kept as that point's result). `metric_names` are those to report (see [`select`]).
+///
+/// Points whose options ask for [`SteadyState::Shooting`] without an initial state run in
+/// continuation chains: consecutive points in groups of [`CHAIN_LENGTH`] (neighbours along the
+/// last grid axis), each started from the steady state of the previous converged point of its
+/// chain. Chains are fixed by the input order alone, so results are the same for any thread
+/// count.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for a bad thread count only; point failures are per-slot.
@@ -305,10 +330,65 @@ pub fn run_points(
     control: &SweepControl,
 ) -> Result<Vec<Option<Result<PointOutput>>>> {
     let threads = resolve_threads(threads)?;
-    run_indexed(points.len(), threads, control, |i| match &points[i] {
-        Ok((device, options)) => run_point(device, options, metric_names, keep_cycle),
-        Err(e) => Err(e.clone()),
-    })
+    let continued = |i: usize| matches!(&points[i], Ok((_, o)) if o.steady_state == SteadyState::Shooting && o.initial.is_none());
+    if !(0..points.len()).any(continued) {
+        return run_indexed(points.len(), threads, control, |i| match &points[i] {
+            Ok((device, options)) => run_point(device, options, metric_names, keep_cycle),
+            Err(e) => Err(e.clone()),
+        });
+    }
+    let n_chains = points.len().div_ceil(CHAIN_LENGTH);
+    let chains = run_indexed(n_chains, threads, control, |c| {
+        let range = c * CHAIN_LENGTH..((c + 1) * CHAIN_LENGTH).min(points.len());
+        let last = range.end - 1;
+        let mut guess: Option<(Vec6, Vec6)> = None;
+        let mut out = Vec::with_capacity(range.len());
+        for i in range {
+            let result = match &points[i] {
+                Ok((device, options)) => {
+                    let started = match guess {
+                        Some(initial) if continued(i) => {
+                            let options = SimulationOptions {
+                                initial: Some(initial),
+                                ..options.clone()
+                            };
+                            run_point(device, &options, metric_names, keep_cycle)
+                        }
+                        _ => run_point(device, options, metric_names, keep_cycle),
+                    };
+                    // A failed continuation start is retried from the spec's own start.
+                    match started {
+                        Err(_) if guess.is_some() => {
+                            run_point(device, options, metric_names, keep_cycle)
+                        }
+                        other => other,
+                    }
+                }
+                Err(e) => Err(e.clone()),
+            };
+            if let Ok(o) = &result {
+                if o.converged {
+                    guess = o.steady_state;
+                }
+            }
+            out.push(result);
+            // run_indexed counts the chain once, at its end.
+            if i != last {
+                control.finished.fetch_add(1, Ordering::AcqRel);
+            }
+        }
+        Ok(out)
+    })?;
+    let mut slots = Vec::with_capacity(points.len());
+    for (c, chain) in chains.into_iter().enumerate() {
+        let len = ((c + 1) * CHAIN_LENGTH).min(points.len()) - c * CHAIN_LENGTH;
+        match chain {
+            Some(Ok(results)) => slots.extend(results.into_iter().map(Some)),
+            Some(Err(e)) => slots.extend((0..len).map(|_| Some(Err(e.clone())))),
+            None => slots.extend((0..len).map(|_| None)),
+        }
+    }
+    Ok(slots)
 }
 
 /// A table of parameter values: named columns, one row per point.

@@ -300,9 +300,18 @@ impl Wing {
     pub fn stroke_plane_terms(&self, p: &Vector3<f64>, p_dot: &Vector3<f64>) -> WingTerms {
         let (phi, psi) = (p.x, p.z);
         let (sp, cp) = phi.sin_cos();
-        let (ss, cs) = psi.sin_cos();
-        let rotation = Matrix3::new(1.0, 0.0, 0.0, 0.0, cp, -sp, 0.0, sp, cp)
-            * Matrix3::new(cs, -ss, 0.0, ss, cs, 0.0, 0.0, 0.0, 1.0);
+        // ψ ≡ 0 on fixed (stroke-only) wings: skip its rotation.
+        let (ss, cs) = if psi == 0.0 {
+            (0.0, 1.0)
+        } else {
+            psi.sin_cos()
+        };
+        let roll = Matrix3::new(1.0, 0.0, 0.0, 0.0, cp, -sp, 0.0, sp, cp);
+        let rotation = if psi == 0.0 {
+            roll
+        } else {
+            roll * Matrix3::new(cs, -ss, 0.0, ss, cs, 0.0, 0.0, 0.0, 1.0)
+        };
         let j6 = Matrix3::new(cs, cp * ss, 0.0, -ss, cp * cs, 0.0, 0.0, 0.0, 1.0);
         let omega = j6 * p_dot;
         let jdot_pdot = Vector3::new(-ss, -cs, 0.0) * (p_dot.x * p_dot.z);

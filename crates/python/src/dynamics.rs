@@ -9,8 +9,8 @@ use paritysim_dynamics::device::{Device, DeviceSpec, Formulation, Transmission};
 use paritysim_dynamics::integrate::Method;
 use paritysim_dynamics::simulate::PerturbTarget;
 use paritysim_dynamics::{
-    Actuator, DcOffset, JointSpring, Perturbation, SimulationOptions, SimulationResult, Waveform,
-    Wing, WingAero,
+    Actuator, DcOffset, JointSpring, Perturbation, SimulationOptions, SimulationResult,
+    SteadyState, Waveform, Wing, WingAero,
 };
 use paritysim_error::{Error, Result};
 
@@ -498,6 +498,18 @@ pub(crate) fn parse_options(
             None => None,
             Some(_) => Some(n.f64("duration_ms")?),
         },
+        steady_state: match n.str_or("steady_state", "transient")?.as_str() {
+            "transient" => SteadyState::Transient,
+            "shooting" => SteadyState::Shooting,
+            other => {
+                return Err(invalid(
+                    "options.steady_state",
+                    other,
+                    "transient or shooting",
+                ));
+            }
+        },
+        ..d
     })
 }
 
@@ -524,6 +536,7 @@ fn result_to_dict<'py>(py: Python<'py>, r: SimulationResult) -> PyResult<Bound<'
     out.set_item("cycles_run", r.cycles_run)?;
     out.set_item("converged", r.converged)?;
     out.set_item("period_ms", r.period_ms)?;
+    out.set_item("residual", r.residual)?;
     Ok(out)
 }
 

@@ -345,8 +345,8 @@ fn floquet_dict<'py>(py: Python<'py>, f: &NonlinearFloquet) -> PyResult<Bound<'p
     let n = f.coordinates.len();
     let n_dof = n / 2;
     let state: Vec<f64> = (0..n_dof)
-        .map(|i| f.orbit.state[i])
-        .chain((0..n_dof).map(|i| f.orbit.state[6 + i]))
+        .map(|i| f.orbit.state.coords[i])
+        .chain((0..n_dof).map(|i| f.orbit.state.rates[i]))
         .collect();
     out.set_item("coordinates", f.coordinates.clone())?;
     out.set_item("orbit_state", PyArray1::from_vec(py, state))?;

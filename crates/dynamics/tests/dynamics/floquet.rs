@@ -138,9 +138,9 @@ fn monodromy_matches_an_independent_adaptive_integrator() {
     struct Hill(f64, f64);
     impl OdeSystem for Hill {
         fn rhs(&self, t: f64, y: &State, dydt: &mut State) -> paritysim_dynamics::Result<()> {
-            dydt.fill(0.0);
-            dydt[0] = y[6];
-            dydt[6] = -self.0 * t.cos().abs() * y[6] - self.1 * y[0];
+            *dydt = State::default();
+            dydt.coords[0] = y.rates[0];
+            dydt.rates[0] = -self.0 * t.cos().abs() * y.rates[0] - self.1 * y.coords[0];
             Ok(())
         }
         fn n_active(&self) -> usize {
@@ -158,8 +158,8 @@ fn monodromy_matches_an_independent_adaptive_integrator() {
         let m = hill_monodromy(beta0, kappa, t0).unwrap();
         for j in 0..2 {
             // The kinks of |cos t| are integration breakpoints for DOP853 too.
-            let mut y = [0.0; 14];
-            y[if j == 0 { 0 } else { 6 }] = 1.0;
+            let mut y = State::default();
+            *slot(&mut y, if j == 0 { 0 } else { 6 }) = 1.0;
             let mut t = t0;
             let mut stops: Vec<f64> = (-3..4)
                 .map(|k| FRAC_PI_2 + k as f64 * PI)
@@ -172,11 +172,11 @@ fn monodromy_matches_an_independent_adaptive_integrator() {
             }
             let scale = 1.0 + m.amax();
             assert!(
-                (y[0] - m[(0, j)]).abs() < 1e-9 * scale,
+                (y.coords[0] - m[(0, j)]).abs() < 1e-9 * scale,
                 "{beta0} {kappa} {t0}"
             );
             assert!(
-                (y[6] - m[(1, j)]).abs() < 1e-9 * scale,
+                (y.rates[0] - m[(1, j)]).abs() < 1e-9 * scale,
                 "{beta0} {kappa} {t0}"
             );
         }
@@ -385,12 +385,12 @@ fn errata_7_drag_generalised_forces_carry_t_cubed() {
         ([-0.1, -0.02], [-0.25, 0.05], 3.1),
         ([0.0, 0.03], [0.1, -0.03], 5.0),
     ] {
-        let mut y = [0.0; 14];
-        (y[0], y[1], y[6], y[7]) = (q[0], q[1], qd[0], qd[1]);
-        let mut f = [0.0; 14];
+        let mut y = State::default();
+        (y.coords[0], y.coords[1], y.rates[0], y.rates[1]) = (q[0], q[1], qd[0], qd[1]);
+        let mut f = State::default();
         device.rhs(time, &y, &mut f).unwrap();
-        let q1_force = 2.0 * i * t * t * f[6] - (actuator.force(time) - k1 * q[0]);
-        let q2_force = 2.0 * i * t * t * l * l * f[7] + k2 * q[1];
+        let q1_force = 2.0 * i * t * t * f.rates[0] - (actuator.force(time) - k1 * q[0]);
+        let q2_force = 2.0 * i * t * t * l * l * f.rates[1] + k2 * q[1];
         let s = qd[0].signum();
         let want1 = -2.0 * omega * t.powi(3) * s * (qd[0].powi(2) + l * l * qd[1].powi(2));
         let want2 = -4.0 * omega * t.powi(3) * l * l * qd[0].abs() * qd[1];
@@ -491,9 +491,9 @@ fn shooting_converges_to_the_orbit_of_long_simulation() {
     let f = floquet(&device, &options()).unwrap();
     assert_eq!(f.orbit.method, OrbitMethod::Newton);
     assert!(
-        f.orbit.state[1].abs() > 1e-3,
+        f.orbit.state.coords[1].abs() > 1e-3,
         "asymmetric: q2 = {}",
-        f.orbit.state[1]
+        f.orbit.state.coords[1]
     );
     let long = simulate(
         &device,
@@ -513,7 +513,7 @@ fn shooting_converges_to_the_orbit_of_long_simulation() {
     assert!(long.cycles_run > 20, "{}", long.cycles_run);
     let tr = &long.trajectory;
     for (name, slot) in [("q1", 0), ("q2", 1), ("q1_dot", 6), ("q2_dot", 7)] {
-        let diff = (tr.column(name).unwrap()[0] - f.orbit.state[slot]).abs();
+        let diff = (tr.column(name).unwrap()[0] - f.orbit.state.to_vec()[slot]).abs();
         assert!(diff < 1e-8, "{name}: {diff:e}");
     }
     assert_eq!(f.stability(), OrbitStability::Asymptotic);
@@ -537,12 +537,12 @@ fn multipliers_match_independent_differences_of_the_stroboscopic_map() {
         let slots = [0, 1, 6, 7];
         let mut jac = DMatrix::zeros(4, 4);
         for (j, &sj) in slots.iter().enumerate() {
-            let h = 3e-6 * (1.0 + y[sj].abs());
+            let h = 3e-6 * (1.0 + y.to_vec()[sj].abs());
             let mut yp = y;
-            yp[sj] += h;
+            *slot(&mut yp, sj) += h;
             let p = stroboscopic_map(&device, &rk, 0.0, f.orbit.period, &yp).unwrap();
             for (i, &si) in slots.iter().enumerate() {
-                jac[(i, j)] = (p[si] - p0[si]) / h;
+                jac[(i, j)] = (p.to_vec()[si] - p0.to_vec()[si]) / h;
             }
         }
         let independent = eigenvalues(&jac).unwrap();
@@ -747,8 +747,8 @@ fn roll_disturbance_obeys_momentum_balance() {
         ([0.05, 0.02], [0.3, -0.1], 0.4),
         ([-0.12, -0.05], [0.1, 0.2], 2.9),
     ] {
-        let mut y = [0.0; 14];
-        (y[0], y[1], y[6], y[7]) = (q[0], q[1], qd[0], qd[1]);
+        let mut y = State::default();
+        (y.coords[0], y.coords[1], y.rates[0], y.rates[1]) = (q[0], q[1], qd[0], qd[1]);
         let roll = system.body_roll(t, &y).unwrap();
         let j = tr.kinematics().evaluate(q[0], q[1]).unwrap().jacobian;
         let generalised = nalgebra::Vector2::new(actuator.force(t) - 467.0 * q[0], -500.0 * q[1]);
@@ -772,9 +772,9 @@ fn roll_disturbance_obeys_momentum_balance() {
     .unwrap();
     let tr = &r.trajectory;
     for k in 0..tr.time.len() {
-        let mut y = [0.0; 14];
-        for (name, slot) in [("q1", 0), ("q2", 1), ("q1_dot", 6), ("q2_dot", 7)] {
-            y[slot] = tr.column(name).unwrap()[k];
+        let mut y = State::default();
+        for (name, s) in [("q1", 0), ("q2", 1), ("q1_dot", 6), ("q2_dot", 7)] {
+            *slot(&mut y, s) = tr.column(name).unwrap()[k];
         }
         let roll = quiet.body_roll(tr.time[k], &y).unwrap();
         let want = tr.column("roll_total").unwrap()[k];
@@ -852,16 +852,16 @@ fn shooting_finds_an_unstable_asymmetric_orbit_that_simulation_cannot_reach() {
     assert_eq!(f.orbit.method, OrbitMethod::Newton);
     assert!(f.orbit.residual <= options().tol);
     assert!(
-        f.orbit.state[1].abs() > 1e-3,
+        f.orbit.state.coords[1].abs() > 1e-3,
         "asymmetric: q2 = {}",
-        f.orbit.state[1]
+        f.orbit.state.coords[1]
     );
     assert_eq!(f.stability(), OrbitStability::Unstable);
     let rk = RungeKutta::new(Method::Dop853, 1e-12, 1e-14, 1_000_000).unwrap();
     let p = stroboscopic_map(&device, &rk, 0.0, f.orbit.period, &f.orbit.state).unwrap();
     for i in [0, 1, 6, 7] {
         assert!(
-            (p[i] - f.orbit.state[i]).abs() < 1e-9,
+            (p.to_vec()[i] - f.orbit.state.to_vec()[i]).abs() < 1e-9,
             "periodic in slot {i}"
         );
     }
@@ -917,4 +917,13 @@ fn undamped_and_unsprung_lines_are_marginal_within_the_multiplier_error() {
     }
     let chart = stability_chart(&[0.0, 0.5], &[0.5, 2.0]).unwrap();
     assert_eq!(chart.marginal, vec![true, true, false, false]);
+}
+
+/// Entry `s` of the flat layout `[coords (6), rates (6)]`.
+fn slot(y: &mut State, s: usize) -> &mut f64 {
+    if s < 6 {
+        &mut y.coords[s]
+    } else {
+        &mut y.rates[s - 6]
+    }
 }

@@ -1,0 +1,607 @@
+//! Our own Dormand–Prince integrators (DOP853 and DOPRI5 with Hairer's dense output and step
+//! control), sampling the solution at requested times through a callback.
+//!
+//! * The integrator works on a compact array of `2n` entries (`n` coordinates, `n` rates) and,
+//!   only when asked for, the two work integrals. The work integrals ride along on the same
+//!   stages but take no part in the error control (they never shorten a step).
+//! * Dense output is prepared only on steps where a sample falls (DOP853's three extra stages
+//!   are not computed on the other steps); a sample at a step's end is the step's value.
+//! * `differential-equations` 0.7.0 is kept as a dev-dependency to cross-check steps; its
+//!   DOP853 interpolant is O(h⁵) (see docs/findings.md), ours is Hairer's CONTD8.
+
+mod dop853;
+mod dopri5;
+#[cfg(test)]
+mod tests;
+mod variational;
+
+use paritysim_error::{Error, Result, check_positive};
+
+/// Largest number of integrated coordinates.
+pub const MAX_DOF: usize = 6;
+
+/// Integrator state: integrated coordinates and their rates (entries past the system's
+/// [`OdeSystem::n_active`] stay zero) and the two work integrals.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct State {
+    /// Integrated coordinates (null-space coordinates `x`, drivetrain coordinates `q`, or `p`).
+    pub coords: [f64; MAX_DOF],
+    /// Their rates.
+    pub rates: [f64; MAX_DOF],
+    /// Actuator work `∫ F q̇1 dt` (µJ); integrated only when asked for.
+    pub work_actuator: f64,
+    /// Aerodynamic work `∫ τ_aero · ṗ dt` (µJ); integrated only when asked for.
+    pub work_aero: f64,
+}
+
+impl State {
+    /// The state as a flat list `[coords, rates, work_actuator, work_aero]` (error reports).
+    pub fn to_vec(&self) -> Vec<f64> {
+        let mut v = Vec::with_capacity(2 * MAX_DOF + 2);
+        v.extend_from_slice(&self.coords);
+        v.extend_from_slice(&self.rates);
+        v.push(self.work_actuator);
+        v.push(self.work_aero);
+        v
+    }
+
+    /// Whether every entry is finite.
+    pub fn is_finite(&self) -> bool {
+        self.coords.iter().chain(&self.rates).all(|v| v.is_finite())
+            && self.work_actuator.is_finite()
+            && self.work_aero.is_finite()
+    }
+
+    /// The state with both work integrals set to zero.
+    pub fn without_work(mut self) -> Self {
+        self.work_actuator = 0.0;
+        self.work_aero = 0.0;
+        self
+    }
+}
+
+/// A first-order system `ẏ = f(t, y)` whose evaluation can fail.
+pub trait OdeSystem {
+    /// Writes `f(t, y)` into `dydt` (coordinates' derivative in `coords`, rates' derivative
+    /// in `rates`, powers in the work fields).
+    ///
+    /// # Errors
+    /// Any model error; the integrator reports it with the time and state.
+    fn rhs(&self, t: f64, y: &State, dydt: &mut State) -> Result<()>;
+
+    /// Number of active coordinates `n` (the rest of `coords` and `rates` stays zero).
+    fn n_active(&self) -> usize {
+        MAX_DOF
+    }
+}
+
+impl OdeSystem for crate::device::Device {
+    fn rhs(&self, t: f64, y: &State, dydt: &mut State) -> Result<()> {
+        crate::device::Device::rhs(self, t, y, dydt)
+    }
+
+    fn n_active(&self) -> usize {
+        self.n_dof()
+    }
+}
+
+/// Explicit Runge-Kutta pair.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Method {
+    /// Dormand-Prince 8(5,3) (the default).
+    #[default]
+    Dop853,
+    /// Dormand-Prince 5(4).
+    Dopri5,
+}
+
+/// Counters of one integration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct IntegrationStats {
+    /// Right-hand side evaluations.
+    pub rhs_calls: usize,
+    /// Accepted steps.
+    pub accepted: usize,
+    /// Rejected steps.
+    pub rejected: usize,
+    /// Accepted steps on which the dense output was prepared (a sample fell inside).
+    pub dense_steps: usize,
+}
+
+/// Receives the samples of an integration: `(index in times, time, state)`.
+pub type Sink<'a> = dyn FnMut(usize, f64, &State) -> Result<()> + 'a;
+
+/// Integrates an [`OdeSystem`] and samples it at requested times.
+pub trait Integrator: Send + Sync {
+    /// Integrates from `(t0, y0)` to `t_end`, calls `sink` at each of `times` (sorted, within
+    /// `[t0, t_end]`) in order, and returns the state at `t_end`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for `t_end <= t0` or times out of order or range;
+    /// [`Error::Integration`] carrying the time and state of the failure (step-size underflow,
+    /// step limit, non-finite state, or a model error raised inside the right-hand side);
+    /// whatever `sink` returns.
+    fn integrate_with(
+        &self,
+        system: &dyn OdeSystem,
+        t0: f64,
+        y0: &State,
+        t_end: f64,
+        times: &[f64],
+        sink: &mut Sink<'_>,
+    ) -> Result<State>;
+
+    /// [`Self::integrate_with`] collecting the samples.
+    ///
+    /// # Errors
+    /// As [`Self::integrate_with`].
+    fn integrate(
+        &self,
+        system: &dyn OdeSystem,
+        t0: f64,
+        y0: &State,
+        t_end: f64,
+        times: &[f64],
+    ) -> Result<Vec<State>> {
+        let mut out = Vec::with_capacity(times.len());
+        self.integrate_with(system, t0, y0, t_end, times, &mut |_, _, y| {
+            out.push(*y);
+            Ok(())
+        })?;
+        Ok(out)
+    }
+
+    /// The state at `t_end` (no samples).
+    ///
+    /// # Errors
+    /// As [`Self::integrate_with`].
+    fn advance(&self, system: &dyn OdeSystem, t0: f64, y0: &State, t_end: f64) -> Result<State> {
+        self.integrate_with(system, t0, y0, t_end, &[], &mut |_, _, _| Ok(()))
+    }
+}
+
+/// Adaptive Dormand–Prince integrator with relative and absolute tolerances.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RungeKutta {
+    method: Method,
+    rtol: f64,
+    atol: f64,
+    max_steps: usize,
+    work: bool,
+}
+
+impl RungeKutta {
+    /// `rtol`, `atol` in (0, 1); `max_steps` > 0 per call. Work integrals are integrated
+    /// (see [`Self::with_work`]).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the bad field.
+    pub fn new(method: Method, rtol: f64, atol: f64, max_steps: usize) -> Result<Self> {
+        for (name, v) in [("rtol", rtol), ("atol", atol)] {
+            check_positive(name, v)?;
+            if v >= 1.0 {
+                return Err(Error::invalid(name, v, "in (0, 1)"));
+            }
+        }
+        if max_steps == 0 {
+            return Err(Error::invalid("max_steps", 0, "> 0"));
+        }
+        Ok(Self {
+            method,
+            rtol,
+            atol,
+            max_steps,
+            work: true,
+        })
+    }
+
+    /// Whether the work integrals are integrated (otherwise they stay at their initial values;
+    /// they never take part in the error control).
+    pub fn with_work(mut self, work: bool) -> Self {
+        self.work = work;
+        self
+    }
+
+    /// The method.
+    pub fn method(&self) -> Method {
+        self.method
+    }
+
+    /// [`Integrator::integrate_with`] that also returns the step counters.
+    ///
+    /// # Errors
+    /// As [`Integrator::integrate_with`].
+    pub fn integrate_counted(
+        &self,
+        system: &dyn OdeSystem,
+        t0: f64,
+        y0: &State,
+        t_end: f64,
+        times: &[f64],
+        sink: &mut Sink<'_>,
+    ) -> Result<(State, IntegrationStats)> {
+        if t_end.is_nan() || t_end <= t0 || !t0.is_finite() || !t_end.is_finite() {
+            return Err(Error::invalid("t_end", t_end, format!("> t0 = {t0}")));
+        }
+        if let Some(i) = (0..times.len())
+            .find(|&i| !(times[i] >= t0 && times[i] <= t_end) || (i > 0 && times[i] < times[i - 1]))
+        {
+            return Err(Error::invalid(
+                format!("times[{i}]"),
+                times[i],
+                format!("sorted and within [{t0}, {t_end}]"),
+            ));
+        }
+        // Smaller arrays make every stage cheaper; unused slots would only be zeros.
+        let n = match system.n_active() {
+            0..=2 => 2,
+            3..=4 => 4,
+            _ => 6,
+        };
+        macro_rules! go {
+            ($m:literal) => {
+                self.solve::<$m>(system, n, t0, y0, t_end, times, sink, &mut |_, _| {})
+            };
+        }
+        match (n, self.work) {
+            (2, false) => go!(4),
+            (2, true) => go!(6),
+            (4, false) => go!(8),
+            (4, true) => go!(10),
+            (_, false) => go!(12),
+            (_, true) => go!(14),
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn solve<const M: usize>(
+        &self,
+        system: &dyn OdeSystem,
+        n: usize,
+        t0: f64,
+        y0: &State,
+        t_end: f64,
+        times: &[f64],
+        sink: &mut Sink<'_>,
+        on_step: &mut dyn FnMut(f64, &State),
+    ) -> Result<(State, IntegrationStats)> {
+        let mut rhs = Adapter {
+            system,
+            n,
+            template: *y0,
+            calls: 0,
+        };
+        let tol = Tolerances {
+            rtol: self.rtol,
+            atol: self.atol,
+            controlled: 2 * n,
+        };
+        let c0 = compress::<M>(n, y0);
+        let (y, mut stats) = match self.method {
+            Method::Dop853 => drive(
+                &mut dop853::Dop853::<M>::new(),
+                &mut rhs,
+                &tol,
+                self.max_steps,
+                t0,
+                c0,
+                t_end,
+                times,
+                sink,
+                on_step,
+            )?,
+            Method::Dopri5 => drive(
+                &mut dopri5::Dopri5::<M>::new(),
+                &mut rhs,
+                &tol,
+                self.max_steps,
+                t0,
+                c0,
+                t_end,
+                times,
+                sink,
+                on_step,
+            )?,
+        };
+        stats.rhs_calls = rhs.calls;
+        Ok((Rhs::<M>::expand(&rhs, &y), stats))
+    }
+}
+
+impl Integrator for RungeKutta {
+    fn integrate_with(
+        &self,
+        system: &dyn OdeSystem,
+        t0: f64,
+        y0: &State,
+        t_end: f64,
+        times: &[f64],
+        sink: &mut Sink<'_>,
+    ) -> Result<State> {
+        self.integrate_counted(system, t0, y0, t_end, times, sink)
+            .map(|(y, _)| y)
+    }
+}
+
+/// Tolerances of the error norm; entries `controlled..` (the work integrals) are not measured.
+pub(crate) struct Tolerances {
+    pub(crate) rtol: f64,
+    pub(crate) atol: f64,
+    pub(crate) controlled: usize,
+}
+
+/// A compact right-hand side `ẏ = f(t, y)` on `M` entries.
+pub(crate) trait Rhs<const M: usize> {
+    fn eval(&mut self, t: f64, y: &[f64; M], dydt: &mut [f64; M]) -> Result<()>;
+    /// The full state of a compact one.
+    fn expand(&self, c: &[f64; M]) -> State;
+}
+
+/// An explicit embedded pair with dense output.
+pub(crate) trait Stepper<const M: usize> {
+    /// Order used by the initial step-size guess.
+    const ORDER: i32;
+    /// Exponent of the error in the step-size factor (Hairer's `EXPO1`).
+    const EXPONENT: f64;
+    /// Lund stabilisation (PI control) exponent on the previous error.
+    const BETA: f64;
+    /// Smallest and largest step-size ratio `h_new / h`.
+    const FAC_MIN: f64;
+    /// See [`Self::FAC_MIN`].
+    const FAC_MAX: f64;
+    /// Evaluations per trial step (after the first stage).
+    #[allow(dead_code)]
+    const EVALS_PER_ATTEMPT: usize;
+    /// Extra evaluations of the dense output.
+    #[allow(dead_code)]
+    const DENSE_EVALS: usize;
+
+    /// One trial step of size `h` from `(t, y)` with `f0 = f(t, y)`; returns the scaled error
+    /// (accept when ≤ 1) and keeps the stages.
+    fn attempt(
+        &mut self,
+        rhs: &mut dyn Rhs<M>,
+        t: f64,
+        y: &[f64; M],
+        f0: &[f64; M],
+        h: f64,
+        tol: &Tolerances,
+    ) -> Result<f64>;
+    /// The new state of the last trial step.
+    fn y1(&self) -> &[f64; M];
+    /// `f(t_new, y1)` after an accepted step.
+    fn new_derivative(&mut self, rhs: &mut dyn Rhs<M>, t_new: f64, f1: &mut [f64; M])
+    -> Result<()>;
+    /// Prepares the interpolant of the accepted step `[t, t + h]`.
+    fn prepare_dense(
+        &mut self,
+        rhs: &mut dyn Rhs<M>,
+        t: f64,
+        y: &[f64; M],
+        f0: &[f64; M],
+        f1: &[f64; M],
+        h: f64,
+    ) -> Result<()>;
+    /// The interpolant at `t + s h`.
+    fn dense(&self, s: f64, out: &mut [f64; M]);
+}
+
+/// [`OdeSystem`] on the compact layout `[coords (n), rates (n), work (0 or 2)]`.
+struct Adapter<'a> {
+    system: &'a dyn OdeSystem,
+    n: usize,
+    /// Supplies the entries the compact state does not carry (work integrals when not
+    /// integrated).
+    template: State,
+    calls: usize,
+}
+
+impl<const M: usize> Rhs<M> for Adapter<'_> {
+    #[inline]
+    fn eval(&mut self, t: f64, c: &[f64; M], dcdt: &mut [f64; M]) -> Result<()> {
+        self.calls += 1;
+        let y = Rhs::<M>::expand(self, c);
+        let mut dydt = State::default();
+        if let Err(e) = self.system.rhs(t, &y, &mut dydt) {
+            return Err(integration_error(t, &y, format!("the model failed: {e}")));
+        }
+        let n = self.n;
+        dcdt[..n].copy_from_slice(&dydt.coords[..n]);
+        dcdt[n..2 * n].copy_from_slice(&dydt.rates[..n]);
+        if M > 2 * n {
+            dcdt[2 * n] = dydt.work_actuator;
+            dcdt[2 * n + 1] = dydt.work_aero;
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn expand(&self, c: &[f64; M]) -> State {
+        let n = self.n;
+        let mut y = State::default();
+        y.coords[..n].copy_from_slice(&c[..n]);
+        y.rates[..n].copy_from_slice(&c[n..2 * n]);
+        if M > 2 * n {
+            y.work_actuator = c[2 * n];
+            y.work_aero = c[2 * n + 1];
+        } else {
+            y.work_actuator = self.template.work_actuator;
+            y.work_aero = self.template.work_aero;
+        }
+        y
+    }
+}
+
+fn compress<const M: usize>(n: usize, y: &State) -> [f64; M] {
+    let mut c = [0.0; M];
+    c[..n].copy_from_slice(&y.coords[..n]);
+    c[n..2 * n].copy_from_slice(&y.rates[..n]);
+    if M > 2 * n {
+        c[2 * n] = y.work_actuator;
+        c[2 * n + 1] = y.work_aero;
+    }
+    c
+}
+
+fn integration_error(time: f64, state: &State, reason: impl Into<String>) -> Error {
+    Error::Integration {
+        time,
+        state: state.to_vec(),
+        reason: reason.into(),
+    }
+}
+
+/// Safety factor of the step-size controller.
+const SAFE: f64 = 0.9;
+
+/// Hairer's initial step size (`HINIT`): one extra evaluation.
+fn initial_step<const M: usize>(
+    rhs: &mut dyn Rhs<M>,
+    order: i32,
+    tol: &Tolerances,
+    t0: f64,
+    y0: &[f64; M],
+    f0: &[f64; M],
+    h_max: f64,
+) -> Result<f64> {
+    let (mut dnf, mut dny) = (0.0, 0.0);
+    for i in 0..tol.controlled {
+        let sk = tol.atol + tol.rtol * y0[i].abs();
+        dnf += (f0[i] / sk).powi(2);
+        dny += (y0[i] / sk).powi(2);
+    }
+    let mut h = if dnf <= 1e-10 || dny <= 1e-10 {
+        1e-6
+    } else {
+        (dny / dnf).sqrt() * 0.01
+    };
+    h = h.min(h_max);
+    let mut y1 = [0.0; M];
+    for i in 0..M {
+        y1[i] = y0[i] + h * f0[i];
+    }
+    let mut f1 = [0.0; M];
+    rhs.eval(t0 + h, &y1, &mut f1)?;
+    let mut der2: f64 = 0.0;
+    for i in 0..tol.controlled {
+        let sk = tol.atol + tol.rtol * y0[i].abs();
+        der2 += ((f1[i] - f0[i]) / sk).powi(2);
+    }
+    let der2 = der2.sqrt() / h;
+    let der12 = der2.abs().max(dnf.sqrt());
+    let h1 = if der12 <= 1e-15 {
+        (h * 1e-3).max(1e-6)
+    } else {
+        (0.01 / der12).powf(1.0 / order as f64)
+    };
+    Ok((100.0 * h).min(h1).min(h_max))
+}
+
+/// The integration loop shared by both pairs (Hairer's `DP86CO` / `DOPCOR`).
+#[allow(clippy::too_many_arguments)]
+fn drive<const M: usize, S: Stepper<M>>(
+    stepper: &mut S,
+    rhs: &mut dyn Rhs<M>,
+    tol: &Tolerances,
+    max_steps: usize,
+    t0: f64,
+    y0: [f64; M],
+    t_end: f64,
+    times: &[f64],
+    sink: &mut Sink<'_>,
+    on_step: &mut dyn FnMut(f64, &State),
+) -> Result<([f64; M], IntegrationStats)> {
+    let mut stats = IntegrationStats::default();
+    let mut y = y0;
+    let mut t = t0;
+    let mut next = 0;
+    if next < times.len() && times[next] <= t0 {
+        let state = rhs.expand(&y);
+        while next < times.len() && times[next] <= t0 {
+            sink(next, times[next], &state)?;
+            next += 1;
+        }
+    }
+    let mut f0 = [0.0; M];
+    rhs.eval(t, &y, &mut f0)?;
+    let h_max = t_end - t0;
+    let mut h = initial_step(rhs, S::ORDER, tol, t0, &y, &f0, h_max)?;
+    let fac_lo = 1.0 / S::FAC_MAX;
+    let fac_hi = 1.0 / S::FAC_MIN;
+    let mut fac_old: f64 = 1e-4;
+    let mut rejected_last = false;
+    let mut f1 = [0.0; M];
+    let mut sample = [0.0; M];
+    loop {
+        if stats.accepted + stats.rejected >= max_steps {
+            return Err(integration_error(
+                t,
+                &rhs.expand(&y),
+                format!("more than {max_steps} steps"),
+            ));
+        }
+        if 0.1 * h.abs() <= t.abs() * f64::EPSILON || !h.is_finite() {
+            return Err(integration_error(t, &rhs.expand(&y), "step size underflow"));
+        }
+        let last = t + 1.01 * h >= t_end;
+        if last {
+            h = t_end - t;
+        }
+        let err = stepper.attempt(rhs, t, &y, &f0, h, tol)?;
+        if !err.is_finite() {
+            // A non-finite trial (e.g. a state thrown out of range): shrink hard and retry.
+            stats.rejected += 1;
+            rejected_last = true;
+            h *= S::FAC_MIN;
+            continue;
+        }
+        let fac11 = err.powf(S::EXPONENT);
+        if err <= 1.0 {
+            // Lund stabilisation (PI control): divide by the previous error's factor.
+            let fac = (fac11 / fac_old.powf(S::BETA) / SAFE).clamp(fac_lo, fac_hi);
+            let mut h_new = h / fac;
+            fac_old = err.max(1e-4);
+            stats.accepted += 1;
+            let t_new = if last { t_end } else { t + h };
+            stepper.new_derivative(rhs, t_new, &mut f1)?;
+            if next < times.len() && times[next] < t_new {
+                stepper.prepare_dense(rhs, t, &y, &f0, &f1, h)?;
+                stats.dense_steps += 1;
+                while next < times.len() && times[next] < t_new {
+                    stepper.dense((times[next] - t) / h, &mut sample);
+                    let state = rhs.expand(&sample);
+                    if !state.is_finite() {
+                        return Err(integration_error(times[next], &state, "non-finite state"));
+                    }
+                    sink(next, times[next], &state)?;
+                    next += 1;
+                }
+            }
+            y = *stepper.y1();
+            f0 = f1;
+            t = t_new;
+            let state = rhs.expand(&y);
+            if !state.is_finite() {
+                return Err(integration_error(t, &state, "non-finite state"));
+            }
+            on_step(t, &state);
+            while next < times.len() && times[next] <= t {
+                sink(next, times[next], &state)?;
+                next += 1;
+            }
+            if last {
+                return Ok((y, stats));
+            }
+            h_new = h_new.min(h_max);
+            if rejected_last {
+                h_new = h_new.min(h);
+            }
+            rejected_last = false;
+            h = h_new;
+        } else {
+            stats.rejected += 1;
+            rejected_last = true;
+            h /= fac_hi.min(fac11 / SAFE);
+        }
+    }
+}

@@ -1,0 +1,297 @@
+//! Closed-form checks of the Dormand–Prince core and a cross-check against
+//! `differential-equations` 0.7.0.
+
+use super::*;
+
+/// `ẍ = −ω² x` in slot 0; the actuator-work slot integrates `ẋ²` (so its value is known too).
+struct Oscillator(f64);
+
+impl OdeSystem for Oscillator {
+    fn rhs(&self, _t: f64, y: &State, dydt: &mut State) -> Result<()> {
+        dydt.coords[0] = y.rates[0];
+        dydt.rates[0] = -self.0 * self.0 * y.coords[0];
+        dydt.work_actuator = y.rates[0] * y.rates[0];
+        Ok(())
+    }
+    fn n_active(&self) -> usize {
+        1
+    }
+}
+
+/// `ẋ = λ x`, `v̇ = μ v` (two decoupled exponentials).
+struct Exponential(f64, f64);
+
+impl OdeSystem for Exponential {
+    fn rhs(&self, _t: f64, y: &State, dydt: &mut State) -> Result<()> {
+        dydt.coords[0] = self.0 * y.coords[0];
+        dydt.rates[0] = self.1 * y.rates[0];
+        Ok(())
+    }
+    fn n_active(&self) -> usize {
+        1
+    }
+}
+
+fn start(x: f64, v: f64) -> State {
+    let mut y = State::default();
+    y.coords[0] = x;
+    y.rates[0] = v;
+    y
+}
+
+/// Largest error at the step ends and at `samples` uniform dense-output times.
+fn step_and_dense_errors(
+    rk: &RungeKutta,
+    system: &dyn OdeSystem,
+    y0: &State,
+    t_end: f64,
+    exact: &dyn Fn(f64) -> [f64; 2],
+    samples: usize,
+) -> (f64, f64, IntegrationStats) {
+    let times: Vec<f64> = (0..samples)
+        .map(|k| t_end * (k as f64 + 0.37) / samples as f64)
+        .collect();
+    let err = |t: f64, y: &State| {
+        let e = exact(t);
+        (y.coords[0] - e[0]).abs().max((y.rates[0] - e[1]).abs())
+    };
+    let mut dense: f64 = 0.0;
+    let mut step: f64 = 0.0;
+    let (_, stats) = rk
+        .solve::<4>(
+            system,
+            2,
+            0.0,
+            y0,
+            t_end,
+            &times,
+            &mut |_, t, y| {
+                dense = dense.max(err(t, y));
+                Ok(())
+            },
+            &mut |t, y| step = step.max(err(t, y)),
+        )
+        .unwrap();
+    (step, dense, stats)
+}
+
+#[test]
+fn dense_error_is_the_step_error_on_a_harmonic_oscillator() {
+    let w = 2.0;
+    let exact = |t: f64| [(w * t).cos(), -w * (w * t).sin()];
+    for method in [Method::Dop853, Method::Dopri5] {
+        for rtol in [1e-6, 1e-8, 1e-10, 1e-12] {
+            let rk = RungeKutta::new(method, rtol, rtol * 1e-2, 100_000).unwrap();
+            let (step, dense, _) =
+                step_and_dense_errors(&rk, &Oscillator(w), &start(1.0, 0.0), 20.0, &exact, 997);
+            assert!(
+                step < 1e3 * rtol,
+                "{method:?} rtol {rtol}: step error {step:e}"
+            );
+            // The global error grows along the run; the interpolant adds no error of its own.
+            assert!(
+                dense <= 3.0 * step + 1e-15,
+                "{method:?} rtol {rtol}: dense {dense:e} vs step {step:e}"
+            );
+        }
+    }
+}
+
+#[test]
+fn dense_error_is_the_step_error_on_exponentials() {
+    let (lam, mu) = (-1.3, 0.7);
+    let exact = |t: f64| [(lam * t).exp(), 2.0 * (mu * t).exp()];
+    for method in [Method::Dop853, Method::Dopri5] {
+        for rtol in [1e-6, 1e-7, 1e-8, 1e-9, 1e-12] {
+            let rk = RungeKutta::new(method, rtol, 1e-14, 100_000).unwrap();
+            let (step, dense, _) = step_and_dense_errors(
+                &rk,
+                &Exponential(lam, mu),
+                &start(1.0, 2.0),
+                5.0,
+                &exact,
+                501,
+            );
+            assert!(step < 1e3 * rtol * 2.0 * (mu * 5.0f64).exp());
+            // Few, long steps: the 8th-order steps are far inside the tolerance, the 7th-order
+            // interpolant (CONTD8) a little less so, but both scale alike with rtol.
+            assert!(dense <= rtol * 2.0 * (mu * 5.0f64).exp());
+            assert!(
+                dense <= 30.0 * step + 1e-15,
+                "{method:?} rtol {rtol}: dense {dense:e} vs step {step:e}"
+            );
+        }
+    }
+}
+
+#[test]
+fn dense_stages_only_on_steps_with_samples_and_counts_match_the_scheme() {
+    let rk = RungeKutta::new(Method::Dop853, 1e-9, 1e-12, 100_000).unwrap();
+    let system = Oscillator(3.0);
+    let y0 = start(1.0, 0.0);
+    let (_, none) = rk
+        .integrate_counted(&system, 0.0, &y0, 10.0, &[], &mut |_, _, _| Ok(()))
+        .unwrap();
+    assert_eq!(none.dense_steps, 0);
+    // f(t0), HINIT, 11 per trial, 1 (FSAL) per accepted step.
+    assert_eq!(
+        none.rhs_calls,
+        2 + 11 * (none.accepted + none.rejected) + none.accepted
+    );
+    // Samples in the second half only: dense output there only, 3 extra calls each.
+    let times: Vec<f64> = (0..50).map(|k| 9.0 + k as f64 * 0.02).collect();
+    let (_, some) = rk
+        .integrate_counted(&system, 0.0, &y0, 10.0, &times, &mut |_, _, _| Ok(()))
+        .unwrap();
+    assert_eq!(some.accepted, none.accepted);
+    assert!(some.dense_steps > 0 && some.dense_steps < some.accepted / 5);
+    assert_eq!(some.rhs_calls, none.rhs_calls + 3 * some.dense_steps);
+    // DOPRI5's interpolant costs nothing.
+    let rk5 = RungeKutta::new(Method::Dopri5, 1e-9, 1e-12, 100_000).unwrap();
+    let (_, five) = rk5
+        .integrate_counted(&system, 0.0, &y0, 10.0, &times, &mut |_, _, _| Ok(()))
+        .unwrap();
+    assert_eq!(five.rhs_calls, 2 + 6 * (five.accepted + five.rejected));
+}
+
+#[test]
+fn work_integrals_do_not_change_the_steps_and_are_exact() {
+    let w = 2.0;
+    let system = Oscillator(w);
+    let y0 = start(1.0, 0.0);
+    let t_end = 7.3;
+    let with = RungeKutta::new(Method::Dop853, 1e-10, 1e-12, 100_000).unwrap();
+    let without = with.with_work(false);
+    let run = |rk: &RungeKutta| {
+        rk.integrate_counted(&system, 0.0, &y0, t_end, &[], &mut |_, _, _| Ok(()))
+            .unwrap()
+    };
+    let ((a, sa), (b, sb)) = (run(&with), run(&without));
+    assert_eq!(sa.accepted, sb.accepted);
+    assert_eq!(sa.rejected, sb.rejected);
+    assert_eq!(a.coords, b.coords);
+    assert_eq!(a.rates, b.rates);
+    assert_eq!(b.work_actuator, 0.0);
+    // ∫ ẋ² dt = w²(t/2 − sin(2wt)/(4w)).
+    let exact = w * w * (t_end / 2.0 - (2.0 * w * t_end).sin() / (4.0 * w));
+    assert!((a.work_actuator - exact).abs() < 1e-8 * exact);
+}
+
+#[test]
+fn agrees_with_differential_equations_steps_and_values() {
+    use differential_equations::prelude::{ExplicitRungeKutta, IVP, ODE};
+    struct Plain(f64);
+    impl ODE<f64, [f64; 2]> for Plain {
+        fn diff(&self, _t: f64, y: &[f64; 2], d: &mut [f64; 2]) {
+            d[0] = y[1];
+            d[1] = -self.0 * self.0 * y[0];
+        }
+    }
+    let w = 2.0;
+    for rtol in [1e-7, 1e-10] {
+        let atol = rtol * 1e-2;
+        let t_end = 30.0;
+        let theirs = IVP::ode(&Plain(w), 0.0, t_end, [1.0, 0.0])
+            .method(ExplicitRungeKutta::dop853().rtol(rtol).atol(atol))
+            .solve()
+            .unwrap();
+        let ours_rk = RungeKutta::new(Method::Dop853, rtol, atol, 100_000)
+            .unwrap()
+            .with_work(false);
+        let (ours, stats) = ours_rk
+            .integrate_counted(
+                &Oscillator(w),
+                0.0,
+                &start(1.0, 0.0),
+                t_end,
+                &[],
+                &mut |_, _, _| Ok(()),
+            )
+            .unwrap();
+        let (_, y) = theirs.last().unwrap();
+        // Same pair, same error norm and tolerances: same accuracy and (up to the
+        // controller's clamps, Hairer's 1/3..6 against the crate's 0.2..10) the same steps.
+        let exact = [(w * t_end).cos(), -w * (w * t_end).sin()];
+        let e_ours = (ours.coords[0] - exact[0]).abs();
+        let e_theirs = (y[0] - exact[0]).abs();
+        assert!(
+            e_ours < 5.0 * e_theirs.max(rtol * 1e-2),
+            "{e_ours:e} vs {e_theirs:e}"
+        );
+        assert!((ours.coords[0] - y[0]).abs() < 100.0 * rtol);
+        let (a, b) = (stats.accepted as f64, theirs.steps.accepted as f64);
+        assert!((a - b).abs() <= 0.1 * b + 2.0, "accepted {a} vs {b}");
+    }
+}
+
+#[test]
+fn differential_equations_dense_output_is_worse_than_ours() {
+    // The finding behind owning the core (docs/findings.md): its DOP853 interpolant is O(h⁵).
+    use differential_equations::prelude::{ExplicitRungeKutta, IVP, ODE};
+    struct Plain(f64);
+    impl ODE<f64, [f64; 2]> for Plain {
+        fn diff(&self, _t: f64, y: &[f64; 2], d: &mut [f64; 2]) {
+            d[0] = y[1];
+            d[1] = -self.0 * self.0 * y[0];
+        }
+    }
+    let w = 2.0;
+    let rtol = 1e-8;
+    let times: Vec<f64> = (0..997).map(|k| 20.0 * (k as f64 + 0.37) / 997.0).collect();
+    let theirs = IVP::ode(&Plain(w), 0.0, 20.0, [1.0, 0.0])
+        .t_eval(times.clone())
+        .method(ExplicitRungeKutta::dop853().rtol(rtol).atol(rtol * 1e-2))
+        .solve()
+        .unwrap();
+    let their_err = theirs
+        .t
+        .iter()
+        .zip(&theirs.y)
+        .map(|(t, y)| (y[0] - (w * t).cos()).abs())
+        .fold(0.0, f64::max);
+    let rk = RungeKutta::new(Method::Dop853, rtol, rtol * 1e-2, 100_000).unwrap();
+    let exact = |t: f64| [(w * t).cos(), -w * (w * t).sin()];
+    let (_, ours, _) =
+        step_and_dense_errors(&rk, &Oscillator(w), &start(1.0, 0.0), 20.0, &exact, 997);
+    assert!(
+        their_err > 10.0 * ours,
+        "theirs {their_err:e}, ours {ours:e}"
+    );
+}
+
+#[test]
+fn bad_times_and_failures_are_typed_errors() {
+    let rk = RungeKutta::new(Method::Dop853, 1e-8, 1e-10, 100).unwrap();
+    let y0 = start(1.0, 0.0);
+    let none = &mut |_: usize, _: f64, _: &State| Ok(());
+    assert!(matches!(
+        rk.integrate_with(&Oscillator(1.0), 0.0, &y0, 1.0, &[0.5, 0.2], none),
+        Err(Error::InvalidParameter { .. })
+    ));
+    assert!(matches!(
+        rk.integrate_with(&Oscillator(1.0), 0.0, &y0, 1.0, &[1.5], none),
+        Err(Error::InvalidParameter { .. })
+    ));
+    // The step limit.
+    assert!(matches!(
+        rk.integrate_with(&Oscillator(1.0), 0.0, &y0, 1e4, &[], none),
+        Err(Error::Integration { .. })
+    ));
+    // A model error carries its time.
+    struct Fails;
+    impl OdeSystem for Fails {
+        fn rhs(&self, t: f64, y: &State, d: &mut State) -> Result<()> {
+            if t > 0.5 {
+                return Err(Error::Singular("boom".into()));
+            }
+            d.coords[0] = y.rates[0];
+            Ok(())
+        }
+    }
+    match rk.integrate_with(&Fails, 0.0, &y0, 1.0, &[], none) {
+        Err(Error::Integration { time, reason, .. }) => {
+            assert!(time > 0.5 && reason.contains("boom"), "{time} {reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+}

@@ -1,0 +1,212 @@
+//! Forward sensitivities: the flow map and its Jacobian `Φ = ∂y(t1)/∂y(t0)` (over one drive
+//! period: the monodromy matrix) by integrating the variational equations `Φ̇ = J(t, y) Φ`
+//! alongside the state, on the same steps.
+//!
+//! `J Φ` is formed column by column by central differences of the right-hand side along each
+//! column (`J v ≈ (f(y + δv) − f(y − δv)) / 2δ`, `δ` scaled to `y` and `v`), so no analytic
+//! Jacobian is needed; the step size is chosen by the state alone (the sensitivities do not
+//! take part in the error control).
+
+use nalgebra::DMatrix;
+use paritysim_error::Result;
+
+use super::{
+    Method, OdeSystem, Rhs, RungeKutta, State, Tolerances, dop853::Dop853, dopri5::Dopri5, drive,
+    integration_error,
+};
+
+/// Relative size of the directional difference step.
+const DIRECTIONAL_STEP: f64 = 1e-6;
+
+struct Variational<'a> {
+    system: &'a dyn OdeSystem,
+    n: usize,
+    calls: usize,
+}
+
+fn to_state(n: usize, c: &[f64]) -> State {
+    let mut y = State::default();
+    y.coords[..n].copy_from_slice(&c[..n]);
+    y.rates[..n].copy_from_slice(&c[n..2 * n]);
+    y
+}
+
+impl Variational<'_> {
+    fn f(&mut self, t: f64, y: &State, out: &mut [f64]) -> Result<()> {
+        self.calls += 1;
+        let mut d = State::default();
+        if let Err(e) = self.system.rhs(t, y, &mut d) {
+            return Err(integration_error(t, y, format!("the model failed: {e}")));
+        }
+        let n = self.n;
+        out[..n].copy_from_slice(&d.coords[..n]);
+        out[n..2 * n].copy_from_slice(&d.rates[..n]);
+        Ok(())
+    }
+}
+
+impl<const M: usize> Rhs<M> for Variational<'_> {
+    fn eval(&mut self, t: f64, c: &[f64; M], dc: &mut [f64; M]) -> Result<()> {
+        let m = 2 * self.n;
+        let y = to_state(self.n, &c[..m]);
+        self.f(t, &y, &mut dc[..m])?;
+        let scale = 1.0 + c[..m].iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let (mut fp, mut fm) = ([0.0; 12], [0.0; 12]);
+        for j in 0..m {
+            let col = m + j * m;
+            let v = &c[col..col + m];
+            let size = v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            if size == 0.0 {
+                dc[col..col + m].fill(0.0);
+                continue;
+            }
+            let delta = DIRECTIONAL_STEP * scale / size;
+            let (mut yp, mut ym) = ([0.0; 12], [0.0; 12]);
+            for i in 0..m {
+                yp[i] = c[i] + delta * v[i];
+                ym[i] = c[i] - delta * v[i];
+            }
+            self.f(t, &to_state(self.n, &yp[..m]), &mut fp[..m])?;
+            self.f(t, &to_state(self.n, &ym[..m]), &mut fm[..m])?;
+            for i in 0..m {
+                dc[col + i] = (fp[i] - fm[i]) / (2.0 * delta);
+            }
+        }
+        Ok(())
+    }
+
+    fn expand(&self, c: &[f64; M]) -> State {
+        to_state(self.n, &c[..2 * self.n])
+    }
+}
+
+impl RungeKutta {
+    /// The state at `t1` from `(t0, y0)` (work integrals left at zero) and the sensitivity
+    /// matrix `∂y(t1)/∂y(t0)` over the `2n` integrated entries `[coords (n), rates (n)]`,
+    /// `n = system.n_active()`.
+    ///
+    /// # Errors
+    /// As [`super::Integrator::integrate_with`].
+    pub fn flow_with_sensitivity(
+        &self,
+        system: &dyn OdeSystem,
+        t0: f64,
+        y0: &State,
+        t1: f64,
+    ) -> Result<(State, DMatrix<f64>)> {
+        if t1.is_nan() || t1 <= t0 {
+            return Err(paritysim_error::Error::invalid(
+                "t_end",
+                t1,
+                format!("> t0 = {t0}"),
+            ));
+        }
+        let n_real = system.n_active().clamp(1, 6);
+        match n_real {
+            1..=2 => self.sensitivity::<20>(system, 2, n_real, t0, y0, t1),
+            3..=4 => self.sensitivity::<72>(system, 4, n_real, t0, y0, t1),
+            _ => self.sensitivity::<156>(system, 6, n_real, t0, y0, t1),
+        }
+    }
+
+    fn sensitivity<const M: usize>(
+        &self,
+        system: &dyn OdeSystem,
+        n: usize,
+        n_real: usize,
+        t0: f64,
+        y0: &State,
+        t1: f64,
+    ) -> Result<(State, DMatrix<f64>)> {
+        let m = 2 * n;
+        debug_assert_eq!(M, m + m * m);
+        let mut c0 = [0.0; M];
+        c0[..n].copy_from_slice(&y0.coords[..n]);
+        c0[n..m].copy_from_slice(&y0.rates[..n]);
+        for j in 0..m {
+            c0[m + j * m + j] = 1.0;
+        }
+        let mut rhs = Variational {
+            system,
+            n,
+            calls: 0,
+        };
+        let tol = Tolerances {
+            rtol: self.rtol,
+            atol: self.atol,
+            controlled: m,
+        };
+        let none = &mut |_: usize, _: f64, _: &State| Ok(());
+        let (c, _) = match self.method {
+            Method::Dop853 => drive(
+                &mut Dop853::<M>::new(),
+                &mut rhs,
+                &tol,
+                self.max_steps,
+                t0,
+                c0,
+                t1,
+                &[],
+                none,
+                &mut |_, _| {},
+            )?,
+            Method::Dopri5 => drive(
+                &mut Dopri5::<M>::new(),
+                &mut rhs,
+                &tol,
+                self.max_steps,
+                t0,
+                c0,
+                t1,
+                &[],
+                none,
+                &mut |_, _| {},
+            )?,
+        };
+        // Rows/columns of the active entries: coords 0..n_real, rates n..n + n_real.
+        let index = |k: usize| if k < n_real { k } else { n + k - n_real };
+        let phi = DMatrix::from_fn(2 * n_real, 2 * n_real, |i, j| {
+            c[m + index(j) * m + index(i)]
+        });
+        Ok((to_state(n, &c[..m]), phi))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Damped Mathieu-like oscillator `ẍ + c ẋ + (a + b cos t) x = 0` (linear: the flow *is*
+    /// the sensitivity applied to y0).
+    struct Mathieu(f64, f64, f64);
+
+    impl OdeSystem for Mathieu {
+        fn rhs(&self, t: f64, y: &State, d: &mut State) -> Result<()> {
+            d.coords[0] = y.rates[0];
+            d.rates[0] = -self.0 * y.rates[0] - (self.1 + self.2 * t.cos()) * y.coords[0];
+            Ok(())
+        }
+        fn n_active(&self) -> usize {
+            1
+        }
+    }
+
+    #[test]
+    fn linear_flow_equals_its_sensitivity_and_liouville_holds() {
+        let (c, a, b) = (0.3, 1.7, 0.8);
+        let rk = RungeKutta::new(Method::Dop853, 1e-11, 1e-13, 100_000).unwrap();
+        let mut y0 = State::default();
+        y0.coords[0] = 0.4;
+        y0.rates[0] = -1.1;
+        let period = std::f64::consts::TAU;
+        let (y1, phi) = rk
+            .flow_with_sensitivity(&Mathieu(c, a, b), 0.0, &y0, period)
+            .unwrap();
+        assert_eq!(phi.shape(), (2, 2));
+        let lin = &phi * nalgebra::DVector::from_vec(vec![0.4, -1.1]);
+        assert!((lin[0] - y1.coords[0]).abs() < 1e-9);
+        assert!((lin[1] - y1.rates[0]).abs() < 1e-9);
+        // Liouville: det Φ(T) = exp(−c T).
+        assert!((phi.determinant() - (-c * period).exp()).abs() < 1e-9);
+    }
+}

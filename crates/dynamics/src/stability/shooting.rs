@@ -1,0 +1,574 @@
+//! The full nonlinear model: stroboscopic map, Newton shooting with forward sensitivities,
+//! Floquet multipliers from the monodromy.
+
+use nalgebra::{Complex, DMatrix, DVector, Matrix2};
+use paritysim_constraints::Vec6;
+use paritysim_error::{Error, Result, bail, check_positive};
+use rayon::prelude::*;
+
+use crate::device::{Device, Formulation};
+use crate::integrate::{Integrator, Method, OdeSystem, RungeKutta, State};
+
+use super::*;
+
+/// Options of [`periodic_orbit`] and [`floquet`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShootingOptions {
+    /// Runge-Kutta pair.
+    pub method: Method,
+    /// Relative tolerance of every period integration.
+    pub rtol: f64,
+    /// Absolute tolerance.
+    pub atol: f64,
+    /// Step limit per period.
+    pub max_steps: usize,
+    /// Start of the stroboscopic section within the drive period (ms, in `[0, T)`).
+    pub t0: f64,
+    /// Cycle-to-cycle simulation from the initial state before Newton (stops early once the
+    /// change per cycle is below `warmup_tol`).
+    pub warmup_cycles: usize,
+    /// Relative change per cycle that ends the warm-up.
+    pub warmup_tol: f64,
+    /// Newton iterations on `P(y) − y`.
+    pub max_newton: usize,
+    /// Converged when `‖P(y) − y‖∞ ≤ tol (1 + ‖y‖∞)`.
+    pub tol: f64,
+    /// Relative finite-difference step (scaled by the size of the coordinates or of the rates)
+    /// of the independent check of the monodromy
+    /// ([`NonlinearFloquet::monodromy_uncertainty`]); Newton and the multipliers use the
+    /// variational equations.
+    pub fd_step: f64,
+    /// Cycles of the fallback simulation when Newton fails.
+    pub fallback_cycles: usize,
+    /// Initial state (full integrator layout); `None`: rest at the constraints' particular
+    /// configuration, as [`crate::simulate()`].
+    pub initial: Option<State>,
+}
+
+impl Default for ShootingOptions {
+    fn default() -> Self {
+        Self {
+            method: Method::Dop853,
+            rtol: 1e-12,
+            atol: 1e-14,
+            max_steps: 1_000_000,
+            t0: 0.0,
+            warmup_cycles: 20,
+            warmup_tol: 1e-6,
+            max_newton: 20,
+            tol: 1e-10,
+            fd_step: 1e-5,
+            fallback_cycles: 2000,
+            initial: None,
+        }
+    }
+}
+
+impl ShootingOptions {
+    fn validate(&self, period: f64) -> Result<RungeKutta> {
+        if !(self.t0.is_finite() && self.t0 >= 0.0 && self.t0 < period) {
+            bail!(invalid "t0", self.t0, format!("in [0, {period}) ms (one drive period)"));
+        }
+        check_positive("tol", self.tol)?;
+        check_positive("warmup_tol", self.warmup_tol)?;
+        if !(self.fd_step.is_finite() && self.fd_step > 0.0 && self.fd_step < 0.01) {
+            bail!(invalid "fd_step", self.fd_step, "in (0, 0.01)");
+        }
+        if self.warmup_cycles > 100_000 || self.fallback_cycles > 100_000 {
+            bail!(invalid "warmup_cycles, fallback_cycles",
+                format!("{}, {}", self.warmup_cycles, self.fallback_cycles), "<= 100000");
+        }
+        if let Some(y) = &self.initial {
+            paritysim_error::check_all_finite("initial", &y.to_vec())?;
+        }
+        RungeKutta::new(self.method, self.rtol, self.atol, self.max_steps)
+    }
+}
+
+/// How the periodic orbit was found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OrbitMethod {
+    /// Newton on the stroboscopic map (stable or not).
+    Newton,
+    /// Cycle-to-cycle simulation (the fallback; finds stable orbits only).
+    Simulation,
+}
+
+/// A periodic orbit of a driven device: the state on the section `t ≡ t0 (mod T)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PeriodicOrbit {
+    /// Integrator state at `t0` (work integrals zero).
+    pub state: State,
+    /// Section time (ms).
+    pub t0: f64,
+    /// Drive period T (ms).
+    pub period: f64,
+    /// `‖P(y) − y‖∞ / (1 + ‖y‖∞)` at the returned state.
+    pub residual: f64,
+    /// Newton iterations used.
+    pub newton_iterations: usize,
+    /// Cycles simulated (warm-up and fallback).
+    pub cycles_simulated: usize,
+    /// How it was found.
+    pub method: OrbitMethod,
+    /// Jacobian of the stroboscopic map from the forward sensitivities, as used by the chord
+    /// Newton iteration: evaluated at a state `monodromy_offset` away from `state` (`None` when
+    /// the orbit came from plain simulation or needed no Newton step).
+    pub monodromy: Option<DMatrix<f64>>,
+    /// `‖y_J − state‖∞` of the state `y_J` where [`Self::monodromy`] was evaluated (0: at the
+    /// orbit itself; NaN without a monodromy).
+    pub monodromy_offset: f64,
+}
+
+fn compact(n: usize, y: &State) -> DVector<f64> {
+    DVector::from_fn(
+        2 * n,
+        |i, _| if i < n { y.coords[i] } else { y.rates[i - n] },
+    )
+}
+
+fn expand(n: usize, v: &DVector<f64>) -> State {
+    let mut y = State::default();
+    for i in 0..n {
+        y.coords[i] = v[i];
+        y.rates[i] = v[n + i];
+    }
+    y
+}
+
+fn drive_period(device: &Device) -> Result<f64> {
+    device.period().ok_or_else(|| {
+        Error::Constraint(
+            "Floquet analysis needs a periodic drive: the device has no actuator".into(),
+        )
+    })
+}
+
+/// The stroboscopic map: integrates `system` over one `period` from `(t0, y)` with the work
+/// integrals reset to zero, and returns the state at `t0 + period` (work integrals zeroed).
+///
+/// # Errors
+/// [`Error::Integration`] when the integration fails.
+pub fn stroboscopic_map(
+    system: &dyn OdeSystem,
+    integrator: &RungeKutta,
+    t0: f64,
+    period: f64,
+    y: &State,
+) -> Result<State> {
+    let integrator = integrator.with_work(false);
+    let out = integrator.advance(system, t0, &y.without_work(), t0 + period)?;
+    Ok(out.without_work())
+}
+
+fn residual_norm(n: usize, y: &State, py: &State) -> f64 {
+    let (mut num, mut den): (f64, f64) = (0.0, 0.0);
+    let pairs =
+        (py.coords[..n].iter().zip(&y.coords[..n])).chain(py.rates[..n].iter().zip(&y.rates[..n]));
+    for (a, b) in pairs {
+        num = num.max((a - b).abs());
+        den = den.max(b.abs());
+    }
+    num / (1.0 + den)
+}
+
+/// Finite-difference steps: `fd_step ×` the largest |coordinate| (resp. |rate|) of `y`, with a
+/// floor so that a coordinate at zero (e.g. `q2` of a symmetric orbit) is still perturbed.
+fn fd_steps(n: usize, y: &State, fd_step: f64) -> Vec<f64> {
+    let pos = y.coords[..n].iter().map(|v| v.abs()).fold(1e-2, f64::max);
+    let vel = y.rates[..n].iter().map(|v| v.abs()).fold(1e-2, f64::max);
+    (0..2 * n)
+        .map(|i| fd_step * if i < n { pos } else { vel })
+        .collect()
+}
+
+/// Jacobian of the stroboscopic map at `y` by central differences over the `2n` integrated
+/// entries (columns evaluated in parallel).
+///
+/// # Errors
+/// [`Error::Integration`] when a perturbed integration fails.
+pub fn map_jacobian(
+    system: &(dyn OdeSystem + Sync),
+    n: usize,
+    integrator: &RungeKutta,
+    t0: f64,
+    period: f64,
+    y: &State,
+    fd_step: f64,
+) -> Result<DMatrix<f64>> {
+    let steps = fd_steps(n, y, fd_step);
+    let base = compact(n, y);
+    let columns: Vec<DVector<f64>> = (0..2 * n)
+        .into_par_iter()
+        .map(|j| {
+            let mut plus = base.clone();
+            let mut minus = base.clone();
+            plus[j] += steps[j];
+            minus[j] -= steps[j];
+            let fp = stroboscopic_map(system, integrator, t0, period, &expand(n, &plus))?;
+            let fm = stroboscopic_map(system, integrator, t0, period, &expand(n, &minus))?;
+            Ok((compact(n, &fp) - compact(n, &fm)) / (2.0 * steps[j]))
+        })
+        .collect::<Result<_>>()?;
+    Ok(DMatrix::from_columns(&columns))
+}
+
+/// Finds the periodic orbit of a driven device on the section `t ≡ t0 (mod T)`.
+///
+/// Warm-up: up to `warmup_cycles` cycles of simulation (stopping at the last good state if an
+/// integration fails). Then Newton on `F(y) = P(y) − y` with
+/// the exact Jacobian of the computed map (forward sensitivities, [`RungeKutta::flow_with_sensitivity`]); the step solves `(DP − I)Δ = −F` by SVD in the
+/// least-squares sense, so a neutral direction (multiplier 1, e.g. K2 = 0 with the linear
+/// drivetrain, where every constant `q2` is an orbit) does not break it; steps are halved until
+/// the residual decreases. If Newton stalls, cycle-to-cycle simulation continues from the best
+/// state (this converges only to a stable orbit).
+///
+/// # Errors
+/// [`Error::Constraint`] without an actuator; [`Error::InvalidParameter`] for bad options;
+/// [`Error::Integration`] when an integration fails or no method converges (with the best
+/// state and its residual).
+pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<PeriodicOrbit> {
+    let period = drive_period(device)?;
+    let integrator = options.validate(period)?;
+    let n = device.n_dof();
+    let t0 = options.t0;
+    let mut y = match options.initial {
+        Some(y) => y,
+        None => device.state_from(device.spec().constraints.particular(), &Vec6::zeros())?,
+    };
+    y = y.without_work();
+    let mut cycles = 0;
+    let mut py = stroboscopic_map(device, &integrator, t0, period, &y)?;
+    let mut res = residual_norm(n, &y, &py);
+    while cycles < options.warmup_cycles && res > options.warmup_tol && res > options.tol {
+        // A warm-up that runs away (an unstable orbit driven out of the linkage's reach) hands
+        // Newton its last good state instead of failing.
+        let Ok(next) = stroboscopic_map(device, &integrator, t0, period, &py) else {
+            break;
+        };
+        (y, py) = (py, next);
+        res = residual_norm(n, &y, &py);
+        cycles += 1;
+    }
+    let mut iterations = 0;
+    // Chord Newton: the exact derivative of the computed map (forward sensitivities, one
+    // augmented period integration) is evaluated once and reused while it keeps the residual
+    // falling fast; trial states cost one plain period each. It is re-evaluated at the
+    // current iterate when a step stalls.
+    let sensitivity = |y: &State| -> Result<(State, DMatrix<f64>)> {
+        let (py, phi) = integrator.with_work(false).flow_with_sensitivity(
+            device,
+            t0,
+            &y.without_work(),
+            t0 + period,
+        )?;
+        Ok((py.without_work(), phi))
+    };
+    let mut monodromy: Option<(DMatrix<f64>, State)> = None;
+    if res > options.tol && options.max_newton > 0 {
+        if let Ok((p, phi)) = sensitivity(&y) {
+            py = p;
+            res = residual_norm(n, &y, &py);
+            monodromy = Some((phi, y));
+        }
+    }
+    while res > options.tol && iterations < options.max_newton {
+        let Some((jac, at)) = monodromy.clone() else {
+            break;
+        };
+        let fresh = at == y;
+        iterations += 1;
+        let a = jac - DMatrix::<f64>::identity(2 * n, 2 * n);
+        let f = compact(n, &py) - compact(n, &y);
+        let svd = a.svd(true, true);
+        let smax = svd.singular_values.max();
+        let delta = svd
+            .solve(&(-&f), 1e-10 * smax.max(f64::MIN_POSITIVE))
+            .map_err(|e| Error::Singular(format!("Newton step of the shooting method: {e}")))?;
+        let mut lambda = 1.0;
+        let mut accepted = false;
+        for _ in 0..if fresh { 8 } else { 1 } {
+            let trial = expand(n, &(compact(n, &y) + &delta * lambda));
+            // A trial step may leave the linkage's reach: treat it as a failed step.
+            if let Ok(pt) = stroboscopic_map(device, &integrator, t0, period, &trial) {
+                let rt = residual_norm(n, &trial, &pt);
+                // A stale Jacobian must still contract fast; a fresh one only needs descent.
+                if rt < if fresh { res } else { 0.3 * res } {
+                    (y, py, res) = (trial, pt, rt);
+                    accepted = true;
+                    break;
+                }
+            }
+            lambda *= 0.5;
+        }
+        if accepted {
+            continue;
+        }
+        if fresh {
+            break;
+        }
+        // Stalled on a stale Jacobian: re-evaluate it here.
+        match sensitivity(&y) {
+            Ok((p, phi)) => {
+                py = p;
+                res = residual_norm(n, &y, &py);
+                monodromy = Some((phi, y));
+            }
+            Err(_) => break,
+        }
+    }
+    if res <= options.tol {
+        let (monodromy, monodromy_offset) = match monodromy {
+            Some((m, at)) => {
+                let offset = (compact(n, &at) - compact(n, &y)).amax();
+                (Some(m), offset)
+            }
+            None => (None, f64::NAN),
+        };
+        return Ok(PeriodicOrbit {
+            state: y,
+            t0,
+            period,
+            residual: res,
+            newton_iterations: iterations,
+            cycles_simulated: cycles,
+            method: OrbitMethod::Newton,
+            monodromy,
+            monodromy_offset,
+        });
+    }
+    // Fallback: plain cycle-to-cycle simulation.
+    for _ in 0..options.fallback_cycles {
+        y = py;
+        py = stroboscopic_map(device, &integrator, t0, period, &y)?;
+        res = residual_norm(n, &y, &py);
+        cycles += 1;
+        if res <= options.tol {
+            return Ok(PeriodicOrbit {
+                state: y,
+                t0,
+                period,
+                residual: res,
+                newton_iterations: iterations,
+                cycles_simulated: cycles,
+                method: OrbitMethod::Simulation,
+                monodromy: None,
+                monodromy_offset: f64::NAN,
+            });
+        }
+    }
+    Err(Error::Integration {
+        time: t0,
+        state: y.to_vec(),
+        reason: format!(
+            "no periodic orbit: Newton ({iterations} iterations) and {cycles} simulated cycles \
+             left the residual at {res:e} > tol = {:e}",
+            options.tol
+        ),
+    })
+}
+
+/// Multipliers whose modulus is within this of 1 (or within the monodromy's estimated error,
+/// if larger) are reported as marginal.
+pub const MARGINAL_TOL: f64 = 1e-5;
+
+/// Stability of a periodic orbit from its Floquet multipliers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OrbitStability {
+    /// Every `|ρ| < 1 − tol`, `tol = max(MARGINAL_TOL, monodromy_uncertainty)`.
+    Asymptotic,
+    /// The largest `|ρ|` is within `tol` of 1 (e.g. a cyclic coordinate).
+    Marginal,
+    /// Some `|ρ| > 1 + tol`.
+    Unstable,
+}
+
+/// Floquet analysis of a device's periodic orbit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NonlinearFloquet {
+    /// The orbit.
+    pub orbit: PeriodicOrbit,
+    /// Monodromy matrix: Jacobian of the stroboscopic map over `[x (n), ẋ (n)]`.
+    pub monodromy: DMatrix<f64>,
+    /// Names of the monodromy's rows/columns (`q1, q2, q1_dot, q2_dot` in drivetrain
+    /// coordinates, else `x0.., x0_dot..`).
+    pub coordinates: Vec<String>,
+    /// Floquet multipliers, largest modulus first.
+    pub multipliers: Vec<Complex<f64>>,
+    /// Multipliers of the `(q2, q̇2)` block (the whippletree mode) for 2-DOF drivetrain
+    /// coordinates; exact when the orbit is left-right symmetric (the blocks then decouple, see
+    /// [`Self::whippletree_coupling`]).
+    pub whippletree: Option<[Complex<f64>; 2]>,
+    /// Largest entry of the off-diagonal `(q1, q̇1)`–`(q2, q̇2)` blocks of the monodromy
+    /// (zero for a symmetric orbit).
+    pub whippletree_coupling: Option<f64>,
+    /// Largest entry of `|M_var − M_fd|` between the monodromy of the variational equations
+    /// and the central-difference Jacobian of the map at `fd_step` (two independent
+    /// formulations): an error estimate, larger for piecewise-smooth models such as
+    /// blade-element aerodynamics.
+    pub monodromy_uncertainty: f64,
+}
+
+impl NonlinearFloquet {
+    /// `max |ρ|`.
+    pub fn spectral_radius(&self) -> f64 {
+        self.multipliers.first().map_or(0.0, |r| r.norm())
+    }
+
+    /// Largest Floquet exponent real part `ln(max|ρ|)/T` (1/ms).
+    pub fn max_exponent(&self) -> f64 {
+        self.spectral_radius().ln() / self.orbit.period
+    }
+
+    /// Asymptotically stable, marginal or unstable.
+    pub fn stability(&self) -> OrbitStability {
+        let r = self.spectral_radius();
+        let tol = self.marginal_tol();
+        if r < 1.0 - tol {
+            OrbitStability::Asymptotic
+        } else if r <= 1.0 + tol {
+            OrbitStability::Marginal
+        } else {
+            OrbitStability::Unstable
+        }
+    }
+
+    /// Half-width of the marginal band around `|ρ| = 1`: `max(MARGINAL_TOL,
+    /// monodromy_uncertainty)`.
+    pub fn marginal_tol(&self) -> f64 {
+        MARGINAL_TOL.max(self.monodromy_uncertainty)
+    }
+
+    /// Slowest decay time `T / (−ln|ρ|)` (ms) among the decaying multipliers
+    /// (`|ρ| < 1 − marginal_tol`); `None` when none decays.
+    pub fn slowest_decay_ms(&self) -> Option<f64> {
+        self.multipliers
+            .iter()
+            .map(|r| r.norm())
+            .filter(|&r| r < 1.0 - self.marginal_tol())
+            .fold(None, |acc: Option<f64>, r| {
+                Some(acc.map_or(r, |a| a.max(r)))
+            })
+            .map(|r| {
+                if r == 0.0 {
+                    0.0
+                } else {
+                    -self.orbit.period / r.ln()
+                }
+            })
+    }
+
+    /// e-folding growth time `T / ln(max|ρ|)` (ms) of an unstable orbit.
+    pub fn growth_time_ms(&self) -> Option<f64> {
+        let r = self.spectral_radius();
+        (r > 1.0 + self.marginal_tol()).then(|| self.orbit.period / r.ln())
+    }
+}
+
+/// Eigenvalues of a real square matrix, largest modulus first.
+///
+/// # Errors
+/// [`Error::Singular`] when the Schur iteration does not converge or the matrix is not finite.
+pub fn eigenvalues(m: &DMatrix<f64>) -> Result<Vec<Complex<f64>>> {
+    if m.iter().any(|v| !v.is_finite()) {
+        bail!(Singular "monodromy matrix has non-finite entries");
+    }
+    let schur = nalgebra::Schur::try_new(m.clone(), 1e-15, 100_000).ok_or_else(|| {
+        Error::Singular("Schur iteration for the Floquet multipliers did not converge".into())
+    })?;
+    let mut ev: Vec<Complex<f64>> = schur.complex_eigenvalues().iter().copied().collect();
+    ev.sort_by(|a, b| b.norm().total_cmp(&a.norm()).then(b.im.total_cmp(&a.im)));
+    Ok(ev)
+}
+
+fn eig2(m: &Matrix2<f64>) -> [Complex<f64>; 2] {
+    multipliers(0.5 * m.trace(), m.determinant())
+}
+
+/// Periodic orbit and Floquet multipliers of a driven device (see [`periodic_orbit`]; the
+/// monodromy is [`map_jacobian`] at the orbit).
+pub fn floquet(device: &Device, options: &ShootingOptions) -> Result<NonlinearFloquet> {
+    let orbit = periodic_orbit(device, options)?;
+    let integrator = options.validate(orbit.period)?;
+    let n = device.n_dof();
+    // The monodromy from the variational equations (exact derivative of the computed map);
+    // its uncertainty from the independent central-difference Jacobian of the map.
+    let variational = || -> Result<DMatrix<f64>> {
+        if let Some(m) = orbit
+            .monodromy
+            .as_ref()
+            .filter(|_| orbit.monodromy_offset == 0.0)
+        {
+            return Ok(m.clone());
+        }
+        integrator
+            .with_work(false)
+            .flow_with_sensitivity(device, orbit.t0, &orbit.state, orbit.t0 + orbit.period)
+            .map(|(_, m)| m)
+    };
+    let differences = || {
+        map_jacobian(
+            device,
+            n,
+            &integrator,
+            orbit.t0,
+            orbit.period,
+            &orbit.state,
+            options.fd_step,
+        )
+    };
+    let (monodromy, coarse) = rayon::join(variational, differences);
+    let (monodromy, coarse) = (monodromy?, coarse?);
+    let monodromy_uncertainty = (&monodromy - coarse).amax();
+    let multipliers = eigenvalues(&monodromy)?;
+    let drivetrain_coords = device.formulation() == Formulation::DrivetrainCoordinates;
+    let coordinates: Vec<String> = (0..n)
+        .map(|i| {
+            if drivetrain_coords {
+                format!("q{}", i + 1)
+            } else {
+                format!("x{i}")
+            }
+        })
+        .chain((0..n).map(|i| {
+            if drivetrain_coords {
+                format!("q{}_dot", i + 1)
+            } else {
+                format!("x{i}_dot")
+            }
+        }))
+        .collect();
+    let (whippletree, whippletree_coupling) = if drivetrain_coords && n == 2 {
+        let block = Matrix2::new(
+            monodromy[(1, 1)],
+            monodromy[(1, 3)],
+            monodromy[(3, 1)],
+            monodromy[(3, 3)],
+        );
+        let coupling = [
+            (0, 1),
+            (0, 3),
+            (2, 1),
+            (2, 3),
+            (1, 0),
+            (1, 2),
+            (3, 0),
+            (3, 2),
+        ]
+        .iter()
+        .map(|&(i, j)| monodromy[(i, j)].abs())
+        .fold(0.0, f64::max);
+        (Some(eig2(&block)), Some(coupling))
+    } else {
+        (None, None)
+    };
+    Ok(NonlinearFloquet {
+        orbit,
+        monodromy,
+        coordinates,
+        multipliers,
+        whippletree,
+        whippletree_coupling,
+        monodromy_uncertainty,
+    })
+}
