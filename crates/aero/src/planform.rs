@@ -132,6 +132,19 @@ fn abs_cube_antiderivative(x: f64) -> f64 {
     x * x * x * x.abs() / 4.0
 }
 
+/// A parametric outline must reach behind the hinge line (`x < 0`): named at `le_offset`.
+fn behind_hinge(le_offset: f64, chord: f64) -> Result<()> {
+    if le_offset < chord {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            "le_offset",
+            le_offset,
+            format!("< the chord ({chord} mm): the membrane must extend behind the hinge line"),
+        ))
+    }
+}
+
 fn fmt_pt(p: [f64; 2]) -> String {
     format!("(z = {}, x = {})", p[0], p[1])
 }
@@ -286,14 +299,15 @@ impl Planform {
     /// # Errors
     /// [`Error::InvalidParameter`] unless `span` and `chord` are lengths in
     /// [`paritysim_error::plausible::LENGTH_MM`], `0 <= root_offset` and `|le_offset|` are within
-    /// [`paritysim_error::plausible::OFFSET_MM`]; [`Error::Geometry`] if `le_offset >= chord` (wrong side of the
-    /// hinge line).
+    /// [`paritysim_error::plausible::OFFSET_MM`], and `le_offset < chord` (the membrane must reach
+    /// behind the hinge line).
     pub fn rectangle(span: f64, chord: f64, root_offset: f64, le_offset: f64) -> Result<Self> {
         check_length_mm("span", span)?;
         check_length_mm("chord", chord)?;
         check_non_negative("root_offset", root_offset)?;
         check_offset_mm("root_offset", root_offset)?;
         check_offset_mm("le_offset", le_offset)?;
+        behind_hinge(le_offset, chord)?;
         let (z0, z1) = (root_offset, root_offset + span);
         let (xt, xl) = (le_offset - chord, le_offset);
         Self::from_points(&[[z0, xt], [z1, xt], [z1, xl], [z0, xl]])
@@ -312,8 +326,8 @@ impl Planform {
     /// # Errors
     /// [`Error::InvalidParameter`] unless `span` and `max_chord` are lengths in
     /// [`paritysim_error::plausible::LENGTH_MM`], `0 <= root_offset` and `|le_offset|` are within
-    /// [`paritysim_error::plausible::OFFSET_MM`], and `4 <= segments <= 1_000_000`; [`Error::Geometry`] if
-    /// `le_offset >= max_chord` (wrong side of the hinge line).
+    /// [`paritysim_error::plausible::OFFSET_MM`], `le_offset < max_chord` (the membrane reaches
+    /// behind the hinge line) and `4 <= segments <= 1_000_000`.
     pub fn semi_ellipse(
         span: f64,
         max_chord: f64,
@@ -326,6 +340,7 @@ impl Planform {
         check_non_negative("root_offset", root_offset)?;
         check_offset_mm("root_offset", root_offset)?;
         check_offset_mm("le_offset", le_offset)?;
+        behind_hinge(le_offset, max_chord)?;
         if !(4..=1_000_000).contains(&segments) {
             return Err(Error::invalid("segments", segments, "in [4, 1000000]"));
         }

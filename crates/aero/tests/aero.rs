@@ -500,8 +500,16 @@ fn bad_outlines_give_typed_errors() {
     ]));
     assert!(m.contains("wrong side") && m.contains("z"), "{m}");
     // Entirely ahead of the hinge line (outline drawn with x toward the trailing edge).
-    let m = geometry_msg(Planform::rectangle(10.0, 3.0, 0.0, 3.0));
+    let m = geometry_msg(Planform::from_points(&[
+        [0.0, 0.0],
+        [10.0, 0.0],
+        [10.0, 3.0],
+        [0.0, 3.0],
+    ]));
     assert!(m.contains("wrong side of the hinge line"), "{m}");
+    // The parametric shapes name the field that put them there.
+    let e = Planform::rectangle(10.0, 3.0, 0.0, 3.0).unwrap_err();
+    assert_eq!(e.field(), Some("le_offset"));
     // Degenerate.
     let m = geometry_msg(Planform::from_points(&[
         [1.0, 0.0],
