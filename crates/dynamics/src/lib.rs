@@ -15,6 +15,7 @@
 //! * [`simulate`]: periodic steady state, perturbations, trajectories and metrics.
 
 pub mod actuator;
+pub mod continuation;
 pub mod device;
 pub mod floquet;
 pub mod integrate;
