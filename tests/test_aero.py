@@ -120,7 +120,10 @@ def test_bad_outlines_raise_geometry_error() -> None:
     with pytest.raises(ps.GeometryError, match="wrong side of the spherical centre"):
         Planform.from_points([[-1, 0], [6, 0], [6, -2]])
     with pytest.raises(ps.GeometryError, match="wrong side of the hinge line"):
+        Planform.from_points([[0, 0], [10, 0], [10, 3], [0, 3]])
+    with pytest.raises(ps.InvalidParameterError, match="behind the hinge line") as info:
         Planform.rectangle(10.0, 3.0, le_offset=3.0)
+    assert info.value.field == "le_offset"
     with pytest.raises(ps.GeometryError, match="zero area"):
         Planform.from_points([[1, 0], [2, -1], [3, -2]])
     # GeometryError is a ValueError and a ParitysimError.

@@ -22,6 +22,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _core
+from ._errors import real, whole
 
 __all__ = [
     "AIR_DENSITY",
@@ -138,7 +139,7 @@ def moments(
         flat[4],
         flat[5],
         str(model),
-        float(rotational_damping),
+        real("rotational_damping", rotational_damping),
         str(normal_force_law),
         force,
     )

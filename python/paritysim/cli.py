@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import tomllib
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -84,24 +85,31 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _common() -> argparse.ArgumentParser:
+    """Options every subcommand takes (also accepted after the subcommand's name)."""
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("--debug", action="store_true", default=argparse.SUPPRESS, help="show the full traceback of an error")
+    return common
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser (exposed for tests and docs)."""
-    parser = argparse.ArgumentParser(prog="paritysim", description="Simulate flapping-wing drivetrains and reproduce the thesis trials.")
+    parser = argparse.ArgumentParser(prog="paritysim", description="Simulate flapping-wing drivetrains and reproduce the thesis trials.", parents=[_common()])
     parser.add_argument("--version", action="version", version=f"paritysim {__import__('paritysim').__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
-    rep = sub.add_parser("reproduce", help="reproduce thesis tables and figures")
+    rep = sub.add_parser("reproduce", help="reproduce thesis tables and figures", parents=[_common()])
     rep.add_argument("names", nargs="*", help="trials to run (see `paritysim reproduce --list`)")
     rep.add_argument("--list", action="store_true", help="list the available trials and exit")
     rep.add_argument("--all", action="store_true", help="run every implemented trial")
     rep.add_argument("--out", default="results", help="output directory (default: results/)")
     rep.add_argument("--quiet", action="store_true", help="no progress output")
     rep.set_defaults(func=_reproduce)
-    run = sub.add_parser("run", help="simulate a device spec (TOML) and write trajectory, metrics and a plot")
+    run = sub.add_parser("run", help="simulate a device spec (TOML) and write trajectory, metrics and a plot", parents=[_common()])
     run.add_argument("spec", help="device spec (TOML path, e.g. examples/hmf.toml) or a named device (see `paritysim devices`)")
     run.add_argument("--out", default="results", help="output directory (default: results/)")
     run.add_argument("--quiet", action="store_true", help="no summary output")
     run.set_defaults(func=_run)
-    dev = sub.add_parser("devices", help="list the named thesis devices (or show one's provenance)")
+    dev = sub.add_parser("devices", help="list the named thesis devices (or show one's provenance)", parents=[_common()])
     dev.add_argument("name", nargs="?", help="a device name: print what the thesis states and what we chose")
     dev.set_defaults(func=_devices)
     try:  # `paritysim sweep` lives with the sweep engine (issue 8)
@@ -109,20 +117,52 @@ def build_parser() -> argparse.ArgumentParser:
     except ImportError:
         pass
     else:
-        add_sweep_parser(sub)
+        add_sweep_parser(sub, parents=[_common()])
     return parser
 
 
+def describe_error(exc: BaseException) -> str:
+    """One line for a user: what failed and on which file or field, without a traceback."""
+    if isinstance(exc, ParitysimError):
+        return f"{type(exc).__name__}: {exc}"
+    if isinstance(exc, FileNotFoundError):
+        return f"no such file or directory: {exc.filename}"
+    if isinstance(exc, IsADirectoryError):
+        return f"expected a file, got a directory: {exc.filename}"
+    if isinstance(exc, NotADirectoryError):
+        return f"not a directory: {exc.filename}"
+    if isinstance(exc, PermissionError):
+        return f"permission denied: {exc.filename}"
+    if isinstance(exc, OSError) and exc.filename is not None:
+        return f"cannot use {exc.filename}: {exc.strerror or exc}"
+    if isinstance(exc, tomllib.TOMLDecodeError):
+        return f"malformed TOML: {exc}"
+    if isinstance(exc, UnicodeDecodeError):
+        return f"not a UTF-8 text file: {exc.reason}"
+    return f"{type(exc).__name__}: {exc}"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``paritysim`` console script (also ``python -m paritysim``)."""
+    """Entry point of the ``paritysim`` console script (also ``python -m paritysim``).
+
+    Exit codes: 0 success, 1 an error (one line on stderr; ``--debug`` shows the traceback),
+    2 bad command-line usage, 130 interrupted (Ctrl-C; a sweep keeps its finished points)."""
     import matplotlib
 
     matplotlib.use("Agg")  # the CLI only writes files
     args = build_parser().parse_args(argv)
+    debug = bool(getattr(args, "debug", False))
     try:
         return int(args.func(args))
-    except ParitysimError as exc:
-        print(f"paritysim: error: {type(exc).__name__}: {exc}", file=sys.stderr)
+    except KeyboardInterrupt:
+        if debug:
+            raise
+        print("paritysim: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # noqa: BLE001 - the CLI's contract: one line, never a traceback
+        if debug:
+            raise
+        print(f"paritysim: error: {describe_error(exc)}", file=sys.stderr)
         return 1
 
 

@@ -11,6 +11,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _core
+from ._errors import real, whole
 from ._core import Drivetrain
 
 __all__ = ["Drivetrain", "drivetrain_map", "shoulder_map", "shoulder_partials", "shoulder_pose"]
@@ -47,7 +48,7 @@ def shoulder_map(alpha2: float, alpha3: float, phi: ArrayLike, theta: ArrayLike)
         For ``alpha2``/``alpha3`` out of range or non-finite inputs.
     """
     p, t, shape = _paired(phi, theta)
-    out = _core.shoulder_map(float(alpha2), float(alpha3), p, t)
+    out = _core.shoulder_map(real("alpha2", alpha2), real("alpha3", alpha3), p, t)
     return {k: v.reshape(shape) for k, v in out.items()}
 
 
@@ -56,12 +57,12 @@ def shoulder_pose(alpha2: float, alpha3: float, phi: float, theta: float, psi: f
 
     Raises ``OutOfDomainError`` outside the joint limit.
     """
-    return _core.shoulder_pose(float(alpha2), float(alpha3), float(phi), float(theta), float(psi))
+    return _core.shoulder_pose(real("alpha2", alpha2), real("alpha3", alpha3), real("phi", phi), real("theta", theta), real("psi", psi))
 
 
 def shoulder_partials(alpha2: float, alpha3: float, phi: float, theta: float, psi: float = 0.0) -> dict[str, np.ndarray]:
     """Gradients and Hessians of gamma2, gamma3, gamma5 w.r.t. (phi, theta) and J6 (A.9)."""
-    return _core.shoulder_partials(float(alpha2), float(alpha3), float(phi), float(theta), float(psi))
+    return _core.shoulder_partials(real("alpha2", alpha2), real("alpha3", alpha3), real("phi", phi), real("theta", theta), real("psi", psi))
 
 
 def drivetrain_map(drivetrain: Any, q1: ArrayLike, q2: ArrayLike = 0.0) -> dict[str, Any]:

@@ -28,7 +28,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _core
-from ._errors import invalid
+from ._errors import invalid, real, whole
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -132,15 +132,15 @@ class Material:
         return {
             "name": self.name,
             "class": self.category,
-            "e1": float(self.e1),
-            "e2": float(self.e2),
-            "g12": float(self.g12),
-            "nu12": float(self.nu12),
-            "density": float(self.density),
-            "alpha1": float(self.alpha1),
-            "alpha2": float(self.alpha2),
-            "d31": None if self.d31 is None else float(self.d31),
-            "max_field": None if self.max_field is None else float(self.max_field),
+            "e1": real("e1", self.e1),
+            "e2": real("e2", self.e2),
+            "g12": real("g12", self.g12),
+            "nu12": real("nu12", self.nu12),
+            "density": real("density", self.density),
+            "alpha1": real("alpha1", self.alpha1),
+            "alpha2": real("alpha2", self.alpha2),
+            "d31": None if self.d31 is None else real("d31", self.d31),
+            "max_field": None if self.max_field is None else real("max_field", self.max_field),
         }
 
     @classmethod
@@ -205,7 +205,7 @@ class Ply:
 
     def to_dict(self) -> dict[str, Any]:
         """Dict form for ``_core``."""
-        return {"material": self.material.to_dict(), "thickness": float(self.thickness), "angle": float(self.angle)}
+        return {"material": self.material.to_dict(), "thickness": real("thickness", self.thickness), "angle": real("angle", self.angle)}
 
 
 @dataclass(frozen=True)
@@ -348,7 +348,7 @@ class Layup:
         (mN), a temperature change ``delta_t`` (K) and one voltage per layer (V, piezo layers only).
         """
         v = np.zeros(0) if voltages is None else np.asarray(voltages, dtype=np.float64).ravel()
-        return _core.laminate_response(self._dicts, _vec3(n), _vec3(m), float(delta_t), v)
+        return _core.laminate_response(self._dicts, _vec3(n), _vec3(m), real("delta_t", delta_t), v)
 
     def thermal_curvature(self, delta_t: float = CURE_DELTA_T) -> FloatArray:
         """Curvature ``(κx, κy, κxy)`` (1/mm) after a uniform temperature change ``delta_t`` (K)
@@ -364,7 +364,7 @@ class Layup:
     ) -> dict[str, np.ndarray]:
         """Stresses (mN/mm², laminate axes) at the bottom and top face of every ply."""
         v = np.zeros(0) if voltages is None else np.asarray(voltages, dtype=np.float64).ravel()
-        return _core.laminate_ply_stresses(self._dicts, _vec3(n), _vec3(m), float(delta_t), v)
+        return _core.laminate_ply_stresses(self._dicts, _vec3(n), _vec3(m), real("delta_t", delta_t), v)
 
     # -- drawing
     def plot(self, ax: Axes | None = None, to_scale: bool = True) -> Axes:
@@ -474,10 +474,10 @@ class Bimorph:
     def __post_init__(self) -> None:
         d = _core.laminate_bimorph(
             self.layup._dicts,
-            float(self.length),
-            float(self.extension),
-            float(self.base_width),
-            float(self.width_ratio),
+            real("length", self.length),
+            real("extension", self.extension),
+            real("base_width", self.base_width),
+            real("width_ratio", self.width_ratio),
             np.zeros(0),
         )
         object.__setattr__(self, "_data", d)
@@ -497,8 +497,8 @@ class Bimorph:
             lay._dicts,
             float(target.stiffness_mn_per_mm),
             float(target.force_per_volt_mn_per_v),
-            float(width_ratio),
-            float(extension_ratio),
+            real("width_ratio", width_ratio),
+            real("extension_ratio", extension_ratio),
         )
         return cls(lay, d["length"], d["extension"], d["base_width"], d["width_ratio"])
 
@@ -541,10 +541,10 @@ class Bimorph:
         v = np.asarray(voltage, dtype=np.float64)
         d = _core.laminate_bimorph(
             self.layup._dicts,
-            float(self.length),
-            float(self.extension),
-            float(self.base_width),
-            float(self.width_ratio),
+            real("length", self.length),
+            real("extension", self.extension),
+            real("base_width", self.base_width),
+            real("width_ratio", self.width_ratio),
             np.ascontiguousarray(v.ravel()),
         )
         d["shape"] = v.shape
@@ -587,7 +587,7 @@ class Flexure:
     _data: dict[str, Any] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        d = _core.laminate_flexure(self.material.to_dict(), float(self.width), float(self.thickness), float(self.length))
+        d = _core.laminate_flexure(self.material.to_dict(), real("width", self.width), real("thickness", self.thickness), real("length", self.length))
         object.__setattr__(self, "_data", d)
 
     @classmethod
@@ -604,7 +604,7 @@ class Flexure:
         flexure of width ``joint_width · flexure_fraction``; ``n_segments`` castellations."""
         m = material("polyimide") if mat is None else mat
         d = _core.laminate_castellated_joint(
-            m.to_dict(), float(joint_width), int(n_segments), float(flexure_fraction), float(thickness), float(flexure_length)
+            m.to_dict(), real("joint_width", joint_width), whole("n_segments", n_segments), real("flexure_fraction", flexure_fraction), real("thickness", thickness), real("flexure_length", flexure_length)
         )
         return cls(d["flexure_width"], flexure_length, thickness, m)
 

@@ -21,7 +21,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _core
-from ._errors import invalid
+from ._errors import invalid, real, whole
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -66,7 +66,7 @@ class Planform:
 
     def __init__(self, points: npt.ArrayLike, *, closure_tolerance: float | None = None) -> None:
         pts = _as_points(points)
-        tol = None if closure_tolerance is None else float(closure_tolerance)
+        tol = None if closure_tolerance is None else real("closure_tolerance", closure_tolerance)
         props = _core.aero_planform_properties(pts, AIR_DENSITY, tol)
         props["vertices"].setflags(write=False)
         object.__setattr__(self, "_props", props)
@@ -87,7 +87,7 @@ class Planform:
     @classmethod
     def rectangle(cls, span: float, chord: float, root_offset: float = 0.0, le_offset: float = 0.0) -> Planform:
         """``z`` in ``[root_offset, root_offset + span]``, ``x`` in ``[le_offset - chord, le_offset]`` (mm)."""
-        return cls(_core.aero_planform_rectangle(float(span), float(chord), float(root_offset), float(le_offset)))
+        return cls(_core.aero_planform_rectangle(real("span", span), real("chord", chord), real("root_offset", root_offset), real("le_offset", le_offset)))
 
     @classmethod
     def semi_ellipse(
@@ -103,7 +103,7 @@ class Planform:
         the ellipse's as ``segments**-2``)."""
         return cls(
             _core.aero_planform_semi_ellipse(
-                float(span), float(max_chord), float(root_offset), float(le_offset), int(segments)
+                real("span", span), real("max_chord", max_chord), real("root_offset", root_offset), real("le_offset", le_offset), whole("segments", segments)
             )
         )
 
@@ -111,7 +111,7 @@ class Planform:
     def hmf_like(cls, tip_radius: float = 16.6, segments: int = 128) -> Planform:
         """A smooth HMF-like wing (Fig. 3.10) scaled to ``tip_radius`` mm; at 16.6 mm its
         Ω1..Ω4 are within 15 % of Table 3.3 (left wing). A stand-in, not the measured outline."""
-        return cls(_core.aero_planform_hmf_like(float(tip_radius), int(segments)))
+        return cls(_core.aero_planform_hmf_like(real("tip_radius", tip_radius), whole("segments", segments)))
 
     # ------------------------------------------------------------------ geometry
     @property
@@ -174,11 +174,11 @@ class Planform:
         """Uniformly scaled about the spherical centre (Ω scale as ``factor**5``)."""
         if not (np.isfinite(factor) and factor > 0):
             raise invalid("factor", factor, "finite and > 0")
-        return Planform(self.points * float(factor))
+        return Planform(self.points * real("factor", factor))
 
     def translated(self, dz: float = 0.0, dx: float = 0.0) -> Planform:
         """Shifted by ``dz`` (spanwise) and ``dx`` (toward the leading edge; moves the hinge line by ``-dx``)."""
-        return Planform(self.points + np.array([float(dz), float(dx)]))
+        return Planform(self.points + np.array([real("dz", dz), real("dx", dx)]))
 
     def cut(self, fraction: float, where: str = "tip", *, measure: str = "span") -> Planform:
         """The membrane left after cutting part of it away along a straight line.
@@ -224,7 +224,7 @@ class Planform:
         """
         if not (math.isfinite(rho) and rho > 0):
             raise invalid("rho", rho, "finite and > 0 (mg/mm^3; air is 1.2e-3)")
-        p = _core.aero_planform_properties(self.points, float(rho), None)
+        p = _core.aero_planform_properties(self.points, real("rho", rho), None)
         return {k: float(p[k]) for k in ("omega1", "omega2", "omega3", "omega4", "force")}
 
     def inertia(
@@ -253,7 +253,7 @@ class Planform:
         """
         out: dict[str, Any] = _core.aero_planform_inertia(
             self.points,
-            float(areal_density),
+            real("areal_density", areal_density),
             _rows(line_masses, 5, "line_masses"),
             _rows(point_masses, 3, "point_masses"),
         )

@@ -31,7 +31,7 @@ import polars as pl
 from matplotlib.figure import Figure
 
 from . import _core
-from ._errors import invalid
+from ._errors import invalid, real, whole
 from .spec import Simulation
 
 __all__ = [
@@ -77,12 +77,12 @@ def hill_monodromy(beta0: float, kappa: float, t0: float = -math.pi / 2) -> np.n
     At ``t0 = -π/2`` and ``kappa = 0`` it is eq. 2.50; its determinant is ``e^{-2 beta0}``
     (eq. 2.45) for every ``kappa`` and ``t0``.
     """
-    return _core.stability_hill_monodromy(float(beta0), float(kappa), float(t0))
+    return _core.stability_hill_monodromy(real("beta0", beta0), real("kappa", kappa), real("t0", t0))
 
 
 def hill_solution(beta0: float, kappa: float, t: Any, t0: float = -math.pi / 2) -> np.ndarray:
     """Solution matrices ``Π(t_i, t0)`` (eq. 2.33) at each ``t_i >= t0``, shape ``(n, 2, 2)``."""
-    return _core.stability_hill_solution(float(beta0), float(kappa), float(t0), _f64(t, "t"))
+    return _core.stability_hill_solution(real("beta0", beta0), real("kappa", kappa), real("t0", t0), _f64(t, "t"))
 
 
 def hill_floquet(beta0: float, kappa: float) -> dict[str, Any]:
@@ -93,7 +93,7 @@ def hill_floquet(beta0: float, kappa: float) -> dict[str, Any]:
     ``multiplier_error`` and ``marginal`` (see :func:`stability_chart`) and ``stable``
     (Region I and not marginal).
     """
-    return _core.stability_hill_floquet(float(beta0), float(kappa))
+    return _core.stability_hill_floquet(real("beta0", beta0), real("kappa", kappa))
 
 
 def region(a: Any, b: Any) -> np.ndarray:
@@ -138,12 +138,12 @@ def brockett(delta: float, period: float, damping_integral: float = 0.0) -> dict
     """Brockett's criterion (eqs. 2.56-2.58) for ``x'' + g(t) x' + x = 0`` with ``|g| <= 2 delta``
     and period ``period``: ``bounded`` is True when all solutions are guaranteed bounded (a
     False guarantees nothing); ``n`` and ``interval`` are the integer and interval of eq. 2.57."""
-    return _core.stability_brockett(float(delta), float(period), float(damping_integral))
+    return _core.stability_brockett(real("delta", delta), real("period", period), real("damping_integral", damping_integral))
 
 
 def brockett_hill(beta0: float, kappa: float) -> dict[str, Any]:
     """Brockett's criterion for eq. 2.25 (κ > 0), after rescaling time by √κ."""
-    return _core.stability_brockett_hill(float(beta0), float(kappa))
+    return _core.stability_brockett_hill(real("beta0", beta0), real("kappa", kappa))
 
 
 def hill_parameters(
@@ -165,7 +165,7 @@ def hill_parameters(
     Units: inertia and drag Ω in mg·mm², T in rad/mm, L in mm, K1 in mN/mm, K2 in mN·mm/rad.
     """
     return _core.stability_hill_parameters(
-        float(inertia), float(drag), float(transmission_ratio), float(arm_length_mm), float(k1), float(k2), float(stroke_amplitude), float(frequency_hz)
+        real("inertia", inertia), real("drag", drag), real("transmission_ratio", transmission_ratio), real("arm_length_mm", arm_length_mm), real("k1", k1), real("k2", k2), real("stroke_amplitude", stroke_amplitude), real("frequency_hz", frequency_hz)
     )
 
 
@@ -174,7 +174,7 @@ def hill_parameters(
 
 def lti_transfer(beta_star: float, kappa0: float, frequency_hz: Any) -> np.ndarray:
     """Eq. 2.59, ``κ0 / (s² + β* s + κ0)`` at ``s = 2πi f`` (s in rad/ms): complex array."""
-    return _core.stability_lti_transfer(float(beta_star), float(kappa0), _f64(frequency_hz, "frequency_hz"))
+    return _core.stability_lti_transfer(real("beta_star", beta_star), real("kappa0", kappa0), _f64(frequency_hz, "frequency_hz"))
 
 
 def _device(spec: Simulation | dict[str, Any]) -> dict[str, Any]:
@@ -319,7 +319,7 @@ def linearise(spec: Simulation | dict[str, Any], samples: int = 2000, **options:
     flapping) and ``lti_averaged`` (cycle average of the full model's variational equation,
     which adds the linkage's ``geometric_stiffness`` in mN·mm/rad).
     """
-    return _core.stability_linearise(_device(spec), _shooting(options), int(samples))
+    return _core.stability_linearise(_device(spec), _shooting(options), whole("samples", samples))
 
 
 def disturbance_response(
@@ -348,7 +348,7 @@ def disturbance_response(
     freqs = _f64(frequency_hz, "frequency_hz")
     dist = {"settle_cycles": settle_cycles, "max_window_cycles": max_window_cycles, "samples_per_cycle": samples_per_cycle}
     device = _device(spec)
-    raw = _core.stability_disturbance_response(device, freqs, float(amplitude), _shooting(options), _shooting(dist))
+    raw = _core.stability_disturbance_response(device, freqs, real("amplitude", amplitude), _shooting(options), _shooting(dist))
     h = raw["transfer"]
     lti = avg = np.full(freqs.size, np.nan + 0j)
     _, n_dof = _core.validate_device(device)

@@ -162,9 +162,9 @@ def _main(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_parser(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
-    """Adds ``paritysim sweep``."""
-    p = sub.add_parser("sweep", help="run a parameter sweep described in a study TOML (device + grid)")
+def add_parser(sub: argparse._SubParsersAction, parents: list[argparse.ArgumentParser] | None = None) -> None:  # type: ignore[type-arg]
+    """Adds ``paritysim sweep`` (``parents``: options shared by every subcommand)."""
+    p = sub.add_parser("sweep", help="run a parameter sweep described in a study TOML (device + grid)", parents=parents or [])
     p.add_argument("study", help="study file, e.g. examples/sweep_resonance.toml")
     p.add_argument("--out", default="runs", help="output directory (default: runs/)")
     p.add_argument("--threads", type=int, default=None, help="engine threads (default: $PARITYSIM_THREADS or all cores)")

@@ -28,7 +28,10 @@
 //! several pieces) `c(z)` is the total cut length and `l(z)` the foremost edge: eqs. 3.14–3.15
 //! then treat the strip as one chord of length `c` behind `l`, which is the thesis' assumption.
 
-use paritysim_error::{Error, Result, bail, check_finite, check_non_negative, check_positive};
+use paritysim_error::{
+    Error, Result, bail, check_finite, check_length_mm, check_non_negative, check_offset_mm,
+    check_positive,
+};
 
 use crate::blade::Omegas;
 
@@ -129,6 +132,19 @@ fn abs_cube_antiderivative(x: f64) -> f64 {
     x * x * x * x.abs() / 4.0
 }
 
+/// A parametric outline must reach behind the hinge line (`x < 0`): named at `le_offset`.
+fn behind_hinge(le_offset: f64, chord: f64) -> Result<()> {
+    if le_offset < chord {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            "le_offset",
+            le_offset,
+            format!("< the chord ({chord} mm): the membrane must extend behind the hinge line"),
+        ))
+    }
+}
+
 fn fmt_pt(p: [f64; 2]) -> String {
     format!("(z = {}, x = {})", p[0], p[1])
 }
@@ -146,12 +162,14 @@ impl Planform {
     ///   outline reaches `z < 0` (inboard of the spherical centre), or it lies entirely at
     ///   `x >= 0` (on the wrong side of the hinge line).
     pub fn from_points(points: &[[f64; 2]]) -> Result<Self> {
+        let reach = paritysim_error::plausible::OFFSET_MM;
         for (i, p) in points.iter().enumerate() {
-            if !(p[0].is_finite() && p[1].is_finite()) {
+            let plausible = |c: f64| c.is_finite() && c.abs() <= reach;
+            if !(plausible(p[0]) && plausible(p[1])) {
                 return Err(Error::invalid(
                     format!("points[{i}]"),
                     format!("[{}, {}]", p[0], p[1]),
-                    "finite [z, x] in mm",
+                    format!("finite [z, x] in mm with |z|, |x| <= {reach:e}"),
                 ));
             }
         }
@@ -279,14 +297,17 @@ impl Planform {
     /// (leading edge `le_offset` ahead of the hinge line; 0 puts the leading edge on it).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] unless `span > 0`, `chord > 0`, `root_offset >= 0` and
-    /// `le_offset` is finite; [`Error::Geometry`] if `le_offset >= chord` (wrong side of the
-    /// hinge line).
+    /// [`Error::InvalidParameter`] unless `span` and `chord` are lengths in
+    /// [`paritysim_error::plausible::LENGTH_MM`], `0 <= root_offset` and `|le_offset|` are within
+    /// [`paritysim_error::plausible::OFFSET_MM`], and `le_offset < chord` (the membrane must reach
+    /// behind the hinge line).
     pub fn rectangle(span: f64, chord: f64, root_offset: f64, le_offset: f64) -> Result<Self> {
-        check_positive("span", span)?;
-        check_positive("chord", chord)?;
+        check_length_mm("span", span)?;
+        check_length_mm("chord", chord)?;
         check_non_negative("root_offset", root_offset)?;
-        check_finite("le_offset", le_offset)?;
+        check_offset_mm("root_offset", root_offset)?;
+        check_offset_mm("le_offset", le_offset)?;
+        behind_hinge(le_offset, chord)?;
         let (z0, z1) = (root_offset, root_offset + span);
         let (xt, xl) = (le_offset - chord, le_offset);
         Self::from_points(&[[z0, xt], [z1, xt], [z1, xl], [z0, xl]])
@@ -303,9 +324,10 @@ impl Planform {
     /// polygon area is `(segments/π) sin(π/segments)` times `π/4 · span · max_chord`.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] unless `span > 0`, `max_chord > 0`, `root_offset >= 0`,
-    /// `le_offset` finite and `4 <= segments <= 1_000_000`; [`Error::Geometry`] if
-    /// `le_offset >= max_chord` (wrong side of the hinge line).
+    /// [`Error::InvalidParameter`] unless `span` and `max_chord` are lengths in
+    /// [`paritysim_error::plausible::LENGTH_MM`], `0 <= root_offset` and `|le_offset|` are within
+    /// [`paritysim_error::plausible::OFFSET_MM`], `le_offset < max_chord` (the membrane reaches
+    /// behind the hinge line) and `4 <= segments <= 1_000_000`.
     pub fn semi_ellipse(
         span: f64,
         max_chord: f64,
@@ -313,10 +335,12 @@ impl Planform {
         le_offset: f64,
         segments: usize,
     ) -> Result<Self> {
-        check_positive("span", span)?;
-        check_positive("max_chord", max_chord)?;
+        check_length_mm("span", span)?;
+        check_length_mm("max_chord", max_chord)?;
         check_non_negative("root_offset", root_offset)?;
-        check_finite("le_offset", le_offset)?;
+        check_offset_mm("root_offset", root_offset)?;
+        check_offset_mm("le_offset", le_offset)?;
+        behind_hinge(le_offset, max_chord)?;
         if !(4..=1_000_000).contains(&segments) {
             return Err(Error::invalid("segments", segments, "in [4, 1000000]"));
         }
@@ -344,9 +368,10 @@ impl Planform {
     /// outline.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] unless `tip_radius > 0` and `4 <= segments <= 1_000_000`.
+    /// [`Error::InvalidParameter`] unless `tip_radius` is a length in
+    /// [`paritysim_error::plausible::LENGTH_MM`] and `4 <= segments <= 1_000_000`.
     pub fn hmf_like(tip_radius: f64, segments: usize) -> Result<Self> {
-        check_positive("tip_radius", tip_radius)?;
+        check_length_mm("tip_radius", tip_radius)?;
         if !(4..=1_000_000).contains(&segments) {
             return Err(Error::invalid("segments", segments, "in [4, 1000000]"));
         }
@@ -429,36 +454,43 @@ impl Planform {
                     fmt_pt(b));
             }
         }
-        for i in 0..n {
-            let (p1, p2) = (v[i], v[(i + 1) % n]);
-            for j in (i + 2)..n {
-                if i == 0 && j == n - 1 {
-                    continue; // adjacent through the closing edge
+        // Sweep over z: only edges whose z-ranges overlap can meet, so a sampled outline of
+        // n vertices costs O(n log n) instead of O(n²) (segments = 10⁶ took over a minute).
+        let edge = |i: usize| (v[i], v[(i + 1) % n]);
+        let z_range = |i: usize| {
+            let (a, b) = edge(i);
+            (a[0].min(b[0]), a[0].max(b[0]))
+        };
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|&a, &b| z_range(a).0.total_cmp(&z_range(b).0));
+        let mut active: Vec<usize> = Vec::new();
+        for &j in &order {
+            let z_lo = z_range(j).0;
+            active.retain(|&i| z_range(i).1 >= z_lo);
+            for &i in &active {
+                let (lo, hi) = (i.min(j), i.max(j));
+                if hi - lo == 1 || (lo == 0 && hi == n - 1) {
+                    continue; // adjacent edges share a vertex
                 }
-                let (q1, q2) = (v[j], v[(j + 1) % n]);
+                let ((p1, p2), (q1, q2)) = (edge(lo), edge(hi));
                 if segments_intersect(p1, p2, q1, q2) {
                     bail!(Geometry
-                        "self-intersecting outline: edge {i} {} -> {} meets edge {j} {} -> {}",
+                        "self-intersecting outline: edge {lo} {} -> {} meets edge {hi} {} -> {}",
                         fmt_pt(p1), fmt_pt(p2), fmt_pt(q1), fmt_pt(q2));
                 }
             }
+            active.push(j);
         }
         Ok(())
     }
 
-    /// Sorted `x` of the edges crossing the line `z`; `strict` counts only edges whose open
-    /// `z`-range contains `z` (used at Gauss nodes), otherwise the half-open crossing rule.
-    fn crossings(v: &[[f64; 2]], z: f64, strict: bool, out: &mut Vec<f64>) {
+    /// Sorted `x` of the edges crossing the line `z` (half-open crossing rule).
+    fn crossings(v: &[[f64; 2]], z: f64, out: &mut Vec<f64>) {
         out.clear();
         let n = v.len();
         for i in 0..n {
             let (a, b) = (v[i], v[(i + 1) % n]);
-            let hit = if strict {
-                (a[0] < z && z < b[0]) || (b[0] < z && z < a[0])
-            } else {
-                (a[0] <= z && z < b[0]) || (b[0] <= z && z < a[0])
-            };
-            if hit {
+            if (a[0] <= z && z < b[0]) || (b[0] <= z && z < a[0]) {
                 out.push(a[1] + (z - a[0]) * (b[1] - a[1]) / (b[0] - a[0]));
             }
         }
@@ -480,15 +512,38 @@ impl Planform {
 
         let mut s = PlanformIntegrals::default();
         let mut xs = Vec::with_capacity(8);
+        // Every vertex z is a break, so the edges crossing a slab's interior span all of it:
+        // sweep them in z order (O(n log n); a full scan per node was O(n²)).
+        let mut by_start: Vec<usize> = (0..n).filter(|&i| v[i][0] != v[(i + 1) % n][0]).collect();
+        by_start.sort_by(|&a, &b| {
+            let lo = |i: usize| v[i][0].min(v[(i + 1) % n][0]);
+            lo(a).total_cmp(&lo(b))
+        });
+        let mut next_edge = 0;
+        let mut active: Vec<usize> = Vec::new();
         for w in breaks.windows(2) {
             let (z0, z1) = (w[0], w[1]);
             if z1 <= z0 {
                 continue;
             }
             let (mid, half) = (0.5 * (z0 + z1), 0.5 * (z1 - z0));
+            while next_edge < by_start.len() {
+                let i = by_start[next_edge];
+                if v[i][0].min(v[(i + 1) % n][0]) > mid {
+                    break;
+                }
+                active.push(i);
+                next_edge += 1;
+            }
+            active.retain(|&i| v[i][0].max(v[(i + 1) % n][0]) > mid);
             for &(t, wt) in &GL3 {
                 let z = mid + half * t;
-                Self::crossings(v, z, true, &mut xs);
+                xs.clear();
+                for &i in &active {
+                    let (a, b) = (v[i], v[(i + 1) % n]);
+                    xs.push(a[1] + (z - a[0]) * (b[1] - a[1]) / (b[0] - a[0]));
+                }
+                xs.sort_unstable_by(f64::total_cmp);
                 let (mut c, mut m1, mut m2, mut m3) = (0.0, 0.0, 0.0, 0.0);
                 let mut lead = f64::NEG_INFINITY;
                 for pair in xs.chunks_exact(2) {
@@ -571,7 +626,7 @@ impl Planform {
     /// (and for non-finite `z`).
     pub fn chord(&self, z: f64) -> f64 {
         let mut xs = Vec::with_capacity(8);
-        Self::crossings(&self.vertices, z, false, &mut xs);
+        Self::crossings(&self.vertices, z, &mut xs);
         xs.chunks_exact(2).map(|p| p[1] - p[0]).sum()
     }
 
@@ -579,7 +634,7 @@ impl Planform {
     /// span or for non-finite `z`.
     pub fn leading_edge(&self, z: f64) -> Option<f64> {
         let mut xs = Vec::with_capacity(8);
-        Self::crossings(&self.vertices, z, false, &mut xs);
+        Self::crossings(&self.vertices, z, &mut xs);
         xs.last().copied()
     }
 

@@ -191,6 +191,54 @@ fn triangle_matches_closed_forms() {
     assert_relative_eq!(o.omega2, H * x3, max_relative = 1e-8);
 }
 
+/// The simple-outline check and the integrals sweep in z, so a finely sampled outline is
+/// cheap; its polygon area is still exact (issue 14: 10⁶ segments took over a minute).
+#[test]
+fn finely_sampled_outlines_are_exact() {
+    let n = 1_000_000;
+    let (span, cm) = (3.0, 3.0);
+    let p = Planform::semi_ellipse(span, cm, 0.0, 0.0, n).unwrap();
+    let nf = n as f64;
+    let area = PI * span * cm / 4.0 * nf / PI * (PI / nf).sin();
+    assert_relative_eq!(p.integrals().area, area, max_relative = 1e-9);
+    let hmf = Planform::hmf_like(16.6, n).unwrap();
+    let coarse = Planform::hmf_like(16.6, 4096).unwrap();
+    assert_relative_eq!(
+        hmf.integrals().z3,
+        coarse.integrals().z3,
+        max_relative = 1e-6
+    );
+}
+
+/// Implausible magnitudes are rejected at the field instead of overflowing (issue 14).
+#[test]
+fn implausible_sizes_name_the_field() {
+    let field = |r: paritysim_error::Result<Planform>| r.unwrap_err().field().map(str::to_owned);
+    assert_eq!(
+        field(Planform::hmf_like(1e300, 64)).as_deref(),
+        Some("tip_radius")
+    );
+    assert_eq!(
+        field(Planform::rectangle(1e300, 3.0, 0.0, 0.0)).as_deref(),
+        Some("span")
+    );
+    assert_eq!(
+        field(Planform::semi_ellipse(3.0, 3.0, 0.0, 1e300, 64)).as_deref(),
+        Some("le_offset")
+    );
+    assert_eq!(
+        field(Planform::from_points(&[
+            [0.0, 0.0],
+            [1e301, 0.0],
+            [1.0, -1.0]
+        ]))
+        .as_deref(),
+        Some("points[1]")
+    );
+    let small = Planform::rectangle(10.0, 3.0, 0.0, 0.0).unwrap();
+    assert!(small.scaled(1e300).is_err());
+}
+
 #[test]
 fn semi_ellipse_converges_to_closed_forms() {
     let (span, cm, z0) = (14.0, 4.0, 0.8);
@@ -452,8 +500,16 @@ fn bad_outlines_give_typed_errors() {
     ]));
     assert!(m.contains("wrong side") && m.contains("z"), "{m}");
     // Entirely ahead of the hinge line (outline drawn with x toward the trailing edge).
-    let m = geometry_msg(Planform::rectangle(10.0, 3.0, 0.0, 3.0));
+    let m = geometry_msg(Planform::from_points(&[
+        [0.0, 0.0],
+        [10.0, 0.0],
+        [10.0, 3.0],
+        [0.0, 3.0],
+    ]));
     assert!(m.contains("wrong side of the hinge line"), "{m}");
+    // The parametric shapes name the field that put them there.
+    let e = Planform::rectangle(10.0, 3.0, 0.0, 3.0).unwrap_err();
+    assert_eq!(e.field(), Some("le_offset"));
     // Degenerate.
     let m = geometry_msg(Planform::from_points(&[
         [1.0, 0.0],

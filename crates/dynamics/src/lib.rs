@@ -16,6 +16,7 @@
 //!   [`metrics`] and, only when asked, into [`trajectory`] columns (a name/unit/getter table).
 
 pub mod actuator;
+pub mod continuation;
 pub mod device;
 pub mod integrate;
 pub mod metrics;

@@ -1,6 +1,8 @@
 //! Integration tests of paritysim-dynamics: each checks physics against an independent
 //! formulation or a conservation law, never against recorded outputs.
 
+#[path = "dynamics/continuation.rs"]
+mod continuation;
 #[path = "dynamics/floquet.rs"]
 mod floquet;
 #[path = "dynamics/metrics.rs"]

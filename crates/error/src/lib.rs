@@ -214,6 +214,60 @@ pub fn check_in_closed(field: &'static str, value: f64, lo: f64, hi: f64) -> Res
     }
 }
 
+/// Physical plausibility ranges shared by every crate (mg-mm-ms-rad-V). A value outside them is
+/// not an insect-scale machine, and letting it through only moves the failure to an overflow or
+/// a NaN far from the field that caused it (issue 14).
+pub mod plausible {
+    /// Lengths of parts: 1 nm to 1 m, in mm.
+    pub const LENGTH_MM: (f64, f64) = (1e-6, 1e3);
+    /// Positions and offsets (may be signed or zero): |x| up to 1 m, in mm.
+    pub const OFFSET_MM: f64 = 1e3;
+    /// Joint and drivetrain angles: |q| up to 1000 rad (overflow guard, not a physical limit).
+    pub const ANGLE_RAD: f64 = 1e3;
+}
+
+/// Requires `|value| <= `[`plausible::ANGLE_RAD`] (rad).
+pub fn check_angle_rad(field: &'static str, value: f64) -> Result<f64> {
+    let hi = plausible::ANGLE_RAD;
+    if value.is_finite() && value.abs() <= hi {
+        Ok(value)
+    } else {
+        Err(Error::invalid(
+            field,
+            value,
+            format!("an angle in [-{hi:e}, {hi:e}] rad"),
+        ))
+    }
+}
+
+/// Requires a part length in [`plausible::LENGTH_MM`] (mm).
+pub fn check_length_mm(field: &'static str, value: f64) -> Result<f64> {
+    let (lo, hi) = plausible::LENGTH_MM;
+    if value.is_finite() && (lo..=hi).contains(&value) {
+        Ok(value)
+    } else {
+        Err(Error::invalid(
+            field,
+            value,
+            format!("a length in [{lo:e}, {hi:e}] mm"),
+        ))
+    }
+}
+
+/// Requires a signed offset with `|value| <= `[`plausible::OFFSET_MM`] (mm).
+pub fn check_offset_mm(field: &'static str, value: f64) -> Result<f64> {
+    let hi = plausible::OFFSET_MM;
+    if value.is_finite() && value.abs() <= hi {
+        Ok(value)
+    } else {
+        Err(Error::invalid(
+            field,
+            value,
+            format!("an offset in [-{hi:e}, {hi:e}] mm"),
+        ))
+    }
+}
+
 /// Requires every element of a slice to be finite; names the first bad index.
 pub fn check_all_finite(field: &'static str, values: &[f64]) -> Result<()> {
     match values.iter().position(|v| !v.is_finite()) {

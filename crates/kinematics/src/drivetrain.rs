@@ -36,7 +36,7 @@
 //! * **Biased pivot** (§2.4.2): arms `hL = L0 r/(1+r)`, `hR = L0/(1+r)` for arm ratio `r = hL/hR`.
 
 use nalgebra::{Matrix2, Vector2};
-use paritysim_error::{Error, Result, bail, check_finite, check_positive};
+use paritysim_error::{Error, Result, bail, check_angle_rad, check_offset_mm, check_positive};
 
 /// Result of evaluating a drivetrain at `(q1, q2)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -304,11 +304,12 @@ impl Drivetrain {
     /// Stroke angles, Jacobian and Hessians at `(q1, q2)` (mm, rad).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] for non-finite input; [`Error::OutOfDomain`] when a linkage
+    /// [`Error::InvalidParameter`] unless `|q1| <=` [`paritysim_error::plausible::OFFSET_MM`] and
+    /// `|q2| <=` [`paritysim_error::plausible::ANGLE_RAD`]; [`Error::OutOfDomain`] when a linkage
     /// cannot reach the pose (rod too short, toggle) or `|q2| >= π/2`.
     pub fn evaluate(&self, q1: f64, q2: f64) -> Result<DrivetrainEval> {
-        check_finite("q1", q1)?;
-        check_finite("q2", q2)?;
+        check_offset_mm("q1", q1)?;
+        check_angle_rad("q2", q2)?;
         match self {
             Drivetrain::HmfFourBar(d) => {
                 let (phi, grad, hess) = d.side.side_stroke(q1, 0.0, 0.0, 1.0)?;

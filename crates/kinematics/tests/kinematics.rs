@@ -540,3 +540,14 @@ fn drivetrain_errors_are_typed() {
         Err(Error::InvalidParameter { .. })
     ));
 }
+
+/// Inputs that would overflow the linear map are rejected at the argument (issue 14).
+#[test]
+fn drivetrain_rejects_implausible_inputs() {
+    let d = Drivetrain::LinearDifferential(LinearDifferential::new(3.05, 2.5, 1.0).unwrap());
+    assert_eq!(d.evaluate(1e308, 0.0).unwrap_err().field(), Some("q1"));
+    assert_eq!(d.evaluate(0.0, -1e300).unwrap_err().field(), Some("q2"));
+    assert_eq!(d.evaluate(f64::NAN, 0.0).unwrap_err().field(), Some("q1"));
+    let e = d.evaluate(0.2, 0.1).unwrap();
+    assert!(e.stroke.iter().all(|s| s.is_finite()));
+}

@@ -21,7 +21,7 @@
 //! ([`Flexure::plate_stiffness`]); the thesis formula ([`Flexure::stiffness`]) ignores this
 //! (≈ 13 % for polyimide).
 
-use paritysim_error::{Error, Result, check_positive};
+use paritysim_error::{Error, Result, check_length_mm, check_positive};
 
 use crate::material::{Material, library};
 
@@ -46,12 +46,16 @@ pub struct Flexure {
 }
 
 impl Flexure {
-    /// A flexure of `width`, `thickness` and free `length` (all mm, finite, > 0); the bending
-    /// modulus is the material's `E1` (axis 1 along the flexure length).
+    /// A flexure of `width`, `thickness` and free `length` (mm); the bending modulus is the
+    /// material's `E1` (axis 1 along the flexure length).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the field unless each length is in
+    /// [`paritysim_error::plausible::LENGTH_MM`].
     pub fn new(material: Material, width: f64, thickness: f64, length: f64) -> Result<Flexure> {
-        check_positive("width", width)?;
-        check_positive("thickness", thickness)?;
-        check_positive("length", length)?;
+        check_length_mm("width", width)?;
+        check_length_mm("thickness", thickness)?;
+        check_length_mm("length", length)?;
         Ok(Flexure {
             material,
             width,
@@ -147,7 +151,7 @@ impl CastellatedJoint {
         thickness: f64,
         flexure_length: f64,
     ) -> Result<CastellatedJoint> {
-        check_positive("joint_width", joint_width)?;
+        check_length_mm("joint_width", joint_width)?;
         if n_segments == 0 {
             return Err(Error::invalid("n_segments", n_segments, ">= 1"));
         }

@@ -738,6 +738,9 @@ fn flexure_stiffness_and_large_deflection_caveat() {
         ((0.0, 0.0075, 0.03), "width"),
         ((1.0, -0.0075, 0.03), "thickness"),
         ((1.0, 0.0075, f64::NAN), "length"),
+        // issue 14: magnitudes that overflowed to inf or divided by zero downstream
+        ((1e300, 0.03, 0.0075), "width"),
+        ((3.0, 5e-324, 2.0), "thickness"),
     ] {
         let e = Flexure::new(library::polyimide(), args.0, args.1, args.2).unwrap_err();
         assert_eq!(field(&e), Some(name));

@@ -65,6 +65,14 @@ impl Default for ShootingOptions {
 }
 
 impl ShootingOptions {
+    /// The integrator these options describe, validated for a drive `period` (ms).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the bad option.
+    pub fn integrator(&self, period: f64) -> Result<RungeKutta> {
+        self.validate(period)
+    }
+
     fn validate(&self, period: f64) -> Result<RungeKutta> {
         if !(self.t0.is_finite() && self.t0 >= 0.0 && self.t0 < period) {
             bail!(invalid "t0", self.t0, format!("in [0, {period}) ms (one drive period)"));
@@ -120,6 +128,16 @@ pub struct PeriodicOrbit {
     pub monodromy_offset: f64,
 }
 
+/// The `2n` integrated entries (coordinates, then rates) of a state.
+pub fn compact_state(n: usize, y: &State) -> DVector<f64> {
+    compact(n, y)
+}
+
+/// A state from its `2n` integrated entries (work integrals zero).
+pub fn expand_state(n: usize, v: &DVector<f64>) -> State {
+    expand(n, v)
+}
+
 fn compact(n: usize, y: &State) -> DVector<f64> {
     DVector::from_fn(
         2 * n,
@@ -136,7 +154,11 @@ fn expand(n: usize, v: &DVector<f64>) -> State {
     y
 }
 
-fn drive_period(device: &Device) -> Result<f64> {
+/// The drive period (ms).
+///
+/// # Errors
+/// [`Error::Constraint`] for a device without an actuator.
+pub fn drive_period(device: &Device) -> Result<f64> {
     device.period().ok_or_else(|| {
         Error::Constraint(
             "Floquet analysis needs a periodic drive: the device has no actuator".into(),

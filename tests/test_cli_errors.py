@@ -1,0 +1,82 @@
+"""The CLI on bad input: one line on stderr naming the problem, exit 1, never a traceback (issue 14)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from paritysim.cli import main
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def _cases(tmp: Path) -> dict[str, tuple[list[str], str]]:
+    """name -> (argv, a phrase the one-line message must contain)."""
+    (tmp / "empty.toml").write_text("")
+    (tmp / "malformed.toml").write_text('name = "x"\n[actuator\n')
+    (tmp / "binary.toml").write_bytes(b"\xff\xfe\x00garbage")
+    (tmp / "wrong_type.toml").write_text((EXAMPLES / "hmf.toml").read_text().replace("crank_mm = 0.4", 'crank_mm = "wide"'))
+    (tmp / "negative.toml").write_text((EXAMPLES / "hmf.toml").read_text().replace("frequency_hz = 110.0", "frequency_hz = -1.0"))
+    (tmp / "unknown_key.toml").write_text((EXAMPLES / "hmf.toml").read_text().replace("[options]\n", "[options]\nrecord_cyles = 3\n"))
+    (tmp / "study_missing_spec.toml").write_text('spec = "nowhere.toml"\n[grid]\n"actuator.voltage_v" = [1.0]\n')
+    (tmp / "study_bad_path.toml").write_text(f'spec = "{EXAMPLES / "hmf.toml"}"\n[grid]\n"actuator.volts" = [1.0]\n')
+    (tmp / "a_directory.toml").mkdir()
+    blocker = tmp / "blocker"
+    blocker.write_text("a file where a directory is expected")
+    hmf = str(EXAMPLES / "hmf.toml")
+    return {
+        "missing spec": (["run", str(tmp / "missing.toml")], "missing.toml"),
+        "empty spec": (["run", str(tmp / "empty.toml")], ""),
+        "malformed spec": (["run", str(tmp / "malformed.toml")], "TOML"),
+        "binary spec": (["run", str(tmp / "binary.toml")], ""),
+        "directory as spec": (["run", str(tmp / "a_directory.toml")], "a_directory.toml"),
+        "wrong type": (["run", str(tmp / "wrong_type.toml")], "crank_mm"),
+        "negative frequency": (["run", str(tmp / "negative.toml")], "frequency_hz"),
+        "unknown option key": (["run", str(tmp / "unknown_key.toml")], "record_cyles"),
+        "out is a file": (["run", hmf, "--out", str(blocker / "sub")], "blocker"),
+        "reproduce out is a file": (["reproduce", "fig2.9", "--out", str(blocker / "sub"), "--quiet"], "blocker"),
+        "missing study": (["sweep", str(tmp / "nope.toml")], "nope.toml"),
+        "study with missing spec": (["sweep", str(tmp / "study_missing_spec.toml"), "--out", str(tmp / "o")], "nowhere.toml"),
+        "study with unknown path": (["sweep", str(tmp / "study_bad_path.toml"), "--out", str(tmp / "o"), "--quiet"], "actuator.volts"),
+        "malformed study": (["sweep", str(tmp / "malformed.toml")], "TOML"),
+    }
+
+
+CASE_NAMES = [
+    "missing spec",
+    "empty spec",
+    "malformed spec",
+    "binary spec",
+    "directory as spec",
+    "wrong type",
+    "negative frequency",
+    "unknown option key",
+    "out is a file",
+    "reproduce out is a file",
+    "missing study",
+    "study with missing spec",
+    "study with unknown path",
+    "malformed study",
+]
+
+
+@pytest.mark.parametrize("case", CASE_NAMES)
+def test_bad_input_is_one_line_and_exit_1(case: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    argv, phrase = _cases(tmp_path)[case]
+    assert main(argv) == 1
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("paritysim: error: "), err
+    assert "Traceback" not in err and len(err.splitlines()) == 1, err
+    assert phrase in err, err
+
+
+def test_debug_flag_shows_the_traceback(tmp_path: Path) -> None:
+    exe = Path(sys.executable).with_name("paritysim")
+    missing = str(tmp_path / "missing.toml")
+    plain = subprocess.run([str(exe), "run", missing], capture_output=True, text=True, check=False)
+    debug = subprocess.run([str(exe), "run", missing, "--debug"], capture_output=True, text=True, check=False)
+    assert plain.returncode == 1 and "Traceback" not in plain.stderr
+    assert debug.returncode != 0 and "Traceback" in debug.stderr and "FileNotFoundError" in debug.stderr

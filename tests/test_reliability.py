@@ -1,0 +1,109 @@
+"""Hostile but fair input to the design-layer APIs (issue 14): every outcome is a finite result or a
+``ParitysimError`` naming the field, never another exception type, an overflow or a silent NaN."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import paritysim as ps
+from paritysim import laminate
+
+# Any float a user could type, including the edges that broke things: 1e300, 5e-324, nan, inf.
+ANY_FLOAT = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([0.0, -0.0, 5e-324, 1e-300, 1e300, 1e308, -1e308, math.nan, math.inf]),
+    st.floats(min_value=1e-4, max_value=50.0),  # plausible sizes, so some calls succeed
+)
+ANY_ARG = st.one_of(ANY_FLOAT, st.integers(min_value=-(2**70), max_value=2**70), st.sampled_from(["3", None, True, [1.0], "wide"]))
+
+
+def _finite(value: Any) -> bool:
+    """Every number reachable in a result (floats, arrays, dict values, properties) is finite."""
+    if isinstance(value, dict):
+        return all(_finite(v) for v in value.values())
+    if isinstance(value, (list, tuple)):
+        return all(_finite(v) for v in value)
+    if isinstance(value, np.ndarray):
+        return value.dtype.kind not in "fc" or bool(np.isfinite(value).all())
+    if isinstance(value, (float, complex)):
+        return math.isfinite(abs(value))
+    return True
+
+
+def _outcome(call: Callable[[], Any], properties: tuple[str, ...] = ()) -> str:
+    try:
+        result = call()
+        values = [result] + [getattr(result, p)() if callable(getattr(result, p)) else getattr(result, p) for p in properties]
+    except ps.ParitysimError as exc:
+        field = getattr(exc, "field", None)
+        assert field, f"typed error without a field: {exc!r}"
+        return "typed"
+    assert _finite(values), f"non-finite result {values!r}"
+    return "finite"
+
+
+SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+@SETTINGS
+@given(width=ANY_ARG, length=ANY_ARG, thickness=ANY_ARG)
+def test_flexure(width: Any, length: Any, thickness: Any) -> None:
+    _outcome(lambda: laminate.Flexure(width, length, thickness), ("stiffness", "plate_stiffness", "elastic_limit_angle"))
+
+
+@SETTINGS
+@given(tip=ANY_ARG, segments=st.one_of(st.integers(min_value=-(2**65), max_value=2**65), ANY_ARG))
+def test_hmf_like_planform(tip: Any, segments: Any) -> None:
+    if isinstance(segments, int) and 4 <= segments <= 1_000_000:
+        segments = min(segments, 512)  # valid counts are exercised below, cheaply
+    _outcome(lambda: ps.Planform.hmf_like(tip, segments=segments), ("area", "span", "mean_chord"))
+
+
+@SETTINGS
+@given(span=ANY_ARG, chord=ANY_ARG, root=ANY_ARG, lead=ANY_ARG)
+def test_rectangle_planform(span: Any, chord: Any, root: Any, lead: Any) -> None:
+    _outcome(lambda: ps.Planform.rectangle(span, chord, root, lead), ("area", "mean_chord"))
+
+
+@SETTINGS
+@given(alpha2=ANY_ARG, alpha3=ANY_ARG, phi=ANY_ARG, theta=ANY_ARG)
+def test_shoulder_pose(alpha2: Any, alpha3: Any, phi: Any, theta: Any) -> None:
+    _outcome(lambda: ps.kinematics.shoulder_pose(alpha2, alpha3, phi, theta))
+
+
+@SETTINGS
+@given(q1=ANY_FLOAT, q2=ANY_FLOAT)
+def test_linear_differential_map(q1: float, q2: float) -> None:
+    drive = ps.Drivetrain.linear_differential(3.05, 2.5)
+    _outcome(lambda: ps.kinematics.drivetrain_map(drive, [q1], q2))
+
+
+def test_reproducers_name_their_field() -> None:
+    """The issue's reproducers, each now a typed error naming the field."""
+    cases: list[tuple[Callable[[], Any], str]] = [
+        (lambda: ps.Planform.hmf_like(16.6, segments=-1), "segments"),
+        (lambda: ps.Planform.hmf_like(1e300), "tip_radius"),
+        (lambda: laminate.Flexure(1e300, 0.03, 7.5), "width"),
+        (lambda: laminate.Flexure(3, 2, 5e-324), "thickness"),
+        (lambda: ps.kinematics.drivetrain_map(ps.Drivetrain.linear_differential(3.05, 2.5), [1e308], 0.0), "q1"),
+        (lambda: ps.kinematics.shoulder_pose("2.0", 1.0, 0.0, 0.0), "alpha2"),
+        (lambda: ps.Planform.semi_ellipse(3, 3, segments=2.5), "segments"),
+    ]
+    for call, field in cases:
+        with pytest.raises(ps.ParitysimError) as info:
+            call()
+        assert field in str(getattr(info.value, "field", "")), (field, info.value)
+
+
+def test_finest_documented_outline_is_exact() -> None:
+    """``segments = 10**6`` (the documented maximum) ran past 60 s; the polygon area is exact."""
+    n = 10**6
+    p = ps.Planform.semi_ellipse(3.0, 3.0, segments=n)
+    assert p.area == pytest.approx(math.pi * 9.0 / 4.0 * n / math.pi * math.sin(math.pi / n), rel=1e-9)
