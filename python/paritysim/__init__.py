@@ -32,7 +32,7 @@ from .simulation import SimulationResult, simulate
 
 # `paritysim.sweep` is the function (the module stays importable as paritysim.sweep via importlib).
 from .sweep import grid, sweep  # noqa: E402
-from .spec import Actuator, Aero, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, TunableHinge, Waveform, Wing, load_spec
+from .spec import Actuator, Aero, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, Springs, TunableHinge, Waveform, Wing, load_spec, spec_paths
 
 __all__ = [
     "Actuator",
@@ -49,6 +49,8 @@ __all__ = [
     "Simulation",
     "SimulationResult",
     "Spring",
+    "Springs",
+    "spec_paths",
     "TunableHinge",
     "Waveform",
     "Wing",

@@ -86,12 +86,12 @@ def simulate(spec: Simulation, **option_overrides: Any) -> SimulationResult:
 
     if option_overrides:
         spec = spec.replace(options=dataclasses.replace(spec.options, **option_overrides))
-    raw = _core.simulate(spec.device_dict(), spec.options_dict())
+    raw = _core.simulate(spec.to_json())
     return SimulationResult(
-        metrics=raw["metrics"],
-        cycles_run=int(raw["cycles_run"]),
-        converged=bool(raw["converged"]),
-        period_ms=float(raw["period_ms"]),
+        metrics=dict(raw.metrics),
+        cycles_run=raw.cycles_run,
+        converged=raw.converged,
+        period_ms=raw.period_ms,
         spec=spec,
-        columns={"time_ms": raw["time_ms"], **raw["columns"]},
+        columns={"time_ms": raw.time_ms, **raw.columns},
     )

@@ -14,7 +14,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{same_len, shaped, to_vec};
-use crate::dynamics::parse_device;
+use crate::spec::device as parse_device;
 use crate::errors::IntoPyResult;
 
 fn c64(z: Complex<f64>) -> Complex64 {
@@ -379,7 +379,7 @@ fn floquet_dict<'py>(py: Python<'py>, f: &NonlinearFloquet) -> PyResult<Bound<'p
 #[pyo3(signature = (spec, options = None))]
 fn stability_floquet<'py>(
     py: Python<'py>,
-    spec: &Bound<'py, PyDict>,
+    spec: &str,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let device = parse_device(spec).py_err()?;
@@ -396,7 +396,7 @@ fn stability_floquet<'py>(
 #[pyo3(signature = (spec, k2, options = None))]
 fn stability_k2_sweep<'py>(
     py: Python<'py>,
-    spec: &Bound<'py, PyDict>,
+    spec: &str,
     k2: PyReadonlyArray1<'py, f64>,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -465,7 +465,7 @@ fn lti_dict<'py>(py: Python<'py>, lti: &floquet::LtiModel) -> PyResult<Bound<'py
 #[pyo3(signature = (spec, options = None, samples = 2000))]
 fn stability_linearise<'py>(
     py: Python<'py>,
-    spec: &Bound<'py, PyDict>,
+    spec: &str,
     options: Option<&Bound<'py, PyDict>>,
     samples: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -518,7 +518,7 @@ const DISTURBANCE_KEYS: [&str; 5] = [
 #[pyo3(signature = (spec, frequency_hz, amplitude, options = None, disturbance = None))]
 fn stability_disturbance_response<'py>(
     py: Python<'py>,
-    spec: &Bound<'py, PyDict>,
+    spec: &str,
     frequency_hz: PyReadonlyArray1<'py, f64>,
     amplitude: f64,
     options: Option<&Bound<'py, PyDict>>,

@@ -217,3 +217,9 @@ pub struct Wing {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tunable_hinge: Option<TunableHinge>,
 }
+
+impl Default for Aero {
+    fn default() -> Self {
+        Aero::StrokeDrag(StrokeDrag::default())
+    }
+}
