@@ -94,6 +94,8 @@ def valid_paths(spec: Simulation, aliases: bool = True) -> list[str]:
     if not aliases:
         return paths
     fields = sorted({p[len("wings[0].") :] for p in paths if p.startswith("wings[0].")})
+    if spec.wings[0].aero is not None:
+        fields.append("omega_ratio")
     out = paths + [f"wings[*].{f}" for f in fields]
     if len(spec.wings) == 2:
         out += [f"wings.{side}.{f}" for side in ("left", "right") for f in fields]

@@ -7,14 +7,15 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct Sine {
-    /// Amplitude (V), in [0, 1000].
-    #[schemars(range(min = 0.0, max = 1000.0), extend("x-unit" = "V"))]
+    /// Amplitude (V), in [0, 1e4] (bimorphs run at a few hundred volts; the bound leaves room
+    /// for deliberately overdriven studies).
+    #[schemars(range(min = 0.0, max = 1e4), extend("x-unit" = "V"))]
     pub amplitude_v: f64,
     /// Drive frequency (Hz), in (0, 1e4].
     #[schemars(range(max = 1e4), extend("exclusiveMinimum" = 0.0, "x-unit" = "Hz"))]
     pub frequency_hz: f64,
-    /// DC offset (V), in [-1000, 1000].
-    #[schemars(range(min = -1000.0, max = 1000.0), extend("x-unit" = "V"))]
+    /// DC offset (V), in [-1e4, 1e4].
+    #[schemars(range(min = -1e4, max = 1e4), extend("x-unit" = "V"))]
     pub offset_v: f64,
     /// Phase (rad), in [-2pi, 2pi].
     #[schemars(range(min = -std::f64::consts::TAU, max = std::f64::consts::TAU), extend("x-unit" = "rad"))]
@@ -40,8 +41,8 @@ pub struct Sampled {
     /// Sample times in `[0, period_ms)`, strictly increasing (ms).
     #[schemars(inner(range(min = 0.0, max = 1e6)), extend("x-unit" = "ms"))]
     pub times_ms: Vec<f64>,
-    /// Voltages (V), each in [-1000, 1000].
-    #[schemars(inner(range(min = -1000.0, max = 1000.0)), extend("x-unit" = "V"))]
+    /// Voltages (V), each in [-1e4, 1e4].
+    #[schemars(inner(range(min = -1e4, max = 1e4)), extend("x-unit" = "V"))]
     pub voltages_v: Vec<f64>,
     /// Period (ms), in (0, 1e6].
     #[schemars(range(max = 1e6), extend("exclusiveMinimum" = 0.0, "x-unit" = "ms"))]

@@ -122,9 +122,9 @@ def device(p: Params, drivetrain: str, omega_l: float, arm_ratio: float = 1.0) -
     elif drivetrain == "PARITY":
         config = "drag_parity_fixed"
         if p.drivetrain == "linkage":
-            kinematics = Drivetrain.linkage_differential(whippletree_length_mm=2 * p.arm_mm, arm_ratio=arm_ratio, balance_stiffness=p.balance_stiffness)
+            kinematics = Drivetrain.linkage_differential(whippletree_length_mm=2 * p.arm_mm, arm_ratio=arm_ratio, balance_spring=p.balance_stiffness)
         else:
-            kinematics = Drivetrain.linear_differential(p.transmission_ratio, p.arm_mm, arm_ratio=arm_ratio, balance_stiffness=p.balance_stiffness)
+            kinematics = Drivetrain.linear_differential(p.transmission_ratio, p.arm_mm, arm_ratio=arm_ratio, balance_spring=p.balance_stiffness)
     else:
         from .._errors import invalid
 
