@@ -18,6 +18,7 @@ import numpy as np
 import polars as pl
 from scipy.optimize import least_squares
 
+from . import _core
 from ._errors import invalid
 from .simulation import simulate
 from .spec import Simulation
@@ -113,7 +114,8 @@ def calibrate(
         def residual_of(out: dict[str, Any]) -> np.ndarray:
             missing = [k for k in keys if k not in out]
             if missing:
-                raise invalid("targets", missing[0], f"an output of the model; available: {', '.join(sorted(k for k in out if not k.startswith('__')))}")
+                available = sorted(k for k in out if not k.startswith("__"))
+                raise invalid(f"targets.{missing[0]}", "<unknown output>", _core.spec_suggestion(missing[0], available))
             return (np.array([float(out[k]) for k in keys]) - goal) / scales
 
     log: list[dict[str, float]] = []

@@ -82,10 +82,8 @@ def simulate(spec: Simulation, **option_overrides: Any) -> SimulationResult:
     IntegrationError
         When integration fails; ``.time`` and ``.state`` say where.
     """
-    import dataclasses
-
     if option_overrides:
-        spec = spec.replace(options=dataclasses.replace(spec.options, **option_overrides))
+        spec = spec.replace(options=spec.options.with_fields("options", **option_overrides))
     raw = _core.simulate(spec.to_json())
     return SimulationResult(
         metrics=dict(raw.metrics),

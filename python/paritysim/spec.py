@@ -157,6 +157,17 @@ def _tuples(x: Any) -> Any:
 class _Node:
     """Conveniences shared by every spec class."""
 
+    def with_fields(self, path: str, **changes: Any) -> Any:
+        """A copy with fields replaced; an unknown field raises ``InvalidParameterError`` naming
+        ``path.<field>`` and the nearest valid field (the Rust core's edit distance)."""
+        names = [f.name for f in dataclasses.fields(self)]  # type: ignore[arg-type]
+        for key in changes:
+            if key not in names:
+                from ._errors import invalid
+
+                raise invalid(f"{path}.{key}", "<unknown field>", _core.spec_suggestion(key, names))
+        return dataclasses.replace(self, **changes)  # type: ignore[type-var]
+
     def to_dict(self) -> dict[str, Any]:
         """Plain data (``None`` fields left out), as the Rust core reads it."""
         return _strip_none(dataclasses.asdict(self))  # type: ignore[call-overload]

@@ -51,7 +51,6 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import contextlib
-import dataclasses
 import hashlib
 import itertools
 import json
@@ -354,10 +353,7 @@ def sweep(
     if not isinstance(spec, Simulation):
         raise invalid("spec", type(spec).__name__, "a paritysim.Simulation")
     if options:
-        try:
-            spec = spec.replace(options=dataclasses.replace(spec.options, **dict(options)))
-        except TypeError as exc:
-            raise invalid("options", repr(dict(options)), f"fields of paritysim.Options ({exc})") from None
+        spec = spec.replace(options=spec.options.with_fields("options", **dict(options)))
     table = _table(grid)
     spec_json = spec.to_json()
     _core.validate_spec(spec_json)  # the base design must be valid (typed error naming the field)

@@ -95,6 +95,12 @@ fn spec_apply(json: &str, values: &str) -> PyResult<(String, Vec<String>)> {
     Ok((out.to_json(), params.into_iter().flat_map(|p| p.notes).collect()))
 }
 
+/// "a known name: did you mean `x`? (valid: ...)" for `word` among `valid` (edit distance).
+#[pyfunction]
+fn spec_suggestion(word: &str, valid: Vec<String>) -> String {
+    schema::suggestion(word, valid.iter().map(String::as_str))
+}
+
 /// Validates a JSON spec and builds its model; returns `(n_wings, n_dof)`.
 #[pyfunction]
 fn validate_spec(json: &str) -> PyResult<(usize, usize)> {
@@ -172,6 +178,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(spec_paths, m)?)?;
     m.add_function(wrap_pyfunction!(spec_apply, m)?)?;
     m.add_function(wrap_pyfunction!(validate_spec, m)?)?;
+    m.add_function(wrap_pyfunction!(spec_suggestion, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     Ok(())
 }

@@ -220,8 +220,8 @@ pub fn nearest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) ->
         .map(|(_, c)| c)
 }
 
-/// "did you mean `x`? " (or nothing) followed by the valid names.
-pub(crate) fn suggestion<'a>(
+/// "a known name: did you mean `x`? (valid: ...)": the allowed text of an unknown name.
+pub fn suggestion<'a>(
     word: &str,
     valid: impl IntoIterator<Item = &'a str> + Clone,
 ) -> String {
