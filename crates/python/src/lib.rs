@@ -11,8 +11,8 @@ mod convert;
 mod errors;
 mod kinematics;
 mod laminate;
-mod stability;
 mod spec;
+mod stability;
 mod sweep;
 
 /// The native module.

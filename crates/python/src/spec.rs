@@ -92,7 +92,10 @@ fn spec_apply(json: &str, values: &str) -> PyResult<(String, Vec<String>)> {
         .py_err()?;
     let pairs: Vec<_> = params.iter().zip(values.values()).collect();
     let out = paths::apply(&spec, &pairs).py_err()?;
-    Ok((out.to_json(), params.into_iter().flat_map(|p| p.notes).collect()))
+    Ok((
+        out.to_json(),
+        params.into_iter().flat_map(|p| p.notes).collect(),
+    ))
 }
 
 /// "a known name: did you mean `x`? (valid: ...)" for `word` among `valid` (edit distance).

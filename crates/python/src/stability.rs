@@ -14,8 +14,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{same_len, shaped, to_vec};
-use crate::spec::device as parse_device;
 use crate::errors::IntoPyResult;
+use crate::spec::device as parse_device;
 
 fn c64(z: Complex<f64>) -> Complex64 {
     Complex64::new(z.re, z.im)

@@ -9,7 +9,7 @@ use std::time::Duration;
 use numpy::PyArray1;
 use paritysim_dynamics::sweep::{THREADS_ENV, metric_names, resolve_threads, trajectory_columns};
 use paritysim_error::Error;
-use paritysim_spec::sweep::{SweepJob, SweepOutcome, SweepPlan};
+use paritysim_spec::sweep::{KeptCycles, SweepJob, SweepOutcome, SweepPlan};
 use pyo3::prelude::*;
 
 use crate::convert::shaped;
@@ -40,8 +40,8 @@ impl SweepRun {
         let rows: Vec<Vec<serde_json::Value>> = serde_json::from_str(rows)
             .map_err(|e| Error::invalid("rows", e.to_string(), "a JSON list of rows"))
             .py_err()?;
-        let plan = SweepPlan::new(base, &names, rows, metrics.as_deref(), keep_cycle, threads)
-            .py_err()?;
+        let plan =
+            SweepPlan::new(base, &names, rows, metrics.as_deref(), keep_cycle, threads).py_err()?;
         Ok(Self {
             job: SweepJob::new(plan),
         })
@@ -170,7 +170,7 @@ impl SweepResult {
 
     /// With `keep_cycle`: column -> per point the last cycle (None where not ok).
     #[getter]
-    fn cycle(&self) -> Option<Vec<(String, Vec<Option<Vec<f64>>>)>> {
+    fn cycle(&self) -> Option<KeptCycles> {
         self.outcome.cycle.clone()
     }
 }

@@ -221,10 +221,7 @@ pub fn nearest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) ->
 }
 
 /// "a known name: did you mean `x`? (valid: ...)": the allowed text of an unknown name.
-pub fn suggestion<'a>(
-    word: &str,
-    valid: impl IntoIterator<Item = &'a str> + Clone,
-) -> String {
+pub fn suggestion<'a>(word: &str, valid: impl IntoIterator<Item = &'a str> + Clone) -> String {
     let list: Vec<&str> = valid.clone().into_iter().collect();
     match nearest(word, valid) {
         Some(best) => format!(
@@ -385,12 +382,9 @@ fn check_plain(value: &Value, s: &Map<String, Value>, path: &str, problems: &mut
                 .unwrap_or_default();
             for (k, v) in obj {
                 match props.and_then(|p| p.get(k)) {
-                    Some(sub) => {
-                        // The tag was checked by the caller.
-                        if k != "kind" || tag_of(s).is_none() {
-                            check(v, sub, &join(path, k), problems);
-                        }
-                    }
+                    // The tag of a tagged enum was checked by the caller.
+                    Some(_) if k == "kind" && tag_of(s).is_some() => {}
+                    Some(sub) => check(v, sub, &join(path, k), problems),
                     None if closed => problems.push(Problem::new(
                         join(path, k),
                         "<unknown field>",
@@ -409,7 +403,7 @@ fn check_plain(value: &Value, s: &Map<String, Value>, path: &str, problems: &mut
                     if !obj.contains_key(r) {
                         let allowed = props
                             .and_then(|p| p.get(r))
-                            .map_or_else(|| "required".to_string(), |sub| describe(sub));
+                            .map_or_else(|| "required".to_string(), describe);
                         problems.push(Problem::new(join(path, r), "missing", allowed));
                     }
                 }

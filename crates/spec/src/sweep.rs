@@ -69,7 +69,11 @@ impl SweepPlan {
                 seen.push((target, &p.name));
             }
         }
-        if let Some((i, row)) = rows.iter().enumerate().find(|(_, r)| r.len() != names.len()) {
+        if let Some((i, row)) = rows
+            .iter()
+            .enumerate()
+            .find(|(_, r)| r.len() != names.len())
+        {
             return Err(Error::Shape(format!(
                 "row {i} has {} values but there are {} parameters",
                 row.len(),
@@ -78,7 +82,11 @@ impl SweepPlan {
         }
         let device = base.device()?;
         let valid = metric_names(&device);
-        let metrics = engine::select("metrics", metrics.map(<[String]>::to_vec).as_deref(), &valid)?;
+        let metrics = engine::select(
+            "metrics",
+            metrics.map(<[String]>::to_vec).as_deref(),
+            &valid,
+        )?;
         let columns = trajectory_columns(&device);
         Ok(Self {
             base,
@@ -118,7 +126,10 @@ impl SweepPlan {
 
     /// Deprecation notes of the parameter names.
     pub fn notes(&self) -> Vec<String> {
-        self.parameters.iter().flat_map(|p| p.notes.clone()).collect()
+        self.parameters
+            .iter()
+            .flat_map(|p| p.notes.clone())
+            .collect()
     }
 
     /// The spec of point `i`.
@@ -135,6 +146,9 @@ impl SweepPlan {
         self.point_spec(i)?.model()
     }
 }
+
+/// Kept cycles: per column (`time_ms` first), per point, the samples (None where not ok).
+pub type KeptCycles = Vec<(String, Vec<Option<Vec<f64>>>)>;
 
 /// Everything a finished (or cancelled) sweep reports, one entry per point in input order.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -154,7 +168,7 @@ pub struct SweepOutcome {
     /// Error kind (the Python class without `Error`) of a failed point.
     pub error_kind: Vec<Option<String>>,
     /// With `keep_cycle`: per column (`time_ms` first), per point, the last cycle.
-    pub cycle: Option<Vec<(String, Vec<Option<Vec<f64>>>)>>,
+    pub cycle: Option<KeptCycles>,
 }
 
 impl SweepOutcome {
@@ -200,9 +214,7 @@ impl SweepOutcome {
                         let per_point = slots
                             .iter()
                             .map(|slot| match slot {
-                                Some(Ok(PointOutput {
-                                    cycle: Some(t), ..
-                                })) => Some(if k == 0 {
+                                Some(Ok(PointOutput { cycle: Some(t), .. })) => Some(if k == 0 {
                                     t.time.clone()
                                 } else {
                                     t.columns[k - 1].1.clone()
@@ -282,7 +294,9 @@ impl SweepJob {
                 signal.notify_all();
                 out
             })
-            .map_err(|e| Error::invalid("threads", 1, format!("a thread the OS can start ({e})")))?;
+            .map_err(|e| {
+                Error::invalid("threads", 1, format!("a thread the OS can start ({e})"))
+            })?;
         self.started.store(true, Ordering::Release);
         *state = State::Running(handle);
         Ok(())
@@ -382,7 +396,9 @@ impl Drop for SweepJob {
         // Never leave a detached worker behind: stop scheduling and wait for running points.
         self.control.cancel();
         let state = self.state.get_mut().unwrap_or_else(|p| p.into_inner());
-        if let State::Running(h) = std::mem::replace(state, State::Done(Ok(SweepOutcome::default()))) {
+        if let State::Running(h) =
+            std::mem::replace(state, State::Done(Ok(SweepOutcome::default())))
+        {
             let _ = h.join();
         }
     }
@@ -391,10 +407,12 @@ impl Drop for SweepJob {
 fn run(plan: &SweepPlan, control: &SweepControl) -> Result<SweepOutcome> {
     // Points are built on the pool too (validation and model construction are per point).
     let points: Vec<Result<(Device, SimulationOptions)>> =
-        engine::run_indexed(plan.len(), plan.threads, &SweepControl::new(), |i| plan.point(i))?
-            .into_iter()
-            .map(|slot| slot.unwrap_or(Err(Error::Cancelled)))
-            .collect();
+        engine::run_indexed(plan.len(), plan.threads, &SweepControl::new(), |i| {
+            plan.point(i)
+        })?
+        .into_iter()
+        .map(|slot| slot.unwrap_or(Err(Error::Cancelled)))
+        .collect();
     let slots = engine::run_points(
         &points,
         &plan.metrics,
