@@ -100,6 +100,11 @@ def _vec3(x: Sequence[float] | FloatArray | None) -> FloatArray:
 # ------------------------------------------------------------------ materials
 
 
+def _num(x: Any) -> Any:
+    """numpy scalars unwrapped; anything else passed on for Rust to check (and name)."""
+    return x.item() if isinstance(x, np.generic) else x
+
+
 @dataclass(frozen=True)
 class Material:
     """A validated orthotropic ply material (axis 1 = fibre / roll direction).
@@ -129,18 +134,19 @@ class Material:
 
     def to_dict(self) -> dict[str, Any]:
         """The dict understood by the ``_core.laminate_*`` functions."""
+        # No float() here: Rust names a non-numeric field with an InvalidParameterError.
         return {
             "name": self.name,
             "class": self.category,
-            "e1": float(self.e1),
-            "e2": float(self.e2),
-            "g12": float(self.g12),
-            "nu12": float(self.nu12),
-            "density": float(self.density),
-            "alpha1": float(self.alpha1),
-            "alpha2": float(self.alpha2),
-            "d31": None if self.d31 is None else float(self.d31),
-            "max_field": None if self.max_field is None else float(self.max_field),
+            "e1": _num(self.e1),
+            "e2": _num(self.e2),
+            "g12": _num(self.g12),
+            "nu12": _num(self.nu12),
+            "density": _num(self.density),
+            "alpha1": _num(self.alpha1),
+            "alpha2": _num(self.alpha2),
+            "d31": None if self.d31 is None else _num(self.d31),
+            "max_field": None if self.max_field is None else _num(self.max_field),
         }
 
     @classmethod
@@ -205,7 +211,8 @@ class Ply:
 
     def to_dict(self) -> dict[str, Any]:
         """Dict form for ``_core``."""
-        return {"material": self.material.to_dict(), "thickness": float(self.thickness), "angle": float(self.angle)}
+        material = self.material.to_dict() if isinstance(self.material, Material) else self.material
+        return {"material": material, "thickness": _num(self.thickness), "angle": _num(self.angle)}
 
 
 @dataclass(frozen=True)
