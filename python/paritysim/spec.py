@@ -294,16 +294,9 @@ class Drivetrain(_Tagged):
         return cls(kind="linkage_differential", crank_mm=crank_mm, rod_mm=rod_mm, whippletree_length_mm=whippletree_length_mm, arm_ratio=arm_ratio, balance_spring=balance_spring)  # type: ignore[call-arg]
 
     def kinematics(self) -> _core.Drivetrain:
-        """The native kinematic object (validates the parameters). The constructor of each
-        kind is the ``_core.Drivetrain`` static method of that name."""
-        from ._errors import invalid
-
-        build = getattr(_core.Drivetrain, self.kind, None)  # type: ignore[attr-defined]
-        if build is None or _variant("Drivetrain", self.kind) is None:  # type: ignore[attr-defined]
-            kinds = [v["properties"]["kind"]["const"] for v in _definition("Drivetrain")["oneOf"]]
-            raise invalid("drivetrain.kind", repr(self.kind), "one of " + ", ".join(kinds))  # type: ignore[attr-defined]
-        args = {k: getattr(self, k) for k in self.kind_fields() if k != "balance_spring"}
-        return build(**args)  # type: ignore[no-any-return]
+        """The native kinematic object, built in Rust from this spec (validates the kind and
+        the lengths)."""
+        return _core.Drivetrain.from_spec(_dumps(self.to_dict()))
 
     @property
     def dof(self) -> int:

@@ -71,6 +71,23 @@ pub fn from_toml(text: &str) -> Result<(Simulation, Vec<String>)> {
     from_value(value)
 }
 
+/// A drivetrain spec alone (a `[drivetrain]` table as JSON), validated like one.
+///
+/// # Errors
+/// As [`from_value`], with paths under `drivetrain`.
+pub fn drivetrain_from_json(text: &str) -> Result<Drivetrain> {
+    let value: Value = serde_json::from_str(text)
+        .map_err(|e| Error::invalid("drivetrain", e.to_string(), "valid JSON"))?;
+    let mut problems = Vec::new();
+    let reference = serde_json::json!({"$ref": "#/$defs/Drivetrain"});
+    schema::check(&value, &reference, "drivetrain", &mut problems);
+    if !problems.is_empty() {
+        return Err(problems.into());
+    }
+    serde_json::from_value(value)
+        .map_err(|e| Error::invalid("drivetrain", e.to_string(), "a drivetrain spec"))
+}
+
 impl Simulation {
     /// The spec as JSON (defaults filled in, current names).
     pub fn to_json(&self) -> String {
