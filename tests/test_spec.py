@@ -145,6 +145,9 @@ def test_unknown_keys_name_the_key_and_the_nearest_valid_one() -> None:
     with pytest.raises(ps.InvalidParameterError, match="did you mean `drivetrain`") as e:
         ps.Simulation.from_dict({**good, "drivetrian": good["drivetrain"]})
     assert e.value.field == "drivetrian"
+    with pytest.raises(ps.InvalidParameterError, match="did you mean `balance_spring`") as e:
+        ps.Drivetrain(kind="linkage_differential", balance_sprin=1.0)
+    assert e.value.field == "Drivetrain.balance_sprin"
     with pytest.raises(ps.InvalidParameterError, match="did you mean `max_cycles`") as e:
         ps.simulate(SPECS[0], max_cycle=3)
     assert e.value.field == "options.max_cycle"

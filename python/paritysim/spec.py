@@ -125,6 +125,19 @@ def _from_core(cls: type) -> type:
             setattr(cls, key, default)
     cls.__annotations__ = annotations
     built = dataclass(frozen=True)(cls)
+    names = [key for key, *_ in specs]
+    init = built.__init__
+
+    @functools.wraps(init)
+    def checked_init(self: Any, *args: Any, **kwargs: Any) -> None:
+        for key in kwargs:
+            if key not in names:  # a typed error with the nearest field, not a bare TypeError
+                from ._errors import invalid
+
+                raise invalid(f"{cls.__name__}.{key}", "<unknown field>", _core.spec_suggestion(key, names))
+        init(self, *args, **kwargs)
+
+    built.__init__ = checked_init  # type: ignore[method-assign]
     _CLASSES[cls.__name__] = built
     return built
 
