@@ -92,10 +92,10 @@ pub struct Actuator {
     pub dc_offset: DcOffset,
 }
 
-/// §3.3.1 actuator stiffness (mN/mm): the one place this number is written.
-pub const THESIS_ACTUATOR_STIFFNESS: f64 = 467.0;
-/// §3.3.1 force per volt (mN/V): 120 mN at 100 V.
-pub const THESIS_FORCE_PER_VOLT: f64 = 1.2;
+/// §3.3.1 actuator stiffness (mN/mm), defined by the engine.
+pub const THESIS_ACTUATOR_STIFFNESS: f64 = paritysim_dynamics::actuator::THESIS_STIFFNESS;
+/// §3.3.1 force per volt (mN/V), defined by the engine.
+pub const THESIS_FORCE_PER_VOLT: f64 = paritysim_dynamics::actuator::THESIS_FORCE_PER_VOLT;
 
 impl Default for Actuator {
     fn default() -> Self {

@@ -35,6 +35,10 @@ TRIALS = {"Uncut": "right_uncut", "1-Cut": "right_1cut", "2-Cut": "right_2cut"}
 DRIVETRAINS = {"HMF": "hmf", "PARITY": "drag_parity"}
 
 
+#: The §3.3.1 actuator constants, as defined once by the Rust spec's defaults.
+_THESIS_ACTUATOR = Actuator()
+
+
 @dataclass(frozen=True)
 class Params:
     """The §3.4 study (mg-mm-ms-rad-V)."""
@@ -48,8 +52,8 @@ class Params:
     offset_v: float = 100.0
     frequency_hz: float = 110.0
     dc_offset: str = "ignore"
-    force_per_volt: float = 1.2
-    actuator_stiffness: float = 467.0
+    force_per_volt: float = _THESIS_ACTUATOR.force_per_volt  # from the Rust spec
+    actuator_stiffness: float = _THESIS_ACTUATOR.stiffness  # from the Rust spec
     model: str = "dickinson1999"
     max_cycles: int = 200
     samples_per_cycle: int = 200
