@@ -40,6 +40,14 @@ pub(crate) fn node(s: &Value) -> Cow<'_, Map<String, Value>> {
     let Some(target) = schema().get("$defs").and_then(|d| d.get(name)) else {
         return empty();
     };
+    // Annotations beside a `$ref` (description, default) change nothing the walker reads: no
+    // merge, no copy.
+    if map
+        .keys()
+        .all(|k| matches!(k.as_str(), "$ref" | "description" | "default"))
+    {
+        return node(target);
+    }
     let mut merged = node(target).into_owned();
     for (k, v) in map {
         match (k.as_str(), merged.get_mut(k)) {
@@ -299,7 +307,8 @@ pub(crate) fn check(value: &Value, schema: &Value, path: &str, problems: &mut Ve
 }
 
 fn check_plain(value: &Value, s: &Map<String, Value>, path: &str, problems: &mut Vec<Problem>) {
-    let schema_value = Value::Object(s.clone());
+    // Only built when a problem is reported (cloning every node would dominate the walk).
+    let described = || describe(&Value::Object(s.clone()));
     if let Some(allowed) = s.get("enum").and_then(Value::as_array) {
         if !allowed.contains(value) {
             let names: Vec<&str> = allowed.iter().filter_map(Value::as_str).collect();
@@ -332,7 +341,7 @@ fn check_plain(value: &Value, s: &Map<String, Value>, path: &str, problems: &mut
         Value::Object(_) => t.contains(&"object"),
     };
     if !fits {
-        let allowed = describe(&schema_value);
+        let allowed = described();
         let allowed = if value.is_string() && (t.contains(&"number") || t.contains(&"integer")) {
             format!("{allowed} (finite)")
         } else {
@@ -349,7 +358,7 @@ fn check_plain(value: &Value, s: &Map<String, Value>, path: &str, problems: &mut
             let above = num(s, "maximum").is_some_and(|m| x > m)
                 || num(s, "exclusiveMaximum").is_some_and(|m| x >= m);
             if below || above || !x.is_finite() {
-                problems.push(Problem::new(path, n.to_string(), describe(&schema_value)));
+                problems.push(Problem::new(path, n.to_string(), described()));
             }
         }
         Value::Array(items) => {
