@@ -68,7 +68,7 @@ fn unknown_paths_and_duplicate_targets_fail_before_running() {
     );
     let e = plan(&["actuator.frequency_hz", "actuator.waveform.frequency_hz"]).unwrap_err();
     assert!(e.to_string().contains("same field"), "{e}");
-    assert!(matches!(plan(&["wings.left.omega_ratio"]), Ok(_)));
+    assert!(plan(&["wings.left.omega_ratio"]).is_ok());
 }
 
 #[test]
