@@ -138,6 +138,8 @@ def _from_core(cls: type) -> type:
         init(self, *args, **kwargs)
 
     built.__init__ = checked_init  # type: ignore[method-assign]
+    if issubclass(built, _Tagged):
+        built.__repr__ = _Tagged.kind_repr  # type: ignore[method-assign]
     _CLASSES[cls.__name__] = built
     return built
 
@@ -200,6 +202,12 @@ class _Tagged(_Node):
         for key, prop in variant["properties"].items():
             if key != "kind" and getattr(self, key) is None and "default" in prop:
                 object.__setattr__(self, key, _tuples(prop["default"]))
+
+    def kind_repr(self) -> str:
+        """``Drivetrain(kind='hmf_four_bar', crank_mm=0.4, rod_mm=0.8)``: the kind's fields only."""
+        names = ["kind", *self.kind_fields()]
+        names += [f.name for f in dataclasses.fields(self) if f.name not in names and getattr(self, f.name) is not None]  # type: ignore[arg-type]
+        return f"{type(self).__name__}({', '.join(f'{n}={getattr(self, n)!r}' for n in names)})"
 
     def kind_fields(self) -> list[str]:
         """The fields of this kind (besides ``kind``)."""
