@@ -264,3 +264,10 @@ def test_non_numeric_laminate_fields_are_typed_errors_naming_the_field() -> None
     with pytest.raises(ps.InvalidParameterError) as exc:
         lam.Layup([lam.Layer("k", (lam.Ply(kapton, "thin"),))]).abd()  # type: ignore[arg-type]
     assert exc.value.field == "layers[0].plies[0].thickness"
+
+
+def test_non_numeric_bimorph_geometry_is_a_typed_error() -> None:
+    layup = lam.Bimorph.design_for().layup
+    with pytest.raises(ps.InvalidParameterError) as exc:
+        lam.Bimorph(layup, "long")  # type: ignore[arg-type]
+    assert exc.value.field == "length"

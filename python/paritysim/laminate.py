@@ -100,6 +100,14 @@ def _vec3(x: Sequence[float] | FloatArray | None) -> FloatArray:
 # ------------------------------------------------------------------ materials
 
 
+def _f(x: Any, field: str) -> float:
+    """``float(x)``, or an ``InvalidParameterError`` naming ``field`` (never a bare ValueError)."""
+    try:
+        return float(x)
+    except (TypeError, ValueError):
+        raise invalid(field, repr(x), "a number") from None
+
+
 def _num(x: Any) -> Any:
     """numpy scalars unwrapped; anything else passed on for Rust to check (and name)."""
     return x.item() if isinstance(x, np.generic) else x
@@ -355,7 +363,7 @@ class Layup:
         (mN), a temperature change ``delta_t`` (K) and one voltage per layer (V, piezo layers only).
         """
         v = np.zeros(0) if voltages is None else np.asarray(voltages, dtype=np.float64).ravel()
-        return _core.laminate_response(self._dicts, _vec3(n), _vec3(m), float(delta_t), v)
+        return _core.laminate_response(self._dicts, _vec3(n), _vec3(m), _f(delta_t, "delta_t"), v)
 
     def thermal_curvature(self, delta_t: float = CURE_DELTA_T) -> FloatArray:
         """Curvature ``(κx, κy, κxy)`` (1/mm) after a uniform temperature change ``delta_t`` (K)
@@ -371,7 +379,7 @@ class Layup:
     ) -> dict[str, np.ndarray]:
         """Stresses (mN/mm², laminate axes) at the bottom and top face of every ply."""
         v = np.zeros(0) if voltages is None else np.asarray(voltages, dtype=np.float64).ravel()
-        return _core.laminate_ply_stresses(self._dicts, _vec3(n), _vec3(m), float(delta_t), v)
+        return _core.laminate_ply_stresses(self._dicts, _vec3(n), _vec3(m), _f(delta_t, "delta_t"), v)
 
     # -- drawing
     def plot(self, ax: Axes | None = None, to_scale: bool = False) -> Axes:
@@ -460,10 +468,10 @@ class Bimorph:
     def __post_init__(self) -> None:
         d = _core.laminate_bimorph(
             self.layup._dicts,
-            float(self.length),
-            float(self.extension),
-            float(self.base_width),
-            float(self.width_ratio),
+            _f(self.length, "length"),
+            _f(self.extension, "extension"),
+            _f(self.base_width, "base_width"),
+            _f(self.width_ratio, "width_ratio"),
             np.zeros(0),
         )
         object.__setattr__(self, "_data", d)
@@ -481,10 +489,10 @@ class Bimorph:
         lay = Layup.bimorph_mobee() if layup is None else layup
         d = _core.laminate_bimorph_design(
             lay._dicts,
-            float(target.stiffness_mn_per_mm),
-            float(target.force_per_volt_mn_per_v),
-            float(width_ratio),
-            float(extension_ratio),
+            _f(target.stiffness_mn_per_mm, "stiffness_mn_per_mm"),
+            _f(target.force_per_volt_mn_per_v, "force_per_volt_mn_per_v"),
+            _f(width_ratio, "width_ratio"),
+            _f(extension_ratio, "extension_ratio"),
         )
         return cls(lay, d["length"], d["extension"], d["base_width"], d["width_ratio"])
 
@@ -527,10 +535,10 @@ class Bimorph:
         v = np.asarray(voltage, dtype=np.float64)
         d = _core.laminate_bimorph(
             self.layup._dicts,
-            float(self.length),
-            float(self.extension),
-            float(self.base_width),
-            float(self.width_ratio),
+            _f(self.length, "length"),
+            _f(self.extension, "extension"),
+            _f(self.base_width, "base_width"),
+            _f(self.width_ratio, "width_ratio"),
             np.ascontiguousarray(v.ravel()),
         )
         d["shape"] = v.shape
@@ -573,7 +581,7 @@ class Flexure:
     _data: dict[str, Any] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        d = _core.laminate_flexure(self.material.to_dict(), float(self.width), float(self.thickness), float(self.length))
+        d = _core.laminate_flexure(self.material.to_dict(), _f(self.width, "width"), _f(self.thickness, "thickness"), _f(self.length, "length"))
         object.__setattr__(self, "_data", d)
 
     @classmethod
@@ -590,7 +598,7 @@ class Flexure:
         flexure of width ``joint_width · flexure_fraction``; ``n_segments`` castellations."""
         m = material("polyimide") if mat is None else mat
         d = _core.laminate_castellated_joint(
-            m.to_dict(), float(joint_width), int(n_segments), float(flexure_fraction), float(thickness), float(flexure_length)
+            m.to_dict(), _f(joint_width, "joint_width"), int(n_segments), _f(flexure_fraction, "flexure_fraction"), _f(thickness, "thickness"), _f(flexure_length, "flexure_length")
         )
         return cls(d["flexure_width"], flexure_length, thickness, m)
 
