@@ -281,7 +281,7 @@ fn check_keys(d: &Bound<'_, PyDict>, allowed: &[&str]) -> Result<()> {
             return Err(Error::invalid(
                 format!("options.{name}"),
                 "<unknown option>",
-                format!("one of {}", allowed.join(", ")),
+                paritysim_spec::schema::suggestion(&name, allowed.iter().copied()),
             ));
         }
     }
