@@ -59,7 +59,7 @@ def _timed_cpu(f):  # type: ignore[no-untyped-def]
 def parallel(points: int, repeat: int) -> None:
     spec = ps.load_spec(EXAMPLES / "drag_parity.toml")
     n_k2 = 25
-    table = grid({"drivetrain.k2": np.linspace(1.0, 20.0, n_k2).tolist(), "actuator.voltage_v": np.linspace(40.0, 100.0, max(1, points // n_k2)).tolist()})
+    table = grid({"drivetrain.balance_spring": np.linspace(1.0, 20.0, n_k2).tolist(), "actuator.voltage_v": np.linspace(40.0, 100.0, max(1, points // n_k2)).tolist()})
     sweep(spec, table.head(50), threads=2, progress=False)  # warm up
     # best of `repeat`: the machine may be shared. CPU time / wall time says how many cores the
     # run actually got (2.0 = both threads ran all the time).
@@ -82,7 +82,7 @@ def baseline(cycles: int, loop_points: int, rtol: float, repeat: int) -> None:
     atol = rtol * 1e-2
     spec = spec_for(PARAMS, cycles, rtol, atol, 0.0)
     k2s, volts = [1.0, 5.0, 20.0, 50.0], np.linspace(60.0, 100.0, 50).tolist()
-    table = grid({"drivetrain.balance_stiffness": k2s, "actuator.waveform.amplitude_v": volts})
+    table = grid({"drivetrain.balance_spring": k2s, "actuator.waveform.amplitude_v": volts})
     rows = table.rows()
     # Timings are robust to a shared machine: the scipy loop by the median point, the Pool and
     # paritysim by the best of `repeat` runs. The Pool runs first, before this process has
@@ -157,7 +157,7 @@ def jax_benchmark(points: int, cycles: int, rtol: float) -> None:
     t_compile_full, _ = _timed(lambda: batched(k2, v).block_until_ready())
     t_run, amps = _timed(lambda: batched(k2, v).block_until_ready())
     spec = spec_for(PARAMS, cycles, rtol, rtol * 1e-2, 0.0)
-    ours_t, ours = _timed(lambda: sweep(spec, {"drivetrain.balance_stiffness": [1.0, 5.0, 20.0, 50.0], "actuator.waveform.amplitude_v": table["v"].unique(maintain_order=True).to_list()}, metrics=METRICS, progress=False))
+    ours_t, ours = _timed(lambda: sweep(spec, {"drivetrain.balance_spring": [1.0, 5.0, 20.0, 50.0], "actuator.waveform.amplitude_v": table["v"].unique(maintain_order=True).to_list()}, metrics=METRICS, progress=False))
     diff = float(np.max(np.abs(np.asarray(amps) - ours["left_stroke_amplitude"].to_numpy())))
     print(f"[jax] {table.height} points: compile {t_compile:.1f} s (+{t_compile_full:.1f} s for the full batch), run {t_run / table.height * 1e3:.3f} ms/pt; "
           f"paritysim {ours_t / table.height * 1e3:.3f} ms/pt -> {t_run / ours_t:.1f}x; max |amplitude diff| {diff:.1e} rad")  # fmt: skip
@@ -167,7 +167,7 @@ def memory(points: int, threads: int | None) -> None:
     spec = ps.load_spec(EXAMPLES / "drag_parity.toml")
     cheap = {"min_cycles": 2, "max_cycles": 2, "samples_per_cycle": 16, "record_cycles": 1, "rtol": 1e-6, "atol": 1e-8}
     side = int(math.ceil(math.sqrt(points)))
-    table = grid({"drivetrain.k2": np.linspace(1.0, 20.0, side).tolist(), "actuator.voltage_v": np.linspace(40.0, 100.0, side).tolist()}).head(points)
+    table = grid({"drivetrain.balance_spring": np.linspace(1.0, 20.0, side).tolist(), "actuator.voltage_v": np.linspace(40.0, 100.0, side).tolist()}).head(points)
     with tempfile.TemporaryDirectory() as tmp:
         start = time.perf_counter()
         df = sweep(spec, table, options=cheap, threads=threads, checkpoint=Path(tmp) / "memory.parquet", progress=sys.stderr.isatty())

@@ -90,7 +90,7 @@ def spec_for(params: dict, cycles: int, rtol: float, atol: float, kick: float) -
     return ps.Simulation(
         wings=(wing(params["omega_left"]), wing(params["omega"])),
         configuration=ps.Configuration("drag_parity_fixed"),
-        drivetrain=ps.Drivetrain.linkage_differential(params["crank"], params["rod"], 2 * params["arm"], balance_stiffness=params["k2"]),
+        drivetrain=ps.Drivetrain.linkage_differential(params["crank"], params["rod"], 2 * params["arm"], balance_spring=params["k2"]),
         actuator=ps.Actuator(ps.Waveform(amplitude_v=params["amplitude_v"], frequency_hz=params["w"] / (2 * math.pi) * 1e3), params["force_per_volt"], params["k1"]),
         options=ps.Options(rtol=rtol, atol=atol, min_cycles=cycles - 1, max_cycles=cycles - 1, steady_tol=1e-30, samples_per_cycle=200,
                            initial_p_dot=None if kick == 0 else None),

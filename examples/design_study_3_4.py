@@ -24,7 +24,7 @@ import polars as pl
 
 import paritysim as ps
 
-HINGE = "wings[*].springs[5].stiffness"  # springs[5] is the ψ hinge of both wings (0-based)
+HINGE = "wings[*].springs.hinge.stiffness"  # the ψ hinge of both wings
 
 
 def grid(cut_fractions: list[float], hinges: list[float], right: ps.Aero) -> pl.DataFrame:

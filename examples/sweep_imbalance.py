@@ -44,14 +44,14 @@ def main() -> None:
     options = {"max_cycles": 400}  # soft whippletree springs settle slowly
     frames = [
         sweep(hmf, {"wings.left.omega_ratio": ratios}, metrics=METRICS, threads=args.threads, options=options)
-        .with_columns(design=pl.lit("HMF"), **{"drivetrain.k2": pl.lit(None, dtype=pl.Float64)}),
+        .with_columns(design=pl.lit("HMF"), **{"drivetrain.balance_spring": pl.lit(None, dtype=pl.Float64)}),
     ]
     for k2 in (2.0, 20.0, 100.0):
-        df = sweep(parity_linear, {"wings.left.omega_ratio": ratios, "drivetrain.k2": [k2]}, metrics=METRICS, threads=args.threads, options=options)
+        df = sweep(parity_linear, {"wings.left.omega_ratio": ratios, "drivetrain.balance_spring": [k2]}, metrics=METRICS, threads=args.threads, options=options)
         frames.append(df.with_columns(design=pl.lit(f"PARITY eq. 2.15, K2 = {k2:g}")))
-    linkage = sweep(parity, {"wings.left.omega_ratio": ratios, "drivetrain.k2": [500.0]}, metrics=METRICS, threads=args.threads, options=options)
+    linkage = sweep(parity, {"wings.left.omega_ratio": ratios, "drivetrain.balance_spring": [500.0]}, metrics=METRICS, threads=args.threads, options=options)
     frames.append(linkage.with_columns(design=pl.lit("PARITY linkage, K2 = 500")))
-    cols = ["design", "wings.left.omega_ratio", "drivetrain.k2", *METRICS, "converged", "status", "error"]
+    cols = ["design", "wings.left.omega_ratio", "drivetrain.balance_spring", *METRICS, "converged", "status", "error"]
     df = pl.concat([f.select(cols) for f in frames]).with_columns(
         roll_imbalance=1 - pl.col("left_roll_aero_peak") / pl.col("right_roll_aero_peak"),
     )

@@ -40,7 +40,7 @@ def main() -> None:
     spec = parity.replace(drivetrain=ps.Drivetrain.linear_differential(2.5, 2.5))  # eq. 2.15
     df = sweep(
         spec,
-        {"drivetrain.k2": [0.0, 20.0], "drivetrain.arm_ratio": np.geomspace(0.5, 2.0, args.points).tolist()},
+        {"drivetrain.balance_spring": [0.0, 20.0], "drivetrain.arm_ratio": np.geomspace(0.5, 2.0, args.points).tolist()},
         metrics=["left_roll_aero_peak", "right_roll_aero_peak", "left_stroke_amplitude", "right_stroke_amplitude", "q2_amplitude"],
         threads=args.threads,
         options={"max_cycles": 400},
@@ -52,7 +52,7 @@ def main() -> None:
     df.write_parquet(args.out / "sweep_pivot_bias.parquet")
 
     fig, ax = plt.subplots(figsize=(6, 4), layout="constrained")
-    plot(df, "drivetrain.arm_ratio", "roll_torque_ratio", hue="drivetrain.k2", ax=ax)
+    plot(df, "drivetrain.arm_ratio", "roll_torque_ratio", hue="drivetrain.balance_spring", ax=ax)
     r = np.geomspace(0.5, 2.0, 100)
     ax.plot(r, 1 / r, "k--", lw=1, label="static balance 1/r")
     ax.set(xscale="log", yscale="log", xlabel="arm ratio r = hL/hR", ylabel="peak roll torque ratio τL/τR")

@@ -254,3 +254,20 @@ def test_castellated_joint() -> None:
     with pytest.raises(ps.InvalidParameterError) as exc:
         lam.Flexure.castellated(2.0, 0, 0.03)
     assert exc.value.field == "n_segments"
+
+
+def test_non_numeric_laminate_fields_are_typed_errors_naming_the_field() -> None:
+    with pytest.raises(ps.InvalidParameterError) as exc:
+        lam.Material("x", "metal", "stiff", 1.0e6, 4.0e5, 0.3, 1.0, 0.0, 0.0)  # type: ignore[arg-type]
+    assert exc.value.field == "e1"
+    kapton = lam.material("kapton")
+    with pytest.raises(ps.InvalidParameterError) as exc:
+        lam.Layup([lam.Layer("k", (lam.Ply(kapton, "thin"),))]).abd()  # type: ignore[arg-type]
+    assert exc.value.field == "layers[0].plies[0].thickness"
+
+
+def test_non_numeric_bimorph_geometry_is_a_typed_error() -> None:
+    layup = lam.Bimorph.design_for().layup
+    with pytest.raises(ps.InvalidParameterError) as exc:
+        lam.Bimorph(layup, "long")  # type: ignore[arg-type]
+    assert exc.value.field == "length"

@@ -8,6 +8,8 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+from typing import Any
+
 import numpy as np
 import polars as pl
 import pytest
@@ -131,9 +133,13 @@ def test_invalid_inputs_name_the_field() -> None:
 # ------------------------------------------------------------------ the nonlinear model
 
 
+def _device_part(spec: ps.Simulation) -> dict[str, Any]:
+    return {k: v for k, v in spec.to_dict().items() if k not in ("name", "options")}
+
+
 def test_trial_specs_are_the_examples() -> None:
-    assert drag_parity_spec(1.0).device_dict() == ps.load_spec(EXAMPLES / "drag_parity.toml").device_dict()
-    assert hmf_spec().device_dict() == ps.load_spec(EXAMPLES / "hmf.toml").device_dict()
+    assert _device_part(drag_parity_spec(1.0)) == _device_part(ps.load_spec(EXAMPLES / "drag_parity.toml"))
+    assert _device_part(hmf_spec()) == _device_part(ps.load_spec(EXAMPLES / "hmf.toml"))
 
 
 def test_whippletree_mode_of_the_example_is_unstable_and_k2_stabilises_it() -> None:

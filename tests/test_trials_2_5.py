@@ -31,7 +31,7 @@ def test_tunable_hinge_stiffens_with_deviation_and_reduces_rotation() -> None:
 def test_hinge_validation_is_typed() -> None:
     import pytest
 
-    with pytest.raises(ps.InvalidParameterError, match="k1"):
+    with pytest.raises(ps.InvalidParameterError, match=r"tunable_hinge\.stiffness_slope"):
         spec = s25.device("lift_parity", "Uncut", hinge_k2=1.0, **FAST)
         bad = ps.Wing.from_moments(49, 50.5, 1.56, 4.2, aero=spec.wings[0].aero, tunable_hinge=ps.TunableHinge(1.0, 5.0, 1.0))
         ps.simulate(spec.replace(wings=(bad, bad)))

@@ -43,7 +43,7 @@ def test_flipping_ixz_flips_the_inertially_driven_rotation() -> None:
     """With drag about the stroke axis only, ψ is driven by inertial coupling alone. The kinetic
     energy ½ωᵀIω with ω = (φ̇ cos ψ, −φ̇ sin ψ, ψ̇) is invariant under (Ixz, ψ) → (−Ixz, −ψ), and
     the hinge spring is even in ψ, so ψ must change sign and φ must not change."""
-    hinge = tuple(ps.Spring(stiffness=2.5 if j == 5 else 0.0) for j in range(6))
+    hinge = ps.Springs(hinge=ps.Spring(stiffness=2.5))
 
     def run(ixz: float) -> ps.SimulationResult:
         wing = ps.Wing.from_moments(49.0, 50.5, 1.56, ixz, springs=hinge, aero=ps.Aero(kind="stroke_drag", omega1=46.8, coefficient=3.46))

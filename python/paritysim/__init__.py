@@ -43,7 +43,7 @@ if TYPE_CHECKING:  # what type checkers see; at run time the names below load la
     from .calibration import CalibrationResult, calibrate
     from .planform import Planform
     from .simulation import SimulationResult, simulate
-    from .spec import Actuator, Aero, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, TunableHinge, Waveform, Wing, load_spec
+    from .spec import Actuator, Aero, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, Springs, TunableHinge, Waveform, Wing, load_spec, spec_paths
     from .sweep import grid, sweep
 
 #: Lazily loaded submodules.
@@ -56,7 +56,7 @@ _NAMES = {
     "SimulationResult": "simulation",
     "simulate": "simulation",
     "grid": "sweep",
-    **{n: "spec" for n in ("Actuator", "Aero", "Configuration", "Drivetrain", "Options", "Shoulder", "Simulation", "Spring", "TunableHinge", "Waveform", "Wing", "load_spec")},
+    **{n: "spec" for n in ("Actuator", "Aero", "Configuration", "Drivetrain", "Options", "Shoulder", "Simulation", "Spring", "Springs", "TunableHinge", "Waveform", "Wing", "load_spec", "spec_paths")},
 }
 
 
@@ -98,6 +98,7 @@ __all__ = [
     "SimulationResult",
     "SingularError",
     "Spring",
+    "Springs",
     "TunableHinge",
     "Waveform",
     "Wing",
@@ -115,6 +116,7 @@ __all__ = [
     "plots",
     "simulate",
     "spec",
+    "spec_paths",
     "stability",
     "sweep",
     "trials",

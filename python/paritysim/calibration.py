@@ -8,7 +8,6 @@ Jacobian columns run in parallel threads (``workers``).
 from __future__ import annotations
 
 import math
-import re
 import threading
 from collections.abc import Callable, Mapping
 from concurrent.futures import ThreadPoolExecutor
@@ -19,62 +18,12 @@ import numpy as np
 import polars as pl
 from scipy.optimize import least_squares
 
+from . import _core
 from ._errors import invalid
 from .simulation import simulate
 from .spec import Simulation
 
-__all__ = ["CalibrationResult", "calibrate", "set_path"]
-
-_TOKEN = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(\d+|\*)\]")
-
-
-def set_path(data: dict[str, Any], path: str, value: float) -> None:
-    """Set ``value`` at a dotted path in nested plain data, e.g. ``"drivetrain.balance_stiffness"``,
-    ``"wings[0].aero.omega1"``, ``"wings[*].inertia[0][0]"`` (``*``: every element).
-
-    Raises ``InvalidParameterError`` naming the path when it does not exist.
-    """
-    tokens = [m.group(1) if m.group(1) is not None else m.group(2) for m in _TOKEN.finditer(path)]
-    if not tokens or "".join(f".{t}" if not (t.isdigit() or t == "*") else f"[{t}]" for t in tokens).lstrip(".") != path:
-        raise invalid("path", repr(path), "a dotted path like 'wings[0].aero.omega1'")
-
-    def walk(node: Any, i: int) -> None:
-        key = tokens[i]
-        last = i == len(tokens) - 1
-        if key == "*":
-            if not isinstance(node, list):
-                raise invalid("path", repr(path), f"'*' must index a list (at step {i})")
-            for k in range(len(node)):
-                if last:
-                    node[k] = value
-                else:
-                    walk(node[k], i + 1)
-            return
-        if key.isdigit():
-            if not isinstance(node, list) or int(key) >= len(node):
-                raise invalid("path", repr(path), f"an existing list index at '[{key}]'")
-            idx: Any = int(key)
-        else:
-            if not isinstance(node, dict) or key not in node:
-                keys = ", ".join(node) if isinstance(node, dict) else "(not a table)"
-                raise invalid("path", repr(path), f"an existing field at '{key}'; here: {keys}")
-            idx = key
-        if last:
-            node[idx] = value
-        else:
-            node[idx] = list(node[idx]) if isinstance(node[idx], tuple) else node[idx]
-            walk(node[idx], i + 1)
-
-    walk(data, 0)
-
-
-def _lists(x: Any) -> Any:
-    if isinstance(x, dict):
-        return {k: _lists(v) for k, v in x.items()}
-    if isinstance(x, list | tuple):
-        return [_lists(v) for v in x]
-    return x
-
+__all__ = ["CalibrationResult", "calibrate"]
 
 @dataclass(frozen=True)
 class CalibrationResult:
@@ -104,8 +53,8 @@ def calibrate(
 ) -> CalibrationResult:
     """Least-squares fit of the ``free`` parameters (name -> (low, high)).
 
-    ``model``: a :class:`Simulation` (names are dotted paths into ``spec.to_dict()``, see
-    :func:`set_path`; outputs are the simulation metrics) or a callable ``f(**values)``
+    ``model``: a :class:`Simulation` (names are the spec paths of :func:`paritysim.spec_paths`,
+    the same language as :func:`paritysim.sweep`; outputs are the simulation metrics) or a callable ``f(**values)``
     returning a mapping of outputs.
 
     ``diff_step``: finite-difference step as a fraction of each parameter's bound range.
@@ -130,17 +79,12 @@ def calibrate(
     trajectory_target = isinstance(targets, pl.DataFrame)
 
     if isinstance(model, Simulation):
-        base = _lists(model.to_dict())
-        if not trajectory_target:
-            # Validate every path before running anything.
-            for n in names:
-                set_path(_lists(model.to_dict()), n, 0.0)
+        base = model
+        # Validate every path (unknown: the nearest valid one) before running anything.
+        base.with_paths({n: float(v) for n, v in zip(names, start, strict=True)})
 
         def outputs(values: dict[str, float]) -> dict[str, Any]:
-            data = _lists(base)
-            for n, v in values.items():
-                set_path(data, n, v)
-            result = simulate(Simulation.from_dict(data))
+            result = simulate(base.with_paths(values))
             out: dict[str, Any] = dict(result.metrics)
             if trajectory_target:
                 out["__trajectory__"] = result.trajectory
@@ -170,7 +114,8 @@ def calibrate(
         def residual_of(out: dict[str, Any]) -> np.ndarray:
             missing = [k for k in keys if k not in out]
             if missing:
-                raise invalid("targets", missing[0], f"an output of the model; available: {', '.join(sorted(k for k in out if not k.startswith('__')))}")
+                available = sorted(k for k in out if not k.startswith("__"))
+                raise invalid(f"targets.{missing[0]}", "<unknown output>", _core.spec_suggestion(missing[0], available))
             return (np.array([float(out[k]) for k in keys]) - goal) / scales
 
     log: list[dict[str, float]] = []

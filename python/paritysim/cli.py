@@ -162,7 +162,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Exception as exc:  # noqa: BLE001 - the CLI's contract: one line, never a traceback
         if debug:
             raise
-        print(f"paritysim: error: {describe_error(exc)}", file=sys.stderr)
+        one_line = " ".join(part.strip() for part in describe_error(exc).splitlines() if part.strip())
+        print(f"paritysim: error: {one_line}", file=sys.stderr)
         return 1
 
 

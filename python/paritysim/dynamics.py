@@ -60,5 +60,5 @@ def wing_terms(wing: Wing | Simulation, p: Any, p_dot: Any, *, index: int = 0) -
         Outside the shoulder's joint limit or at a singular pose.
     """
     spec = wing if isinstance(wing, Simulation) else Simulation(wings=(wing,), configuration=Configuration(name=None))
-    raw = _core.dynamics_wing_terms(spec.device_dict(), int(index), _vec3(p, "p"), _vec3(p_dot, "p_dot"))
+    raw = _core.dynamics_wing_terms(spec.to_json(), int(index), _vec3(p, "p"), _vec3(p_dot, "p_dot"))
     return WingTerms(**raw)

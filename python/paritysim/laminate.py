@@ -100,6 +100,16 @@ def _vec3(x: Sequence[float] | FloatArray | None) -> FloatArray:
 # ------------------------------------------------------------------ materials
 
 
+def _f(x: Any, field: str) -> float:
+    """``float(x)``, or an ``InvalidParameterError`` naming ``field`` (never a bare ValueError)."""
+    return real(field, x)
+
+
+def _num(x: Any) -> Any:
+    """numpy scalars unwrapped; anything else passed on for Rust to check (and name)."""
+    return x.item() if isinstance(x, np.generic) else x
+
+
 @dataclass(frozen=True)
 class Material:
     """A validated orthotropic ply material (axis 1 = fibre / roll direction).
@@ -129,18 +139,19 @@ class Material:
 
     def to_dict(self) -> dict[str, Any]:
         """The dict understood by the ``_core.laminate_*`` functions."""
+        # No float() here: Rust names a non-numeric field with an InvalidParameterError.
         return {
             "name": self.name,
             "class": self.category,
-            "e1": real("e1", self.e1),
-            "e2": real("e2", self.e2),
-            "g12": real("g12", self.g12),
-            "nu12": real("nu12", self.nu12),
-            "density": real("density", self.density),
-            "alpha1": real("alpha1", self.alpha1),
-            "alpha2": real("alpha2", self.alpha2),
-            "d31": None if self.d31 is None else real("d31", self.d31),
-            "max_field": None if self.max_field is None else real("max_field", self.max_field),
+            "e1": _num(self.e1),
+            "e2": _num(self.e2),
+            "g12": _num(self.g12),
+            "nu12": _num(self.nu12),
+            "density": _num(self.density),
+            "alpha1": _num(self.alpha1),
+            "alpha2": _num(self.alpha2),
+            "d31": None if self.d31 is None else _num(self.d31),
+            "max_field": None if self.max_field is None else _num(self.max_field),
         }
 
     @classmethod
@@ -205,7 +216,8 @@ class Ply:
 
     def to_dict(self) -> dict[str, Any]:
         """Dict form for ``_core``."""
-        return {"material": self.material.to_dict(), "thickness": real("thickness", self.thickness), "angle": real("angle", self.angle)}
+        material = self.material.to_dict() if isinstance(self.material, Material) else self.material
+        return {"material": material, "thickness": _num(self.thickness), "angle": _num(self.angle)}
 
 
 @dataclass(frozen=True)
@@ -348,7 +360,7 @@ class Layup:
         (mN), a temperature change ``delta_t`` (K) and one voltage per layer (V, piezo layers only).
         """
         v = np.zeros(0) if voltages is None else np.asarray(voltages, dtype=np.float64).ravel()
-        return _core.laminate_response(self._dicts, _vec3(n), _vec3(m), real("delta_t", delta_t), v)
+        return _core.laminate_response(self._dicts, _vec3(n), _vec3(m), _f(delta_t, "delta_t"), v)
 
     def thermal_curvature(self, delta_t: float = CURE_DELTA_T) -> FloatArray:
         """Curvature ``(κx, κy, κxy)`` (1/mm) after a uniform temperature change ``delta_t`` (K)
@@ -364,7 +376,7 @@ class Layup:
     ) -> dict[str, np.ndarray]:
         """Stresses (mN/mm², laminate axes) at the bottom and top face of every ply."""
         v = np.zeros(0) if voltages is None else np.asarray(voltages, dtype=np.float64).ravel()
-        return _core.laminate_ply_stresses(self._dicts, _vec3(n), _vec3(m), real("delta_t", delta_t), v)
+        return _core.laminate_ply_stresses(self._dicts, _vec3(n), _vec3(m), _f(delta_t, "delta_t"), v)
 
     # -- drawing
     def plot(self, ax: Axes | None = None, to_scale: bool = True) -> Axes:
@@ -474,10 +486,10 @@ class Bimorph:
     def __post_init__(self) -> None:
         d = _core.laminate_bimorph(
             self.layup._dicts,
-            real("length", self.length),
-            real("extension", self.extension),
-            real("base_width", self.base_width),
-            real("width_ratio", self.width_ratio),
+            _f(self.length, "length"),
+            _f(self.extension, "extension"),
+            _f(self.base_width, "base_width"),
+            _f(self.width_ratio, "width_ratio"),
             np.zeros(0),
         )
         object.__setattr__(self, "_data", d)
@@ -495,10 +507,10 @@ class Bimorph:
         lay = Layup.bimorph_mobee() if layup is None else layup
         d = _core.laminate_bimorph_design(
             lay._dicts,
-            float(target.stiffness_mn_per_mm),
-            float(target.force_per_volt_mn_per_v),
-            real("width_ratio", width_ratio),
-            real("extension_ratio", extension_ratio),
+            _f(target.stiffness_mn_per_mm, "stiffness_mn_per_mm"),
+            _f(target.force_per_volt_mn_per_v, "force_per_volt_mn_per_v"),
+            _f(width_ratio, "width_ratio"),
+            _f(extension_ratio, "extension_ratio"),
         )
         return cls(lay, d["length"], d["extension"], d["base_width"], d["width_ratio"])
 
@@ -541,10 +553,10 @@ class Bimorph:
         v = np.asarray(voltage, dtype=np.float64)
         d = _core.laminate_bimorph(
             self.layup._dicts,
-            real("length", self.length),
-            real("extension", self.extension),
-            real("base_width", self.base_width),
-            real("width_ratio", self.width_ratio),
+            _f(self.length, "length"),
+            _f(self.extension, "extension"),
+            _f(self.base_width, "base_width"),
+            _f(self.width_ratio, "width_ratio"),
             np.ascontiguousarray(v.ravel()),
         )
         d["shape"] = v.shape
@@ -587,7 +599,7 @@ class Flexure:
     _data: dict[str, Any] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        d = _core.laminate_flexure(self.material.to_dict(), real("width", self.width), real("thickness", self.thickness), real("length", self.length))
+        d = _core.laminate_flexure(self.material.to_dict(), _f(self.width, "width"), _f(self.thickness, "thickness"), _f(self.length, "length"))
         object.__setattr__(self, "_data", d)
 
     @classmethod
@@ -604,7 +616,7 @@ class Flexure:
         flexure of width ``joint_width · flexure_fraction``; ``n_segments`` castellations."""
         m = material("polyimide") if mat is None else mat
         d = _core.laminate_castellated_joint(
-            m.to_dict(), real("joint_width", joint_width), whole("n_segments", n_segments), real("flexure_fraction", flexure_fraction), real("thickness", thickness), real("flexure_length", flexure_length)
+            m.to_dict(), _f(joint_width, "joint_width"), whole("n_segments", n_segments), _f(flexure_fraction, "flexure_fraction"), _f(thickness, "thickness"), _f(flexure_length, "flexure_length")
         )
         return cls(d["flexure_width"], flexure_length, thickness, m)
 

@@ -56,7 +56,7 @@ def label_with_unit(column: str) -> str:
             return column if unit == "-" else f"{column} ({unit})"
     if name.endswith(("cycles_run", "point", "_phase_lag")):
         return f"{column} (rad)" if name.endswith("_phase_lag") else column
-    if name.startswith("wings") and ".springs[" in name:
+    if name.startswith("wings") and (".springs." in name or ".springs[" in name):
         return f"{column} (mN·mm/rad{'³' if name.endswith('cubic') else ''})" if not name.endswith("rest_angle") else f"{column} (rad)"
     for key, unit in _UNITS.items():
         if key in name:

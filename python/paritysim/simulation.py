@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -30,14 +31,21 @@ class SimulationResult:
         power, work integrals and mechanical energy. Units: rad, rad/ms, mN·mm, mN, µJ.
     metrics:
         Dict of scalar metrics (stroke and rotation amplitude and mean per wing, phase lag of
-        rotation behind stroke, peak and mean torques, work per cycle...).
+        rotation behind stroke, peak and mean torques, work per cycle...). A metric that is
+        undefined for this run is ``None``, never NaN: ``*_rotation_phase_lag`` of a wing that
+        does not rotate (fixed wings), the Table 3.2 imbalance percentages when the right wing's
+        roll torque is zero.
+    residual:
+        Relative change of the state over the last cycle before recording (the Newton residual
+        with ``options.steady_state = "shooting"``); ``None`` without a periodic drive.
     """
 
-    metrics: dict[str, float]
+    metrics: dict[str, float | None]
     cycles_run: int
     converged: bool
     period_ms: float
     spec: Simulation
+    residual: float | None
     columns: dict[str, np.ndarray] = field(repr=False)
 
     @cached_property
@@ -82,16 +90,15 @@ def simulate(spec: Simulation, **option_overrides: Any) -> SimulationResult:
     IntegrationError
         When integration fails; ``.time`` and ``.state`` say where.
     """
-    import dataclasses
-
     if option_overrides:
-        spec = spec.replace(options=dataclasses.replace(spec.options, **option_overrides))
-    raw = _core.simulate(spec.device_dict(), spec.options_dict())
+        spec = spec.replace(options=spec.options.with_fields("options", **option_overrides))
+    raw = _core.simulate(spec.to_json())
     return SimulationResult(
-        metrics=raw["metrics"],
-        cycles_run=int(raw["cycles_run"]),
-        converged=bool(raw["converged"]),
-        period_ms=float(raw["period_ms"]),
+        metrics={k: (v if math.isfinite(v) else None) for k, v in raw.metrics},
+        cycles_run=raw.cycles_run,
+        converged=raw.converged,
+        period_ms=raw.period_ms,
         spec=spec,
-        columns={"time_ms": raw["time_ms"], **raw["columns"]},
+        residual=raw.residual if math.isfinite(raw.residual) else None,
+        columns={"time_ms": raw.time_ms, **raw.columns},
     )

@@ -1,9 +1,20 @@
-"""Device and simulation specs: frozen dataclasses mirroring the Rust types.
+"""Device and simulation specs: frozen dataclasses whose fields and defaults come from the Rust core.
 
-A spec is plain data: build it in Python, load it from TOML (:func:`load_spec`), save it
-(:meth:`Simulation.save`). Validation happens in Rust when the spec is used
-(:meth:`Simulation.validate`, :func:`paritysim.simulate`), with errors naming the dotted field
-path (``wings[0].inertia``) and the allowed range.
+The spec types live in Rust (``crates/spec``); their JSON Schema (``spec.schema.json``, also
+:func:`schema`) is the single source of every field name, default, unit and range. The classes
+here are generated from it at import time (:func:`_from_core`), so Python and Rust cannot drift;
+they add constructors and conveniences only.
+
+A spec is plain data: build it in Python, load it from TOML (:func:`load_spec`, parsed in Rust),
+save it (:meth:`Simulation.save`). Validation happens in Rust when the spec is used
+(:meth:`Simulation.validate`, :func:`paritysim.simulate`), reporting every invalid field with its
+dotted path (``wings[0].aero.omega1``), allowed range and, for unknown keys, the nearest valid
+name. Old spellings (``balance_stiffness``, ``springs`` as a list of six, ``tunable_hinge.k0``)
+are accepted with a ``DeprecationWarning``.
+
+Tagged kinds (``Drivetrain.kind``, ``Aero.kind``, ``Waveform.kind``) are flat classes here: the
+fields of the chosen kind get that kind's defaults, the others stay ``None`` (setting one is an
+unknown-field error naming the kind's fields).
 
 Units: mg-mm-ms-rad-V; names carry the unit where it could be misread (``frequency_hz``).
 """
@@ -12,8 +23,10 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import json
 import math
-import tomllib
+import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -21,7 +34,6 @@ from typing import Any
 import numpy as np
 
 from . import _core
-from ._errors import invalid
 
 __all__ = [
     "Actuator",
@@ -32,173 +44,316 @@ __all__ = [
     "Shoulder",
     "Simulation",
     "Spring",
+    "Springs",
     "TunableHinge",
     "Waveform",
     "Wing",
     "load_spec",
+    "schema",
+    "spec_paths",
 ]
 
+_SCHEMA: dict[str, Any] = json.loads(_core.spec_schema())
+_KIND_DEFAULTS: dict[str, Any] = json.loads(_core.spec_defaults())
+_CLASSES: dict[str, type] = {}
 
-@dataclass(frozen=True)
-class Shoulder:
+
+def schema() -> dict[str, Any]:
+    """The JSON Schema of a spec (a fresh copy); also shipped as ``paritysim/spec.schema.json``."""
+    return json.loads(_core.spec_schema())
+
+
+def _definition(name: str) -> dict[str, Any]:
+    return _SCHEMA if name == "Simulation" else _SCHEMA["$defs"][name]
+
+
+def _ref(prop: dict[str, Any]) -> str | None:
+    """The definition a property refers to, through ``Option`` (anyOf null) and lists."""
+    if "$ref" in prop:
+        return str(prop["$ref"]).rsplit("/", 1)[1]
+    for key in ("anyOf", "oneOf"):
+        for branch in prop.get(key, []):
+            found = _ref(branch)
+            if found:
+                return found
+    if prop.get("type") == "array" and isinstance(prop.get("items"), dict):
+        return _ref(prop["items"])
+    return None
+
+
+_MISSING = object()
+
+
+def _fields(name: str) -> list[tuple[str, Any, str | None, bool]]:
+    """``(field, default JSON or _MISSING, referenced definition, is a list)`` of a definition."""
+    d = _definition(name)
+    if "oneOf" in d:  # a tagged enum: kind plus the union of the kinds' fields
+        out: list[tuple[str, Any, str | None, bool]] = [("kind", _KIND_DEFAULTS[name]["kind"], None, False)]
+        for variant in d["oneOf"]:
+            for key, prop in variant["properties"].items():
+                if all(key != f[0] for f in out):
+                    out.append((key, None, _ref(prop), prop.get("type") == "array" and _ref(prop) is not None))
+        return out
+    required = set(d.get("required", []))
+    out = []
+    for key, prop in d["properties"].items():
+        default = prop["default"] if "default" in prop else (_MISSING if key in required else None)
+        out.append((key, default, _ref(prop), prop.get("type") == "array" and _ref(prop) is not None))
+    return out
+
+
+def _variant(name: str, kind: str) -> dict[str, Any] | None:
+    for v in _definition(name).get("oneOf", []):
+        if v["properties"]["kind"].get("const") == kind:
+            return v
+    return None
+
+
+def _from_core(cls: type) -> type:
+    """Makes ``cls`` a frozen dataclass with the fields and defaults of the Rust type of the same
+    name (required fields first, then declaration order)."""
+    specs = _fields(cls.__name__)
+    specs.sort(key=lambda f: f[1] is not _MISSING)
+    annotations: dict[str, Any] = {}
+    for key, default, ref, _ in specs:
+        annotations[key] = "Any"
+        if default is _MISSING:
+            continue
+        if ref in _MODELS and isinstance(default, dict):
+            setattr(cls, key, field(default_factory=functools.partial(_build_known, ref, default)))
+        else:
+            setattr(cls, key, default)
+    cls.__annotations__ = annotations
+    built = dataclass(frozen=True)(cls)
+    names = [key for key, *_ in specs]
+    init = built.__init__
+
+    @functools.wraps(init)
+    def checked_init(self: Any, *args: Any, **kwargs: Any) -> None:
+        for key in kwargs:
+            if key not in names:  # a typed error with the nearest field, not a bare TypeError
+                from ._errors import invalid
+
+                raise invalid(f"{cls.__name__}.{key}", "<unknown field>", _core.spec_suggestion(key, names))
+        init(self, *args, **kwargs)
+
+    built.__init__ = checked_init  # type: ignore[method-assign]
+    if issubclass(built, _Tagged):
+        built.__repr__ = _Tagged.kind_repr  # type: ignore[method-assign]
+    _CLASSES[cls.__name__] = built
+    return built
+
+
+_MODELS = {"Simulation", "Wing", "Shoulder", "Spring", "Springs", "Aero", "TunableHinge", "Drivetrain", "Waveform", "Actuator", "Configuration", "Options"}
+
+
+def _build_known(name: str, data: Any) -> Any:
+    """Builds class ``name`` from canonical plain data (no validation: it came from Rust)."""
+    cls = _CLASSES[name]
+    if not isinstance(data, dict):
+        return data
+    kwargs: dict[str, Any] = {}
+    for key, _, ref, is_list in _fields(name):
+        if key not in data:
+            continue
+        value = data[key]
+        if ref in _MODELS and value is not None:
+            value = tuple(_build_known(ref, v) for v in value) if is_list else _build_known(ref, value)
+        elif isinstance(value, list):
+            value = _tuples(value)
+        kwargs[key] = value
+    return cls(**kwargs)
+
+
+def _tuples(x: Any) -> Any:
+    return tuple(_tuples(v) for v in x) if isinstance(x, list | tuple) else x
+
+
+class _Node:
+    """Conveniences shared by every spec class."""
+
+    def with_fields(self, path: str, **changes: Any) -> Any:
+        """A copy with fields replaced; an unknown field raises ``InvalidParameterError`` naming
+        ``path.<field>`` and the nearest valid field (the Rust core's edit distance)."""
+        names = [f.name for f in dataclasses.fields(self)]  # type: ignore[arg-type]
+        for key in changes:
+            if key not in names:
+                from ._errors import invalid
+
+                raise invalid(f"{path}.{key}", "<unknown field>", _core.spec_suggestion(key, names))
+        return dataclasses.replace(self, **changes)  # type: ignore[type-var]
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data (``None`` fields left out), as the Rust core reads it."""
+        return _strip_none(dataclasses.asdict(self))  # type: ignore[call-overload]
+
+    def replace(self, **changes: Any) -> Any:
+        """A copy with fields replaced (``dataclasses.replace``)."""
+        return dataclasses.replace(self, **changes)  # type: ignore[type-var]
+
+
+class _Tagged(_Node):
+    """A flat view of a Rust tagged enum: the chosen kind's fields get its defaults."""
+
+    def __post_init__(self) -> None:
+        variant = _variant(type(self).__name__, self.kind)  # type: ignore[attr-defined]
+        if variant is None:
+            return  # unknown kind: Rust names it and the valid kinds when the spec is used
+        for key, prop in variant["properties"].items():
+            if key != "kind" and getattr(self, key) is None and "default" in prop:
+                object.__setattr__(self, key, _tuples(prop["default"]))
+
+    def kind_repr(self) -> str:
+        """``Drivetrain(kind='hmf_four_bar', crank_mm=0.4, rod_mm=0.8)``: the kind's fields only."""
+        names = ["kind", *self.kind_fields()]
+        names += [f.name for f in dataclasses.fields(self) if f.name not in names and getattr(self, f.name) is not None]  # type: ignore[arg-type]
+        return f"{type(self).__name__}({', '.join(f'{n}={getattr(self, n)!r}' for n in names)})"
+
+    def kind_fields(self) -> list[str]:
+        """The fields of this kind (besides ``kind``)."""
+        variant = _variant(type(self).__name__, self.kind) or {"properties": {}}  # type: ignore[attr-defined]
+        return [k for k in variant["properties"] if k != "kind"]
+
+
+@_from_core
+class Shoulder(_Node):
     """Spherical five-bar shoulder (§2.3.3): ``0 <= alpha3 < alpha2 <= pi`` (rad)."""
 
-    alpha2: float = math.pi / 2
-    alpha3: float = 0.0
 
-
-@dataclass(frozen=True)
-class Spring:
+@_from_core
+class Spring(_Node):
     """Joint torsion spring ``tau = k (g - g0) + k3 (g - g0)^3`` (mN·mm/rad, mN·mm/rad³, rad)."""
 
-    stiffness: float = 0.0
-    cubic: float = 0.0
-    rest_angle: float = 0.0
+
+@_from_core
+class Springs(_Node):
+    """The six shoulder joint springs by joint: ``stroke`` (γ1 = φ), ``passive_s2``, ``passive_s3``,
+    ``deviation`` (γ4 = θ), ``wing_deviation`` (γ5 = θ_w), ``hinge`` (γ6 = ψ)."""
+
+    @classmethod
+    def from_joints(cls, springs: Any) -> Springs:
+        """From six springs in joint order (the old list form)."""
+        names = [f.name for f in dataclasses.fields(cls)]  # type: ignore[arg-type]
+        springs = list(springs)
+        if len(springs) != len(names):
+            from ._errors import invalid
+
+            raise invalid("springs", f"{len(springs)} springs", f"exactly {len(names)} (joints 1..6) or named springs {', '.join(names)}")
+        return cls(**{n: s if isinstance(s, Spring) else Spring(**s) for n, s in zip(names, springs, strict=True)})
 
 
-@dataclass(frozen=True)
-class Aero:
-    """Wing aerodynamics (Ω in mg·mm²).
+@_from_core
+class Aero(_Tagged):
+    """Wing aerodynamics, tagged by ``kind`` (Ω in mg·mm²).
 
-    ``kind = "stroke_drag"``: ``tau = -omega1 * coefficient * sgn(phi_dot) phi_dot^2`` about the
-    stroke axis; ``coefficient = 1`` is eq. 2.16, ``coefficient = C_N(90°)`` is eq. 3.8 for a
-    fixed wing (docs/errata.md#12).
-
-    ``kind = "blade_element"``: the quasi-steady model of §3.2.4 (eqs. 3.8-3.11) with
-    ``omega1..omega4`` (e.g. from :meth:`paritysim.Planform.omegas` or Table 3.3), coefficient
-    ``model`` (``dickinson1999`` or ``whitney_wood2010``), rotational damping coefficient
-    ``rotational_damping`` (None: the aero crate's cited default) and ``normal_force_law``
-    (``coefficient`` or ``unit``).
+    ``stroke_drag``: ``tau = -omega1 * coefficient * sgn(phi_dot) phi_dot^2`` about the stroke
+    axis; ``coefficient = 1`` is eq. 2.16, ``C_N(90°)`` is eq. 3.8 for a fixed wing (docs/errata.md#12).
+    ``blade_element``: the quasi-steady model of §3.2.4 (eqs. 3.8-3.11) with ``omega1..omega4``,
+    coefficient ``model``, ``rotational_damping`` (None: the aero crate's cited default) and
+    ``normal_force_law``.
     """
 
-    kind: str = "stroke_drag"
-    omega1: float = 31.3
-    coefficient: float = 1.0
-    omega2: float = 0.0
-    omega3: float = 0.0
-    omega4: float = 0.0
-    model: str = "dickinson1999"
-    rotational_damping: float | None = None
-    normal_force_law: str = "coefficient"
+
+@_from_core
+class TunableHinge(_Node):
+    """The tunable wing hinge of §2.5.1: ``V = ½ k(θ) ψ²`` with ``k(θ) = stiffness_at_zero +
+    stiffness_slope θ + stiffness_curvature θ²`` (validated in Rust: ``k(θ) > 0`` for every θ)."""
 
 
-@dataclass(frozen=True)
-class TunableHinge:
-    """The tunable wing hinge of §2.5.1: ``V = ½ (k0 + k1 θ + k2 θ²) ψ²`` (mN·mm/rad); stiffer
-    with deviation. Validated in Rust (``k(θ) > 0`` for every θ)."""
-
-    k0: float
-    k1: float = 0.0
-    k2: float = 0.0
-
-
-@dataclass(frozen=True)
-class Wing:
+@_from_core
+class Wing(_Node):
     """A wing: inertia tensor about the spherical centre in frame 6 (mg·mm², 3×3), shoulder,
-    six joint springs (joints 1..6; None = no springs) and aerodynamics (None = vacuum)."""
+    named joint springs (:class:`Springs`), aerodynamics (None = vacuum), tunable hinge."""
 
-    inertia: tuple[tuple[float, float, float], ...]
-    shoulder: Shoulder = field(default_factory=Shoulder)
-    springs: tuple[Spring, ...] | None = None
-    aero: Aero | None = None
-    tunable_hinge: TunableHinge | None = None
+    def __post_init__(self) -> None:
+        springs = self.springs  # type: ignore[attr-defined]
+        if isinstance(springs, list | tuple):
+            warnings.warn("Wing(springs=<6 springs in joint order>) is deprecated: use Springs(stroke=..., hinge=...)", DeprecationWarning, stacklevel=3)
+            object.__setattr__(self, "springs", Springs.from_joints(springs))
+        elif springs is None:
+            object.__setattr__(self, "springs", Springs())
+        elif isinstance(springs, Mapping):
+            object.__setattr__(self, "springs", _build_known("Springs", dict(springs)))
+        object.__setattr__(self, "inertia", _tuples(self.inertia))  # type: ignore[attr-defined]
 
     @classmethod
     def from_moments(cls, ixx: float, iyy: float, izz: float, ixz: float = 0.0, **kwargs: Any) -> Wing:
         """A wing from the Table 3.3 moments ``Ixx, Iyy, Izz, Ixz`` (mg·mm²)."""
         inertia = ((ixx, 0.0, ixz), (0.0, iyy, 0.0), (ixz, 0.0, izz))
-        return cls(inertia=inertia, **kwargs)
+        return cls(inertia=inertia, **kwargs)  # type: ignore[call-arg]
 
 
-@dataclass(frozen=True)
-class Drivetrain:
-    """A planar drivetrain spec (§2.3-2.4) plus its balance-beam spring K2 (mN·mm/rad).
-
-    ``kind``: ``hmf_four_bar`` (1 DOF), ``linear_differential`` (eq. 2.15) or
-    ``linkage_differential`` (the §3.3.2 linkage). Use the constructors; ``.evaluate`` maps
-    actuator coordinates to stroke angles through the Rust kinematics.
+@_from_core
+class Drivetrain(_Tagged):
+    """A planar drivetrain (§2.3-2.4), tagged by ``kind`` (the kinds registered in Rust:
+    ``hmf_four_bar``, ``linear_differential``, ``linkage_differential``), with the balance-beam
+    spring ``balance_spring`` K2 (mN·mm/rad) of the 2-DOF kinds. ``.evaluate`` maps actuator
+    coordinates to stroke angles through the Rust kinematics.
     """
 
-    kind: str = "linkage_differential"
-    crank_mm: float = 0.4
-    rod_mm: float = 0.8
-    whippletree_length_mm: float = 5.0
-    arm_ratio: float = 1.0
-    transmission_ratio: float = 2.5
-    arm_length_mm: float = 2.5
-    balance_stiffness: float = 0.0
-
     def __post_init__(self) -> None:
-        self.kinematics()  # validates kind and lengths in Rust
-        if not (math.isfinite(self.balance_stiffness) and self.balance_stiffness >= 0):
-            raise invalid("balance_stiffness", self.balance_stiffness, "finite and >= 0 (mN mm/rad)")
+        super().__post_init__()
+        self.kinematics()  # validates the lengths in Rust
 
     @classmethod
     def hmf_four_bar(cls, crank_mm: float = 0.4, rod_mm: float = 0.8) -> Drivetrain:
         """HMF four-bar (§2.3.1): 400 µm of actuator stroke gives 60° with the defaults."""
-        return cls(kind="hmf_four_bar", crank_mm=crank_mm, rod_mm=rod_mm)
+        return cls(kind="hmf_four_bar", crank_mm=crank_mm, rod_mm=rod_mm)  # type: ignore[call-arg]
 
     @classmethod
-    def linear_differential(cls, transmission_ratio: float, arm_length_mm: float, arm_ratio: float = 1.0, balance_stiffness: float = 0.0) -> Drivetrain:
-        """Eq. 2.15 with ratio T (rad/mm), mean arm L (mm), arm ratio hL/hR."""
-        return cls(kind="linear_differential", transmission_ratio=transmission_ratio, arm_length_mm=arm_length_mm, arm_ratio=arm_ratio, balance_stiffness=balance_stiffness)
+    def linear_differential(cls, transmission_ratio: float, arm_length_mm: float, arm_ratio: float = 1.0, balance_spring: float = 0.0, **deprecated: float) -> Drivetrain:
+        """Eq. 2.15 with ratio T (rad/mm), mean arm L (mm), arm ratio hL/hR, spring K2."""
+        balance_spring = _balance(balance_spring, deprecated)
+        return cls(kind="linear_differential", transmission_ratio=transmission_ratio, arm_length_mm=arm_length_mm, arm_ratio=arm_ratio, balance_spring=balance_spring)  # type: ignore[call-arg]
 
     @classmethod
     def linkage_differential(
-        cls, crank_mm: float = 0.4, rod_mm: float = 0.8, whippletree_length_mm: float = 5.0, arm_ratio: float = 1.0, balance_stiffness: float = 0.0
+        cls, crank_mm: float = 0.4, rod_mm: float = 0.8, whippletree_length_mm: float = 5.0, arm_ratio: float = 1.0, balance_spring: float = 0.0, **deprecated: float
     ) -> Drivetrain:
         """The Drag PARITY linkage (§3.3.2 lengths by default; arm ratio hL/hR of §2.4.2)."""
-        return cls(kind="linkage_differential", crank_mm=crank_mm, rod_mm=rod_mm, whippletree_length_mm=whippletree_length_mm, arm_ratio=arm_ratio, balance_stiffness=balance_stiffness)
+        balance_spring = _balance(balance_spring, deprecated)
+        return cls(kind="linkage_differential", crank_mm=crank_mm, rod_mm=rod_mm, whippletree_length_mm=whippletree_length_mm, arm_ratio=arm_ratio, balance_spring=balance_spring)  # type: ignore[call-arg]
 
     def kinematics(self) -> _core.Drivetrain:
-        """The native kinematic object (validates the parameters)."""
-        if self.kind == "hmf_four_bar":
-            return _core.Drivetrain.hmf_four_bar(self.crank_mm, self.rod_mm)
-        if self.kind == "linear_differential":
-            return _core.Drivetrain.linear_differential(self.transmission_ratio, self.arm_length_mm, self.arm_ratio)
-        if self.kind == "linkage_differential":
-            return _core.Drivetrain.linkage_differential(self.crank_mm, self.rod_mm, self.whippletree_length_mm, self.arm_ratio)
-        raise invalid("drivetrain.kind", repr(self.kind), "one of hmf_four_bar, linear_differential, linkage_differential")
+        """The native kinematic object, built in Rust from this spec (validates the kind and
+        the lengths)."""
+        return _core.Drivetrain.from_spec(_dumps(self.to_dict()))
 
     @property
     def dof(self) -> int:
         """Degrees of freedom (1 or 2)."""
-        return self.kinematics().dof
+        return int(self.kinematics().dof)
 
     @property
     def name(self) -> str:
         """Kind name."""
-        return self.kind
+        return str(self.kind)  # type: ignore[attr-defined]
 
     def evaluate(self, q1: Any, q2: Any) -> dict[str, np.ndarray]:
         """Stroke angles, Jacobian and Hessian over paired arrays (see ``paritysim.kinematics``)."""
-        return self.kinematics().evaluate(np.ascontiguousarray(q1, dtype=np.float64), np.ascontiguousarray(q2, dtype=np.float64))
+        return self.kinematics().evaluate(np.ascontiguousarray(q1, dtype=np.float64), np.ascontiguousarray(q2, dtype=np.float64))  # type: ignore[no-any-return]
 
 
-@dataclass(frozen=True)
-class Waveform:
-    """Drive voltage. ``sine``: ``offset_v + amplitude_v sin(2π frequency_hz t + phase)`` (eq. 3.24);
-    ``sampled``: one period of samples (``times_ms``, ``voltages_v``, ``period_ms``)."""
-
-    kind: str = "sine"
-    amplitude_v: float = 100.0
-    frequency_hz: float = 110.0
-    offset_v: float = 0.0
-    phase: float = 0.0
-    times_ms: tuple[float, ...] | None = None
-    voltages_v: tuple[float, ...] | None = None
-    period_ms: float | None = None
+def _balance(value: float, deprecated: dict[str, float]) -> float:
+    if "balance_stiffness" in deprecated:
+        warnings.warn("balance_stiffness= is deprecated: use balance_spring=", DeprecationWarning, stacklevel=3)
+        value = deprecated.pop("balance_stiffness")
+    if deprecated:
+        raise TypeError(f"unexpected keyword arguments: {', '.join(deprecated)}")
+    return value
 
 
-@dataclass(frozen=True)
-class Actuator:
+@_from_core
+class Waveform(_Tagged):
+    """Drive voltage, tagged by ``kind``. ``sine``: ``offset_v + amplitude_v sin(2π frequency_hz t
+    + phase)`` (eq. 3.24); ``sampled``: one period of samples (``times_ms``, ``voltages_v``,
+    ``period_ms``)."""
+
+
+@_from_core
+class Actuator(_Node):
     """Zeroth-order piezo actuator (§3.2.2): force = force_per_volt (mN/V) × V(t), in parallel
     with ``stiffness`` (mN/mm). ``dc_offset``: ``as_force`` or ``ignore`` (docs/errata.md#14)."""
-
-    waveform: Waveform = field(default_factory=Waveform)
-    force_per_volt: float = 1.2
-    stiffness: float = 467.0
-    dc_offset: str = "as_force"
 
     @classmethod
     def from_laminate(cls, bimorph: Any, waveform: Waveform | None = None, dc_offset: str = "as_force") -> Actuator:
@@ -212,110 +367,108 @@ class Actuator:
         if stiffness is None or force is None:  # ActuatorConstants
             stiffness, force = bimorph.stiffness_mn_per_mm, bimorph.force_per_volt_mn_per_v
         # The sign of d31 only sets the direction of q1; the engine takes the magnitude.
-        return cls(waveform=waveform or Waveform(), force_per_volt=abs(float(force)), stiffness=float(stiffness), dc_offset=dc_offset)
+        return cls(waveform=waveform or Waveform(), force_per_volt=abs(float(force)), stiffness=float(stiffness), dc_offset=dc_offset)  # type: ignore[call-arg]
 
 
-@dataclass(frozen=True)
-class Configuration:
-    """Constraints ``C p = c0``: a Table 3.1 ``name`` or explicit ``rows`` / ``c0``."""
-
-    name: str | None = "drag_parity_fixed"
-    rows: tuple[tuple[float, ...], ...] | None = None
-    c0: tuple[float, ...] | None = None
+@_from_core
+class Configuration(_Node):
+    """Constraints ``C p = c0``: a Table 3.1 ``name`` or explicit ``rows`` / ``c0``; neither:
+    unconstrained."""
 
 
-@dataclass(frozen=True)
-class Options:
-    """Integration and steady-state options (see the Rust ``SimulationOptions``)."""
-
-    method: str = "dop853"
-    rtol: float = 1e-8
-    atol: float = 1e-10
-    max_steps: int = 1_000_000
-    min_cycles: int = 3
-    max_cycles: int = 300
-    steady_tol: float = 1e-7
-    samples_per_cycle: int = 200
-    record_cycles: int = 1
-    duration_ms: float | None = None
-    initial_p: tuple[float, ...] | None = None
-    initial_p_dot: tuple[float, ...] | None = None
-    perturbation: dict[str, Any] | None = None
-    #: "transient" (cycle-to-cycle simulation) or "shooting" (Newton on the stroboscopic map).
-    steady_state: str = "transient"
+@_from_core
+class Options(_Node):
+    """Integration and steady-state options (defaults: the Rust engine's)."""
 
 
-@dataclass(frozen=True)
-class Simulation:
+@_from_core
+class Simulation(_Node):
     """A complete, runnable spec: device (wings, configuration, drivetrain, actuator) + options."""
 
-    wings: tuple[Wing, ...]
-    configuration: Configuration = field(default_factory=Configuration)
-    drivetrain: Drivetrain | None = None
-    actuator: Actuator | None = None
-    formulation: str = "auto"
-    options: Options = field(default_factory=Options)
-    name: str = ""
-
     @functools.cached_property
-    def _device_dict(self) -> dict[str, Any]:
-        return self._build_device_dict()
+    def _json(self) -> str:
+        return _dumps(self.to_dict())
 
-    @functools.cached_property
-    def _options_dict(self) -> dict[str, Any]:
-        return _strip_none(dataclasses.asdict(self.options))
-
-    def device_dict(self) -> dict[str, Any]:
-        """The device part as the plain dict the Rust core reads (cached: specs are frozen)."""
-        return self._device_dict
-
-    def _build_device_dict(self) -> dict[str, Any]:
-        d = _strip_none(dataclasses.asdict(self))
-        d.pop("options", None)
-        d.pop("name", None)
-        cfg = d.pop("configuration", {})
-        d["configuration"] = cfg["name"] if cfg.get("name") else {"rows": cfg.get("rows", []), "c0": cfg.get("c0")}
-        if d["configuration"] == {"rows": [], "c0": None}:
-            d.pop("configuration")
-        return d
-
-    def options_dict(self) -> dict[str, Any]:
-        """The options as a plain dict (cached)."""
-        return self._options_dict
+    def to_json(self) -> str:
+        """The spec as JSON text (what the Rust core reads; cached: specs are frozen)."""
+        return self._json
 
     def validate(self) -> Simulation:
-        """Validates in Rust; returns self or raises a ``ParitysimError`` naming the field."""
-        _core.validate_device(self.device_dict())
+        """Validates in Rust; returns self or raises a ``ParitysimError`` naming every bad field."""
+        _core.validate_spec(self.to_json())
         return self
 
-    def replace(self, **changes: Any) -> Simulation:
-        """A copy with top-level fields replaced (``dataclasses.replace``)."""
-        return dataclasses.replace(self, **changes)
-
-    def to_dict(self) -> dict[str, Any]:
-        """Everything, as plain data (what :meth:`save` writes)."""
-        return _strip_none(dataclasses.asdict(self))
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Simulation:
+        """Inverse of :meth:`to_dict`, validated in Rust (unknown keys raise
+        ``InvalidParameterError`` naming the key and the nearest valid one)."""
+        canonical, notes = _core.spec_normalize(_dumps(data))
+        return _canonical(canonical, notes)
 
     @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> Simulation:
-        """Inverse of :meth:`to_dict`; unknown keys raise ``InvalidParameterError``."""
-        return _build(cls, data, "")
+    def from_json(cls, text: str) -> Simulation:
+        """From JSON text (validated in Rust)."""
+        canonical, notes = _core.spec_normalize(text)
+        return _canonical(canonical, notes)
+
+    def with_paths(self, values: Mapping[str, Any]) -> Simulation:
+        """A copy with ``{path: value}`` applied; paths as listed by :func:`spec_paths` (aliases
+        such as ``wings.left.omega_ratio`` included)."""
+        canonical, notes = _core.spec_apply(self.to_json(), _dumps(dict(values)))
+        return _canonical(canonical, notes)
+
+    def to_toml(self) -> str:
+        """The spec as TOML (written by the Rust core)."""
+        return _core.spec_to_toml(self.to_json())
 
     def save(self, path: str | Path) -> Path:
         """Writes the spec as TOML."""
-        import tomli_w
-
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(tomli_w.dumps(self.to_dict()))
+        path.write_text(self.to_toml())
         return path
 
 
+def _canonical(text: str, notes: list[str]) -> Simulation:
+    for note in notes:
+        warnings.warn(note, DeprecationWarning, stacklevel=3)
+    return _build_known("Simulation", json.loads(text))  # type: ignore[no-any-return]
+
+
 def load_spec(path: str | Path) -> Simulation:
-    """Loads a :class:`Simulation` from a TOML file."""
-    with open(path, "rb") as f:
-        data = tomllib.load(f)
-    return Simulation.from_dict(data)
+    """Loads a :class:`Simulation` from a TOML file (parsed and validated in Rust)."""
+    canonical, notes = _core.spec_from_toml(Path(path).read_text())
+    return _canonical(canonical, notes)
+
+
+def spec_paths(spec: Simulation) -> Any:
+    """Every parameter path of ``spec`` (the names :func:`paritysim.sweep`,
+    :func:`paritysim.calibrate` and :meth:`Simulation.with_paths` accept) as a Polars DataFrame:
+    ``path``, ``unit``, ``allowed`` (type and range) and ``value`` (JSON text)."""
+    import polars as pl
+
+    rows = _core.spec_paths(spec.to_json())
+    return pl.DataFrame(rows, schema=["path", "unit", "allowed", "value"], orient="row")
+
+
+def _plain(x: Any) -> Any:
+    """JSON-ready data: numpy scalars unwrapped, non-finite floats as strings (so Rust names the
+    field instead of failing to parse)."""
+    if isinstance(x, Mapping):
+        return {str(k): _plain(v) for k, v in x.items() if v is not None}
+    if isinstance(x, list | tuple | np.ndarray):
+        return [_plain(v) for v in x]
+    if isinstance(x, np.generic):
+        x = x.item()
+    if isinstance(x, float) and not math.isfinite(x):
+        return repr(x)
+    if dataclasses.is_dataclass(x) and not isinstance(x, type):
+        return _plain(dataclasses.asdict(x))
+    return x
+
+
+def _dumps(data: Any) -> str:
+    return json.dumps(_plain(data), allow_nan=False)
 
 
 def _strip_none(x: Any) -> Any:
@@ -324,43 +477,3 @@ def _strip_none(x: Any) -> Any:
     if isinstance(x, list | tuple):
         return [_strip_none(v) for v in x]
     return x
-
-
-_NESTED: dict[tuple[type, str], Any] = {}
-
-
-def _build(cls: type, data: Any, path: str) -> Any:
-    """Recursively builds dataclasses from plain data, naming unknown fields by path."""
-    if not isinstance(data, dict):
-        raise invalid(path or "spec", repr(data), "a table")
-    fields = {f.name: f for f in dataclasses.fields(cls)}
-    unknown = sorted(set(data) - set(fields))
-    if unknown:
-        raise invalid(f"{path + '.' if path else ''}{unknown[0]}", "<unknown field>", f"a known field; valid fields: {', '.join(fields)}")
-    kwargs: dict[str, Any] = {}
-    for name, value in data.items():
-        sub = f"{path}.{name}" if path else name
-        kwargs[name] = _convert(cls, name, value, sub)
-    return cls(**kwargs)
-
-
-def _convert(cls: type, name: str, value: Any, path: str) -> Any:
-    nested = {
-        (Simulation, "configuration"): Configuration,
-        (Simulation, "drivetrain"): Drivetrain,
-        (Simulation, "actuator"): Actuator,
-        (Simulation, "options"): Options,
-        (Actuator, "waveform"): Waveform,
-        (Wing, "shoulder"): Shoulder,
-        (Wing, "aero"): Aero,
-        (Wing, "tunable_hinge"): TunableHinge,
-    }
-    if (cls, name) in nested:
-        return _build(nested[(cls, name)], value, path)
-    if (cls, name) == (Simulation, "wings"):
-        return tuple(_build(Wing, w, f"{path}[{i}]") for i, w in enumerate(value))
-    if (cls, name) == (Wing, "springs"):
-        return tuple(_build(Spring, s, f"{path}[{i}]") for i, s in enumerate(value))
-    if isinstance(value, list):
-        return tuple(tuple(v) if isinstance(v, list) else v for v in value)
-    return value

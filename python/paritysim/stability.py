@@ -177,12 +177,13 @@ def lti_transfer(beta_star: float, kappa0: float, frequency_hz: Any) -> np.ndarr
     return _core.stability_lti_transfer(real("beta_star", beta_star), real("kappa0", kappa0), _f64(frequency_hz, "frequency_hz"))
 
 
-def _device(spec: Simulation | dict[str, Any]) -> dict[str, Any]:
+def _device(spec: Simulation | dict[str, Any]) -> str:
+    """The spec as the JSON text the Rust core reads."""
     if isinstance(spec, Simulation):
-        return spec.device_dict()
+        return spec.to_json()
     if isinstance(spec, dict):
-        return spec
-    raise invalid("spec", type(spec).__name__, "a paritysim.Simulation or a device dict")
+        return Simulation.from_dict(spec).to_json()
+    raise invalid("spec", type(spec).__name__, "a paritysim.Simulation or a spec dict")
 
 
 @dataclass(frozen=True)
@@ -351,7 +352,7 @@ def disturbance_response(
     raw = _core.stability_disturbance_response(device, freqs, real("amplitude", amplitude), _shooting(options), _shooting(dist))
     h = raw["transfer"]
     lti = avg = np.full(freqs.size, np.nan + 0j)
-    _, n_dof = _core.validate_device(device)
+    _, n_dof = _core.validate_spec(device)
     if n_dof == 2:  # eq. 2.59 models the whippletree mode of a 2-DOF (Drag PARITY) drivetrain
         lin = _core.stability_linearise(device, _shooting(options), 2000)
         lti = lti_transfer(lin["lti"]["beta_star"], lin["lti"]["kappa0"], freqs)

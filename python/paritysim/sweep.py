@@ -3,7 +3,7 @@
 ```python
 import paritysim as ps
 spec = ps.devices.load("sreetharan2012_3_3_parity")   # §3.3 Drag PARITY (eq. 2.15)
-df = ps.sweep(spec, {"drivetrain.k2": [0.0, 1.0, 2.0], "wings.left.omega_ratio": [1.0, 0.8, 0.6]},
+df = ps.sweep(spec, {"drivetrain.balance_spring": [0.0, 1.0, 2.0], "wings.left.omega_ratio": [1.0, 0.8, 0.6]},
               metrics=["left_roll_aero_peak", "right_roll_aero_peak"])
 ```
 
@@ -19,25 +19,28 @@ and class of a failing point; every other row is kept).
 
 Parameter paths
 ---------------
-Dotted paths into the spec, checked before anything runs (an unknown path raises
-``InvalidParameterError`` listing the valid ones; `valid_paths` lists them too):
+One path language for sweeps, calibration and overrides, owned by the Rust spec crate and
+checked before anything runs (an unknown path raises ``InvalidParameterError`` naming the nearest
+valid one). `paritysim.spec_paths` lists every path of a spec with its unit and range:
 
-* ``wings[i].inertia[r][c]``, ``wings[i].shoulder.alpha2``, ``wings[i].springs[j].stiffness``
-  (``cubic``, ``rest_angle``), ``wings[i].aero.omega1`` (and every other ``Aero`` field);
-* ``drivetrain.<field>`` (``balance_stiffness``, ``crank_mm``, ``arm_ratio``, ``kind``...);
-* ``actuator.force_per_volt``, ``actuator.stiffness``, ``actuator.waveform.<field>``
-  (``frequency_hz``, ``amplitude_v``, ``offset_v``...);
+* ``wings[i].inertia[r][c]``, ``wings[i].shoulder.alpha2``,
+  ``wings[i].springs.<joint>.stiffness`` (joints ``stroke``, ``passive_s2``, ``passive_s3``,
+  ``deviation``, ``wing_deviation``, ``hinge``; fields ``stiffness``, ``cubic``, ``rest_angle``),
+  ``wings[i].aero.<field>``, ``wings[i].tunable_hinge.<field>``;
+* ``drivetrain.<field>`` (``balance_spring``, ``crank_mm``, ``arm_ratio``, ``kind``...);
+* ``actuator.force_per_volt``, ``actuator.stiffness``, ``actuator.waveform.<field>``;
 * ``configuration.name``, ``formulation`` and ``options.<field>`` (``max_cycles``, ``rtol``...).
 
 Aliases: ``wings.left`` / ``wings.right`` for ``wings[0]`` / ``wings[1]`` of a two-wing spec;
-``wings[*]`` for every wing at once; ``drivetrain.k2`` for ``drivetrain.balance_stiffness``;
-``actuator.frequency_hz`` and ``actuator.amplitude_v`` (or ``actuator.voltage_v``) for the
-waveform fields; ``wings[i].omega_ratio`` multiplies that wing's ``aero.omega1`` by the value
-(a cut wing of Table 3.2: ``wings.left.omega_ratio = 0.6``).
+``wings[*]`` for every wing at once; ``actuator.frequency_hz`` and ``actuator.amplitude_v`` (or
+``actuator.voltage_v``) for the waveform fields; ``wings[i].omega_ratio`` multiplies that wing's
+``aero.omega1`` by the value (a cut wing of Table 3.2: ``wings.left.omega_ratio = 0.6``).
+Deprecated (accepted with a warning): ``drivetrain.k2`` and ``drivetrain.balance_stiffness``
+(now ``drivetrain.balance_spring``), ``wings[i].springs[j].<field>`` (now named joints).
 
-Indices are 0-based: ``wings[0]`` is the left wing (eq. 3.21), ``springs[j]`` is joint ``j + 1``
-of the shoulder, so ``springs[0]`` is the stroke φ (γ1), ``springs[3]`` the deviation θ (γ4)
-and ``springs[5]`` the wing-rotation (ψ) hinge (γ6, eq. 2.1).
+Indices are 0-based: ``wings[0]`` is the left wing (eq. 3.21). Springs are named by joint:
+``springs.stroke`` is the stroke φ (γ1), ``springs.deviation`` the deviation θ (γ4) and
+``springs.hinge`` the wing-rotation (ψ) hinge (γ6, eq. 2.1).
 
 Label columns
 -------------
@@ -62,7 +65,6 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import contextlib
-import dataclasses
 import hashlib
 import itertools
 import json
@@ -82,7 +84,7 @@ import polars as pl
 
 from . import _core
 from ._errors import invalid
-from .spec import Actuator, Aero, Drivetrain, Options, Simulation
+from .spec import Simulation, _dumps
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -102,156 +104,22 @@ _FORMAT = 1
 
 # --------------------------------------------------------------------------- parameter paths
 
-_ALIASES = {
-    "drivetrain.k2": "drivetrain.balance_stiffness",
-    "actuator.frequency_hz": "actuator.waveform.frequency_hz",
-    "actuator.amplitude_v": "actuator.waveform.amplitude_v",
-    "actuator.voltage_v": "actuator.waveform.amplitude_v",
-}
-_WAVEFORM_SCALARS = ("kind", "amplitude_v", "frequency_hz", "offset_v", "phase", "period_ms")
-_OPTION_SCALARS = tuple(f.name for f in dataclasses.fields(Options) if f.name not in ("initial_p", "initial_p_dot", "perturbation"))
-_SPRING_FIELDS = ("stiffness", "cubic", "rest_angle")
-_SHOULDER_FIELDS = ("alpha2", "alpha3")
-
-
-@dataclass(frozen=True)
-class _Target:
-    """Where a value goes: the device or options dict, a key path, and an optional scale."""
-
-    section: str  # "device" or "options"
-    keys: tuple[str | int, ...]
-    scale: float | None = None  # ratio aliases: value * scale
-
-
-@dataclass(frozen=True)
-class _Param:
-    name: str
-    targets: tuple[_Target, ...]
-
-
-def _names(cls: type) -> list[str]:
-    return [f.name for f in dataclasses.fields(cls)]
-
-
-def _schema(spec: Simulation) -> dict[str, _Target]:
-    """Every canonical path of this spec and where it points."""
-    out: dict[str, _Target] = {}
-    for i, wing in enumerate(spec.wings):
-        w = f"wings[{i}]"
-        for r, c in itertools.product(range(3), range(3)):
-            out[f"{w}.inertia[{r}][{c}]"] = _Target("device", ("wings", i, "inertia", r, c))
-        for f in _SHOULDER_FIELDS:
-            out[f"{w}.shoulder.{f}"] = _Target("device", ("wings", i, "shoulder", f))
-        for j, f in itertools.product(range(6), _SPRING_FIELDS):
-            out[f"{w}.springs[{j}].{f}"] = _Target("device", ("wings", i, "springs", j, f))
-        if wing.aero is not None:
-            for name in _names(Aero):
-                out[f"{w}.aero.{name}"] = _Target("device", ("wings", i, "aero", name))
-            out[f"{w}.omega_ratio"] = _Target("device", ("wings", i, "aero", "omega1"), float(wing.aero.omega1))
-    out["configuration.name"] = _Target("device", ("configuration",))
-    out["formulation"] = _Target("device", ("formulation",))
-    if spec.drivetrain is not None:
-        for name in _names(Drivetrain):
-            out[f"drivetrain.{name}"] = _Target("device", ("drivetrain", name))
-    if spec.actuator is not None:
-        for name in _names(Actuator):
-            if name != "waveform":
-                out[f"actuator.{name}"] = _Target("device", ("actuator", name))
-        for name in _WAVEFORM_SCALARS:
-            out[f"actuator.waveform.{name}"] = _Target("device", ("actuator", "waveform", name))
-    for name in _OPTION_SCALARS:
-        out[f"options.{name}"] = _Target("options", (name,))
-    return out
-
-
-def _expand(spec: Simulation, path: str) -> list[str] | None:
-    """Canonical paths an alias stands for (None: not an alias form this spec supports)."""
-    n = len(spec.wings)
-    if path.startswith("wings[*]."):
-        return [f"wings[{i}].{path[len('wings[*].') :]}" for i in range(n)]
-    for side, index in (("left", 0), ("right", 1)):
-        if path.startswith(f"wings.{side}."):
-            return [f"wings[{index}].{path[len(f'wings.{side}.') :]}"] if n == 2 else None
-    if path in _ALIASES:
-        return [_ALIASES[path]]
-    return [path]
-
-
-def _resolve(spec: Simulation, path: str, schema: dict[str, _Target]) -> _Param:
-    if not isinstance(path, str):
-        raise invalid("grid", repr(path), "parameter paths given as strings")
-    canonical = _expand(spec, path) or []
-    targets = [schema[c] for c in canonical if c in schema]
-    if not canonical or len(targets) != len(canonical):
-        raise invalid(path, "<unknown parameter path>", "a parameter path of this spec; valid paths: " + _describe(spec, schema))
-    return _Param(path, tuple(targets))
-
-
-def _describe(spec: Simulation, schema: dict[str, _Target]) -> str:
-    """A compact listing of the valid paths for error messages."""
-    n = len(spec.wings)
-    wing = [p[len("wings[0].") :] for p in schema if p.startswith("wings[0].")]
-    wing = [p for p in wing if not p.startswith(("inertia[", "springs["))]
-    parts = [f"wings[i].{{inertia[r][c], springs[j].{{{', '.join(_SPRING_FIELDS)}}}, {', '.join(wing)}}} (i < {n}, j < 6)"]
-    for head in ("drivetrain.", "actuator.waveform.", "actuator.", "options."):
-        names = [p[len(head) :] for p in schema if p.startswith(head) and "." not in p[len(head) :]]
-        if names:
-            parts.append(f"{head}{{{', '.join(names)}}}")
-    parts.append("configuration.name, formulation")
-    aliases = ["wings[*].<field>"]
-    if n == 2:
-        aliases.append("wings.left/right.<field>")
-    aliases += [a for a, c in _ALIASES.items() if c in schema]
-    parts.append("aliases: " + ", ".join(aliases))
-    return "; ".join(parts)
-
 
 def valid_paths(spec: Simulation, aliases: bool = True) -> list[str]:
     """Every parameter path `sweep` accepts for ``spec`` (canonical, then aliases)."""
-    schema = _schema(spec)
-    out = list(schema)
-    if aliases:
-        out += [a for a, c in _ALIASES.items() if c in schema]
-        fields = sorted({p[len("wings[0].") :] for p in schema if p.startswith("wings[0].")})
-        out += [f"wings[*].{f}" for f in fields]
-        if len(spec.wings) == 2:
-            out += [f"wings.{side}.{f}" for side in ("left", "right") for f in fields]
+    paths = [row[0] for row in _core.spec_paths(spec.to_json())]
+    if not aliases:
+        return paths
+    fields = sorted({p[len("wings[0].") :] for p in paths if p.startswith("wings[0].")})
+    if spec.wings[0].aero is not None:
+        fields.append("omega_ratio")
+    out = paths + [f"wings[*].{f}" for f in fields]
+    if len(spec.wings) == 2:
+        out += [f"wings.{side}.{f}" for side in ("left", "right") for f in fields]
+    if spec.actuator is not None:
+        out += ["actuator.frequency_hz", "actuator.amplitude_v", "actuator.voltage_v"]
+    out += [f"wings[{i}].omega_ratio" for i, w in enumerate(spec.wings) if w.aero is not None]
     return out
-
-
-def _set(node: Any, keys: Sequence[str | int], value: Any) -> Any:
-    """A copy of ``node`` with ``keys`` set to ``value``; untouched branches are shared."""
-    key = keys[0]
-    if isinstance(node, dict):
-        new: Any = dict(node)
-        child = node.get(key)  # type: ignore[arg-type]
-    else:
-        new = list(node)
-        child = node[key]  # type: ignore[index]
-    if len(keys) == 1:
-        new[key] = value
-        return new
-    if child is None:  # springs absent: six default springs
-        child = [{} for _ in range(6)] if isinstance(keys[1], int) else {}
-    new[key] = _set(child, keys[1:], value)
-    return new
-
-
-def _point_dicts(device: dict[str, Any], options: dict[str, Any], params: Sequence[_Param], row: Sequence[Any]) -> tuple[dict[str, Any], dict[str, Any] | None]:
-    """The device (and, when an option is swept, options) dict of one point."""
-    opts: dict[str, Any] | None = None
-    for param, value in zip(params, row, strict=True):
-        if value is None:  # a null in an explicit table keeps the base value
-            continue
-        if isinstance(value, np.generic):
-            value = value.item()
-        for t in param.targets:
-            v = value * t.scale if t.scale is not None else value
-            if t.section == "device":
-                device = _set(device, t.keys, v)
-            else:
-                opts = _set(opts if opts is not None else options, t.keys, v)
-    return device, opts
 
 
 # ------------------------------------------------------------------------------ grids
@@ -261,7 +129,7 @@ def grid(axes: Mapping[str, Iterable[Any]]) -> pl.DataFrame:
     """The Cartesian product of ``axes`` as a DataFrame (first axis slowest, like
     ``itertools.product``); pass it, filtered or not, as `sweep`'s ``grid``.
 
-    >>> grid({"drivetrain.k2": [1, 2], "actuator.frequency_hz": [100.0, 110.0, 120.0]}).height
+    >>> grid({"drivetrain.balance_spring": [1, 2], "actuator.frequency_hz": [100.0, 110.0, 120.0]}).height
     6
     """
     if not isinstance(axes, Mapping):
@@ -302,9 +170,8 @@ def _table(spec_grid: Any) -> pl.DataFrame:
 class _Chunk:
     """A picklable batch of points (what an executor worker receives)."""
 
-    device: dict[str, Any]
-    options: dict[str, Any]
-    params: tuple[_Param, ...]
+    spec: str  # JSON
+    names: tuple[str, ...]
     rows: list[tuple[Any, ...]]
     points: list[int]
     metrics: list[str]
@@ -313,20 +180,23 @@ class _Chunk:
 
 
 def _prepare(chunk: _Chunk) -> _core.SweepRun:
-    """Builds the point dicts and parses them (GIL held); the run is not started."""
-    devices = []
-    options: list[dict[str, Any]] = []
-    per_point = any(t.section == "options" for p in chunk.params for t in p.targets)
-    for row in chunk.rows:
-        d, o = _point_dicts(chunk.device, chunk.options, chunk.params, row)
-        devices.append(d)
-        options.append(o if o is not None else chunk.options)
-    return _core.SweepRun(devices, options if per_point else chunk.options, chunk.metrics, chunk.keep_cycle, chunk.threads)
+    """The run of a chunk (paths resolved in Rust; points are built on the engine's pool)."""
+    return _core.SweepRun(chunk.spec, list(chunk.names), _dumps([list(r) for r in chunk.rows]), chunk.metrics, chunk.keep_cycle, chunk.threads)
+
+
+_RESULT_FIELDS = ("finished", "ok", "metrics", "converged", "cycles_run", "error", "error_kind", "cycle")
+
+
+def _raw(result: _core.SweepResult) -> dict[str, Any]:
+    """The fields of a native result as a picklable dict."""
+    raw = {name: getattr(result, name) for name in _RESULT_FIELDS}
+    raw["cycle"] = dict(raw["cycle"]) if raw["cycle"] is not None else None
+    return raw
 
 
 def _run_chunk(chunk: _Chunk) -> dict[str, Any]:
     """Runs a chunk to completion (executor workers call this)."""
-    return _prepare(chunk).result()
+    return _raw(_prepare(chunk).result())
 
 
 def _frame(raw: dict[str, Any], params: pl.DataFrame, points: Sequence[int], metrics: Sequence[str], cycle_columns: Sequence[str]) -> pl.DataFrame:
@@ -343,8 +213,9 @@ def _frame(raw: dict[str, Any], params: pl.DataFrame, points: Sequence[int], met
     ok_f = ok[idx]
     for k, name in enumerate(metrics):
         values = m[idx, k].astype(np.float64)
-        # failed points have no metrics (null); NaN stays NaN for ok points (e.g. no rotation)
-        cols[name] = pl.Series(name, values, dtype=pl.Float64, nan_to_null=False).scatter(np.flatnonzero(~ok_f), None)
+        # failed points have no metrics, and undefined metrics (NaN from the engine, e.g. the
+        # phase lag of a wing that does not rotate) are null too: never a silent NaN
+        cols[name] = pl.Series(name, values, dtype=pl.Float64, nan_to_null=True).scatter(np.flatnonzero(~ok_f), None)
     converged = np.asarray(raw["converged"], dtype=bool)[idx]
     cycles = np.asarray(raw["cycles_run"], dtype=np.int64)[idx]
     cols["converged"] = pl.Series("converged", [bool(c) if o else None for c, o in zip(converged, ok_f, strict=True)], dtype=pl.Boolean)
@@ -357,7 +228,7 @@ def _frame(raw: dict[str, Any], params: pl.DataFrame, points: Sequence[int], met
     if cycle_columns:
         cycle = raw["cycle"]
         for name in cycle_columns:
-            values = [None if cycle[name][i] is None else np.asarray(cycle[name][i]).tolist() for i in idx]
+            values = [None if cycle[name][i] is None else list(cycle[name][i]) for i in idx]
             cols[f"cycle_{name}"] = pl.Series(f"cycle_{name}", values, dtype=pl.List(pl.Float64))
     return pl.DataFrame(cols)
 
@@ -417,12 +288,11 @@ class _Checkpoint:
                 self.parts.rmdir()
 
 
-def _fingerprint(device: dict[str, Any], options: dict[str, Any], names: Sequence[str], metrics: Sequence[str], cycle: Sequence[str]) -> str:
+def _fingerprint(spec: str, names: Sequence[str], metrics: Sequence[str], cycle: Sequence[str]) -> str:
     payload = {
         "format": _FORMAT,
         "version": _core.__version__,
-        "device": device,
-        "options": options,
+        "spec": json.loads(spec),
         "parameters": list(names),
         "metrics": list(metrics),
         "cycle": list(cycle),
@@ -513,34 +383,22 @@ def sweep(
     if not isinstance(spec, Simulation):
         raise invalid("spec", type(spec).__name__, "a paritysim.Simulation")
     if options:
-        try:
-            spec = spec.replace(options=dataclasses.replace(spec.options, **dict(options)))
-        except TypeError as exc:
-            raise invalid("options", repr(dict(options)), f"fields of paritysim.Options ({exc})") from None
+        spec = spec.replace(options=spec.options.with_fields("options", **dict(options)))
     table = _table(grid)
     label_names = [labels] if isinstance(labels, str) else list(labels)
     for name in label_names:
         if name not in table.columns:
             raise invalid("labels", repr(name), "columns of the grid: " + ", ".join(table.columns))
     param_table = table.drop(label_names) if label_names else table
-    schema = _schema(spec)
-    params = tuple(_resolve(spec, name, schema) for name in param_table.columns)
-    seen: dict[tuple[str, tuple[str | int, ...]], str] = {}
-    for p in params:
-        for t in p.targets:
-            other = seen.setdefault((t.section, t.keys), p.name)
-            if other != p.name:
-                raise invalid(p.name, "<same field as " + repr(other) + ">", "each spec field swept by one column only")
-
-    device, opts = spec.device_dict(), spec.options_dict()
-    _core.validate_device(device)  # the base design must be valid (typed error naming the field)
-    _core.SweepRun([device], opts)  # parses the options: raises for a bad option
-    valid_metrics = _core.sweep_metric_names(device)
+    spec_json = spec.to_json()
+    _core.validate_spec(spec_json)  # the base design must be valid (typed error naming the field)
+    valid_metrics = _core.sweep_metric_names(spec_json)
     metric_names = list(valid_metrics if metrics is None else metrics)
-    for name in metric_names:
-        if name not in valid_metrics:
-            raise invalid("metrics", repr(name), "one of: " + ", ".join(valid_metrics))
-    cycle_columns = _cycle_columns(device, keep_cycle)
+    # Resolves every path (unknown: the nearest valid one), duplicates, metrics: before running.
+    probe = _core.SweepRun(spec_json, [str(c) for c in param_table.columns], "[]", metric_names)
+    for note in probe.notes:
+        warnings.warn(note, DeprecationWarning, stacklevel=2)
+    cycle_columns = _cycle_columns(spec_json, keep_cycle)
     if executor is None:
         n_threads = _core.sweep_resolve_threads(threads)
     else:
@@ -552,7 +410,7 @@ def sweep(
 
     rows = param_table.rows() if param_table.width else [()] * max(table.height, 1)
     n = len(rows)
-    store = _Checkpoint(checkpoint, _fingerprint(device, opts, table.columns, metric_names, cycle_columns)) if checkpoint is not None else None
+    store = _Checkpoint(checkpoint, _fingerprint(spec_json, table.columns, metric_names, cycle_columns)) if checkpoint is not None else None
     done: list[pl.DataFrame] = []
     todo = list(range(n))
     if store is not None:
@@ -570,7 +428,7 @@ def sweep(
     chunks = [todo[i : i + chunk_size] for i in range(0, len(todo), chunk_size)]
 
     def make(points: list[int]) -> _Chunk:
-        return _Chunk(device, opts, params, [rows[i] for i in points], points, metric_names, bool(cycle_columns), n_threads)
+        return _Chunk(spec_json, tuple(param_table.columns), [rows[i] for i in points], points, metric_names, bool(cycle_columns), n_threads)
 
     def frame(points: list[int], raw: dict[str, Any]) -> pl.DataFrame:
         return _frame(raw, table[points] if table.width else table, points, metric_names, cycle_columns)
@@ -637,10 +495,10 @@ def _caller_stacklevel() -> int:
     return level
 
 
-def _cycle_columns(device: dict[str, Any], keep_cycle: bool | Sequence[str]) -> list[str]:
+def _cycle_columns(spec_json: str, keep_cycle: bool | Sequence[str]) -> list[str]:
     if keep_cycle is False or keep_cycle is None:
         return []
-    available = ["time_ms", *_core.sweep_trajectory_columns(device)]
+    available = ["time_ms", *_core.sweep_trajectory_columns(spec_json)]
     if keep_cycle is True:
         return available
     if isinstance(keep_cycle, str):
@@ -732,7 +590,7 @@ def _run_local(
             if upcoming is not None:
                 upcoming[1].start()
                 started.append(upcoming)
-            raw = run.result()
+            raw = _raw(run.result())
             started.pop(0)
             finished_chunk(frame(points, raw))
             upcoming = prepared()
@@ -741,7 +599,7 @@ def _run_local(
             run.cancel()
         for points, run in started:
             run.wait(None)
-            finished_chunk(frame(points, run.result()))
+            finished_chunk(frame(points, _raw(run.result())))
         return True
     return False
 

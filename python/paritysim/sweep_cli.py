@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 import polars as pl
 
+from . import _core
 from ._errors import invalid
 from .spec import Simulation, load_spec
 
@@ -84,7 +85,7 @@ def load_study(path: str | Path) -> Study:
         data = tomllib.load(f)
     unknown = sorted(set(data) - set(_KEYS))
     if unknown:
-        raise invalid(unknown[0], "<unknown key>", "one of: " + ", ".join(_KEYS))
+        raise invalid(unknown[0], "<unknown key>", _core.spec_suggestion(unknown[0], list(_KEYS)))
     raw_spec = data.get("spec")
     if isinstance(raw_spec, str):
         spec = load_spec(path.parent / raw_spec)

@@ -160,6 +160,11 @@ impl Waveform {
     }
 }
 
+/// §3.3.1 actuator stiffness (mN/mm): the one place this number is written.
+pub const THESIS_STIFFNESS: f64 = 467.0;
+/// §3.3.1 blocked force per volt (mN/V): 120 mN at 100 V.
+pub const THESIS_FORCE_PER_VOLT: f64 = 1.2;
+
 /// Piezo actuator: `F(t) = force_per_volt · V(t)` in parallel with `stiffness` on `q1`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Actuator {
@@ -188,8 +193,8 @@ impl Actuator {
     /// The §3.3.1 actuator (467 mN/mm, 1.2 mN/V) with the given waveform.
     pub fn thesis(waveform: Waveform) -> Self {
         Self {
-            force_per_volt: 1.2,
-            stiffness: 467.0,
+            force_per_volt: THESIS_FORCE_PER_VOLT,
+            stiffness: THESIS_STIFFNESS,
             waveform,
             dc_offset: DcOffset::AsForce,
         }

@@ -15,6 +15,9 @@
 //! body roll frame): `delta_tau_peak = max |τL + τR|` (eq. 3.23), `tau_l_peak`, `tau_r_peak`,
 //! `imbalance_instantaneous_pct = 100 Δτ_peak / τR_peak`,
 //! `imbalance_peak_pct = 100 (τR_peak − τL_peak) / τR_peak`.
+//!
+//! Undefined metrics are NaN (Python turns them into `None` / null): the phase lag of a wing
+//! that does not rotate, the imbalance percentages when `τR_peak = 0`.
 
 use std::f64::consts::{PI, TAU};
 
@@ -235,8 +238,15 @@ impl MetricsAccumulator {
             out.push(("delta_tau_peak".into(), delta));
             out.push(("tau_l_peak".into(), tau_l));
             out.push(("tau_r_peak".into(), tau_r));
-            out.push(("imbalance_instantaneous_pct".into(), 100.0 * delta / tau_r));
-            out.push(("imbalance_peak_pct".into(), 100.0 * (tau_r - tau_l) / tau_r));
+            let percent = |x: f64| {
+                if tau_r > 0.0 {
+                    100.0 * x / tau_r
+                } else {
+                    f64::NAN
+                }
+            };
+            out.push(("imbalance_instantaneous_pct".into(), percent(delta)));
+            out.push(("imbalance_peak_pct".into(), percent(tau_r - tau_l)));
         }
         out
     }

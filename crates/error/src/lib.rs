@@ -13,6 +13,7 @@
 //! | `Singular`           | `SingularError(ParitysimError, ArithmeticError)`      |
 //! | `Integration`        | `IntegrationError(ParitysimError, RuntimeError)`      |
 //! | `Cancelled`          | `CancelledError(ParitysimError)`                      |
+//! | `InvalidSpec`        | `InvalidParameterError` (with every problem listed)   |
 //!
 //! Use [`ensure!`] / [`bail!`] and the `check_*` helpers so that every message names the
 //! offending field and the allowed range.
@@ -24,8 +25,9 @@ use std::fmt;
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 /// Every failure paritysim can report.
+// Not `#[non_exhaustive]`: the bindings map every variant in one exhaustive `match`, so a new
+// variant fails to compile until it has a Python class.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[non_exhaustive]
 pub enum Error {
     /// A parameter is non-finite or outside its allowed range.
     #[error("invalid `{field}` = {value}: must be {allowed}")]
@@ -71,6 +73,55 @@ pub enum Error {
     /// Work was cancelled by the caller.
     #[error("cancelled")]
     Cancelled,
+    /// Several invalid fields of one spec, every one with its dotted path and allowed range.
+    #[error("{} problems in the spec: {}", .0.len(), Problem::list(.0))]
+    InvalidSpec(Vec<Problem>),
+}
+
+/// One invalid field of a spec: its dotted path, the value found and what is allowed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Problem {
+    /// Dotted path, e.g. `wings[0].aero.omega1`.
+    pub field: String,
+    /// The rejected value (formatted), `missing` or `<unknown field>`.
+    pub value: String,
+    /// Allowed values or range, with the unit.
+    pub allowed: String,
+}
+
+impl Problem {
+    /// A problem at `field`.
+    pub fn new(
+        field: impl Into<String>,
+        value: impl fmt::Display,
+        allowed: impl Into<String>,
+    ) -> Self {
+        Self {
+            field: field.into(),
+            value: value.to_string(),
+            allowed: allowed.into(),
+        }
+    }
+
+    fn list(problems: &[Problem]) -> String {
+        problems
+            .iter()
+            .map(|p| format!("`{}` = {}: must be {}", p.field, p.value, p.allowed))
+            .collect::<Vec<_>>()
+            .join("; ")
+    }
+}
+
+impl From<Vec<Problem>> for Error {
+    /// One problem is an [`Error::InvalidParameter`]; several are an [`Error::InvalidSpec`].
+    fn from(mut problems: Vec<Problem>) -> Self {
+        if problems.len() == 1 {
+            let p = problems.remove(0);
+            Error::invalid(p.field, p.value, p.allowed)
+        } else {
+            Error::InvalidSpec(problems)
+        }
+    }
 }
 
 impl Error {
@@ -85,6 +136,7 @@ impl Error {
             Error::Singular(_) => "Singular",
             Error::Integration { .. } => "Integration",
             Error::Cancelled => "Cancelled",
+            Error::InvalidSpec(_) => "InvalidParameter",
         }
     }
 
@@ -92,6 +144,7 @@ impl Error {
     pub fn field(&self) -> Option<&str> {
         match self {
             Error::InvalidParameter { field, .. } => Some(field),
+            Error::InvalidSpec(problems) => problems.first().map(|p| p.field.as_str()),
             _ => None,
         }
     }

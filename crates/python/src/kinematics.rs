@@ -2,8 +2,7 @@
 
 use numpy::{PyArray1, PyReadonlyArray1};
 use paritysim_error::Error;
-use paritysim_kinematics::drivetrain::{HmfFourBar, LinearDifferential, LinkageDifferential};
-use paritysim_kinematics::{Drivetrain, RodCrank, SphericalShoulder};
+use paritysim_kinematics::{Drivetrain, SphericalShoulder};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -115,66 +114,31 @@ fn shoulder_partials<'py>(
     Ok(out)
 }
 
-/// Constructor name and arguments: what `__reduce__` hands to `paritysim._drivetrain_pickle.rebuild`.
-type ConstructorArgs = (String, Vec<f64>);
-
-/// A planar drivetrain mapping `(q1, q2)` (mm, rad) to stroke angles `(φL, φR)` (rad).
+/// A planar drivetrain mapping `(q1, q2)` (mm, rad) to stroke angles `(φL, φR)` (rad), built
+/// from a `[drivetrain]` spec (any registered kind).
 #[pyclass(name = "Drivetrain", module = "paritysim._core", frozen)]
 #[derive(Clone)]
 pub struct PyDrivetrain {
     pub inner: Drivetrain,
-    args: ConstructorArgs,
+    spec: paritysim_spec::Drivetrain,
 }
 
 #[pymethods]
 impl PyDrivetrain {
-    /// HMF four-bar (§2.3.1), 1 DOF. Defaults: crank 0.4 mm, rod 0.8 mm (60° for 400 µm).
+    /// From a drivetrain spec as JSON text (`{"kind": ..., <fields>}`), validated like a
+    /// `[drivetrain]` table.
     #[staticmethod]
-    #[pyo3(signature = (crank_mm=0.4, rod_mm=0.8))]
-    fn hmf_four_bar(crank_mm: f64, rod_mm: f64) -> PyResult<Self> {
-        let side = RodCrank::new(crank_mm, rod_mm).py_err()?;
+    fn from_spec(json: &str) -> PyResult<Self> {
+        let spec = paritysim_spec::drivetrain_from_json(json).py_err()?;
         Ok(Self {
-            inner: Drivetrain::HmfFourBar(HmfFourBar::new(side)),
-            args: ("hmf_four_bar".into(), vec![crank_mm, rod_mm]),
+            inner: spec.kinematics().py_err()?,
+            spec,
         })
     }
 
-    /// Drag PARITY linear map of eq. 2.15: ratio T (rad/mm), mean arm L (mm), arm ratio hL/hR.
-    #[staticmethod]
-    #[pyo3(signature = (transmission_ratio, arm_length_mm, arm_ratio=1.0))]
-    fn linear_differential(
-        transmission_ratio: f64,
-        arm_length_mm: f64,
-        arm_ratio: f64,
-    ) -> PyResult<Self> {
-        let d = LinearDifferential::new(transmission_ratio, arm_length_mm, arm_ratio).py_err()?;
-        Ok(Self {
-            inner: Drivetrain::LinearDifferential(d),
-            args: (
-                "linear_differential".into(),
-                vec![transmission_ratio, arm_length_mm, arm_ratio],
-            ),
-        })
-    }
-
-    /// Drag PARITY nonlinear linkage (§2.3.2, §3.3.2 lengths by default; arm ratio hL/hR).
-    #[staticmethod]
-    #[pyo3(signature = (crank_mm=0.4, rod_mm=0.8, whippletree_length_mm=5.0, arm_ratio=1.0))]
-    fn linkage_differential(
-        crank_mm: f64,
-        rod_mm: f64,
-        whippletree_length_mm: f64,
-        arm_ratio: f64,
-    ) -> PyResult<Self> {
-        let side = RodCrank::new(crank_mm, rod_mm).py_err()?;
-        let d = LinkageDifferential::new(side, whippletree_length_mm, arm_ratio).py_err()?;
-        Ok(Self {
-            inner: Drivetrain::LinkageDifferential(d),
-            args: (
-                "linkage_differential".into(),
-                vec![crank_mm, rod_mm, whippletree_length_mm, arm_ratio],
-            ),
-        })
+    /// The spec as JSON text.
+    fn to_spec(&self) -> String {
+        serde_json::to_string(&self.spec).expect("a spec serialises")
     }
 
     /// Kind name.
@@ -187,12 +151,6 @@ impl PyDrivetrain {
     #[getter]
     fn dof(&self) -> usize {
         self.inner.dof()
-    }
-
-    /// Constructor name and arguments, for pickling and TOML round trips.
-    #[getter]
-    fn parameters(&self) -> (String, Vec<f64>) {
-        self.args.clone()
     }
 
     /// Evaluates over paired arrays `q1` (mm), `q2` (rad). Returns `stroke_left`,
@@ -247,21 +205,16 @@ impl PyDrivetrain {
     }
 
     fn __repr__(&self) -> String {
-        let (name, args) = &self.args;
-        let args: Vec<String> = args.iter().map(|a| format!("{a}")).collect();
-        format!("Drivetrain.{name}({})", args.join(", "))
+        format!("Drivetrain.from_spec({:?})", self.to_spec())
     }
 
     fn __eq__(&self, other: &Self) -> bool {
-        self.args == other.args
+        self.spec == other.spec
     }
 
-    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, ConstructorArgs)> {
-        let py = slf.py();
-        let rebuild = py
-            .import("paritysim._drivetrain_pickle")?
-            .getattr("rebuild")?;
-        Ok((rebuild, slf.get().args.clone()))
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        let from_spec = slf.get_type().getattr("from_spec")?;
+        Ok((from_spec, (slf.get().to_spec(),)))
     }
 }
 

@@ -40,31 +40,54 @@ fn get_item<'py>(d: &Bound<'py, PyDict>, key: &str, ctx: &str) -> PyResult<Bound
         .ok_or_else(|| missing(format!("{ctx}{key}")))
 }
 
-fn get_f64(d: &Bound<'_, PyDict>, key: &str, ctx: &str) -> PyResult<f64> {
-    get_item(d, key, ctx)?.extract::<f64>()
+/// Extracts `T`, or an `InvalidParameterError` naming `field` (never a bare `TypeError`).
+fn typed<'py, T: FromPyObject<'py>>(v: &Bound<'py, PyAny>, field: &str, what: &str) -> PyResult<T> {
+    v.extract::<T>().map_err(|_| {
+        let shown = v.repr().map(|r| r.to_string()).unwrap_or_default();
+        to_pyerr(Error::invalid(field.to_string(), shown, what))
+    })
 }
 
-fn get_opt_f64(d: &Bound<'_, PyDict>, key: &str) -> PyResult<Option<f64>> {
+/// A dict, or an `InvalidParameterError` naming `field`.
+fn table<'a, 'py>(v: &'a Bound<'py, PyAny>, field: &str) -> PyResult<&'a Bound<'py, PyDict>> {
+    v.cast::<PyDict>().map_err(|_| {
+        to_pyerr(Error::invalid(
+            field.trim_end_matches('.').to_string(),
+            "not a dict",
+            "a dict",
+        ))
+    })
+}
+
+fn get_f64(d: &Bound<'_, PyDict>, key: &str, ctx: &str) -> PyResult<f64> {
+    typed(&get_item(d, key, ctx)?, &format!("{ctx}{key}"), "a number")
+}
+
+fn get_str(d: &Bound<'_, PyDict>, key: &str, ctx: &str) -> PyResult<String> {
+    typed(&get_item(d, key, ctx)?, &format!("{ctx}{key}"), "a string")
+}
+
+fn get_opt_f64(d: &Bound<'_, PyDict>, key: &str, ctx: &str) -> PyResult<Option<f64>> {
     match d.get_item(key)? {
         None => Ok(None),
         Some(v) if v.is_none() => Ok(None),
-        Some(v) => Ok(Some(v.extract::<f64>()?)),
+        Some(v) => Ok(Some(typed(&v, &format!("{ctx}{key}"), "a number or None")?)),
     }
 }
 
 fn material_from_py(obj: &Bound<'_, PyAny>, ctx: &str) -> PyResult<Material> {
     if obj.is_instance_of::<PyString>() {
-        let key: String = obj.extract()?;
+        let key: String = typed(obj, ctx.trim_end_matches('.'), "a material key")?;
         return library::by_name(&key).map_err(|e| within(e, ctx)).py_err();
     }
-    let d = obj.cast::<PyDict>()?;
-    let name: String = get_item(d, "name", ctx)?.extract()?;
-    let class: String = get_item(d, "class", ctx)?.extract()?;
+    let d = table(obj, ctx)?;
+    let name = get_str(d, "name", ctx)?;
+    let class = get_str(d, "class", ctx)?;
     let class = MaterialClass::parse(&class)
         .map_err(|e| within(e, ctx))
         .py_err()?;
-    let d31 = get_opt_f64(d, "d31")?;
-    let max_field = get_opt_f64(d, "max_field")?;
+    let d31 = get_opt_f64(d, "d31", ctx)?;
+    let max_field = get_opt_f64(d, "max_field", ctx)?;
     let piezo = match (d31, max_field) {
         (None, None) => None,
         (Some(d31), Some(max_field)) => Some(Piezo { d31, max_field }),
@@ -108,21 +131,27 @@ fn layers_from_py(layers: &Bound<'_, PyList>) -> PyResult<Layup> {
     let mut out = Vec::with_capacity(layers.len());
     for (i, item) in layers.iter().enumerate() {
         let ctx = format!("layers[{i}].");
-        let d = item.cast::<PyDict>()?;
-        let name: String = get_item(d, "name", &ctx)?.extract()?;
+        let d = table(&item, &ctx)?;
+        let name = get_str(d, "name", &ctx)?;
         let plies_obj = get_item(d, "plies", &ctx)?;
-        let plies_list = plies_obj.cast::<PyList>()?;
+        let plies_list = plies_obj.cast::<PyList>().map_err(|_| {
+            to_pyerr(Error::invalid(
+                format!("{ctx}plies"),
+                "not a list",
+                "a list of ply dicts",
+            ))
+        })?;
         let mut plies = Vec::with_capacity(plies_list.len());
         for (j, p) in plies_list.iter().enumerate() {
             let pctx = format!("{ctx}plies[{j}].");
-            let pd = p.cast::<PyDict>()?;
+            let pd = table(&p, &pctx)?;
             let material = material_from_py(
                 &get_item(pd, "material", &pctx)?,
                 &format!("{pctx}material."),
             )?;
             let thickness = get_f64(pd, "thickness", &pctx)?;
             let angle = match pd.get_item("angle")? {
-                Some(a) => a.extract::<f64>()?,
+                Some(a) => typed(&a, &format!("{pctx}angle"), "a number (rad)")?,
                 None => 0.0,
             };
             plies.push(

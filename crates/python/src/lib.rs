@@ -8,10 +8,10 @@ use pyo3::prelude::*;
 
 mod aero;
 mod convert;
-mod dynamics;
 mod errors;
 mod kinematics;
 mod laminate;
+mod spec;
 mod stability;
 mod sweep;
 mod wing_terms;
@@ -22,7 +22,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     errors::register(m)?;
     kinematics::register(m)?;
-    dynamics::register(m)?;
+    spec::register(m)?;
     aero::register(m)?;
     laminate::register(m)?;
     stability::register(m)?;

@@ -14,8 +14,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::{same_len, shaped, to_vec};
-use crate::dynamics::parse_device;
 use crate::errors::IntoPyResult;
+use crate::spec::device as parse_device;
 
 fn c64(z: Complex<f64>) -> Complex64 {
     Complex64::new(z.re, z.im)
@@ -295,7 +295,7 @@ fn check_keys(d: &Bound<'_, PyDict>, allowed: &[&str]) -> Result<()> {
             return Err(Error::invalid(
                 format!("options.{name}"),
                 "<unknown option>",
-                format!("one of {}", allowed.join(", ")),
+                paritysim_spec::schema::suggestion(&name, allowed.iter().copied()),
             ));
         }
     }
@@ -393,7 +393,7 @@ fn floquet_dict<'py>(py: Python<'py>, f: &NonlinearFloquet) -> PyResult<Bound<'p
 #[pyo3(signature = (spec, options = None))]
 fn stability_floquet<'py>(
     py: Python<'py>,
-    spec: &Bound<'py, PyDict>,
+    spec: &str,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let device = parse_device(spec).py_err()?;
@@ -410,7 +410,7 @@ fn stability_floquet<'py>(
 #[pyo3(signature = (spec, k2, options = None))]
 fn stability_k2_sweep<'py>(
     py: Python<'py>,
-    spec: &Bound<'py, PyDict>,
+    spec: &str,
     k2: PyReadonlyArray1<'py, f64>,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -479,7 +479,7 @@ fn lti_dict<'py>(py: Python<'py>, lti: &floquet::LtiModel) -> PyResult<Bound<'py
 #[pyo3(signature = (spec, options = None, samples = 2000))]
 fn stability_linearise<'py>(
     py: Python<'py>,
-    spec: &Bound<'py, PyDict>,
+    spec: &str,
     options: Option<&Bound<'py, PyDict>>,
     samples: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -532,7 +532,7 @@ const DISTURBANCE_KEYS: [&str; 5] = [
 #[pyo3(signature = (spec, frequency_hz, amplitude, options = None, disturbance = None))]
 fn stability_disturbance_response<'py>(
     py: Python<'py>,
-    spec: &Bound<'py, PyDict>,
+    spec: &str,
     frequency_hz: PyReadonlyArray1<'py, f64>,
     amplitude: f64,
     options: Option<&Bound<'py, PyDict>>,

@@ -7,7 +7,6 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::convert::shaped;
-use crate::dynamics::parse_device;
 use crate::errors::IntoPyResult;
 
 fn row_major(m: &Matrix3<f64>) -> Vec<f64> {
@@ -20,7 +19,7 @@ fn vector<'py>(py: Python<'py>, v: &Vector3<f64>) -> Bound<'py, PyArray1<f64>> {
     PyArray1::from_vec(py, v.as_slice().to_vec())
 }
 
-/// `Wing::terms` of wing `wing` of a device dict at `p = (φ, θ, ψ)`, `ṗ`: a dict of
+/// `Wing::terms` of wing `wing` of a JSON spec at `p = (φ, θ, ψ)`, `ṗ`: a dict of
 /// `mass` (M, A.36, 3×3, mg·mm²), `coriolis` (c, mN·mm), `spring_gradient` (∇V of the joint
 /// springs and tunable hinge, A.6, mN·mm), `aero` (J6ᵀτ⁶, mN·mm), `j6` (A.9, 3×3), `omega`
 /// (J6 ṗ, rad/ms), `jdot_pdot` (J̇6 ṗ, rad/ms²), `rotation` (R_6^1), `theta_w`, `kinetic`
@@ -32,12 +31,12 @@ fn vector<'py>(py: Python<'py>, v: &Vector3<f64>) -> Bound<'py, PyArray1<f64>> {
 #[pyfunction]
 fn dynamics_wing_terms<'py>(
     py: Python<'py>,
-    device: &Bound<'py, PyDict>,
+    spec: &str,
     wing: usize,
     p: [f64; 3],
     p_dot: [f64; 3],
 ) -> PyResult<Bound<'py, PyDict>> {
-    let device = parse_device(device).py_err()?;
+    let device = crate::spec::device(spec).py_err()?;
     let n = device.n_wings();
     let w = device
         .spec()

@@ -22,7 +22,7 @@ import polars as pl
 from .. import aero
 from ..claims import Claim, render
 from ..simulation import simulate
-from ..spec import Configuration, Spring, TunableHinge, Wing
+from ..spec import Configuration, Spring, Springs, TunableHinge, Wing
 # The package exports the function `section_3_4` under the module's name: load the module itself.
 s34 = importlib.import_module("paritysim.trials.section_3_4")
 
@@ -39,7 +39,7 @@ CONFIGURATIONS = [
 
 def _wing(key: str, hinge_k0: float, hinge_k2: float, deviation_stiffness: float) -> Wing:
     w = aero.TABLE_3_3[key]
-    springs = tuple(Spring(stiffness=deviation_stiffness if joint == 3 else 0.0) for joint in range(6))  # joint 4 = θ
+    springs = Springs(deviation=Spring(stiffness=deviation_stiffness))  # joint 4 = θ
     blade = dataclasses.replace(s34._wing(key, hinge_k0, "dickinson1999").aero)  # type: ignore[arg-type]
     return Wing.from_moments(w["ixx"], w["iyy"], w["izz"], w["ixz"], springs=springs, aero=blade, tunable_hinge=TunableHinge(hinge_k0, 0.0, hinge_k2))
 

@@ -42,7 +42,7 @@ def drag_parity_spec(k2: float = 1.0, *, linear: bool = False, omega_left: float
     L = 2.5 mm (docs/findings.md item 2).
     """
     drivetrain = (
-        Drivetrain.linear_differential(2.5, 2.5, balance_stiffness=k2) if linear else Drivetrain.linkage_differential(balance_stiffness=k2)
+        Drivetrain.linear_differential(2.5, 2.5, balance_spring=k2) if linear else Drivetrain.linkage_differential(balance_spring=k2)
     )
     return Simulation(
         wings=_wings(omega_left, coefficient),

@@ -59,6 +59,10 @@ TABLE_COLUMNS = [
 ]
 
 
+#: The §3.3.1 actuator constants, as defined once by the Rust spec's defaults.
+_THESIS_ACTUATOR = Actuator()
+
+
 @dataclass(frozen=True)
 class Params:
     """The §3.3 study (units mg-mm-ms-rad-V). Thesis values where stated (§3.3.1-3.3.2)."""
@@ -71,8 +75,8 @@ class Params:
     drivetrain: str = "linear"  # "linear" (eq. 2.15) or "linkage"
     drag_law: str = "cn90"  # "cn90" (eq. 3.8) or "unit" (eq. 2.16)
     drag_multiplier: float = 1.0  # extra factor on the drag law (for calibration)
-    force_per_volt: float = 1.2  # 120 mN at 100 V
-    actuator_stiffness: float = 467.0  # mN/mm
+    force_per_volt: float = _THESIS_ACTUATOR.force_per_volt  # 120 mN at 100 V (from the Rust spec)
+    actuator_stiffness: float = _THESIS_ACTUATOR.stiffness  # mN/mm (from the Rust spec)
     amplitude_v: float = 100.0
     frequency_hz: float = 110.0
     samples_per_cycle: int = 400
@@ -125,9 +129,9 @@ def device(p: Params, drivetrain: str, omega_l: float, arm_ratio: float = 1.0) -
     elif drivetrain == "PARITY":
         config = "drag_parity_fixed"
         if p.drivetrain == "linkage":
-            kinematics = Drivetrain.linkage_differential(whippletree_length_mm=2 * p.arm_mm, arm_ratio=arm_ratio, balance_stiffness=p.balance_stiffness)
+            kinematics = Drivetrain.linkage_differential(whippletree_length_mm=2 * p.arm_mm, arm_ratio=arm_ratio, balance_spring=p.balance_stiffness)
         else:
-            kinematics = Drivetrain.linear_differential(p.transmission_ratio, p.arm_mm, arm_ratio=arm_ratio, balance_stiffness=p.balance_stiffness)
+            kinematics = Drivetrain.linear_differential(p.transmission_ratio, p.arm_mm, arm_ratio=arm_ratio, balance_spring=p.balance_stiffness)
     else:
         from .._errors import invalid
 

@@ -29,11 +29,15 @@ from .. import aero
 from ..claims import Claim, render
 from ._io import write_claims, write_trial
 from ..simulation import SimulationResult, simulate
-from ..spec import Actuator, Aero, Configuration, Drivetrain, Options, Simulation, Spring, Waveform, Wing
+from ..spec import Actuator, Aero, Configuration, Drivetrain, Options, Simulation, Spring, Springs, Waveform, Wing
 
 #: Right-wing key of Table 3.3 per trial (the left wing is the same in all trials).
 TRIALS = {"Uncut": "right_uncut", "1-Cut": "right_1cut", "2-Cut": "right_2cut"}
 DRIVETRAINS = {"HMF": "hmf", "PARITY": "drag_parity"}
+
+
+#: The §3.3.1 actuator constants, as defined once by the Rust spec's defaults.
+_THESIS_ACTUATOR = Actuator()
 
 
 @dataclass(frozen=True)
@@ -49,8 +53,8 @@ class Params:
     offset_v: float = 100.0
     frequency_hz: float = 110.0
     dc_offset: str = "ignore"
-    force_per_volt: float = 1.2
-    actuator_stiffness: float = 467.0
+    force_per_volt: float = _THESIS_ACTUATOR.force_per_volt  # from the Rust spec
+    actuator_stiffness: float = _THESIS_ACTUATOR.stiffness  # from the Rust spec
     model: str = "dickinson1999"
     max_cycles: int = 200
     samples_per_cycle: int = 200
@@ -63,7 +67,7 @@ class Params:
 
 def _wing(key: str, hinge: float, model: str) -> Wing:
     w = aero.TABLE_3_3[key]
-    springs = tuple(Spring(stiffness=hinge if joint == 5 else 0.0) for joint in range(6))  # joint 6 = ψ hinge
+    springs = Springs(hinge=Spring(stiffness=hinge))  # joint 6 = ψ hinge
     blade = Aero(kind="blade_element", omega1=w["omega1"], omega2=w["omega2"], omega3=w["omega3"], omega4=w["omega4"], model=model)
     return Wing.from_moments(w["ixx"], w["iyy"], w["izz"], w["ixz"], springs=springs, aero=blade)
 
@@ -75,7 +79,7 @@ def device(p: Params, drivetrain: str, trial: str, hinge: float | None = None) -
         name=f"§3.4 {drivetrain} {trial}",
         wings=(_wing("left", k, p.model), _wing(TRIALS[trial], k, p.model)),
         configuration=Configuration(DRIVETRAINS[drivetrain]),
-        drivetrain=Drivetrain.linear_differential(p.transmission_ratio, p.arm_mm, balance_stiffness=p.balance_stiffness),
+        drivetrain=Drivetrain.linear_differential(p.transmission_ratio, p.arm_mm, balance_spring=p.balance_stiffness),
         actuator=Actuator(Waveform(amplitude_v=p.amplitude_v, offset_v=p.offset_v, frequency_hz=p.frequency_hz), p.force_per_volt, p.actuator_stiffness, p.dc_offset),
         options=Options(max_cycles=p.max_cycles, samples_per_cycle=p.samples_per_cycle),
     )

@@ -1,0 +1,261 @@
+//! From a spec to the dynamics model ([`Device`]) and its [`SimulationOptions`].
+
+use nalgebra::Matrix3;
+use paritysim_aero::{BladeElementModel, CoefficientSet, Omegas};
+use paritysim_constraints::{Constraints, Vec6};
+use paritysim_dynamics::device::{DeviceSpec, Formulation as EngineFormulation, Transmission};
+use paritysim_dynamics::simulate::PerturbTarget as EngineTarget;
+use paritysim_dynamics::{
+    Actuator as EngineActuator, DcOffset as EngineDc, Device, JointSpring,
+    Perturbation as EngineKick, SimulationOptions, TunableHinge as EngineHinge,
+    Waveform as EngineWaveform, Wing as EngineWing, WingAero,
+};
+use paritysim_error::{Error, Result};
+use paritysim_kinematics::SphericalShoulder;
+
+use crate::actuator::{Actuator, DcOffset, Waveform};
+use crate::options::{Options, PerturbTarget};
+use crate::spec::{Configuration, Formulation, Simulation};
+use crate::wing::{Aero, CoefficientModel, NormalForceLaw, SPRING_NAMES, Wing};
+
+impl Simulation {
+    /// The validated model and options.
+    ///
+    /// # Errors
+    /// Whatever the engine's constructors reject (cross-field conditions such as a 1-DOF
+    /// drivetrain driving untied wings), with the dotted field path.
+    pub fn model(&self) -> Result<(Device, SimulationOptions)> {
+        let device = self.device()?;
+        let options = options(&self.options, device.n_coords())?;
+        Ok((device, options))
+    }
+
+    /// The validated dynamics model.
+    ///
+    /// # Errors
+    /// See [`Simulation::model`].
+    pub fn device(&self) -> Result<Device> {
+        let wings = self
+            .wings
+            .iter()
+            .enumerate()
+            .map(|(i, w)| wing(w).map_err(|e| e.in_field(&format!("wings[{i}]"))))
+            .collect::<Result<Vec<_>>>()?;
+        let constraints = constraints(&self.configuration, 3 * wings.len())?;
+        let transmission = match &self.drivetrain {
+            None => None,
+            Some(d) => Some(
+                d.kinematics()
+                    .and_then(|k| Transmission::new(k, d.balance_spring()))
+                    .map_err(|e| rename_field(e, "balance_stiffness", "balance_spring"))
+                    .map_err(|e| e.in_field("drivetrain"))?,
+            ),
+        };
+        let actuator = self
+            .actuator
+            .as_ref()
+            .map(actuator)
+            .transpose()
+            .map_err(|e| e.in_field("actuator"))?;
+        Device::new(DeviceSpec {
+            wings,
+            constraints,
+            transmission,
+            actuator,
+            formulation: match self.formulation {
+                Formulation::Auto => EngineFormulation::Auto,
+                Formulation::NullSpace => EngineFormulation::NullSpace,
+                Formulation::Projection => EngineFormulation::Projection,
+                Formulation::DrivetrainCoordinates => EngineFormulation::DrivetrainCoordinates,
+            },
+        })
+    }
+}
+
+fn wing(w: &Wing) -> Result<EngineWing> {
+    let shoulder = SphericalShoulder::new(w.shoulder.alpha2, w.shoulder.alpha3)
+        .map_err(|e| e.in_field("shoulder"))?;
+    let inertia = Matrix3::from_fn(|i, j| w.inertia[i][j]);
+    let mut springs = [JointSpring::default(); 6];
+    for (k, s) in w.springs.in_joint_order().into_iter().enumerate() {
+        springs[k] = JointSpring::nonlinear(s.stiffness, s.cubic, s.rest_angle)
+            .map_err(|e| e.in_field(&format!("springs.{}", SPRING_NAMES[k])))?;
+    }
+    let aero = match &w.aero {
+        None => WingAero::None,
+        Some(Aero::StrokeDrag(a)) => {
+            WingAero::stroke_drag(a.omega1, a.coefficient).map_err(|e| e.in_field("aero"))?
+        }
+        Some(Aero::BladeElement(a)) => {
+            let at = |e: Error| e.in_field("aero");
+            let omegas = Omegas::new(a.omega1, a.omega2, a.omega3, a.omega4).map_err(at)?;
+            let coefficients = CoefficientSet::from_name(match a.model {
+                CoefficientModel::Dickinson1999 => "dickinson1999",
+                CoefficientModel::WhitneyWood2010 => "whitney_wood2010",
+            })
+            .map_err(at)?;
+            let damping = a
+                .rotational_damping
+                .unwrap_or(paritysim_aero::DEFAULT_ROTATIONAL_DAMPING);
+            let law = match a.normal_force_law {
+                NormalForceLaw::Coefficient => paritysim_aero::NormalForceLaw::Coefficient,
+                NormalForceLaw::Unit => paritysim_aero::NormalForceLaw::Unit,
+            };
+            WingAero::BladeElement(
+                BladeElementModel::new(omegas, coefficients)
+                    .and_then(|m| m.with_rotational_damping(damping))
+                    .map_err(at)?
+                    .with_normal_force_law(law),
+            )
+        }
+    };
+    let built = EngineWing::new(shoulder, inertia, springs, aero)?;
+    Ok(match &w.tunable_hinge {
+        None => built,
+        Some(h) => built.with_tunable_hinge(
+            EngineHinge::new(
+                h.stiffness_at_zero,
+                h.stiffness_slope,
+                h.stiffness_curvature,
+            )
+            .map_err(|e| rename_hinge(e).in_field("tunable_hinge"))?,
+        ),
+    })
+}
+
+/// Renames the field of an [`Error::InvalidParameter`] whose field is `from`.
+fn rename_field(e: Error, from: &str, to: &'static str) -> Error {
+    match e {
+        Error::InvalidParameter {
+            field,
+            value,
+            allowed,
+        } if field == from => Error::invalid(to, value, allowed),
+        other => other,
+    }
+}
+
+/// The engine names the hinge coefficients `k0, k1, k2`; the spec names say what they are.
+fn rename_hinge(e: Error) -> Error {
+    match e {
+        Error::InvalidParameter {
+            field,
+            value,
+            allowed,
+        } => {
+            let name = match field.as_ref() {
+                "k0" => "stiffness_at_zero",
+                "k1" => "stiffness_slope",
+                "k2" => "stiffness_curvature",
+                other => return Error::invalid(other.to_string(), value, allowed),
+            };
+            let allowed = allowed
+                .replace("k0", "stiffness_at_zero")
+                .replace("k1", "stiffness_slope")
+                .replace("k2", "stiffness_curvature");
+            Error::invalid(name, value, allowed)
+        }
+        other => other,
+    }
+}
+
+fn constraints(c: &Configuration, n_coords: usize) -> Result<Constraints> {
+    match (&c.name, &c.rows) {
+        (Some(_), Some(_)) => Err(Error::invalid(
+            "configuration",
+            "both name and rows",
+            "a Table 3.1 name or explicit rows, not both",
+        )),
+        (Some(name), None) => Constraints::configuration(name).map_err(|e| match e {
+            Error::InvalidParameter { value, allowed, .. } => {
+                Error::invalid("configuration.name", value, allowed)
+            }
+            other => other,
+        }),
+        (None, Some(rows)) => {
+            let c0 = c.c0.clone().unwrap_or_else(|| vec![0.0; rows.len()]);
+            Constraints::new(n_coords, rows, &c0)
+        }
+        (None, None) => match &c.c0 {
+            Some(_) => Err(Error::invalid(
+                "configuration.c0",
+                "given without rows",
+                "c0 only together with rows",
+            )),
+            None => Constraints::none(n_coords),
+        },
+    }
+}
+
+fn actuator(a: &Actuator) -> Result<EngineActuator> {
+    let waveform = match &a.waveform {
+        Waveform::Sine(s) => {
+            EngineWaveform::sine(s.amplitude_v, s.frequency_hz, s.offset_v, s.phase)
+        }
+        Waveform::Sampled(s) => {
+            EngineWaveform::sampled(s.times_ms.clone(), s.voltages_v.clone(), s.period_ms)
+        }
+    }
+    .map_err(|e| e.in_field("waveform"))?;
+    let dc = match a.dc_offset {
+        DcOffset::AsForce => EngineDc::AsForce,
+        DcOffset::Ignore => EngineDc::Ignore,
+    };
+    EngineActuator::new(a.force_per_volt, a.stiffness, waveform, dc)
+}
+
+fn vec6(field: &str, v: &Option<Vec<f64>>, n_coords: usize) -> Result<Option<Vec6>> {
+    match v {
+        None => Ok(None),
+        Some(v) if v.len() == n_coords => {
+            let mut out = Vec6::zeros();
+            for (i, x) in v.iter().enumerate() {
+                out[i] = *x;
+            }
+            Ok(Some(out))
+        }
+        Some(v) => Err(Error::invalid(
+            format!("options.{field}"),
+            v.len(),
+            format!("{n_coords} values (3 per wing)"),
+        )),
+    }
+}
+
+/// Engine options for a device with `n_coords` coordinates.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for initial states of the wrong length.
+pub fn options(o: &Options, n_coords: usize) -> Result<SimulationOptions> {
+    let initial = match (
+        vec6("initial_p", &o.initial_p, n_coords)?,
+        vec6("initial_p_dot", &o.initial_p_dot, n_coords)?,
+    ) {
+        (None, None) => None,
+        (p, v) => Some((p.unwrap_or_else(Vec6::zeros), v.unwrap_or_else(Vec6::zeros))),
+    };
+    let to_usize = |x: u64| usize::try_from(x).unwrap_or(usize::MAX);
+    Ok(SimulationOptions {
+        method: o.method.into(),
+        rtol: o.rtol,
+        atol: o.atol,
+        max_steps: to_usize(o.max_steps),
+        initial,
+        min_cycles: to_usize(o.min_cycles),
+        max_cycles: to_usize(o.max_cycles),
+        steady_tol: o.steady_tol,
+        samples_per_cycle: to_usize(o.samples_per_cycle),
+        record_cycles: to_usize(o.record_cycles),
+        perturbation: o.perturbation.as_ref().map(|p| EngineKick {
+            target: match p.target {
+                PerturbTarget::Named(_) => EngineTarget::WhippletreeRate,
+                PerturbTarget::Coordinate(i) => EngineTarget::Coordinate(usize::from(i)),
+            },
+            delta: p.delta,
+            phase: p.phase,
+        }),
+        duration_ms: o.duration_ms,
+        steady_state: o.steady_state.into(),
+        ..SimulationOptions::default()
+    })
+}

@@ -1,0 +1,52 @@
+//! The linearised differential of eq. 2.15.
+
+use paritysim_error::Result;
+use paritysim_kinematics::Drivetrain as Kinematics;
+use paritysim_kinematics::drivetrain::LinearDifferential as Linear;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use super::DrivetrainConfig;
+
+/// `φ_{L,R} = T (q1 ± h_{L,R} q2)`-type linear differential (eq. 2.15), 2 DOF.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(default, deny_unknown_fields)]
+pub struct LinearDifferential {
+    /// Transmission ratio T (rad/mm), in (0, 100].
+    #[schemars(range(max = 100.0), extend("exclusiveMinimum" = 0.0, "x-unit" = "rad/mm"))]
+    pub transmission_ratio: f64,
+    /// Mean arm length L (mm), in (0, 100].
+    #[schemars(range(max = 100.0), extend("exclusiveMinimum" = 0.0, "x-unit" = "mm"))]
+    pub arm_length_mm: f64,
+    /// Arm ratio hL/hR, in (0, 100].
+    #[schemars(range(max = 100.0), extend("exclusiveMinimum" = 0.0, "x-unit" = "1"))]
+    pub arm_ratio: f64,
+    /// Balance-beam spring K2 on `q2` (mN·mm/rad), in [0, 1e4] (docs/errata.md#14).
+    #[schemars(range(min = 0.0, max = 1e4), extend("x-unit" = "mN mm/rad"))]
+    pub balance_spring: f64,
+}
+
+impl Default for LinearDifferential {
+    fn default() -> Self {
+        Self {
+            transmission_ratio: 2.5,
+            arm_length_mm: 2.5,
+            arm_ratio: 1.0,
+            balance_spring: 0.0,
+        }
+    }
+}
+
+impl DrivetrainConfig for LinearDifferential {
+    fn kinematics(&self) -> Result<Kinematics> {
+        Ok(Kinematics::LinearDifferential(Linear::new(
+            self.transmission_ratio,
+            self.arm_length_mm,
+            self.arm_ratio,
+        )?))
+    }
+
+    fn balance_spring(&self) -> f64 {
+        self.balance_spring
+    }
+}

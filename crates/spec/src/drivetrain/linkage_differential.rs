@@ -1,0 +1,56 @@
+//! The Drag PARITY linkage differential (§3.3.2): a rod-crank driving a whippletree.
+
+use paritysim_error::Result;
+use paritysim_kinematics::drivetrain::LinkageDifferential as Linkage;
+use paritysim_kinematics::{Drivetrain as Kinematics, RodCrank};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+use super::DrivetrainConfig;
+
+/// The §3.3.2 linkage (lengths by default), 2 DOF.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(default, deny_unknown_fields)]
+pub struct LinkageDifferential {
+    /// Crank length (mm), in (0, 10].
+    #[schemars(range(max = 10.0), extend("exclusiveMinimum" = 0.0, "x-unit" = "mm"))]
+    pub crank_mm: f64,
+    /// Rod length (mm), in (0, 100].
+    #[schemars(range(max = 100.0), extend("exclusiveMinimum" = 0.0, "x-unit" = "mm"))]
+    pub rod_mm: f64,
+    /// Whippletree length (mm), in (0, 100].
+    #[schemars(range(max = 100.0), extend("exclusiveMinimum" = 0.0, "x-unit" = "mm"))]
+    pub whippletree_length_mm: f64,
+    /// Arm ratio hL/hR (§2.4.2), in (0, 100].
+    #[schemars(range(max = 100.0), extend("exclusiveMinimum" = 0.0, "x-unit" = "1"))]
+    pub arm_ratio: f64,
+    /// Balance-beam spring K2 on `q2` (mN·mm/rad), in [0, 1e4] (docs/errata.md#14).
+    #[schemars(range(min = 0.0, max = 1e4), extend("x-unit" = "mN mm/rad"))]
+    pub balance_spring: f64,
+}
+
+impl Default for LinkageDifferential {
+    fn default() -> Self {
+        Self {
+            crank_mm: 0.4,
+            rod_mm: 0.8,
+            whippletree_length_mm: 5.0,
+            arm_ratio: 1.0,
+            balance_spring: 0.0,
+        }
+    }
+}
+
+impl DrivetrainConfig for LinkageDifferential {
+    fn kinematics(&self) -> Result<Kinematics> {
+        Ok(Kinematics::LinkageDifferential(Linkage::new(
+            RodCrank::new(self.crank_mm, self.rod_mm)?,
+            self.whippletree_length_mm,
+            self.arm_ratio,
+        )?))
+    }
+
+    fn balance_spring(&self) -> f64 {
+        self.balance_spring
+    }
+}

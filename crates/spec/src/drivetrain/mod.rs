@@ -1,0 +1,87 @@
+//! Drivetrain configurations: one file per configuration, one registry line each.
+//!
+//! A configuration is a serde struct (its fields are the spec fields under `[drivetrain]`)
+//! implementing [`DrivetrainConfig`]: how it builds the planar kinematics and which balance
+//! spring it puts on `q2`. [`registry!`] turns the list below into the tagged enum
+//! [`Drivetrain`] (`kind = "<snake_case name>"`), its JSON Schema and the dispatch.
+
+use paritysim_error::Result;
+use paritysim_kinematics::Drivetrain as Kinematics;
+
+mod hmf_four_bar;
+mod linear_differential;
+mod linkage_differential;
+
+pub use hmf_four_bar::HmfFourBar;
+pub use linear_differential::LinearDifferential;
+pub use linkage_differential::LinkageDifferential;
+
+/// What a drivetrain configuration provides to the model.
+pub trait DrivetrainConfig {
+    /// The planar kinematics `φ(q)`.
+    ///
+    /// # Errors
+    /// [`paritysim_error::Error::InvalidParameter`] naming the field (relative to
+    /// `drivetrain`) for lengths the linkage cannot be built with.
+    fn kinematics(&self) -> Result<Kinematics>;
+
+    /// Balance-beam spring K2 on `q2` (mN·mm/rad); 0 for 1-DOF drivetrains.
+    fn balance_spring(&self) -> f64 {
+        0.0
+    }
+}
+
+macro_rules! registry {
+    ($($(#[$doc:meta])* $variant:ident),+ $(,)?) => {
+        /// A drivetrain spec, tagged by `kind`.
+        #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize, schemars::JsonSchema)]
+        #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+        pub enum Drivetrain {
+            $($(#[$doc])* $variant($variant),)+
+        }
+
+        impl Drivetrain {
+            fn config(&self) -> &dyn DrivetrainConfig {
+                match self {
+                    $(Drivetrain::$variant(c) => c,)+
+                }
+            }
+
+            /// One default spec of every registered kind (for defaults and documentation).
+            pub fn every_kind() -> Vec<Drivetrain> {
+                vec![$(Drivetrain::$variant($variant::default()),)+]
+            }
+        }
+    };
+}
+
+// The registry: add a line (and a file) for a new configuration.
+registry! {
+    /// HMF four-bar (§2.3.1), 1 DOF.
+    HmfFourBar,
+    /// Linearised differential of eq. 2.15, 2 DOF.
+    LinearDifferential,
+    /// The Drag PARITY linkage differential of §3.3.2, 2 DOF.
+    LinkageDifferential,
+}
+
+impl Drivetrain {
+    /// The planar kinematics.
+    ///
+    /// # Errors
+    /// See [`DrivetrainConfig::kinematics`].
+    pub fn kinematics(&self) -> Result<Kinematics> {
+        self.config().kinematics()
+    }
+
+    /// K2 (mN·mm/rad).
+    pub fn balance_spring(&self) -> f64 {
+        self.config().balance_spring()
+    }
+}
+
+impl Default for Drivetrain {
+    fn default() -> Self {
+        Drivetrain::LinkageDifferential(LinkageDifferential::default())
+    }
+}

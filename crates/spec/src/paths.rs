@@ -1,0 +1,322 @@
+//! The one path language for sweeps, calibration and overrides.
+//!
+//! Canonical paths are dotted field names with list indices:
+//! `wings[0].springs.hinge.stiffness`, `wings[1].inertia[0][0]`, `drivetrain.balance_spring`,
+//! `actuator.waveform.frequency_hz`, `options.max_cycles`, `configuration.name`. Aliases:
+//!
+//! * `wings.left.<field>` / `wings.right.<field>`: `wings[0]` / `wings[1]` of a two-wing spec;
+//! * `wings[*].<field>`: every wing at once;
+//! * `actuator.frequency_hz`, `actuator.amplitude_v` (or `actuator.voltage_v`):
+//!   the sine waveform's fields;
+//! * `wings[i].omega_ratio`: multiplies that wing's `aero.omega1` (a cut wing of Table 3.2);
+//! * deprecated spellings ([`crate::migrate::migrate_path`]): `drivetrain.k2`,
+//!   `drivetrain.balance_stiffness`, `wings[i].springs[j].<field>`, `tunable_hinge.k0..k2`.
+
+use paritysim_error::{Error, Result};
+use serde::Serialize;
+use serde_json::Value;
+
+use crate::migrate::migrate_path;
+use crate::schema::{Branch, classify, describe, join, node, schema, suggestion, unit};
+use crate::spec::Simulation;
+
+/// One settable path of a spec.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PathInfo {
+    /// Canonical path.
+    pub path: String,
+    /// Unit (`1` for dimensionless, empty for names and flags).
+    pub unit: String,
+    /// What the path accepts (type, range and unit).
+    pub allowed: String,
+    /// Its value in this spec (`null` when absent).
+    pub value: Value,
+}
+
+/// Every canonical path of `spec`, in declaration order.
+pub fn spec_paths(spec: &Simulation) -> Vec<PathInfo> {
+    let value = serde_json::to_value(spec).expect("a spec serialises");
+    let mut out = Vec::new();
+    walk(&value, schema(), "", "", &mut out);
+    out
+}
+
+fn leaf(path: &str, value: &Value, schema: &Value, parent_unit: &str, out: &mut Vec<PathInfo>) {
+    let n = node(schema);
+    let own = unit(&n).unwrap_or_else(|| parent_unit.to_string());
+    out.push(PathInfo {
+        path: path.to_string(),
+        unit: own,
+        allowed: describe(schema),
+        value: value.clone(),
+    });
+}
+
+fn is_scalar_schema(s: &Value) -> bool {
+    let n = node(s);
+    if n.contains_key("enum") || n.contains_key("const") {
+        return true;
+    }
+    match n.get("type") {
+        Some(Value::String(t)) => matches!(t.as_str(), "number" | "integer" | "string" | "boolean"),
+        Some(Value::Array(ts)) => ts
+            .iter()
+            .filter_map(Value::as_str)
+            .any(|t| matches!(t, "number" | "integer" | "string" | "boolean")),
+        _ => false,
+    }
+}
+
+fn walk(value: &Value, schema: &Value, path: &str, parent_unit: &str, out: &mut Vec<PathInfo>) {
+    let s = node(schema);
+    let unit_here = unit(&s).unwrap_or_else(|| parent_unit.to_string());
+    match classify(&s) {
+        Branch::Optional(inner) => {
+            if value.is_null() {
+                if is_scalar_schema(inner) {
+                    leaf(path, value, schema, &unit_here, out);
+                }
+            } else {
+                walk(value, inner, path, &unit_here, out);
+            }
+            return;
+        }
+        Branch::Tagged(variants) => {
+            let kind = value
+                .get("kind")
+                .and_then(Value::as_str)
+                .unwrap_or_default();
+            let tags: Vec<&str> = variants.iter().map(|(t, _)| t.as_str()).collect();
+            out.push(PathInfo {
+                path: join(path, "kind"),
+                unit: String::new(),
+                allowed: format!("one of {}", tags.join(", ")),
+                value: Value::String(kind.to_string()),
+            });
+            if let Some((_, branch)) = variants.iter().find(|(t, _)| t == kind) {
+                walk_object(value, branch, path, &unit_here, out);
+            }
+            return;
+        }
+        Branch::Untagged(_) => {
+            leaf(path, value, schema, &unit_here, out);
+            return;
+        }
+        Branch::Plain => {}
+    }
+    if s.contains_key("properties") {
+        walk_object(value, &s, path, &unit_here, out);
+    } else if let (Some(items), Value::Array(list)) = (s.get("items"), value) {
+        let fixed = s.get("minItems").is_some() && s.get("minItems") == s.get("maxItems");
+        if fixed || !is_scalar_schema(items) {
+            for (i, v) in list.iter().enumerate() {
+                walk(v, items, &format!("{path}[{i}]"), &unit_here, out);
+            }
+        } else {
+            leaf(path, value, schema, &unit_here, out);
+        }
+    } else {
+        leaf(path, value, schema, &unit_here, out);
+    }
+}
+
+fn walk_object(
+    value: &Value,
+    s: &serde_json::Map<String, Value>,
+    path: &str,
+    parent_unit: &str,
+    out: &mut Vec<PathInfo>,
+) {
+    let Some(props) = s.get("properties").and_then(Value::as_object) else {
+        return;
+    };
+    for (k, sub) in props {
+        if k == "kind" && crate::schema::tag_of(s).is_some() {
+            continue;
+        }
+        let v = value.get(k).unwrap_or(&Value::Null);
+        walk(v, sub, &join(path, k), parent_unit, out);
+    }
+}
+
+/// Where a parameter goes: canonical paths and an optional scale (for `omega_ratio`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Parameter {
+    /// The name the caller used.
+    pub name: String,
+    /// `(canonical path, scale)`; the value written is `value * scale` when a scale is given.
+    pub targets: Vec<(String, Option<f64>)>,
+    /// Deprecation notes for the name.
+    pub notes: Vec<String>,
+}
+
+/// Resolves a parameter name against `spec`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming the path, with the nearest valid path.
+pub fn resolve(spec: &Simulation, name: &str) -> Result<Parameter> {
+    let paths = spec_paths(spec);
+    resolve_in(spec, &paths, name)
+}
+
+/// [`resolve`] with the paths already listed.
+///
+/// # Errors
+/// See [`resolve`].
+pub fn resolve_in(spec: &Simulation, paths: &[PathInfo], name: &str) -> Result<Parameter> {
+    let mut notes = Vec::new();
+    let n_wings = spec.wings.len();
+    let mut expanded: Vec<String> = if let Some(rest) = name.strip_prefix("wings[*].") {
+        (0..n_wings).map(|i| format!("wings[{i}].{rest}")).collect()
+    } else if let Some(rest) = name.strip_prefix("wings.left.") {
+        side(n_wings, 0, rest, name)?
+    } else if let Some(rest) = name.strip_prefix("wings.right.") {
+        side(n_wings, 1, rest, name)?
+    } else {
+        vec![name.to_string()]
+    };
+    for p in &mut expanded {
+        if let Some(new) = migrate_path(p) {
+            notes.push(format!("parameter `{p}` is deprecated: use `{new}`"));
+            *p = new;
+        }
+        if let Some(field) = p.strip_prefix("actuator.") {
+            if matches!(field, "frequency_hz" | "amplitude_v" | "voltage_v") {
+                let field = if field == "voltage_v" {
+                    "amplitude_v"
+                } else {
+                    field
+                };
+                *p = format!("actuator.waveform.{field}");
+            }
+        }
+    }
+    let mut targets = Vec::new();
+    for p in expanded {
+        if let Some(head) = p.strip_suffix(".omega_ratio") {
+            let omega = format!("{head}.aero.omega1");
+            let base = paths
+                .iter()
+                .find(|i| i.path == omega)
+                .and_then(|i| i.value.as_f64())
+                .ok_or_else(|| unknown(name, paths))?;
+            targets.push((omega, Some(base)));
+        } else if paths.iter().any(|i| i.path == p) {
+            targets.push((p, None));
+        } else {
+            return Err(unknown(name, paths));
+        }
+    }
+    Ok(Parameter {
+        name: name.to_string(),
+        targets,
+        notes,
+    })
+}
+
+fn side(n_wings: usize, index: usize, rest: &str, name: &str) -> Result<Vec<String>> {
+    if n_wings != 2 {
+        return Err(Error::invalid(
+            name.to_string(),
+            "<left/right alias>",
+            format!("a two-wing spec (this one has {n_wings}); use wings[0].<field>"),
+        ));
+    }
+    Ok(vec![format!("wings[{index}].{rest}")])
+}
+
+fn unknown(name: &str, paths: &[PathInfo]) -> Error {
+    let valid: Vec<&str> = paths.iter().map(|p| p.path.as_str()).collect();
+    Error::invalid(
+        name.to_string(),
+        "<unknown parameter path>",
+        format!(
+            "a parameter path of this spec; {}",
+            suggestion(name, valid.iter().copied())
+        ),
+    )
+}
+
+/// Sets `path` (canonical) in a spec value.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] when the path does not exist in `value`.
+pub fn set(value: &mut Value, path: &str, new: Value) -> Result<()> {
+    let bad = || Error::invalid(path.to_string(), "<path>", "an existing field path");
+    let mut node = value;
+    let tokens = tokens(path).ok_or_else(bad)?;
+    let (last, head) = tokens.split_last().ok_or_else(bad)?;
+    for t in head {
+        node = match t {
+            Token::Key(k) => node
+                .as_object_mut()
+                .ok_or_else(bad)?
+                .entry(k.clone())
+                .or_insert_with(|| Value::Object(Default::default())),
+            Token::Index(i) => node
+                .as_array_mut()
+                .and_then(|a| a.get_mut(*i))
+                .ok_or_else(bad)?,
+        };
+    }
+    match last {
+        Token::Key(k) => {
+            node.as_object_mut().ok_or_else(bad)?.insert(k.clone(), new);
+        }
+        Token::Index(i) => {
+            *node
+                .as_array_mut()
+                .and_then(|a| a.get_mut(*i))
+                .ok_or_else(bad)? = new;
+        }
+    }
+    Ok(())
+}
+
+enum Token {
+    Key(String),
+    Index(usize),
+}
+
+fn tokens(path: &str) -> Option<Vec<Token>> {
+    let mut out = Vec::new();
+    for part in path.split('.') {
+        let (key, mut rest) = match part.find('[') {
+            Some(at) => (&part[..at], &part[at..]),
+            None => (part, ""),
+        };
+        if !key.is_empty() {
+            out.push(Token::Key(key.to_string()));
+        }
+        while let Some(r) = rest.strip_prefix('[') {
+            let close = r.find(']')?;
+            out.push(Token::Index(r[..close].parse().ok()?));
+            rest = &r[close + 1..];
+        }
+        if !rest.is_empty() {
+            return None;
+        }
+    }
+    Some(out)
+}
+
+/// `spec` with every `(parameter, value)` applied (a `null` value keeps the base value).
+///
+/// # Errors
+/// The typed errors of [`crate::from_value`] for the resulting spec.
+pub fn apply(spec: &Simulation, overrides: &[(&Parameter, &Value)]) -> Result<Simulation> {
+    let mut value = serde_json::to_value(spec).expect("a spec serialises");
+    for (param, v) in overrides {
+        if v.is_null() {
+            continue;
+        }
+        for (path, scale) in &param.targets {
+            let v = match (scale, v.as_f64()) {
+                (Some(s), Some(x)) => Value::from(x * s),
+                _ => (*v).clone(),
+            };
+            set(&mut value, path, v)?;
+        }
+    }
+    crate::from_value(value).map(|(s, _)| s)
+}

@@ -1,0 +1,188 @@
+//! Spec round trips, validation messages, paths and the shipped schema.
+
+use nalgebra::Matrix3;
+use paritysim_constraints::Constraints;
+use paritysim_dynamics::device::{DeviceSpec, Formulation, Transmission};
+use paritysim_dynamics::{Actuator, DcOffset, Device, JointSpring, Waveform, Wing, WingAero};
+use paritysim_error::Error;
+use paritysim_kinematics::drivetrain::LinkageDifferential;
+use paritysim_kinematics::{Drivetrain, RodCrank, SphericalShoulder};
+use paritysim_spec::{from_json, from_toml, paths, schema};
+
+fn root() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn example(name: &str) -> String {
+    std::fs::read_to_string(root().join("examples").join(name)).unwrap()
+}
+
+#[test]
+fn shipped_schema_is_current() {
+    // PARITYSIM_BLESS=1 cargo test -p paritysim-spec regenerates it.
+    let file = root().join("python/paritysim/spec.schema.json");
+    let fresh = schema::schema_json();
+    if std::env::var_os("PARITYSIM_BLESS").is_some() {
+        std::fs::write(&file, &fresh).unwrap();
+    }
+    let shipped = std::fs::read_to_string(&file).unwrap_or_default();
+    assert!(
+        shipped == fresh,
+        "python/paritysim/spec.schema.json is stale: run PARITYSIM_BLESS=1 cargo test -p paritysim-spec"
+    );
+}
+
+#[test]
+fn examples_round_trip_through_toml_and_json() {
+    for name in ["drag_parity.toml", "hmf.toml"] {
+        let (spec, _) = from_toml(&example(name)).unwrap();
+        let (again, notes) = from_toml(&spec.to_toml()).unwrap();
+        assert_eq!(spec, again, "{name}");
+        assert!(notes.is_empty());
+        assert_eq!(from_json(&spec.to_json()).unwrap().0, spec);
+    }
+}
+
+#[test]
+fn the_spec_builds_the_same_device_as_the_engine_constructors() {
+    let (spec, notes) = from_toml(&example("drag_parity.toml")).unwrap();
+    assert!(notes.is_empty(), "{notes:?}");
+    // The old name still reads, with a deprecation note.
+    let old = example("drag_parity.toml").replace("balance_spring", "balance_stiffness");
+    let (same, notes) = from_toml(&old).unwrap();
+    assert_eq!((&same, notes.len()), (&spec, 1));
+    let wing = Wing::new(
+        SphericalShoulder::new(std::f64::consts::FRAC_PI_2, 0.0).unwrap(),
+        Matrix3::new(29.0, 0.0, 0.0, 0.0, 29.0, 0.0, 0.0, 0.0, 1.0),
+        [JointSpring::default(); 6],
+        WingAero::stroke_drag(31.3, 3.4609).unwrap(),
+    )
+    .unwrap();
+    let linkage = LinkageDifferential::new(RodCrank::new(0.4, 0.8).unwrap(), 5.0, 1.0).unwrap();
+    let by_hand = Device::new(DeviceSpec {
+        wings: vec![wing.clone(), wing],
+        constraints: Constraints::configuration("drag_parity_fixed").unwrap(),
+        transmission: Some(
+            Transmission::new(Drivetrain::LinkageDifferential(linkage), 1.0).unwrap(),
+        ),
+        actuator: Some(
+            Actuator::new(
+                1.2,
+                467.0,
+                Waveform::sine(100.0, 110.0, 0.0, 0.0).unwrap(),
+                DcOffset::AsForce,
+            )
+            .unwrap(),
+        ),
+        formulation: Formulation::Auto,
+    })
+    .unwrap();
+    assert_eq!(spec.device().unwrap(), by_hand);
+}
+
+fn problems(e: Error) -> Vec<(String, String)> {
+    match e {
+        Error::InvalidSpec(p) => p.into_iter().map(|p| (p.field, p.allowed)).collect(),
+        Error::InvalidParameter { field, allowed, .. } => vec![(field.into_owned(), allowed)],
+        other => panic!("not a validation error: {other}"),
+    }
+}
+
+#[test]
+fn every_problem_is_reported_with_path_and_range() {
+    let text = example("hmf.toml")
+        .replace("crank_mm = 0.4", "crank_mm = -0.4")
+        .replace("rtol = 1e-8", "rtol = 1e-8\nmax_cycles = true")
+        .replace("omega1 = 31.3\n", "omega1 = 31.3\nomegaa2 = 1.0\n");
+    let found = problems(from_toml(&text).unwrap_err());
+    let fields: Vec<&str> = found.iter().map(|(f, _)| f.as_str()).collect();
+    // Only the right wing's line has no comment after `omega1 = 31.3`.
+    assert_eq!(
+        fields,
+        [
+            "drivetrain.crank_mm",
+            "options.max_cycles",
+            "wings[1].aero.omegaa2"
+        ]
+    );
+    assert!(found[0].1.contains("(0, 10] mm"), "{:?}", found[0]);
+    assert!(found[1].1.contains("integer"), "{:?}", found[1]);
+    // stroke_drag has omega1 and coefficient: the nearest is omega1.
+    assert!(
+        found[2].1.contains("did you mean `omega1`"),
+        "{:?}",
+        found[2]
+    );
+}
+
+#[test]
+fn unknown_kinds_and_keys_suggest_the_nearest_name() {
+    let text = example("hmf.toml").replace("kind = \"hmf_four_bar\"", "kind = \"hmf_fourbar\"");
+    let found = problems(from_toml(&text).unwrap_err());
+    assert_eq!(found[0].0, "drivetrain.kind");
+    assert!(found[0].1.contains("did you mean `hmf_four_bar`"));
+    let text = example("hmf.toml").replace("[options]", "[option]");
+    let found = problems(from_toml(&text).unwrap_err());
+    assert_eq!(found[0].0, "option");
+    assert!(found[0].1.contains("did you mean `options`"));
+    // An empty configuration name is a typed error, not "no constraints".
+    let text = example("hmf.toml").replace("name = \"hmf_fixed\"", "name = \"\"");
+    let (spec, _) = from_toml(&text).unwrap();
+    assert_eq!(
+        spec.device().unwrap_err().field(),
+        Some("configuration.name")
+    );
+}
+
+#[test]
+fn parameter_paths_resolve_aliases_and_deprecated_names() {
+    let (spec, _) = from_toml(&example("drag_parity.toml")).unwrap();
+    let listed = paths::spec_paths(&spec);
+    let k2 = paths::resolve(&spec, "drivetrain.k2").unwrap();
+    assert_eq!(
+        k2.targets,
+        [("drivetrain.balance_spring".to_string(), None)]
+    );
+    assert_eq!(k2.notes.len(), 1);
+    let hinge = paths::resolve(&spec, "wings[1].springs[5].cubic").unwrap();
+    assert_eq!(hinge.targets[0].0, "wings[1].springs.hinge.cubic");
+    let both = paths::resolve(&spec, "wings[*].aero.omega1").unwrap();
+    assert_eq!(both.targets.len(), 2);
+    let ratio = paths::resolve(&spec, "wings.left.omega_ratio").unwrap();
+    let scaled = paths::apply(&spec, &[(&ratio, &serde_json::json!(0.5))]).unwrap();
+    match &scaled.wings[0].aero {
+        Some(paritysim_spec::Aero::StrokeDrag(a)) => assert_eq!(a.omega1, 0.5 * 31.3),
+        other => panic!("{other:?}"),
+    }
+    let err = paths::resolve(&spec, "drivetrain.crank").unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("did you mean `drivetrain.crank_mm`"),
+        "{err}"
+    );
+    for p in &listed {
+        assert!(paths::resolve(&spec, &p.path).is_ok(), "{}", p.path);
+    }
+    let unit = |path: &str| listed.iter().find(|p| p.path == path).unwrap().unit.clone();
+    assert_eq!(unit("actuator.stiffness"), "mN/mm");
+    assert_eq!(unit("wings[0].inertia[2][2]"), "mg mm^2");
+}
+
+/// A spec crosses Python -> JSON -> Rust bit for bit: serde_json's default float parser is not
+/// correctly rounded (`float_roundtrip` is enabled for this), and 0.42·31.3 came back 1 ulp off.
+#[test]
+fn floats_survive_json_bit_for_bit() {
+    let values: [f64; 6] = [
+        0.42 * 31.3,
+        0.1 + 0.2,
+        1.0 / 3.0,
+        2.533928021702924,
+        5e-324,
+        1.7976931348623157e308,
+    ];
+    for x in values {
+        let text = serde_json::to_string(&x).unwrap();
+        let back: f64 = serde_json::from_str(&text).unwrap();
+        assert_eq!(back.to_bits(), x.to_bits(), "{text}");
+    }
+}
