@@ -126,8 +126,9 @@ def test_shipped_schema_is_current_and_validates_every_example() -> None:
     checked = 0
     for path in sorted(EXAMPLES.glob("*.toml")):
         data = tomllib.loads(path.read_text())
-        if "spec" in data:  # a sweep study: its spec file and its option overrides
-            validator.validate(tomllib.loads((path.parent / data["spec"]).read_text()))
+        if "spec" in data:  # a sweep or continuation study: its spec (file or named device)
+            source = ps.devices.path(data["spec"]) if data["spec"] in ps.devices.list() else path.parent / data["spec"]
+            validator.validate(tomllib.loads(Path(source).read_text()))
             options = jsonschema.Draft202012Validator({"$defs": shipped["$defs"], "$ref": "#/$defs/Options"})
             options.validate(data.get("options", {}))
         else:

@@ -41,17 +41,19 @@ logging.getLogger(__name__).addHandler(logging.NullHandler())
 if TYPE_CHECKING:  # what type checkers see; at run time the names below load lazily
     from . import aero, claims, devices, dynamics, kinematics, laminate, planform, plots, spec, stability, trials
     from .calibration import CalibrationResult, calibrate
+    from .continuation import ContinuationResult
     from .planform import Planform
     from .simulation import SimulationResult, simulate
     from .spec import Actuator, Aero, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, Springs, TunableHinge, Waveform, Wing, load_spec, spec_paths
     from .sweep import grid, sweep
 
 #: Lazily loaded submodules.
-_SUBMODULES = ("aero", "calibration", "claims", "devices", "dynamics", "kinematics", "laminate", "planform", "plots", "simulation", "spec", "stability", "sweep", "trials")
+_SUBMODULES = ("aero", "calibration", "claims", "continuation", "devices", "dynamics", "kinematics", "laminate", "planform", "plots", "simulation", "spec", "stability", "sweep", "trials")
 #: Lazily loaded names -> the submodule defining them.
 _NAMES = {
     "CalibrationResult": "calibration",
     "calibrate": "calibration",
+    "ContinuationResult": "continuation",
     "Planform": "planform",
     "SimulationResult": "simulation",
     "simulate": "simulation",
@@ -81,6 +83,7 @@ __all__ = [
     "Actuator",
     "Aero",
     "CalibrationResult",
+    "ContinuationResult",
     "CancelledError",
     "Configuration",
     "ConstraintError",
@@ -106,6 +109,7 @@ __all__ = [
     "aero",
     "calibrate",
     "claims",
+    "continuation",
     "devices",
     "dynamics",
     "grid",

@@ -112,6 +112,9 @@ def build_parser() -> argparse.ArgumentParser:
     dev = sub.add_parser("devices", help="list the named thesis devices (or show one's provenance)", parents=[_common()])
     dev.add_argument("name", nargs="?", help="a device name: print what the thesis states and what we chose")
     dev.set_defaults(func=_devices)
+    from .continuation_cli import add_parser as add_continue_parser
+
+    add_continue_parser(sub, parents=[_common()])
     try:  # `paritysim sweep` lives with the sweep engine (issue 8)
         from .sweep_cli import add_parser as add_sweep_parser
     except ImportError:

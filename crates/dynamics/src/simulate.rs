@@ -287,6 +287,41 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
     })
 }
 
+/// The metrics of one drive period recorded from `state` at `t = 0` (a state on the section
+/// `t ≡ 0 mod T`, e.g. a periodic orbit from continuation), with `options`' tolerances and
+/// `samples_per_cycle`; no transient, no columns.
+///
+/// # Errors
+/// [`Error::Constraint`] without a periodic drive; integration errors.
+pub fn orbit_metrics(
+    device: &Device,
+    state: &State,
+    options: &SimulationOptions,
+) -> Result<Vec<(String, f64)>> {
+    validate(options)?;
+    let Some(period) = device.period() else {
+        bail!(Constraint "orbit metrics need a periodic drive (the device has no actuator)");
+    };
+    let integrator = RungeKutta::new(
+        options.method,
+        options.rtol,
+        options.atol,
+        options.max_steps,
+    )?;
+    let (_, metrics) = record_window(
+        device,
+        &integrator,
+        0.0,
+        &state.without_work(),
+        period,
+        options.samples_per_cycle,
+        Some(period),
+        None,
+        Vec::new(),
+    )?;
+    Ok(metrics)
+}
+
 /// Integrates the recorded window from `(t_start, y)`, evaluating each of the `n_samples + 1`
 /// samples once: it feeds the metrics and the asked columns, nothing else is kept.
 #[allow(clippy::too_many_arguments)]

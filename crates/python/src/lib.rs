@@ -7,6 +7,7 @@
 use pyo3::prelude::*;
 
 mod aero;
+mod continuation;
 mod convert;
 mod errors;
 mod kinematics;
@@ -23,6 +24,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
     kinematics::register(m)?;
     spec::register(m)?;
+    continuation::register(m)?;
     aero::register(m)?;
     laminate::register(m)?;
     stability::register(m)?;

@@ -14,6 +14,7 @@
 
 pub mod actuator;
 mod build;
+pub mod continuation;
 pub mod drivetrain;
 pub mod migrate;
 pub mod options;

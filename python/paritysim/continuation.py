@@ -1,0 +1,240 @@
+"""Continuation of periodic orbits with Floquet bifurcation detection.
+
+A driven device's periodic steady state is a fixed point of its period map. `continuation`
+follows it as one spec parameter changes — pseudo-arclength by default, so it turns around
+folds and follows the unstable branch — and reports every point's Floquet multipliers, its
+stability and its orbit metrics. Between points it watches the test functions of the
+codimension-one bifurcations of a forced orbit and locates each by bisection:
+
+* ``fold``: a multiplier through +1 where the branch turns back;
+* ``period_doubling``: a multiplier through −1;
+* ``neimark_sacker``: a complex pair through the unit circle;
+* ``branch_point``: a multiplier through +1 without a turn (symmetry breaking: e.g. the Drag
+  PARITY whippletree of a symmetric device).
+
+```python
+import paritysim as ps
+spec = ps.devices.load("sreetharan2012_3_3_parity_linkage")
+branch = ps.continuation(spec, "drivetrain.balance_spring", start=1000.0, stop=100.0)
+branch.bifurcations        # the whippletree loses stability near K2 = 377 mN·mm/rad
+branch.plot("q2_amplitude", path="branch.png")   # stable solid, unstable dashed
+```
+
+A located fold or period doubling can be followed in a second parameter with
+`ContinuationResult.follow`. The numerics are in the Rust crate ``paritysim-continuation``
+(validated on a linear oscillator, the Duffing folds against harmonic balance and the driven
+pendulum's period doubling against simulation).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from . import _core
+from ._errors import invalid, real
+from .spec import Simulation
+
+if TYPE_CHECKING:
+    import polars as pl
+    from matplotlib.figure import Figure
+
+__all__ = ["ContinuationResult", "continuation"]
+
+#: Keywords of `continuation` passed to the Rust settings (validated there, unknown ones named).
+SETTINGS = ("method", "initial_step", "min_step", "max_step", "max_points", "tolerance", "parameter_scale", "multiplier_tolerance", "cyclic", "locate", "metrics")
+
+
+@dataclass(frozen=True)
+class ContinuationResult:
+    """A branch of periodic orbits.
+
+    Attributes
+    ----------
+    path:
+        The continued parameter path (the branch's first column).
+    spec:
+        The spec that was continued.
+    branch:
+        One row per orbit, in branch order: the parameter, ``stability`` (``stable``,
+        ``unstable``, ``marginal``), ``spectral_radius`` (largest non-trivial |μ|),
+        ``multiplier_modulus`` and ``multiplier_angle`` (lists, rad), ``iterations``,
+        ``residual``, ``arclength``, ``drift`` (cyclic coordinate shift per period), the orbit's
+        state ``x0..`` and its metrics (as `paritysim.simulate` names them).
+    bifurcations:
+        ``kind``, the parameter, ``after`` (branch row it follows), ``located`` and the
+        ``critical_modulus`` / ``critical_angle`` of the multiplier that crossed.
+    stop_reason:
+        Why the branch ended (``ReachedStop``, ``LeftInterval``, ``MaxPoints``, ``StepTooSmall``).
+    map_evaluations:
+        Period-map evaluations with the monodromy: the cost.
+    """
+
+    path: str
+    spec: Simulation
+    branch: pl.DataFrame
+    bifurcations: pl.DataFrame
+    stop_reason: str
+    map_evaluations: int
+    _native: Any
+
+    def follow(self, bifurcation: int, path: str, stop: float, start: float | None = None) -> pl.DataFrame:
+        """Follows fold or period-doubling ``bifurcation`` (row of `bifurcations`) in a second
+        parameter ``path`` from ``start`` (default: the spec's value) to ``stop``: the curve of
+        (first parameter, second parameter) along which the bifurcation persists."""
+        import polars as pl
+
+        second_start = _current(self.spec, path) if start is None else real("start", start)
+        rows, reason = self._native.follow(int(bifurcation), path, second_start, real("stop", stop))
+        return pl.DataFrame(
+            {
+                self.path: [r[0] for r in rows],
+                path: [r[1] for r in rows],
+                "spectral_radius": [max((math.hypot(*m) for m in r[2]), default=float("nan")) for r in rows],
+            }
+        ).with_columns(pl.lit(reason).alias("stop_reason"))
+
+    def plot(self, y: str = "spectral_radius", path: str | Path | None = None, ax: Any = None) -> Figure:
+        """Branch diagram: ``y`` against the parameter, stable segments solid, unstable dashed,
+        marginal dotted, bifurcations marked and labelled; saved as PNG when ``path`` is given."""
+        import matplotlib.pyplot as plt
+
+        from .plots import label_with_unit
+
+        if y not in self.branch.columns:
+            raise invalid("y", repr(y), "a column of the branch: " + ", ".join(self.branch.columns))
+        if ax is None:
+            fig, ax = plt.subplots(figsize=(7, 4.2), constrained_layout=True)
+        else:
+            fig = ax.figure
+        x = self.branch[self.path].to_list()
+        values = self.branch[y].to_list()
+        kinds = self.branch["stability"].to_list()
+        style = {"stable": "-", "unstable": "--", "marginal": ":"}
+        drawn: set[str] = set()
+        start = 0
+        for i in range(1, len(x) + 1):
+            if i == len(x) or kinds[i] != kinds[start]:
+                end = min(i + 1, len(x))  # overlap one point so segments join
+                label = kinds[start] if kinds[start] not in drawn else None
+                drawn.add(kinds[start])
+                ax.plot(x[start:end], values[start:end], style[kinds[start]], color="C0", label=label)
+                start = i
+        for row in self.bifurcations.iter_rows(named=True):
+            k = row["after"]
+            xb = row[self.path]
+            yb = values[k] if k + 1 >= len(values) else values[k] + (values[k + 1] - values[k]) * ((xb - x[k]) / (x[k + 1] - x[k]) if x[k + 1] != x[k] else 0.0)
+            ax.plot([xb], [yb], "o", color="C3")
+            ax.annotate(f"{row['kind']} {xb:.4g}", (xb, yb), textcoords="offset points", xytext=(5, 5), fontsize=8)
+        ax.set_xlabel(label_with_unit(self.path))
+        ax.set_ylabel(label_with_unit(y))
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        ax.set_title(f"periodic orbits continued in {self.path}")
+        if path is not None:
+            from .plots import save
+
+            save(fig, path)
+        return fig
+
+
+def _current(spec: Simulation, path: str) -> float:
+    from .spec import spec_paths
+
+    table = spec_paths(spec)
+    match = table.filter(table["path"] == path)
+    if match.height == 0:
+        raise invalid("start", "None", f"a number: `{path}` is an alias or not a canonical path, so its current value is not known")
+    value = json.loads(match["value"][0])
+    if not isinstance(value, int | float) or isinstance(value, bool):
+        raise invalid("start", "None", f"a number: `{path}` holds {value!r}")
+    return float(value)
+
+
+def continuation(spec: Simulation, path: str, stop: float, *, start: float | None = None, **settings: Any) -> ContinuationResult:
+    """Follows the periodic orbit of ``spec`` as ``path`` goes from ``start`` (default: the
+    spec's value) to ``stop``.
+
+    Keyword settings (all optional): ``method`` (``"arclength"`` or ``"natural"``),
+    ``initial_step``, ``min_step``, ``max_step`` (scaled arclength), ``max_points``,
+    ``tolerance`` (Newton, on the state), ``parameter_scale`` (parameter units per state unit;
+    default |stop − start| / 10), ``multiplier_tolerance``, ``cyclic`` (index of a cyclic
+    integrated coordinate, e.g. 1 for ``q2`` of a K2 = 0 linear whippletree), ``locate``,
+    ``metrics`` (orbit metrics per point, default True). The spec's ``options`` set the
+    integration (rtol capped at 1e-10 for shooting).
+
+    Raises
+    ------
+    InvalidParameterError
+        For an unknown path or setting (named, with the nearest valid one).
+    IntegrationError, OutOfDomainError
+        When no periodic orbit is found at ``start``. Failures later on end the branch
+        (``stop_reason``) and keep the points found.
+    """
+    import polars as pl
+
+    if not isinstance(spec, Simulation):
+        raise invalid("spec", type(spec).__name__, "a paritysim.Simulation")
+    if not isinstance(path, str):
+        raise invalid("path", repr(path), "a parameter path (see paritysim.spec_paths)")
+    unknown = sorted(set(settings) - set(SETTINGS))
+    if unknown:
+        raise invalid(unknown[0], "<unknown setting>", _core.spec_suggestion(unknown[0], list(SETTINGS)) or "one of: " + ", ".join(SETTINGS))
+    first = _current(spec, path) if start is None else real("start", start)
+    native = _core.continuation(spec.to_json(), path, first, real("stop", stop), json.dumps(settings))
+    mus = native.multipliers
+    states = native.states
+    diag = native.diagnostics
+    columns: dict[str, Any] = {
+        path: native.parameter,
+        "stability": native.stability,
+        "spectral_radius": [max((math.hypot(*m) for m in row), default=float("nan")) for row in mus],
+        "multiplier_modulus": [[math.hypot(*m) for m in row] for row in mus],
+        "multiplier_angle": [[math.atan2(m[1], m[0]) for m in row] for row in mus],
+        "iterations": [d[0] for d in diag],
+        "residual": [d[1] for d in diag],
+        "arclength": [d[2] for d in diag],
+        "drift": [d[3] for d in diag],
+    }
+    for k in range(len(states[0]) if states else 0):
+        columns[f"x{k}"] = [s[k] for s in states]
+    metric_rows = native.metrics
+    names = list(dict.fromkeys(name for row in metric_rows for name, _ in row))
+    for name in names:
+        values = [dict(row).get(name) for row in metric_rows]
+        columns[name] = [v if v is not None and math.isfinite(v) else None for v in values]
+    branch = pl.DataFrame(columns, strict=False)
+    bif = native.bifurcations
+
+    def critical(kind: str, ms: list[tuple[float, float]]) -> tuple[float, float]:
+        target = {"fold": 1.0, "branch_point": 1.0, "period_doubling": -1.0}.get(kind)
+        if not ms:
+            return (float("nan"), float("nan"))
+        if target is None:  # Neimark-Sacker: the complex pair nearest the unit circle
+            m = min((m for m in ms if abs(m[1]) > 0), key=lambda m: abs(math.hypot(*m) - 1.0), default=ms[0])
+        else:
+            m = min(ms, key=lambda m: math.hypot(m[0] - target, m[1]))
+        return (math.hypot(*m), math.atan2(m[1], m[0]))
+
+    crit = [critical(b[0], b[4]) for b in bif]
+    bifurcations = pl.DataFrame(
+        {
+            "kind": [b[0] for b in bif],
+            path: [b[1] for b in bif],
+            "after": [b[2] for b in bif],
+            "located": [b[3] for b in bif],
+            "critical_modulus": [c[0] for c in crit],
+            "critical_angle": [c[1] for c in crit],
+        },
+        schema={"kind": pl.String, path: pl.Float64, "after": pl.Int64, "located": pl.Boolean, "critical_modulus": pl.Float64, "critical_angle": pl.Float64},
+    )
+    return ContinuationResult(path=path, spec=spec, branch=branch, bifurcations=bifurcations, stop_reason=native.stop_reason, map_evaluations=native.map_evaluations, _native=native)
+
+
+# `paritysim.continuation` is this module and, called, the `continuation` function.
+from ._callable_module import make_callable  # noqa: E402
+
+make_callable(__name__, "continuation")
