@@ -81,14 +81,17 @@ class ContinuationResult:
     map_evaluations: int
     _native: Any
 
-    def follow(self, bifurcation: int, path: str, stop: float, start: float | None = None) -> pl.DataFrame:
+    def follow(self, bifurcation: int, path: str, stop: float, start: float | None = None, max_step: float | None = None) -> pl.DataFrame:
         """Follows fold or period-doubling ``bifurcation`` (row of `bifurcations`) in a second
         parameter ``path`` from ``start`` (default: the spec's value) to ``stop``: the curve of
-        (first parameter, second parameter) along which the bifurcation persists."""
+        (first parameter, second parameter) along which the bifurcation persists. ``max_step``
+        (scaled arclength; the first step is a quarter of it) defaults to the branch's; the curve's Newton tolerance is at least
+        1e-7 (its test function is a derivative of the computed map)."""
         import polars as pl
 
         second_start = _current(self.spec, path) if start is None else real("start", start)
-        rows, reason = self._native.follow(int(bifurcation), path, second_start, real("stop", stop))
+        step = None if max_step is None else real("max_step", max_step)
+        rows, reason = self._native.follow(int(bifurcation), path, second_start, real("stop", stop), step)
         return pl.DataFrame(
             {
                 self.path: [r[0] for r in rows],

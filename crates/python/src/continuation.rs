@@ -12,6 +12,8 @@ use crate::errors::IntoPyResult;
 use crate::spec::parse;
 
 type Complexes = Vec<(f64, f64)>;
+/// `(first parameter, second parameter, multipliers)` of each curve point.
+type CurveRows = Vec<(f64, f64, Complexes)>;
 
 fn settings(json: &str) -> Result<ContinuationSettings, Error> {
     serde_json::from_str(json).map_err(|e| {
@@ -121,7 +123,9 @@ impl ContinuationOutput {
     }
 
     /// Follows bifurcation `index` (a fold or period doubling) in `second_path` from
-    /// `second_start` to `stop`: `[(first, second, multipliers)]` and the stop reason.
+    /// `second_start` to `stop` (`max_step`: the curve's largest step, default the branch's):
+    /// `[(first, second, multipliers)]` and the stop reason.
+    #[pyo3(signature = (index, second_path, second_start, stop, max_step=None))]
     fn follow(
         &self,
         py: Python<'_>,
@@ -129,7 +133,21 @@ impl ContinuationOutput {
         second_path: &str,
         second_start: f64,
         stop: f64,
-    ) -> PyResult<(Vec<(f64, f64, Complexes)>, String)> {
+        max_step: Option<f64>,
+    ) -> PyResult<(CurveRows, String)> {
+        let mut settings = self.settings.clone();
+        if let Some(step) = max_step {
+            if !(step.is_finite() && step >= settings.min_step) {
+                return Err(Error::invalid(
+                    "max_step",
+                    step,
+                    format!(">= min_step = {}", settings.min_step),
+                ))
+                .py_err();
+            }
+            settings.max_step = step;
+            settings.initial_step = (0.25 * step).max(settings.min_step);
+        }
         let n = self.outcome.branch.bifurcations.len();
         let bif = self
             .outcome
@@ -144,10 +162,11 @@ impl ContinuationOutput {
                     &self.spec,
                     &self.path,
                     bif,
+                    self.outcome.parameter_scale,
                     second_path,
                     second_start,
                     stop,
-                    &self.settings,
+                    &settings,
                 )
             })
             .py_err()?;

@@ -76,6 +76,8 @@ pub struct ContinuationOutcome {
     pub metrics: Vec<Vec<(String, f64)>>,
     /// Deprecation notes of the path.
     pub notes: Vec<String>,
+    /// Parameter units per state unit used in the arclength.
+    pub parameter_scale: f64,
 }
 
 fn shooting(options: &SimulationOptions) -> ShootingOptions {
@@ -161,20 +163,28 @@ pub fn continue_path(
         Vec::new()
     };
     Ok(ContinuationOutcome {
+        parameter_scale: options.parameter_scale,
         branch,
         metrics,
         notes,
     })
 }
 
-/// Follows a located fold or period doubling of a branch of `path` in a second path.
+/// Smallest Newton tolerance of a bifurcation curve: its test function is a derivative of the
+/// computed (adaptive-step) map, so its noise floor lies far above the branch's.
+pub const CURVE_TOLERANCE_FLOOR: f64 = 1e-7;
+
+/// Follows a located fold or period doubling of a branch of `path` (continued with
+/// `parameter_scale`) in a second path.
 ///
 /// # Errors
 /// As [`continue_fold_curve`], and for unknown paths.
+#[allow(clippy::too_many_arguments)]
 pub fn continue_bifurcation_path(
     spec: &Simulation,
     path: &str,
     bifurcation: &Bifurcation,
+    parameter_scale: f64,
     second_path: &str,
     second_start: f64,
     stop: f64,
@@ -191,10 +201,9 @@ pub fn continue_bifurcation_path(
     options.min_step = settings.min_step;
     options.max_step = settings.max_step;
     options.max_points = settings.max_points;
-    options.tolerance = settings.tolerance;
-    let scale = settings.parameter_scale.unwrap_or(1.0);
+    options.tolerance = settings.tolerance.max(CURVE_TOLERANCE_FLOOR);
     options.parameter_scales = (
-        scale,
+        parameter_scale,
         ((stop - second_start).abs() / 10.0).max(f64::MIN_POSITIVE),
     );
     continue_fold_curve(&map, bifurcation, &start, 0, &options)
