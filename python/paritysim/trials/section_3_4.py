@@ -124,15 +124,16 @@ def _angle_of_attack(cycle: pl.DataFrame, wing: str) -> tuple[float, float]:
     return float(np.mean(alpha[mid])), reversal
 
 
-def summarize(result: SimulationResult) -> dict[str, float]:
+def summarize(result: SimulationResult) -> dict[str, float | None]:
     """The §3.4 quantities of one run (angles in degrees, torques in mN·mm)."""
     m, cycle = result.metrics, result.cycle
-    out: dict[str, float] = {}
+    out: dict[str, float | None] = {}
     for wing in ("left", "right"):
         out[f"{wing}_stroke_p2p_deg"] = math.degrees(m[f"{wing}_stroke_peak_to_peak"])
         out[f"{wing}_stroke_mean_deg"] = math.degrees(m[f"{wing}_stroke_mean"])
         out[f"{wing}_rotation_amplitude_deg"] = math.degrees(m[f"{wing}_rotation_amplitude"])
-        out[f"{wing}_rotation_lag_deg"] = math.degrees(m[f"{wing}_rotation_phase_lag"])
+        lag = m[f"{wing}_rotation_phase_lag"]  # None when the wing does not rotate
+        out[f"{wing}_rotation_lag_deg"] = None if lag is None else math.degrees(lag)
         mid, rev = _angle_of_attack(cycle, wing)
         out[f"{wing}_alpha_midstroke_deg"] = mid
         out[f"{wing}_alpha_reversal_deg"] = rev
