@@ -199,8 +199,8 @@ def _cli(out: Path) -> list[Path]:
     from .. import plots
 
     branch, bifurcations, brute, timing = boundary()
-    written = write_trial(branch.drop("multiplier_modulus", "multiplier_angle"), out, "continuation_3_3", _figure(branch, bifurcations, brute))
-    bifurcations.write_csv(out / "continuation_3_3_bifurcations.csv")
+    written = write_trial(branch.drop("multiplier_modulus", "multiplier_angle"), out, "continuation", _figure(branch, bifurcations, brute))
+    bifurcations.write_csv(out / "continuation_bifurcations.csv")
     points = bifurcations.filter(pl.col("kind") == "branch_point")[PATH].to_list()
     k_star = points[0] if points else float("nan")
     curve, grid, curve_timing = boundary_curve()
@@ -208,7 +208,7 @@ def _cli(out: Path) -> list[Path]:
     grid.write_csv(out / "continuation_map.csv")
     png = plots.save(_curve_figure(curve, grid, k_star), out / "continuation_fold_curve.png")
     found = claims(bifurcations, brute) + curve_claims(curve, grid, k_star)
-    extra = [out / "continuation_3_3_bifurcations.csv", out / "continuation_fold_curve.csv", out / "continuation_map.csv", png]
+    extra = [out / "continuation_bifurcations.csv", out / "continuation_fold_curve.csv", out / "continuation_map.csv", png]
     return [*written, *extra, write_claims(out, "continuation", found, {**timing, **curve_timing, "map_points": float(grid.height)})]
 
 
@@ -233,5 +233,5 @@ def report_section(out: Path) -> str:
         f"({values['curve_s']:.1f} s) and drawn over a brute-force map of {values['map_points']:.0f} "
         f"Floquet analyses ({values['map_s']:.1f} s).\n\n"
         + render(found)
-        + "\n![continuation](continuation_3_3.png)\n\n![fold curve](continuation_fold_curve.png)\n"
+        + "\n![continuation](continuation.png)\n\n![fold curve](continuation_fold_curve.png)\n"
     )
