@@ -2,7 +2,7 @@
 //!
 //! Thin by design: convert numpy/Python values, release the GIL (`Python::detach`), call the
 //! pure-Rust crates, convert the result back. Every `paritysim_error::Error` becomes the matching
-//! exception of the tree built in [`errors`]; nothing here panics on user input.
+//! exception of the tree built in `errors`; nothing here panics on user input.
 
 use pyo3::prelude::*;
 

@@ -2,7 +2,7 @@
 //!
 //! A configuration is a serde struct (its fields are the spec fields under `[drivetrain]`)
 //! implementing [`DrivetrainConfig`]: how it builds the planar kinematics and which balance
-//! spring it puts on `q2`. [`registry!`] turns the list below into the tagged enum
+//! spring it puts on `q2`. `registry!` turns the list below into the tagged enum
 //! [`Drivetrain`] (`kind = "<snake_case name>"`), its JSON Schema and the dispatch.
 
 use paritysim_error::Result;
