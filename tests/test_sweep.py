@@ -214,9 +214,11 @@ def test_run_handle_reports_progress_and_cancel_keeps_finished_points(parity: ps
         run.start()
 
 
-def test_ctrl_c_cancels_and_returns_the_finished_rows(parity: ps.Simulation, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_ctrl_c_checkpoints_the_finished_rows_then_raises(parity: ps.Simulation, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     """Ctrl-C (SIGINT via ``_thread.interrupt_main``) once 128 points have finished: a count, not
-    a timer, so the outcome does not depend on the machine's load."""
+    a timer, so the outcome does not depend on the machine's load. The finished rows are in the
+    checkpoint and on the raised `SweepInterrupted` (a KeyboardInterrupt), bit-identical to a
+    fresh run of the same points."""
     table = grid({"drivetrain.balance_spring": np.linspace(1.0, 2.0, 10_000).tolist()})
     after = 128
     advance = sweep_module._advance
@@ -231,11 +233,17 @@ def test_ctrl_c_cancels_and_returns_the_finished_rows(parity: ps.Simulation, mon
         return advance(bar, finished, reported)
 
     monkeypatch.setattr(sweep_module, "_advance", advance_then_interrupt)
-    with pytest.warns(RuntimeWarning, match="cancelled"):
-        partial = sweep(parity, table, metrics=["q2_amplitude", "left_stroke_amplitude"], threads=2, chunk_size=64, progress=False)
-    assert fired and after <= partial.height < table.height
+    checkpoint = tmp_path / "study.parquet"
+    metrics = ["q2_amplitude", "left_stroke_amplitude"]
+    with pytest.raises(KeyboardInterrupt) as stopped:
+        sweep(parity, table, metrics=metrics, threads=2, chunk_size=64, progress=False, checkpoint=checkpoint)
+    assert isinstance(stopped.value, sweep_module.SweepInterrupted)
+    partial = stopped.value.result
+    assert fired and after <= partial.height < table.height and stopped.value.total == table.height
     assert partial["point"].is_sorted() and (partial["status"] == "ok").all()
-    again = sweep(parity, table[partial["point"].to_list()], metrics=["q2_amplitude", "left_stroke_amplitude"], progress=False)
+    saved = pl.concat([pl.read_parquet(f) for f in sorted(checkpoint.with_name("study.parquet.parts").glob("part-*.parquet"))]).sort("point")
+    assert_same(saved, partial)
+    again = sweep(parity, table[partial["point"].to_list()], metrics=metrics, progress=False)
     assert_same(partial.drop("point"), again.drop("point"))
 
 

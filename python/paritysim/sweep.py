@@ -52,7 +52,8 @@ Threads, progress, checkpoints, clusters
 ----------------------------------------
 ``threads=None`` uses ``$PARITYSIM_THREADS`` if set, else every core. ``progress=True`` shows a
 tqdm bar (rate, ETA) fed from the engine's atomic counter; Ctrl-C cancels cleanly: running points
-finish, the finished rows are returned (and checkpointed) with a ``RuntimeWarning``.
+stop within milliseconds (they count as not run), the finished rows are checkpointed and
+`SweepInterrupted` (a ``KeyboardInterrupt``) is raised carrying them as ``.result``.
 ``checkpoint="runs/study.parquet"`` flushes finished chunks to ``runs/study.parquet.parts/``
 and writes the complete, ordered table to ``runs/study.parquet`` at the end; re-running the
 same call skips every point already there (points are matched by their parameter values, so an
@@ -89,7 +90,7 @@ from .spec import Simulation, _dumps
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-__all__ = ["THREADS_ENV", "grid", "plot", "sweep", "valid_paths"]
+__all__ = ["THREADS_ENV", "SweepInterrupted", "grid", "plot", "sweep", "valid_paths"]
 
 logger = logging.getLogger(__name__)
 
@@ -379,6 +380,9 @@ def sweep(
         ``threads`` / ``chunk_size`` / ``options``, or a checkpoint from a different sweep.
         Invalid base specs raise the usual typed errors. Failures of individual points do not
         raise: they are rows with ``status = "error"``.
+    SweepInterrupted
+        On Ctrl-C, after the finished rows were flushed to the checkpoint; ``.result`` holds
+        them.
     """
     if not isinstance(spec, Simulation):
         raise invalid("spec", type(spec).__name__, "a paritysim.Simulation")
@@ -452,15 +456,30 @@ def sweep(
         bar.close()
     result = _assemble(done + new, table, metric_names, cycle_columns)
     if cancelled:
-        warnings.warn(
-            f"sweep cancelled: returning the {result.height} of {n} points that finished" + (f" (checkpointed in {store.parts})" if store else ""),
-            RuntimeWarning,
-            stacklevel=2,
-        )
-    elif store is not None:
+        # The finished rows are flushed (checkpoint) before this; the caller gets them on the
+        # exception, never as a silently short table.
+        raise SweepInterrupted(result, n, store.parts if store is not None else None)
+    if store is not None:
         store.finish(result)
     _report_failures(result)
     return result
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C during `sweep`: raised after the finished rows were saved.
+
+    A ``KeyboardInterrupt`` (code that stops on Ctrl-C keeps stopping); ``.result`` holds the
+    rows of the points that finished (sorted by ``point``), ``.total`` the number of points of
+    the sweep and ``.checkpoint`` the directory the rows were flushed to (None without
+    ``checkpoint=``). Re-running the same call with the same checkpoint resumes.
+    """
+
+    def __init__(self, result: pl.DataFrame, total: int, checkpoint: Path | None) -> None:
+        where = f"; checkpointed in {checkpoint}" if checkpoint is not None else ""
+        super().__init__(f"sweep interrupted after {result.height} of {total} points{where}")
+        self.result = result
+        self.total = total
+        self.checkpoint = checkpoint
 
 
 def _report_failures(result: pl.DataFrame) -> None:
