@@ -200,6 +200,24 @@ def _run_chunk(chunk: _Chunk) -> dict[str, Any]:
     return _raw(_prepare(chunk).result())
 
 
+def _failed_raw(n: int, n_metrics: int, cycle_columns: Sequence[str], exc: BaseException) -> dict[str, Any]:
+    """The raw result of a chunk of ``n`` points that failed as a whole (its run could not be
+    built, its worker died, ...): one error row per point with the chunk's error, so a sweep
+    never loses rows."""
+    kind = getattr(exc, "kind", None) or type(exc).__name__.removesuffix("Error") or "Error"
+    message = f"the chunk of this point failed: {type(exc).__name__}: {exc}"
+    return {
+        "finished": np.ones(n, bool),
+        "ok": np.zeros(n, bool),
+        "metrics": np.full((n, n_metrics), np.nan),
+        "converged": np.zeros(n, bool),
+        "cycles_run": np.full(n, -1, np.int64),
+        "error": [message] * n,
+        "error_kind": [kind] * n,
+        "cycle": {c: [None] * n for c in cycle_columns} if cycle_columns else None,
+    }
+
+
 def _frame(raw: dict[str, Any], params: pl.DataFrame, points: Sequence[int], metrics: Sequence[str], cycle_columns: Sequence[str]) -> pl.DataFrame:
     """The rows of the finished points of a chunk."""
     finished = np.asarray(raw["finished"], dtype=bool)
@@ -434,7 +452,9 @@ def sweep(
     def make(points: list[int]) -> _Chunk:
         return _Chunk(spec_json, tuple(param_table.columns), [rows[i] for i in points], points, metric_names, bool(cycle_columns), n_threads)
 
-    def frame(points: list[int], raw: dict[str, Any]) -> pl.DataFrame:
+    def frame(points: list[int], raw: dict[str, Any] | BaseException) -> pl.DataFrame:
+        if isinstance(raw, BaseException):
+            raw = _failed_raw(len(points), len(metric_names), cycle_columns, raw)
         return _frame(raw, table[points] if table.width else table, points, metric_names, cycle_columns)
 
     from tqdm.auto import tqdm  # type: ignore[import-untyped]
@@ -579,7 +599,7 @@ def _assemble(frames: list[pl.DataFrame], table: pl.DataFrame, metrics: Sequence
 def _run_local(
     chunks: list[list[int]],
     make: Callable[[list[int]], _Chunk],
-    frame: Callable[[list[int], dict[str, Any]], pl.DataFrame],
+    frame: Callable[[list[int], dict[str, Any] | BaseException], pl.DataFrame],
     finished_chunk: Callable[[pl.DataFrame], None],
     bar: Any,
 ) -> bool:
@@ -589,12 +609,31 @@ def _run_local(
     pending: Iterator[list[int]] = iter(chunks)
     started: list[tuple[list[int], _core.SweepRun]] = []  # running or finished, not collected
 
+    failed: list[tuple[list[int], Exception]] = []  # chunks whose run could not be built
+
     def prepared() -> tuple[list[int], _core.SweepRun] | None:
-        points = next(pending, None)
-        return None if points is None else (points, _prepare(make(points)))
+        while (points := next(pending, None)) is not None:
+            try:
+                return points, _prepare(make(points))
+            except Exception as exc:  # noqa: BLE001 - a failed chunk becomes its error rows
+                failed.append((points, exc))
+        return None
+
+    def flush_failed() -> None:
+        while failed:
+            points, exc = failed.pop(0)
+            finished_chunk(frame(points, exc))
+            bar.update(len(points))
+
+    def collect(points: list[int], run: _core.SweepRun) -> pl.DataFrame:
+        try:
+            return frame(points, _raw(run.result()))
+        except Exception as exc:  # noqa: BLE001 - e.g. the sweep thread failed: error rows
+            return frame(points, exc)
 
     try:
         upcoming = prepared()
+        flush_failed()
         if upcoming is None:
             return False
         upcoming[1].start()
@@ -609,16 +648,20 @@ def _run_local(
             if upcoming is not None:
                 upcoming[1].start()
                 started.append(upcoming)
-            raw = _raw(run.result())
+            rows = collect(points, run)
             started.pop(0)
-            finished_chunk(frame(points, raw))
+            finished_chunk(rows)
+            flush_failed()
             upcoming = prepared()
+            if upcoming is None:
+                flush_failed()
     except KeyboardInterrupt:
         for _, run in started:
             run.cancel()
         for points, run in started:
             run.wait(None)
-            finished_chunk(frame(points, _raw(run.result())))
+            finished_chunk(collect(points, run))
+        flush_failed()
         return True
     return False
 
@@ -633,7 +676,7 @@ def _run_executor(
     executor: cf.Executor,
     chunks: list[list[int]],
     make: Callable[[list[int]], _Chunk],
-    frame: Callable[[list[int], dict[str, Any]], pl.DataFrame],
+    frame: Callable[[list[int], dict[str, Any] | BaseException], pl.DataFrame],
     finished_chunk: Callable[[pl.DataFrame], None],
     bar: Any,
 ) -> bool:
@@ -649,13 +692,19 @@ def _run_executor(
                 points = next(queue, None)
                 if points is None:
                     break
-                in_flight[executor.submit(_run_chunk, make(points))] = points
+                try:
+                    in_flight[executor.submit(_run_chunk, make(points))] = points
+                except Exception as exc:  # noqa: BLE001 - e.g. a broken pool: error rows
+                    finished_chunk(frame(points, exc))
+                    bar.update(len(points))
             if not in_flight:
                 return False
             done, _ = cf.wait(list(in_flight), timeout=0.2, return_when=cf.FIRST_COMPLETED)
             for fut in done:
                 points = in_flight.pop(fut)
-                finished_chunk(frame(points, fut.result()))
+                # A chunk whose worker raised or died (BrokenProcessPool...) is error rows.
+                error = fut.exception()
+                finished_chunk(frame(points, error if error is not None else fut.result()))
                 bar.update(len(points))
     except KeyboardInterrupt:
         for fut in in_flight:
