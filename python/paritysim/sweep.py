@@ -642,7 +642,7 @@ def _run_local(
         while started:
             points, run = started[0]
             reported = 0
-            while not run.wait(0.1):
+            while not run.wait(0.02):  # short: Ctrl-C is seen between waits
                 reported = _advance(bar, run.finished, reported)
             _advance(bar, run.finished, reported)
             if upcoming is not None:
