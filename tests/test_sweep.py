@@ -214,9 +214,11 @@ def test_run_handle_reports_progress_and_cancel_keeps_finished_points(parity: ps
         run.start()
 
 
-def test_ctrl_c_cancels_and_returns_the_finished_rows(parity: ps.Simulation, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_ctrl_c_checkpoints_the_finished_rows_then_raises(parity: ps.Simulation, monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     """Ctrl-C (SIGINT via ``_thread.interrupt_main``) once 128 points have finished: a count, not
-    a timer, so the outcome does not depend on the machine's load."""
+    a timer, so the outcome does not depend on the machine's load. The finished rows are in the
+    checkpoint and on the raised `SweepInterrupted` (a KeyboardInterrupt), bit-identical to a
+    fresh run of the same points."""
     table = grid({"drivetrain.balance_spring": np.linspace(1.0, 2.0, 10_000).tolist()})
     after = 128
     advance = sweep_module._advance
@@ -231,11 +233,17 @@ def test_ctrl_c_cancels_and_returns_the_finished_rows(parity: ps.Simulation, mon
         return advance(bar, finished, reported)
 
     monkeypatch.setattr(sweep_module, "_advance", advance_then_interrupt)
-    with pytest.warns(RuntimeWarning, match="cancelled"):
-        partial = sweep(parity, table, metrics=["q2_amplitude", "left_stroke_amplitude"], threads=2, chunk_size=64, progress=False)
-    assert fired and after <= partial.height < table.height
+    checkpoint = tmp_path / "study.parquet"
+    metrics = ["q2_amplitude", "left_stroke_amplitude"]
+    with pytest.raises(KeyboardInterrupt) as stopped:
+        sweep(parity, table, metrics=metrics, threads=2, chunk_size=64, progress=False, checkpoint=checkpoint)
+    assert isinstance(stopped.value, sweep_module.SweepInterrupted)
+    partial = stopped.value.result
+    assert fired and after <= partial.height < table.height and stopped.value.total == table.height
     assert partial["point"].is_sorted() and (partial["status"] == "ok").all()
-    again = sweep(parity, table[partial["point"].to_list()], metrics=["q2_amplitude", "left_stroke_amplitude"], progress=False)
+    saved = pl.concat([pl.read_parquet(f) for f in sorted(checkpoint.with_name("study.parquet.parts").glob("part-*.parquet"))]).sort("point")
+    assert_same(saved, partial)
+    again = sweep(parity, table[partial["point"].to_list()], metrics=metrics, progress=False)
     assert_same(partial.drop("point"), again.drop("point"))
 
 
@@ -406,3 +414,40 @@ def test_plot_draws_one_line_per_hue(hmf: ps.Simulation) -> None:
     fig = sweep_module.plot(df, "actuator.frequency_hz", "left_stroke_amplitude", hue="actuator.voltage_v")
     assert len(fig.axes[0].lines) == 2
     assert math.isfinite(fig.axes[0].lines[0].get_ydata()[0])
+
+
+# ----------------------------------------------------------------------------- chunk failures
+
+
+def test_a_chunk_whose_run_cannot_be_built_becomes_error_rows(parity: ps.Simulation, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Any failure of a whole chunk (here its native run raising when built) gives one error row
+    per point of that chunk; the other chunks are unaffected."""
+    real = sweep_module._prepare
+
+    def prepare(chunk: Any) -> Any:
+        if 2 in chunk.points:
+            raise MemoryError("simulated failure of the chunk")
+        return real(chunk)
+
+    monkeypatch.setattr(sweep_module, "_prepare", prepare)
+    df = sweep(parity, {"actuator.voltage_v": [60.0, 70.0, 80.0, 90.0, 100.0]}, metrics=["left_stroke_amplitude"], chunk_size=2, threads=1, progress=False)
+    assert df["point"].to_list() == [0, 1, 2, 3, 4]
+    assert df["status"].to_list() == ["ok", "ok", "error", "error", "ok"]
+    assert df["error_kind"][2] == "Memory" and "simulated failure" in df["error"][3]
+    assert df["left_stroke_amplitude"][2] is None and df["left_stroke_amplitude"][4] > 0
+
+
+def test_a_chunk_whose_executor_worker_raises_becomes_error_rows(parity: ps.Simulation, monkeypatch: pytest.MonkeyPatch) -> None:
+    real = sweep_module._run_chunk
+
+    def run_chunk(chunk: Any) -> Any:
+        if 0 in chunk.points:
+            raise RuntimeError("worker lost")
+        return real(chunk)
+
+    monkeypatch.setattr(sweep_module, "_run_chunk", run_chunk)
+    with cf.ThreadPoolExecutor(2) as pool:
+        df = sweep(parity, {"actuator.voltage_v": [60.0, 70.0, 80.0, 90.0]}, metrics=["left_stroke_amplitude"], executor=pool, chunk_size=2, keep_cycle=["left_phi"], progress=False)
+    assert df["status"].to_list() == ["error", "error", "ok", "ok"]
+    assert df["error"].str.contains("worker lost").to_list() == [True, True, None, None]
+    assert df["cycle_left_phi"][0] is None and len(df["cycle_left_phi"][2]) > 8

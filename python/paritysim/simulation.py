@@ -88,7 +88,11 @@ def simulate(spec: Simulation, **option_overrides: Any) -> SimulationResult:
     InvalidParameterError, ConstraintError, ShapeError
         For an invalid spec (the message names the field).
     IntegrationError
-        When integration fails; ``.time`` and ``.state`` say where.
+        When integration fails; ``.time`` and ``.state`` say where. Also when one integration
+        needs more than ``options.max_steps`` steps or the run takes longer than
+        ``options.max_wall_ms`` (default 60 000 ms); the message names the option.
+    KeyboardInterrupt
+        On Ctrl-C: the run stops inside the integration (within about 20 ms).
     """
     if option_overrides:
         spec = spec.replace(options=spec.options.with_fields("options", **option_overrides))

@@ -52,7 +52,8 @@ Threads, progress, checkpoints, clusters
 ----------------------------------------
 ``threads=None`` uses ``$PARITYSIM_THREADS`` if set, else every core. ``progress=True`` shows a
 tqdm bar (rate, ETA) fed from the engine's atomic counter; Ctrl-C cancels cleanly: running points
-finish, the finished rows are returned (and checkpointed) with a ``RuntimeWarning``.
+stop within milliseconds (they count as not run), the finished rows are checkpointed and
+`SweepInterrupted` (a ``KeyboardInterrupt``) is raised carrying them as ``.result``.
 ``checkpoint="runs/study.parquet"`` flushes finished chunks to ``runs/study.parquet.parts/``
 and writes the complete, ordered table to ``runs/study.parquet`` at the end; re-running the
 same call skips every point already there (points are matched by their parameter values, so an
@@ -89,7 +90,7 @@ from .spec import Simulation, _dumps
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-__all__ = ["THREADS_ENV", "grid", "plot", "sweep", "valid_paths"]
+__all__ = ["THREADS_ENV", "SweepInterrupted", "grid", "plot", "sweep", "valid_paths"]
 
 logger = logging.getLogger(__name__)
 
@@ -197,6 +198,24 @@ def _raw(result: _core.SweepResult) -> dict[str, Any]:
 def _run_chunk(chunk: _Chunk) -> dict[str, Any]:
     """Runs a chunk to completion (executor workers call this)."""
     return _raw(_prepare(chunk).result())
+
+
+def _failed_raw(n: int, n_metrics: int, cycle_columns: Sequence[str], exc: BaseException) -> dict[str, Any]:
+    """The raw result of a chunk of ``n`` points that failed as a whole (its run could not be
+    built, its worker died, ...): one error row per point with the chunk's error, so a sweep
+    never loses rows."""
+    kind = getattr(exc, "kind", None) or type(exc).__name__.removesuffix("Error") or "Error"
+    message = f"the chunk of this point failed: {type(exc).__name__}: {exc}"
+    return {
+        "finished": np.ones(n, bool),
+        "ok": np.zeros(n, bool),
+        "metrics": np.full((n, n_metrics), np.nan),
+        "converged": np.zeros(n, bool),
+        "cycles_run": np.full(n, -1, np.int64),
+        "error": [message] * n,
+        "error_kind": [kind] * n,
+        "cycle": {c: [None] * n for c in cycle_columns} if cycle_columns else None,
+    }
 
 
 def _frame(raw: dict[str, Any], params: pl.DataFrame, points: Sequence[int], metrics: Sequence[str], cycle_columns: Sequence[str]) -> pl.DataFrame:
@@ -379,6 +398,9 @@ def sweep(
         ``threads`` / ``chunk_size`` / ``options``, or a checkpoint from a different sweep.
         Invalid base specs raise the usual typed errors. Failures of individual points do not
         raise: they are rows with ``status = "error"``.
+    SweepInterrupted
+        On Ctrl-C, after the finished rows were flushed to the checkpoint; ``.result`` holds
+        them.
     """
     if not isinstance(spec, Simulation):
         raise invalid("spec", type(spec).__name__, "a paritysim.Simulation")
@@ -430,7 +452,9 @@ def sweep(
     def make(points: list[int]) -> _Chunk:
         return _Chunk(spec_json, tuple(param_table.columns), [rows[i] for i in points], points, metric_names, bool(cycle_columns), n_threads)
 
-    def frame(points: list[int], raw: dict[str, Any]) -> pl.DataFrame:
+    def frame(points: list[int], raw: dict[str, Any] | BaseException) -> pl.DataFrame:
+        if isinstance(raw, BaseException):
+            raw = _failed_raw(len(points), len(metric_names), cycle_columns, raw)
         return _frame(raw, table[points] if table.width else table, points, metric_names, cycle_columns)
 
     from tqdm.auto import tqdm  # type: ignore[import-untyped]
@@ -452,15 +476,30 @@ def sweep(
         bar.close()
     result = _assemble(done + new, table, metric_names, cycle_columns)
     if cancelled:
-        warnings.warn(
-            f"sweep cancelled: returning the {result.height} of {n} points that finished" + (f" (checkpointed in {store.parts})" if store else ""),
-            RuntimeWarning,
-            stacklevel=2,
-        )
-    elif store is not None:
+        # The finished rows are flushed (checkpoint) before this; the caller gets them on the
+        # exception, never as a silently short table.
+        raise SweepInterrupted(result, n, store.parts if store is not None else None)
+    if store is not None:
         store.finish(result)
     _report_failures(result)
     return result
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C during `sweep`: raised after the finished rows were saved.
+
+    A ``KeyboardInterrupt`` (code that stops on Ctrl-C keeps stopping); ``.result`` holds the
+    rows of the points that finished (sorted by ``point``), ``.total`` the number of points of
+    the sweep and ``.checkpoint`` the directory the rows were flushed to (None without
+    ``checkpoint=``). Re-running the same call with the same checkpoint resumes.
+    """
+
+    def __init__(self, result: pl.DataFrame, total: int, checkpoint: Path | None) -> None:
+        where = f"; checkpointed in {checkpoint}" if checkpoint is not None else ""
+        super().__init__(f"sweep interrupted after {result.height} of {total} points{where}")
+        self.result = result
+        self.total = total
+        self.checkpoint = checkpoint
 
 
 def _report_failures(result: pl.DataFrame) -> None:
@@ -560,7 +599,7 @@ def _assemble(frames: list[pl.DataFrame], table: pl.DataFrame, metrics: Sequence
 def _run_local(
     chunks: list[list[int]],
     make: Callable[[list[int]], _Chunk],
-    frame: Callable[[list[int], dict[str, Any]], pl.DataFrame],
+    frame: Callable[[list[int], dict[str, Any] | BaseException], pl.DataFrame],
     finished_chunk: Callable[[pl.DataFrame], None],
     bar: Any,
 ) -> bool:
@@ -570,12 +609,31 @@ def _run_local(
     pending: Iterator[list[int]] = iter(chunks)
     started: list[tuple[list[int], _core.SweepRun]] = []  # running or finished, not collected
 
+    failed: list[tuple[list[int], Exception]] = []  # chunks whose run could not be built
+
     def prepared() -> tuple[list[int], _core.SweepRun] | None:
-        points = next(pending, None)
-        return None if points is None else (points, _prepare(make(points)))
+        while (points := next(pending, None)) is not None:
+            try:
+                return points, _prepare(make(points))
+            except Exception as exc:  # noqa: BLE001 - a failed chunk becomes its error rows
+                failed.append((points, exc))
+        return None
+
+    def flush_failed() -> None:
+        while failed:
+            points, exc = failed.pop(0)
+            finished_chunk(frame(points, exc))
+            bar.update(len(points))
+
+    def collect(points: list[int], run: _core.SweepRun) -> pl.DataFrame:
+        try:
+            return frame(points, _raw(run.result()))
+        except Exception as exc:  # noqa: BLE001 - e.g. the sweep thread failed: error rows
+            return frame(points, exc)
 
     try:
         upcoming = prepared()
+        flush_failed()
         if upcoming is None:
             return False
         upcoming[1].start()
@@ -584,22 +642,26 @@ def _run_local(
         while started:
             points, run = started[0]
             reported = 0
-            while not run.wait(0.1):
+            while not run.wait(0.02):  # short: Ctrl-C is seen between waits
                 reported = _advance(bar, run.finished, reported)
             _advance(bar, run.finished, reported)
             if upcoming is not None:
                 upcoming[1].start()
                 started.append(upcoming)
-            raw = _raw(run.result())
+            rows = collect(points, run)
             started.pop(0)
-            finished_chunk(frame(points, raw))
+            finished_chunk(rows)
+            flush_failed()
             upcoming = prepared()
+            if upcoming is None:
+                flush_failed()
     except KeyboardInterrupt:
         for _, run in started:
             run.cancel()
         for points, run in started:
             run.wait(None)
-            finished_chunk(frame(points, _raw(run.result())))
+            finished_chunk(collect(points, run))
+        flush_failed()
         return True
     return False
 
@@ -614,7 +676,7 @@ def _run_executor(
     executor: cf.Executor,
     chunks: list[list[int]],
     make: Callable[[list[int]], _Chunk],
-    frame: Callable[[list[int], dict[str, Any]], pl.DataFrame],
+    frame: Callable[[list[int], dict[str, Any] | BaseException], pl.DataFrame],
     finished_chunk: Callable[[pl.DataFrame], None],
     bar: Any,
 ) -> bool:
@@ -630,13 +692,19 @@ def _run_executor(
                 points = next(queue, None)
                 if points is None:
                     break
-                in_flight[executor.submit(_run_chunk, make(points))] = points
+                try:
+                    in_flight[executor.submit(_run_chunk, make(points))] = points
+                except Exception as exc:  # noqa: BLE001 - e.g. a broken pool: error rows
+                    finished_chunk(frame(points, exc))
+                    bar.update(len(points))
             if not in_flight:
                 return False
             done, _ = cf.wait(list(in_flight), timeout=0.2, return_when=cf.FIRST_COMPLETED)
             for fut in done:
                 points = in_flight.pop(fut)
-                finished_chunk(frame(points, fut.result()))
+                # A chunk whose worker raised or died (BrokenProcessPool...) is error rows.
+                error = fut.exception()
+                finished_chunk(frame(points, error if error is not None else fut.result()))
                 bar.update(len(points))
     except KeyboardInterrupt:
         for fut in in_flight:

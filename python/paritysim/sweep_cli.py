@@ -25,7 +25,6 @@ after an interruption resumes where it stopped.
 from __future__ import annotations
 
 import argparse
-import math
 import shutil
 import sys
 import time
@@ -152,10 +151,12 @@ def _main(args: argparse.Namespace) -> int:
     study = load_study(args.study)
     stem = Path(args.study).stem
     start = time.perf_counter()
-    df, written = run_study(study, args.out, stem, threads=args.threads, progress=not args.quiet, fresh=args.fresh)
-    expected = math.prod(len(v) for v in study.grid.values())
-    if df.height < expected:
-        print(f"{stem}: interrupted after {df.height} of {expected} points; re-run the same command to resume", file=sys.stderr)
+    from .sweep import SweepInterrupted
+
+    try:
+        df, written = run_study(study, args.out, stem, threads=args.threads, progress=not args.quiet, fresh=args.fresh)
+    except SweepInterrupted as stop:
+        print(f"{stem}: interrupted after {stop.result.height} of {stop.total} points; re-run the same command to resume", file=sys.stderr)
         return 130
     if not args.quiet:
         n_err = df.filter(pl.col("status") == "error").height

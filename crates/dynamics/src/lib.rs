@@ -28,6 +28,7 @@ pub mod wing;
 
 pub use actuator::{Actuator, DcOffset, Waveform};
 pub use device::{Device, DeviceSpec, Formulation, Transmission};
+pub use integrate::budget::CancelFlag;
 pub use integrate::{Integrator, MAX_DOF, Method, State};
 pub use paritysim_error::{Error, Result};
 pub use simulate::{

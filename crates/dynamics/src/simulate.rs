@@ -5,6 +5,7 @@ use paritysim_constraints::Vec6;
 use paritysim_error::{Error, Result, bail, check_positive};
 
 use crate::device::Device;
+use crate::integrate::budget::{Budget, CancelFlag};
 use crate::integrate::{Integrator, Method, RungeKutta, State};
 use crate::metrics::MetricsAccumulator;
 use crate::trajectory::{Recorder, Sample, select_columns};
@@ -76,7 +77,16 @@ pub struct SimulationOptions {
     pub columns: Option<Vec<String>>,
     /// How the periodic steady state is found (driven devices).
     pub steady_state: SteadyState,
+    /// Wall-clock budget of one run (ms; None: unlimited), checked inside integration: past
+    /// it the run fails with an [`Error::Integration`] naming `options.max_wall_ms`.
+    pub max_wall_ms: Option<f64>,
+    /// Stops the run at the next budget check with [`Error::Cancelled`] once set (not part of
+    /// the spec: a sweep's or a caller's flag).
+    pub cancel: Option<CancelFlag>,
 }
+
+/// Default wall-clock budget of one run (ms): a minute.
+pub const DEFAULT_MAX_WALL_MS: f64 = 60_000.0;
 
 impl Default for SimulationOptions {
     fn default() -> Self {
@@ -95,6 +105,8 @@ impl Default for SimulationOptions {
             duration_ms: None,
             columns: None,
             steady_state: SteadyState::Transient,
+            max_wall_ms: Some(DEFAULT_MAX_WALL_MS),
+            cancel: None,
         }
     }
 }
@@ -128,6 +140,9 @@ pub struct SimulationResult {
 
 fn validate(options: &SimulationOptions) -> Result<()> {
     check_positive("steady_tol", options.steady_tol)?;
+    if let Some(ms) = options.max_wall_ms {
+        check_positive("max_wall_ms", ms)?;
+    }
     if options.samples_per_cycle < 8 {
         bail!(invalid "samples_per_cycle", options.samples_per_cycle, ">= 8");
     }
@@ -146,6 +161,48 @@ fn validate(options: &SimulationOptions) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Most samples one run records (`samples_per_cycle × record_cycles`).
+pub const MAX_RECORDED_SAMPLES: usize = 10_000_000;
+
+/// Most memory (bytes) the recorded columns of one run may take.
+pub const MAX_RECORDING_BYTES: usize = 1 << 30;
+
+/// The work limit of the recording: samples and the memory of the asked columns, checked
+/// before anything runs.
+fn check_recording_size(options: &SimulationOptions, n_columns: usize) -> Result<()> {
+    // The field to blame: the per-cycle count when it alone is too much, else the cycles.
+    let field = if options.samples_per_cycle > MAX_RECORDED_SAMPLES {
+        "samples_per_cycle"
+    } else {
+        "record_cycles"
+    };
+    let (spc, cycles) = (options.samples_per_cycle, options.record_cycles);
+    let samples = spc
+        .checked_mul(cycles)
+        .filter(|&n| n <= MAX_RECORDED_SAMPLES);
+    let Some(samples) = samples else {
+        bail!(invalid field, options_value(field, spc, cycles),
+            format!("samples_per_cycle × record_cycles ≤ {MAX_RECORDED_SAMPLES} recorded samples per run"));
+    };
+    // Time plus every asked column, one f64 per sample each.
+    let bytes = (samples + 1)
+        .saturating_mul(n_columns + 1)
+        .saturating_mul(8);
+    if bytes > MAX_RECORDING_BYTES {
+        bail!(invalid field, format!("{} ({n_columns} columns: {} MiB)", options_value(field, spc, cycles), bytes >> 20),
+            format!("at most {} MiB of recorded columns per run (ask fewer columns, samples or cycles)",
+                MAX_RECORDING_BYTES >> 20));
+    }
+    Ok(())
+}
+
+fn options_value(field: &str, samples_per_cycle: usize, record_cycles: usize) -> String {
+    match field {
+        "samples_per_cycle" => format!("{samples_per_cycle} (× record_cycles = {record_cycles})"),
+        _ => format!("{record_cycles} (× samples_per_cycle = {samples_per_cycle})"),
+    }
 }
 
 fn state_change(a: &State, b: &State) -> f64 {
@@ -168,10 +225,14 @@ fn state_change(a: &State, b: &State) -> f64 {
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for bad options; [`Error::Constraint`] for an inconsistent
-/// initial state; [`Error::Integration`] (with time and state) when integration fails.
+/// initial state; [`Error::Integration`] (with time and state) when integration fails, more
+/// than `max_steps` steps are needed in one integration or the run takes longer than
+/// `max_wall_ms`; [`Error::Cancelled`] when `options.cancel` is set during the run.
 pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<SimulationResult> {
     validate(options)?;
+    let _budget = Budget::new(options.max_wall_ms, options.cancel.clone()).enter();
     let columns = select_columns(device, options.columns.as_deref())?;
+    check_recording_size(options, columns.len())?;
     let recording = RungeKutta::new(
         options.method,
         options.rtol,
@@ -234,6 +295,7 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
                     cycles_run = warm_up;
                 }
                 while cycles_run < options.max_cycles {
+                    crate::integrate::budget::check(t)?;
                     let next = transient.advance(device, t, &y, t + period)?;
                     residual = state_change(&next, &y);
                     y = next;
@@ -299,6 +361,7 @@ pub fn orbit_metrics(
     options: &SimulationOptions,
 ) -> Result<Vec<(String, f64)>> {
     validate(options)?;
+    let _budget = Budget::new(options.max_wall_ms, options.cancel.clone()).enter();
     let Some(period) = device.period() else {
         bail!(Constraint "orbit metrics need a periodic drive (the device has no actuator)");
     };

@@ -12,7 +12,8 @@
 //!   inside a point is caught and reported the same way (it never unwinds into the caller).
 //! * **Progress and cancellation.** [`SweepControl`] holds an atomic counter of finished points
 //!   (poll it from another thread) and a cancel flag: once set, no new point starts, the running
-//!   ones finish and the unstarted slots come back as `None`.
+//!   ones stop at their integrator's next budget check, and their slots and the unstarted ones
+//!   come back as `None`.
 //! * **Threads.** [`resolve_threads`]: an explicit count, else the environment variable
 //!   [`THREADS_ENV`] (`PARITYSIM_THREADS`), else all available cores. Each run builds its own
 //!   pool, so the global rayon pool is never touched.
@@ -55,13 +56,14 @@
 //! ```
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 
 use paritysim_error::{Error, Result, bail};
 
 use crate::device::Device;
+use crate::integrate::budget::{Budget, CancelFlag};
 use crate::metrics;
 use crate::simulate::{SimulationOptions, SteadyState, Trajectory, simulate};
 use crate::trajectory::column_table;
@@ -105,7 +107,7 @@ pub fn resolve_threads(requested: Option<usize>) -> Result<usize> {
 #[derive(Debug, Default)]
 pub struct SweepControl {
     finished: AtomicUsize,
-    cancelled: AtomicBool,
+    cancelled: CancelFlag,
 }
 
 impl SweepControl {
@@ -119,14 +121,15 @@ impl SweepControl {
         self.finished.load(Ordering::Acquire)
     }
 
-    /// Stops scheduling new points; running points finish normally.
+    /// Stops scheduling new points and stops the running ones at their next budget check
+    /// (they are reported as not run).
     pub fn cancel(&self) {
-        self.cancelled.store(true, Ordering::Release);
+        self.cancelled.cancel();
     }
 
     /// Whether [`SweepControl::cancel`] was called.
     pub fn is_cancelled(&self) -> bool {
-        self.cancelled.load(Ordering::Acquire)
+        self.cancelled.is_cancelled()
     }
 }
 
@@ -152,6 +155,8 @@ where
         if control.is_cancelled() {
             return None;
         }
+        // The sweep's cancel flag reaches the integrator of a running point too.
+        let _budget = Budget::new(None, Some(control.cancelled.clone())).enter();
         let out = catch_unwind(AssertUnwindSafe(|| f(i))).unwrap_or_else(|payload| {
             let what = payload
                 .downcast_ref::<&str>()
@@ -164,6 +169,10 @@ where
                 reason: format!("internal error (panic) at sweep point {i}: {what}"),
             })
         });
+        if matches!(out, Err(Error::Cancelled)) && control.is_cancelled() {
+            // Stopped mid-run by the cancel: not finished (a resume recomputes it).
+            return None;
+        }
         control.finished.fetch_add(1, Ordering::AcqRel);
         Some(out)
     };
@@ -373,7 +382,7 @@ pub fn run_points(
             }
             out.push(result);
             // run_indexed counts the chain once, at its end.
-            if i != last {
+            if i != last && !control.is_cancelled() {
                 control.finished.fetch_add(1, Ordering::AcqRel);
             }
         }
@@ -383,7 +392,11 @@ pub fn run_points(
     for (c, chain) in chains.into_iter().enumerate() {
         let len = ((c + 1) * CHAIN_LENGTH).min(points.len()) - c * CHAIN_LENGTH;
         match chain {
-            Some(Ok(results)) => slots.extend(results.into_iter().map(Some)),
+            Some(Ok(results)) => slots.extend(results.into_iter().map(|r| match r {
+                // Points of the chain stopped by the cancel did not run.
+                Err(Error::Cancelled) if control.is_cancelled() => None,
+                other => Some(other),
+            })),
             Some(Err(e)) => slots.extend((0..len).map(|_| Some(Err(e.clone())))),
             None => slots.extend((0..len).map(|_| None)),
         }

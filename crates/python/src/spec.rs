@@ -7,7 +7,7 @@
 //! simulation).
 
 use numpy::PyArray1;
-use paritysim_dynamics::{Device, SimulationResult};
+use paritysim_dynamics::{CancelFlag, Device, SimulationResult};
 use paritysim_error::{Error, Result};
 use paritysim_spec::{Simulation, paths, schema};
 use pyo3::prelude::*;
@@ -176,13 +176,64 @@ impl SimulationOutput {
     }
 }
 
-/// Simulates a JSON spec (GIL released while integrating).
+/// How often a waiting call checks for Python signals (Ctrl-C).
+const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(20);
+
+/// Runs `work` on a worker thread with the GIL released while this thread checks Python's
+/// signals every [`SIGNAL_POLL`]: on Ctrl-C (or any handler raising) `cancel` is set, the
+/// worker stops at its next budget check and the handler's exception is returned.
+pub(crate) fn interruptible<T: Send>(
+    py: Python<'_>,
+    cancel: &CancelFlag,
+    work: impl FnOnce() -> Result<T> + Send,
+) -> PyResult<T> {
+    let (out, interrupted) = py.detach(|| {
+        std::thread::scope(|scope| {
+            let (done_tx, done_rx) = std::sync::mpsc::channel::<()>();
+            let worker = scope.spawn(move || {
+                let out = work();
+                let _ = done_tx.send(());
+                out
+            });
+            let mut interrupted = None;
+            loop {
+                match done_rx.recv_timeout(SIGNAL_POLL) {
+                    Err(std::sync::mpsc::RecvTimeoutError::Timeout) if interrupted.is_none() => {
+                        if let Err(e) = Python::attach(|py| py.check_signals()) {
+                            cancel.cancel();
+                            interrupted = Some(e);
+                        }
+                    }
+                    Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+                    _ => break,
+                }
+            }
+            let out = worker.join().unwrap_or_else(|_| {
+                Err(Error::Integration {
+                    time: f64::NAN,
+                    state: Vec::new(),
+                    reason: "internal error (panic) in the simulation thread".into(),
+                })
+            });
+            (out, interrupted)
+        })
+    });
+    match interrupted {
+        Some(e) => Err(e),
+        None => out.py_err(),
+    }
+}
+
+/// Simulates a JSON spec on a worker thread (GIL released); Ctrl-C stops it within a few
+/// tens of milliseconds and raises `KeyboardInterrupt`.
 #[pyfunction]
 fn simulate(py: Python<'_>, json: &str) -> PyResult<SimulationOutput> {
-    let (device, options) = parse(json).and_then(|s| s.model()).py_err()?;
-    let result = py
-        .detach(|| paritysim_dynamics::simulate(&device, &options))
-        .py_err()?;
+    let (device, mut options) = parse(json).and_then(|s| s.model()).py_err()?;
+    let cancel = CancelFlag::new();
+    options.cancel = Some(cancel.clone());
+    let result = interruptible(py, &cancel, || {
+        paritysim_dynamics::simulate(&device, &options)
+    })?;
     Ok(SimulationOutput { result })
 }
 

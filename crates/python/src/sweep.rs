@@ -52,7 +52,8 @@ impl SweepRun {
         self.job.start().py_err()
     }
 
-    /// Stops scheduling new points; running points finish and are kept.
+    /// Stops scheduling new points; running points stop within milliseconds and are reported
+    /// as not run.
     fn cancel(&self) {
         self.job.cancel();
     }

@@ -256,6 +256,7 @@ pub fn options(o: &Options, n_coords: usize) -> Result<SimulationOptions> {
         }),
         duration_ms: o.duration_ms,
         steady_state: o.steady_state.into(),
+        max_wall_ms: Some(o.max_wall_ms),
         ..SimulationOptions::default()
     })
 }

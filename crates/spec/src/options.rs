@@ -133,6 +133,10 @@ pub struct Options {
     pub perturbation: Option<Perturbation>,
     /// How the periodic steady state is reached.
     pub steady_state: SteadyState,
+    /// Wall-clock budget of one run (ms), in (0, 8.64e7] (a day): a run past it fails with
+    /// an error naming this field (a sweep point becomes an error row).
+    #[schemars(range(max = 8.64e7), extend("exclusiveMinimum" = 0.0, "x-unit" = "ms"))]
+    pub max_wall_ms: f64,
 }
 
 impl Default for Options {
@@ -154,6 +158,9 @@ impl Default for Options {
             initial_p_dot: None,
             perturbation: None,
             steady_state: SteadyState::default(),
+            max_wall_ms: d
+                .max_wall_ms
+                .unwrap_or(paritysim_dynamics::simulate::DEFAULT_MAX_WALL_MS),
         }
     }
 }

@@ -307,7 +307,8 @@ impl SweepJob {
         self.started.load(Ordering::Acquire)
     }
 
-    /// Stops scheduling new points; running points finish and are kept.
+    /// Stops scheduling new points; running points stop at their next budget check and are
+    /// reported as not run (`finished = false`, recomputed by a resume).
     pub fn cancel(&self) {
         self.control.cancel();
     }

@@ -9,6 +9,7 @@
 //! * `differential-equations` 0.7.0 is kept as a dev-dependency to cross-check steps; its
 //!   DOP853 interpolant is O(h⁵) (see docs/findings.md), ours is Hairer's CONTD8.
 
+pub mod budget;
 mod dop853;
 mod dopri5;
 #[cfg(test)]
@@ -119,8 +120,9 @@ pub trait Integrator: Send + Sync {
     /// # Errors
     /// [`Error::InvalidParameter`] for `t_end <= t0` or times out of order or range;
     /// [`Error::Integration`] carrying the time and state of the failure (step-size underflow,
-    /// step limit, non-finite state, or a model error raised inside the right-hand side);
-    /// whatever `sink` returns.
+    /// step limit, non-finite state, a model error raised inside the right-hand side, or the
+    /// wall-time budget of the thread's [`budget::Budget`]); [`Error::Cancelled`] when the
+    /// budget's cancel flag is set; whatever `sink` returns.
     fn integrate_with(
         &self,
         system: &dyn OdeSystem,
@@ -533,12 +535,21 @@ fn drive<const M: usize, S: Stepper<M>>(
     let mut f1 = [0.0; M];
     let mut sample = [0.0; M];
     loop {
-        if stats.accepted + stats.rejected >= max_steps {
+        let attempts = stats.accepted + stats.rejected;
+        if attempts >= max_steps {
             return Err(integration_error(
                 t,
                 &rhs.expand(&y),
-                format!("more than {max_steps} steps"),
+                format!(
+                    "more than {max_steps} steps in one integration (the step budget \
+                     `options.max_steps`)"
+                ),
             ));
+        }
+        if attempts % budget::CHECK_EVERY == 0 {
+            if let Err(stop) = budget::check_current() {
+                return Err(budget::stop_error(stop, t, rhs.expand(&y).to_vec()));
+            }
         }
         if 0.1 * h.abs() <= t.abs() * f64::EPSILON || !h.is_finite() {
             return Err(integration_error(t, &rhs.expand(&y), "step size underflow"));

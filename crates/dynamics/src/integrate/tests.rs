@@ -295,3 +295,88 @@ fn bad_times_and_failures_are_typed_errors() {
         other => panic!("{other:?}"),
     }
 }
+
+/// The oscillator over a very long span needs millions of steps: the budget must stop it.
+fn long_run(rk: &RungeKutta) -> (Result<State>, std::time::Duration) {
+    let start_time = std::time::Instant::now();
+    let out = rk.advance(&Oscillator(1.0), 0.0, &start(1.0, 0.0), 1e9);
+    (out, start_time.elapsed())
+}
+
+#[test]
+fn a_set_cancel_flag_stops_the_integration_at_its_first_check() {
+    let rk = RungeKutta::new(Method::Dop853, 1e-10, 1e-12, usize::MAX).unwrap();
+    let flag = budget::CancelFlag::new();
+    flag.cancel();
+    let _guard = budget::Budget::new(None, Some(flag)).enter();
+    let (out, _) = long_run(&rk);
+    assert_eq!(out.unwrap_err(), Error::Cancelled);
+}
+
+#[test]
+fn a_cancel_from_another_thread_stops_a_running_integration() {
+    let rk = RungeKutta::new(Method::Dop853, 1e-10, 1e-12, usize::MAX).unwrap();
+    let flag = budget::CancelFlag::new();
+    let remote = flag.clone();
+    let canceller = std::thread::spawn(move || {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        remote.cancel();
+    });
+    let _guard = budget::Budget::new(None, Some(flag)).enter();
+    let (out, _) = long_run(&rk);
+    canceller.join().unwrap();
+    assert_eq!(out.unwrap_err(), Error::Cancelled);
+}
+
+#[test]
+fn the_wall_budget_becomes_an_error_naming_the_option() {
+    let rk = RungeKutta::new(Method::Dop853, 1e-10, 1e-12, usize::MAX).unwrap();
+    let _guard = budget::Budget::new(Some(20.0), None).enter();
+    let (out, _) = long_run(&rk);
+    match out.unwrap_err() {
+        Error::Integration { reason, time, .. } => {
+            assert!(
+                reason.contains("options.max_wall_ms") && reason.contains("20 ms"),
+                "{reason}"
+            );
+            // It stopped partway, not at the end.
+            assert!(time > 0.0 && time < 1e9, "{time}");
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn the_budget_ends_with_its_guard_and_an_inner_one_keeps_the_outer_flag() {
+    let rk = RungeKutta::new(Method::Dop853, 1e-8, 1e-10, 100_000).unwrap();
+    let flag = budget::CancelFlag::new();
+    {
+        let _outer = budget::Budget::new(None, Some(flag.clone())).enter();
+        let _inner = budget::Budget::new(Some(60_000.0), None).enter();
+        flag.cancel();
+        assert_eq!(
+            rk.advance(&Oscillator(1.0), 0.0, &start(1.0, 0.0), 10.0)
+                .unwrap_err(),
+            Error::Cancelled
+        );
+    }
+    // Guards dropped: no budget on this thread any more.
+    let y = rk
+        .advance(&Oscillator(1.0), 0.0, &start(1.0, 0.0), 10.0)
+        .unwrap();
+    assert!((y.coords[0] - 10f64.cos()).abs() < 1e-6);
+}
+
+#[test]
+fn the_step_budget_names_the_option() {
+    let rk = RungeKutta::new(Method::Dop853, 1e-10, 1e-12, 50).unwrap();
+    match long_run(&rk).0.unwrap_err() {
+        Error::Integration { reason, .. } => {
+            assert!(
+                reason.contains("options.max_steps") && reason.contains("50"),
+                "{reason}"
+            )
+        }
+        other => panic!("{other:?}"),
+    }
+}

@@ -1,0 +1,149 @@
+//! Per-run budget and cancellation, checked inside the integration loop.
+//!
+//! A run ([`crate::simulate()`]) installs a [`Budget`] on its thread for its duration
+//! ([`Budget::enter`]); every integrator call on that thread (transient, shooting, recording)
+//! checks it every [`CHECK_EVERY`] steps. A thread-local scope rather than a parameter: the
+//! budget then reaches every integration a run makes (Newton shooting, variational flows)
+//! without threading it through each call, and integrations outside a run are unaffected.
+
+use std::cell::RefCell;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use paritysim_error::{Error, Result};
+
+/// Steps between two checks of the budget (a check costs a clock read and an atomic load;
+/// a step costs microseconds, so 32 steps keep the reaction well below a millisecond).
+pub const CHECK_EVERY: usize = 32;
+
+/// A cancel flag shared between a run and whoever may stop it (another thread, a signal
+/// handler's poller). Equality is identity.
+#[derive(Clone, Debug, Default)]
+pub struct CancelFlag(Arc<AtomicBool>);
+
+impl CancelFlag {
+    /// A flag not yet set.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Asks the runs holding this flag to stop at their next check.
+    pub fn cancel(&self) {
+        self.0.store(true, Ordering::Release);
+    }
+
+    /// Whether [`Self::cancel`] was called.
+    pub fn is_cancelled(&self) -> bool {
+        self.0.load(Ordering::Acquire)
+    }
+}
+
+impl PartialEq for CancelFlag {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+/// What a run may spend: a wall-clock deadline and a cancel flag.
+#[derive(Clone, Debug, Default)]
+pub struct Budget {
+    deadline: Option<(Instant, f64)>,
+    cancel: Option<CancelFlag>,
+}
+
+thread_local! {
+    static CURRENT: RefCell<Option<Budget>> = const { RefCell::new(None) };
+}
+
+/// Restores the previous budget of the thread when dropped.
+#[must_use = "the budget applies while the guard lives"]
+pub struct BudgetGuard {
+    previous: Option<Budget>,
+}
+
+impl Drop for BudgetGuard {
+    fn drop(&mut self) {
+        let previous = self.previous.take();
+        CURRENT.with(|c| *c.borrow_mut() = previous);
+    }
+}
+
+impl Budget {
+    /// `max_wall_ms` from now (None or non-finite: no deadline) and an optional cancel flag.
+    pub fn new(max_wall_ms: Option<f64>, cancel: Option<CancelFlag>) -> Self {
+        let deadline = max_wall_ms
+            .filter(|ms| ms.is_finite() && *ms > 0.0)
+            .and_then(|ms| {
+                Instant::now()
+                    .checked_add(Duration::from_secs_f64(ms / 1e3))
+                    .map(|d| (d, ms))
+            });
+        Self { deadline, cancel }
+    }
+
+    /// Installs this budget on the current thread until the guard drops. A budget already
+    /// installed (an outer run) still applies: the earlier deadline wins and either cancel
+    /// flag stops the run.
+    pub fn enter(self) -> BudgetGuard {
+        let previous = CURRENT.with(|c| c.borrow().clone());
+        let merged = match &previous {
+            None => self,
+            Some(outer) => Budget {
+                deadline: match (self.deadline, outer.deadline) {
+                    (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
+                    (a, b) => a.or(b),
+                },
+                cancel: self.cancel.or_else(|| outer.cancel.clone()),
+            },
+        };
+        CURRENT.with(|c| *c.borrow_mut() = Some(merged));
+        BudgetGuard { previous }
+    }
+
+    fn check(&self) -> Result<(), Stop> {
+        if self.cancel.as_ref().is_some_and(CancelFlag::is_cancelled) {
+            return Err(Stop::Cancelled);
+        }
+        match self.deadline {
+            Some((deadline, ms)) if Instant::now() >= deadline => Err(Stop::Wall(ms)),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Why the current thread's budget stops a run.
+pub(crate) enum Stop {
+    Cancelled,
+    /// The wall-clock budget (ms) is spent.
+    Wall(f64),
+}
+
+/// Checks the current thread's budget (no budget: always fine).
+pub(crate) fn check_current() -> Result<(), Stop> {
+    CURRENT.with(|c| c.borrow().as_ref().map_or(Ok(()), Budget::check))
+}
+
+/// The error of a [`Stop`] at time `t` (ms) with `state`.
+pub(crate) fn stop_error(stop: Stop, time: f64, state: Vec<f64>) -> Error {
+    match stop {
+        Stop::Cancelled => Error::Cancelled,
+        Stop::Wall(ms) => Error::Integration {
+            time,
+            state,
+            reason: format!(
+                "exceeded the wall-time budget `options.max_wall_ms` = {ms} ms \
+                 (raise it, or make the point cheaper)"
+            ),
+        },
+    }
+}
+
+/// Checks the current thread's budget between integrator calls.
+///
+/// # Errors
+/// [`Error::Cancelled`] when the run's cancel flag is set; [`Error::Integration`] naming
+/// `options.max_wall_ms` when its deadline has passed.
+pub fn check(time: f64) -> Result<()> {
+    check_current().map_err(|s| stop_error(s, time, Vec::new()))
+}

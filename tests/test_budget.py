@@ -1,0 +1,160 @@
+"""Bounded work (issue 14): the per-run step and wall-time budgets, cancellation inside the
+integrator (Ctrl-C during ``ps.simulate`` and a sweep), work limits of the recording, and the
+reproducers of the issue as tests. Latencies are measured in benchmarks/ctrl_c_latency.py; the
+bounds here only tell "reacted" from "ignored" (the point would otherwise run for minutes)."""
+
+from __future__ import annotations
+
+import _thread
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+import paritysim as ps
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+@pytest.fixture(scope="module")
+def hmf() -> ps.Simulation:
+    return ps.load_spec(EXAMPLES / "hmf.toml")
+
+
+def test_a_pathological_point_becomes_an_error_row_naming_the_budget(hmf: ps.Simulation) -> None:
+    """Reproducer 4: the §3.4 HMF device at 1e-3 Hz (a period of 1e6 ms) would run for minutes;
+    with a 300 ms budget it is an error row and the other point is unaffected."""
+    df = ps.sweep(hmf, {"actuator.frequency_hz": [1e-3, 120.0]}, options={"max_wall_ms": 300.0, "max_cycles": 5}, progress=False)
+    assert df.height == 2
+    slow, normal = df.row(0, named=True), df.row(1, named=True)
+    assert slow["status"] == "error" and slow["error_kind"] == "Integration"
+    assert "options.max_wall_ms" in slow["error"] and "300 ms" in slow["error"]
+    assert normal["status"] == "ok" and normal["left_stroke_amplitude"] > 0.1
+
+
+def test_simulate_names_the_wall_budget(hmf: ps.Simulation) -> None:
+    with pytest.raises(ps.IntegrationError, match=r"options\.max_wall_ms") as info:
+        ps.simulate(hmf.with_paths({"actuator.frequency_hz": 1e-3}), max_wall_ms=100.0)
+    assert 0.0 < info.value.time < 1e6 * 300  # stopped partway through the transient
+
+
+def test_the_step_budget_names_max_steps(hmf: ps.Simulation) -> None:
+    with pytest.raises(ps.IntegrationError, match=r"options\.max_steps"):
+        ps.simulate(hmf, max_steps=20)
+
+
+@pytest.mark.parametrize("value", [0.0, -1.0, float("nan"), 1e9])
+def test_a_bad_wall_budget_is_a_typed_error(hmf: ps.Simulation, value: float) -> None:
+    with pytest.raises(ps.InvalidParameterError) as info:
+        ps.simulate(hmf, max_wall_ms=value)
+    assert "max_wall_ms" in str(info.value.field)
+
+
+def test_ctrl_c_interrupts_simulate_inside_the_integration(hmf: ps.Simulation) -> None:
+    """SIGINT (``_thread.interrupt_main``) 0.3 s into a run that would take a minute: the
+    integrator's cancel flag stops it and ``KeyboardInterrupt`` is raised."""
+    slow = hmf.with_paths({"actuator.frequency_hz": 1e-3})
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            ps.simulate(slow, max_wall_ms=60_000.0)
+    finally:
+        timer.cancel()
+    assert time.monotonic() - start < 30.0  # ignored, it would run to the 60 s budget
+
+
+def test_simulate_works_again_after_an_interrupt(hmf: ps.Simulation) -> None:
+    fast = {"max_cycles": 5, "samples_per_cycle": 40}
+    first = ps.simulate(hmf, **fast).metrics
+    timer = threading.Timer(0.2, _thread.interrupt_main)
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        ps.simulate(hmf.with_paths({"actuator.frequency_hz": 1e-3}))
+    timer.cancel()
+    assert ps.simulate(hmf, **fast).metrics == first
+
+
+def test_ctrl_c_stops_running_sweep_points_and_raises_with_the_finished_rows(hmf: ps.Simulation) -> None:
+    """Four slow points on two threads: Ctrl-C stops the two running ones inside integration; they
+    count as not run, so the interrupt carries no row, and nothing waits for the points."""
+    timer = threading.Timer(0.5, _thread.interrupt_main)
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(ps.sweep.SweepInterrupted) as info:
+            ps.sweep(hmf, {"actuator.frequency_hz": [1e-3] * 4}, options={"max_wall_ms": 60_000.0}, threads=2, progress=False)
+    finally:
+        timer.cancel()
+    assert time.monotonic() - start < 30.0
+    assert info.value.result.height == 0 and info.value.total == 4
+
+
+def test_reproducer_1_record_cycles_out_of_range_is_an_error_row_not_an_abort(hmf: ps.Simulation) -> None:
+    df = ps.sweep(hmf, {"options.record_cycles": [1, 10**15]}, options={"max_cycles": 5, "samples_per_cycle": 40}, progress=False)
+    assert df["status"].to_list() == ["ok", "error"]
+    assert "options.record_cycles" in df["error"][1] and df["error_kind"][1] == "InvalidParameter"
+
+
+def test_reproducer_2_a_chunk_where_every_point_fails_keeps_its_rows(hmf: ps.Simulation) -> None:
+    with pytest.warns(RuntimeWarning, match="1 of 1 sweep points failed"):
+        df = ps.sweep(hmf, {"actuator.frequency_hz": [-1.0]}, keep_cycle=True, progress=False)
+    assert df.height == 1 and df["status"][0] == "error"
+    assert "frequency_hz" in df["error"][0] and df["cycle_time_ms"][0] is None
+
+
+def test_reproducer_2_with_several_chunks_all_failing(hmf: ps.Simulation) -> None:
+    values = [-1.0, -2.0, 0.0, float("nan"), 1e9]
+    with pytest.warns(RuntimeWarning):
+        df = ps.sweep(hmf, {"actuator.frequency_hz": values}, keep_cycle=["left_phi"], chunk_size=2, progress=False)
+    assert df["point"].to_list() == list(range(len(values)))
+    assert (df["status"] == "error").all() and df["error"].str.contains("frequency_hz").all()
+
+
+def test_reproducer_3_samples_per_cycle_2_pow_63_is_a_typed_error(hmf: ps.Simulation) -> None:
+    with pytest.raises(ps.InvalidParameterError) as info:
+        ps.simulate(hmf, samples_per_cycle=2**63, record_cycles=2)
+    assert "samples_per_cycle" in str(info.value.field)
+
+
+def test_the_recording_size_is_limited_before_anything_runs(hmf: ps.Simulation) -> None:
+    """Each field is in its range, the product is not: 1e6 samples × 1e4 cycles would be 80 GB."""
+    start = time.monotonic()
+    with pytest.raises(ps.InvalidParameterError, match="recorded samples per run") as info:
+        ps.simulate(hmf, samples_per_cycle=10**6, record_cycles=10**4)
+    assert info.value.field == "record_cycles"
+    assert time.monotonic() - start < 5.0  # rejected up front, not after the transient
+
+
+def test_cli_sweep_ctrl_c_exits_130_in_one_line_and_keeps_the_finished_rows(tmp_path: Path) -> None:
+    """``paritysim sweep`` with two fast points then slow ones: SIGINT once the first chunk is
+    checkpointed; exit 130, one line on stderr, the finished rows on disk."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    study = tmp_path / "study.toml"
+    study.write_text(
+        f'spec = "{(EXAMPLES / "hmf.toml").as_posix()}"\nmetrics = ["left_stroke_amplitude"]\nchunk_size = 2\n'
+        '[options]\nmax_cycles = 5\nsamples_per_cycle = 40\nmax_wall_ms = 600000.0\n'
+        '[grid]\n"actuator.frequency_hz" = [100.0, 110.0, 0.001, 0.001]\n'
+    )
+    out = tmp_path / "runs"
+    proc = subprocess.Popen([sys.executable, "-m", "paritysim", "sweep", str(study), "--out", str(out), "--quiet", "--threads", "1"], stderr=subprocess.PIPE, text=True, env={**os.environ})
+    parts = out / "study.parquet.parts"
+    deadline = time.monotonic() + 60
+    while not list(parts.glob("part-*.parquet")):
+        assert proc.poll() is None and time.monotonic() < deadline
+        time.sleep(0.02)
+    time.sleep(0.3)  # inside the slow chunk
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130
+    assert err.strip().splitlines() == ["study: interrupted after 2 of 4 points; re-run the same command to resume"]
+    import polars as pl
+
+    saved = pl.concat([pl.read_parquet(p) for p in parts.glob("part-*.parquet")])
+    assert sorted(saved["point"].to_list()) == [0, 1] and (saved["status"] == "ok").all()
