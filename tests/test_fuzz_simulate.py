@@ -76,6 +76,9 @@ def _run(spec: ps.Simulation) -> str:
     except (ps.ConstraintError, ps.SingularError, ps.OutOfDomainError) as exc:
         assert str(exc)
         return "ran: model error"
+    except ps.InvalidParameterError as exc:  # a cross-field condition checked when the model is built
+        assert getattr(exc, "field", None), f"typed error without a field: {exc!r}"
+        return "rejected when built: typed error naming the field"
     assert _finite(result), result.metrics
     return "ran: finite result"
 

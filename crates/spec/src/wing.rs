@@ -7,9 +7,9 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct Shoulder {
-    /// Angle between the stroke and deviation axes of the five-bar (rad), in [0, pi]; pi/2
+    /// Angle between the stroke and deviation axes of the five-bar (rad), in (0, pi]; pi/2
     /// gives a decoupled shoulder (eq. 2.7).
-    #[schemars(range(min = 0.0, max = std::f64::consts::PI), extend("x-unit" = "rad"))]
+    #[schemars(range(max = std::f64::consts::PI), extend("exclusiveMinimum" = 0.0, "x-unit" = "rad"))]
     pub alpha2: f64,
     /// Second link angle (rad), in [0, pi) and below `alpha2`.
     #[schemars(range(min = 0.0, max = std::f64::consts::PI), extend("x-unit" = "rad"))]
