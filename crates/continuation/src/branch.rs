@@ -87,19 +87,7 @@ impl ContinuationOptions {
             ));
         }
         paritysim_error::check_finite("stop", self.stop)?;
-        check_positive("initial_step", self.initial_step)?;
-        check_positive("min_step", self.min_step)?;
-        check_positive("max_step", self.max_step)?;
-        if !(self.min_step <= self.initial_step && self.initial_step <= self.max_step) {
-            return Err(Error::invalid(
-                "initial_step",
-                self.initial_step,
-                format!(
-                    "in [min_step, max_step] = [{}, {}]",
-                    self.min_step, self.max_step
-                ),
-            ));
-        }
+        crate::system::check_steps(self.initial_step, self.min_step, self.max_step)?;
         if !(2..=1_000_000).contains(&self.max_points) {
             return Err(Error::invalid(
                 "max_points",

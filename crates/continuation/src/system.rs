@@ -2,7 +2,7 @@
 //! continuation shares: the tangent of the solution curve and the Newton corrector.
 
 use nalgebra::{DMatrix, DVector};
-use paritysim_error::{Error, Result};
+use paritysim_error::{Error, Result, check_positive};
 
 /// The residual, its `m × (m+1)` Jacobian, and the monodromy at the point (if the system has
 /// one) so that multipliers cost no extra integration.
@@ -98,4 +98,19 @@ pub(crate) fn correct<S: System>(
         what: "continuation corrector".into(),
         detail: format!("Newton did not converge in {max_iterations} iterations"),
     })
+}
+
+/// Step sizes of a continuation: each positive and `min_step <= initial_step <= max_step`.
+pub(crate) fn check_steps(initial: f64, min: f64, max: f64) -> Result<()> {
+    check_positive("initial_step", initial)?;
+    check_positive("min_step", min)?;
+    check_positive("max_step", max)?;
+    if !(min <= initial && initial <= max) {
+        return Err(Error::invalid(
+            "initial_step",
+            initial,
+            format!("in [min_step, max_step] = [{min}, {max}]"),
+        ));
+    }
+    Ok(())
 }

@@ -203,9 +203,7 @@ pub fn continue_fold_curve<M: PeriodMap>(
             ),
         ));
     }
-    check_positive("initial_step", options.initial_step)?;
-    check_positive("min_step", options.min_step)?;
-    check_positive("max_step", options.max_step)?;
+    crate::system::check_steps(options.initial_step, options.min_step, options.max_step)?;
     check_positive("parameter_scales.0", options.parameter_scales.0)?;
     check_positive("parameter_scales.1", options.parameter_scales.1)?;
     let mut p = parameters.to_vec();

@@ -279,46 +279,40 @@ pub mod plausible {
     pub const ANGLE_RAD: f64 = 1e3;
 }
 
-/// Requires `|value| <= `[`plausible::ANGLE_RAD`] (rad).
-pub fn check_angle_rad(field: &'static str, value: f64) -> Result<f64> {
-    let hi = plausible::ANGLE_RAD;
-    if value.is_finite() && value.abs() <= hi {
-        Ok(value)
-    } else {
-        Err(Error::invalid(
-            field,
-            value,
-            format!("an angle in [-{hi:e}, {hi:e}] rad"),
-        ))
-    }
-}
-
-/// Requires a part length in [`plausible::LENGTH_MM`] (mm).
-pub fn check_length_mm(field: &'static str, value: f64) -> Result<f64> {
-    let (lo, hi) = plausible::LENGTH_MM;
+/// Requires a finite `value` in `[lo, hi]`; the message names what it is (`a length`) and its unit.
+fn check_plausible(
+    field: &'static str,
+    value: f64,
+    (lo, hi): (f64, f64),
+    what: &str,
+    unit: &str,
+) -> Result<f64> {
     if value.is_finite() && (lo..=hi).contains(&value) {
         Ok(value)
     } else {
         Err(Error::invalid(
             field,
             value,
-            format!("a length in [{lo:e}, {hi:e}] mm"),
+            format!("{what} in [{lo:e}, {hi:e}] {unit}"),
         ))
     }
+}
+
+/// Requires `|value| <= `[`plausible::ANGLE_RAD`] (rad).
+pub fn check_angle_rad(field: &'static str, value: f64) -> Result<f64> {
+    let hi = plausible::ANGLE_RAD;
+    check_plausible(field, value, (-hi, hi), "an angle", "rad")
+}
+
+/// Requires a part length in [`plausible::LENGTH_MM`] (mm).
+pub fn check_length_mm(field: &'static str, value: f64) -> Result<f64> {
+    check_plausible(field, value, plausible::LENGTH_MM, "a length", "mm")
 }
 
 /// Requires a signed offset with `|value| <= `[`plausible::OFFSET_MM`] (mm).
 pub fn check_offset_mm(field: &'static str, value: f64) -> Result<f64> {
     let hi = plausible::OFFSET_MM;
-    if value.is_finite() && value.abs() <= hi {
-        Ok(value)
-    } else {
-        Err(Error::invalid(
-            field,
-            value,
-            format!("an offset in [-{hi:e}, {hi:e}] mm"),
-        ))
-    }
+    check_plausible(field, value, (-hi, hi), "an offset", "mm")
 }
 
 /// Requires every element of a slice to be finite; names the first bad index.
