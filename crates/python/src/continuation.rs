@@ -12,6 +12,8 @@ use crate::errors::IntoPyResult;
 use crate::spec::parse;
 
 type Complexes = Vec<(f64, f64)>;
+/// A followed bifurcation curve: `(first, second, multipliers)` per point, and the stop reason.
+type FollowedCurve = (Vec<(f64, f64, Complexes)>, String);
 
 fn settings(json: &str) -> Result<ContinuationSettings, Error> {
     serde_json::from_str(json).map_err(|e| {
@@ -129,7 +131,7 @@ impl ContinuationOutput {
         second_path: &str,
         second_start: f64,
         stop: f64,
-    ) -> PyResult<(Vec<(f64, f64, Complexes)>, String)> {
+    ) -> PyResult<FollowedCurve> {
         let n = self.outcome.branch.bifurcations.len();
         let bif = self
             .outcome
