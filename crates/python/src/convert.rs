@@ -51,7 +51,11 @@ pub fn from_json<T: DeserializeOwned>(field: &str, text: &str) -> Result<T, Erro
         let quoted: Vec<&str> = msg.split('`').skip(1).step_by(2).collect();
         match quoted.split_first() {
             Some((key, valid)) if msg.starts_with("unknown field") => Error::invalid(
-                format!("{field}.{key}"),
+                if field.is_empty() {
+                    key.to_string()
+                } else {
+                    format!("{field}.{key}")
+                },
                 "<unknown field>",
                 paritysim_spec::schema::suggestion(key, valid.iter().copied()),
             ),

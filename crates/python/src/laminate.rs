@@ -24,7 +24,7 @@ fn layup(layers: &str) -> PyResult<Layup> {
 }
 
 fn material(json: &str, ctx: &str) -> PyResult<Material> {
-    from_json::<MaterialRecord>(ctx, json)
+    from_json::<MaterialRecord>("material", json)
         .and_then(|m| m.build(ctx))
         .py_err()
 }

@@ -4,26 +4,23 @@
 //! are the `floquet::records` types through [`to_py`] (complex numbers as `[re, im]` pairs);
 //! options are JSON records of `ShootingOptions` / `DisturbanceOptions`.
 
-use nalgebra::{Complex, Matrix2};
+use nalgebra::Complex;
 use numpy::{Complex64, PyArray1, PyReadonlyArray1};
 use paritysim_dynamics::floquet::records::{
     BalanceSweepRecord, DisturbanceRecord, FloquetRecord, HillFloquetRecord, HillParametersRecord,
+    hill_solutions, regions, rows2,
 };
 use paritysim_dynamics::floquet::{self, DisturbanceOptions, PhysicalParameters, ShootingOptions};
 use paritysim_error::Result;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{from_json, same_len, shaped, to_py, to_vec};
+use crate::convert::{from_json, same_len, to_py, to_vec};
 use crate::errors::IntoPyResult;
 use crate::spec::device as parse_device;
 
 fn c64(z: Complex<f64>) -> Complex64 {
     Complex64::new(z.re, z.im)
-}
-
-fn matrix2(m: &Matrix2<f64>) -> Vec<f64> {
-    vec![m[(0, 0)], m[(0, 1)], m[(1, 0)], m[(1, 1)]]
 }
 
 /// Options from JSON (`None`: the defaults); unknown keys name the nearest valid one.
@@ -40,8 +37,10 @@ fn stability_hill_monodromy<'py>(
     kappa: f64,
     t0: f64,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let m = floquet::hill_monodromy(beta0, kappa, t0).py_err()?;
-    shaped(py, matrix2(&m), &[2, 2])
+    to_py(
+        py,
+        &rows2(&floquet::hill_monodromy(beta0, kappa, t0).py_err()?),
+    )
 }
 
 /// Solution matrices `Π(t_i, t0)` of eq. 2.25 at each `t_i >= t0`, shape `(n, 2, 2)`.
@@ -54,19 +53,10 @@ fn stability_hill_solution<'py>(
     t: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let t = to_vec(&t);
-    let n = t.len();
-    let flat = py
-        .detach(|| -> Result<Vec<f64>> {
-            let mut out = Vec::with_capacity(4 * n);
-            for (i, &ti) in t.iter().enumerate() {
-                let m = floquet::hill_solution_matrix(beta0, kappa, t0, ti)
-                    .map_err(|e| e.at_index(i, Some("t")))?;
-                out.extend(matrix2(&m));
-            }
-            Ok(out)
-        })
+    let m = py
+        .detach(|| hill_solutions(beta0, kappa, t0, &t))
         .py_err()?;
-    shaped(py, flat, &[n, 2, 2])
+    to_py(py, &m)
 }
 
 /// Floquet analysis of eq. 2.25 (`floquet::records::HillFloquetRecord`).
@@ -123,18 +113,11 @@ fn stability_region<'py>(
 ) -> PyResult<Bound<'py, PyArray1<i64>>> {
     let (a, b) = (to_vec(&a), to_vec(&b));
     same_len(("a", a.len()), ("b", b.len())).py_err()?;
-    let out = a
-        .iter()
-        .zip(&b)
-        .enumerate()
-        .map(|(i, (&x, &y))| {
-            floquet::region(x, y)
-                .map(|r| i64::from(r.index()))
-                .map_err(|e| e.at_index(i, None))
-        })
-        .collect::<Result<Vec<_>>>()
-        .py_err()?;
-    Ok(PyArray1::from_vec(py, out))
+    let r = regions(&a, &b).py_err()?;
+    Ok(PyArray1::from_vec(
+        py,
+        r.into_iter().map(i64::from).collect(),
+    ))
 }
 
 /// Brockett's criterion (eqs. 2.57-2.58) for `|g| <= 2 delta`, period T and `∫g dt`.
