@@ -271,3 +271,21 @@ def test_non_numeric_bimorph_geometry_is_a_typed_error() -> None:
     with pytest.raises(ps.InvalidParameterError) as exc:
         lam.Bimorph(layup, "long")  # type: ignore[arg-type]
     assert exc.value.field == "length"
+
+
+def test_unknown_record_keys_are_typed_errors_naming_the_nearest_field() -> None:
+    import json
+
+    from paritysim import _core
+
+    record = lam.material("brass").to_dict()
+    record["densty"] = record.pop("density")
+    with pytest.raises(ps.InvalidParameterError) as exc:
+        _core.laminate_check_material(json.dumps(record))
+    assert exc.value.field == "material.densty"
+    assert "did you mean `density`" in str(exc.value)
+    layers = [{"name": "b", "plies": [{"material": lam.material("brass").to_dict(), "thickness": 0.01, "angel": 0.0}]}]
+    with pytest.raises(ps.InvalidParameterError) as exc:
+        _core.laminate_abd(json.dumps(layers))
+    assert exc.value.field == "layers.angel"
+    assert "did you mean `angle`" in str(exc.value)

@@ -20,6 +20,8 @@ Quick start::
 
 from __future__ import annotations
 
+import json
+import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -106,8 +108,42 @@ def _f(x: Any, field: str) -> float:
 
 
 def _num(x: Any) -> Any:
-    """numpy scalars unwrapped; anything else passed on for Rust to check (and name)."""
+    """numpy scalars unwrapped; anything else passed on unchanged."""
     return x.item() if isinstance(x, np.generic) else x
+
+
+def _wire(field: str, x: Any) -> float | None:
+    """A number for the JSON read by ``_core``, or an ``InvalidParameterError`` naming
+    ``field``. JSON has no NaN: a non-finite value travels as null and Rust's range check
+    names it."""
+    value = real(field, x)
+    return value if math.isfinite(value) else None
+
+
+def _material_json(m: Any, field: str = "material") -> str:
+    if not isinstance(m, Material):
+        raise invalid(field, repr(m), "a Material")
+    return json.dumps(m._wire_dict())
+
+
+def _layers_json(layers: Sequence[Layer]) -> str:
+    """The layup as the JSON list of layer records read by ``_core``, numbers checked with
+    their dotted path (``layers[i].plies[j].thickness``)."""
+    out = []
+    for i, layer in enumerate(layers):
+        plies = []
+        for j, p in enumerate(layer.plies):
+            at = f"layers[{i}].plies[{j}]"
+            m = material(p.material) if isinstance(p.material, str) else p.material
+            if not isinstance(m, Material):
+                raise invalid(f"{at}.material", repr(m), "a Material or a library key")
+            plies.append({
+                "material": m._wire_dict(),
+                "thickness": _wire(f"{at}.thickness", p.thickness),
+                "angle": _wire(f"{at}.angle", p.angle),
+            })
+        out.append({"name": str(layer.name), "plies": plies})
+    return json.dumps(out)
 
 
 @dataclass(frozen=True)
@@ -135,11 +171,20 @@ class Material:
     max_field: float | None = None
 
     def __post_init__(self) -> None:
-        _core.laminate_check_material(self.to_dict())
+        _core.laminate_check_material(json.dumps(self._wire_dict()))
+
+    def _wire_dict(self) -> dict[str, Any]:
+        d = self.to_dict()
+        for key, value in d.items():
+            if key not in ("name", "class") and value is not None:
+                d[key] = _wire(key, value)
+        if not isinstance(d["class"], str):
+            raise invalid("class", repr(d["class"]), "a material class name")
+        d["name"] = str(d["name"])
+        return d
 
     def to_dict(self) -> dict[str, Any]:
         """The dict understood by the ``_core.laminate_*`` functions."""
-        # No float() here: Rust names a non-numeric field with an InvalidParameterError.
         return {
             "name": self.name,
             "class": self.category,
@@ -270,8 +315,8 @@ class Layup:
 
     def __init__(self, layers: Iterable[Layer]) -> None:
         self._layers: tuple[Layer, ...] = tuple(layers)
-        self._dicts = [layer.to_dict() for layer in self._layers]
-        self._summary: dict[str, Any] = _core.laminate_summary(self._dicts)
+        self._json = _layers_json(self._layers)
+        self._summary: dict[str, Any] = _core.laminate_summary(self._json)
 
     # -- constructors
     @classmethod
@@ -347,7 +392,7 @@ class Layup:
     # -- CLPT
     def abd(self) -> FloatArray:
         """The 6×6 ``[A B; B D]`` matrix (A mN/mm, B mN, D mN·mm)."""
-        return _core.laminate_abd(self._dicts)
+        return _core.laminate_abd(self._json)
 
     def response(
         self,
@@ -360,7 +405,7 @@ class Layup:
         (mN), a temperature change ``delta_t`` (K) and one voltage per layer (V, piezo layers only).
         """
         v = np.zeros(0) if voltages is None else np.asarray(voltages, dtype=np.float64).ravel()
-        return _core.laminate_response(self._dicts, _vec3(n), _vec3(m), _f(delta_t, "delta_t"), v)
+        return _core.laminate_response(self._json, _vec3(n), _vec3(m), _f(delta_t, "delta_t"), v)
 
     def thermal_curvature(self, delta_t: float = CURE_DELTA_T) -> FloatArray:
         """Curvature ``(κx, κy, κxy)`` (1/mm) after a uniform temperature change ``delta_t`` (K)
@@ -376,7 +421,7 @@ class Layup:
     ) -> dict[str, np.ndarray]:
         """Stresses (mN/mm², laminate axes) at the bottom and top face of every ply."""
         v = np.zeros(0) if voltages is None else np.asarray(voltages, dtype=np.float64).ravel()
-        return _core.laminate_ply_stresses(self._dicts, _vec3(n), _vec3(m), _f(delta_t, "delta_t"), v)
+        return _core.laminate_ply_stresses(self._json, _vec3(n), _vec3(m), _f(delta_t, "delta_t"), v)
 
     # -- drawing
     def plot(self, ax: Axes | None = None, to_scale: bool = True) -> Axes:
@@ -485,7 +530,7 @@ class Bimorph:
 
     def __post_init__(self) -> None:
         d = _core.laminate_bimorph(
-            self.layup._dicts,
+            self.layup._json,
             _f(self.length, "length"),
             _f(self.extension, "extension"),
             _f(self.base_width, "base_width"),
@@ -506,7 +551,7 @@ class Bimorph:
         taper ``width_ratio`` and ``extension_ratio = extension / length``."""
         lay = Layup.bimorph_mobee() if layup is None else layup
         d = _core.laminate_bimorph_design(
-            lay._dicts,
+            lay._json,
             _f(target.stiffness_mn_per_mm, "stiffness_mn_per_mm"),
             _f(target.force_per_volt_mn_per_v, "force_per_volt_mn_per_v"),
             _f(width_ratio, "width_ratio"),
@@ -552,7 +597,7 @@ class Bimorph:
     def _at(self, voltage: float | npt.ArrayLike) -> dict[str, Any]:
         v = np.asarray(voltage, dtype=np.float64)
         d = _core.laminate_bimorph(
-            self.layup._dicts,
+            self.layup._json,
             _f(self.length, "length"),
             _f(self.extension, "extension"),
             _f(self.base_width, "base_width"),
@@ -599,7 +644,7 @@ class Flexure:
     _data: dict[str, Any] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        d = _core.laminate_flexure(self.material.to_dict(), _f(self.width, "width"), _f(self.thickness, "thickness"), _f(self.length, "length"))
+        d = _core.laminate_flexure(_material_json(self.material), _f(self.width, "width"), _f(self.thickness, "thickness"), _f(self.length, "length"))
         object.__setattr__(self, "_data", d)
 
     @classmethod
@@ -616,7 +661,7 @@ class Flexure:
         flexure of width ``joint_width · flexure_fraction``; ``n_segments`` castellations."""
         m = material("polyimide") if mat is None else mat
         d = _core.laminate_castellated_joint(
-            m.to_dict(), _f(joint_width, "joint_width"), whole("n_segments", n_segments), _f(flexure_fraction, "flexure_fraction"), _f(thickness, "thickness"), _f(flexure_length, "flexure_length")
+            _material_json(m), _f(joint_width, "joint_width"), whole("n_segments", n_segments), _f(flexure_fraction, "flexure_fraction"), _f(thickness, "thickness"), _f(flexure_length, "flexure_length")
         )
         return cls(d["flexure_width"], flexure_length, thickness, m)
 

@@ -21,6 +21,7 @@ Units: mg-mm-ms-rad; frequencies in Hz, rates in 1/ms.
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -93,7 +94,9 @@ def hill_floquet(beta0: float, kappa: float) -> dict[str, Any]:
     ``multiplier_error`` and ``marginal`` (see :func:`stability_chart`) and ``stable``
     (Region I and not marginal).
     """
-    return _core.stability_hill_floquet(real("beta0", beta0), real("kappa", kappa))
+    raw: dict[str, Any] = _core.stability_hill_floquet(real("beta0", beta0), real("kappa", kappa))
+    raw["multipliers"] = _complex(raw["multipliers"])
+    return raw
 
 
 def region(a: Any, b: Any) -> np.ndarray:
@@ -246,8 +249,19 @@ class FloquetResult:
         return pl.DataFrame({"re": m.real, "im": m.imag, "modulus": modulus, "exponent_per_ms": exponent})
 
 
-def _shooting(options: dict[str, Any]) -> dict[str, Any] | None:
-    return {k: v for k, v in options.items() if v is not None} or None
+def _shooting(options: dict[str, Any]) -> str | None:
+    """Options as the JSON record read by ``_core`` (None values dropped: the Rust defaults
+    apply; anything not JSON-like travels as text for Rust to reject with the key)."""
+    given = {k: v for k, v in options.items() if v is not None}
+    return json.dumps(given, default=lambda o: o.item() if isinstance(o, np.generic) else repr(o)) if given else None
+
+
+def _complex(pairs: Any) -> np.ndarray:
+    """``[re, im]`` pairs (last axis) from ``_core`` as a complex array."""
+    a = np.asarray(pairs, dtype=float)
+    if a.ndim == 0 or a.shape[-1] != 2:
+        return a.astype(complex)
+    return a[..., 0] + 1j * a[..., 1]
 
 
 def floquet(spec: Simulation | dict[str, Any], **options: Any) -> FloquetResult:
@@ -269,7 +283,7 @@ def floquet(spec: Simulation | dict[str, Any], **options: Any) -> FloquetResult:
     """
     raw = _core.stability_floquet(_device(spec), _shooting(options))
     return FloquetResult(
-        multipliers=raw["multipliers"],
+        multipliers=_complex(raw["multipliers"]),
         spectral_radius=float(raw["spectral_radius"]),
         stability=str(raw["stability"]),
         slowest_decay_ms=raw["slowest_decay_ms"],
@@ -279,7 +293,7 @@ def floquet(spec: Simulation | dict[str, Any], **options: Any) -> FloquetResult:
         coordinates=list(raw["coordinates"]),
         orbit_state=raw["orbit_state"],
         monodromy=raw["monodromy"],
-        whippletree_multipliers=raw["whippletree_multipliers"],
+        whippletree_multipliers=None if raw["whippletree_multipliers"] is None else _complex(raw["whippletree_multipliers"]),
         whippletree_coupling=raw["whippletree_coupling"],
         monodromy_uncertainty=float(raw["monodromy_uncertainty"]),
         method=str(raw["method"]),
@@ -305,7 +319,7 @@ def k2_sweep(spec: Simulation | dict[str, Any], k2: Any, **options: Any) -> pl.D
             "max_exponent_per_ms": raw["max_exponent_per_ms"],
             "slowest_decay_ms": raw["slowest_decay_ms"],
             "stability": raw["stability"],
-            "moduli": [list(np.abs(row)) for row in raw["multipliers"]],
+            "moduli": [list(np.abs(row)) for row in _complex(raw["multipliers"])],
         }
     ).with_columns(pl.col("whippletree_radius", "slowest_decay_ms").fill_nan(None))
 
@@ -350,7 +364,7 @@ def disturbance_response(
     dist = {"settle_cycles": settle_cycles, "max_window_cycles": max_window_cycles, "samples_per_cycle": samples_per_cycle}
     device = _device(spec)
     raw = _core.stability_disturbance_response(device, freqs, real("amplitude", amplitude), _shooting(options), _shooting(dist))
-    h = raw["transfer"]
+    h = _complex(raw["transfer"])
     lti = avg = np.full(freqs.size, np.nan + 0j)
     _, n_dof = _core.validate_spec(device)
     if n_dof == 2:  # eq. 2.59 models the whippletree mode of a 2-DOF (Drag PARITY) drivetrain

@@ -65,7 +65,7 @@
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use nalgebra::{Matrix3, Vector3};
-use paritysim_error::{Result, bail, check_finite, check_non_negative};
+use paritysim_error::{Error, Result, bail, check_finite, check_non_negative};
 
 use crate::coefficients::{
     CoefficientModel, CoefficientSet, DEFAULT_ROTATIONAL_DAMPING, center_of_pressure,
@@ -148,6 +148,24 @@ pub enum NormalForceLaw {
     /// the coefficient absorbed): `C_N ≡ 1`, `C_T ≡ 0` everywhere (so `C_L = cos α`,
     /// `C_D = sin α` in [`BladeElementModel::loads`]).
     Unit,
+}
+
+impl NormalForceLaw {
+    /// By name: `coefficient` or `unit`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] (field `normal_force_law`) for another name.
+    pub fn from_name(name: &str) -> Result<Self> {
+        match name {
+            "coefficient" => Ok(NormalForceLaw::Coefficient),
+            "unit" => Ok(NormalForceLaw::Unit),
+            other => Err(Error::invalid(
+                "normal_force_law",
+                format!("{other:?}"),
+                "one of \"coefficient\", \"unit\"",
+            )),
+        }
+    }
 }
 
 /// Wing angles (rad) and rates (rad/ms): stroke `φ`, deviation `θ` (= `θ_w`), rotation `ψ`.

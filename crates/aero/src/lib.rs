@@ -34,6 +34,7 @@ pub mod coefficients;
 pub mod cut;
 pub mod inertia;
 pub mod planform;
+pub mod records;
 
 pub use blade::{
     AeroLoads, AeroMoments, BladeElementModel, NormalForceLaw, Omegas, WindRelative, WingState,

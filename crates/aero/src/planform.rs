@@ -52,7 +52,7 @@ const GL3: [(f64, f64); 3] = [
 /// Exact area integrals of a planform (mm^k); density-free.
 ///
 /// All double integrals are over the membrane; `∫ … dz` integrals run over the span.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct PlanformIntegrals {
     /// `∬ dA` (mm²).
     pub area: f64,

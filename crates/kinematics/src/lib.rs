@@ -14,6 +14,7 @@
 //! [`paritysim_error::Error::OutOfDomain`], never NaN.
 
 pub mod drivetrain;
+pub mod records;
 pub mod rotation;
 pub mod shoulder;
 

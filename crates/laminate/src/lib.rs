@@ -36,6 +36,7 @@ pub mod clpt;
 pub mod flexure;
 pub mod material;
 pub mod pcmems;
+pub mod records;
 
 pub use bimorph::{ActuatorConstants, Bimorph, BimorphGeometry};
 pub use clpt::{

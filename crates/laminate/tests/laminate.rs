@@ -841,3 +841,23 @@ fn cure_curvature_of_asymmetric_and_symmetric_stacks() {
     let lower = Layup::new(s.layers()[..7].to_vec()).unwrap();
     assert!(lower.thermal_curvature(CURE_DELTA_T).unwrap().amax() > 1e-4);
 }
+
+#[test]
+fn records_round_trip_and_name_the_dotted_field() {
+    use paritysim_laminate::records::{LayerRecord, MaterialRecord, preset};
+    let stack = preset("mobee").unwrap();
+    let records = LayerRecord::all(&stack);
+    let rebuilt = LayerRecord::build_layup(records.clone()).unwrap();
+    assert_eq!(LayerRecord::all(&rebuilt), records);
+    assert_eq!(rebuilt.abd().matrix(), stack.abd().matrix());
+    let mut bad = records;
+    bad[2].plies[0].thickness = -0.01;
+    let err = LayerRecord::build_layup(bad).unwrap_err();
+    assert_eq!(err.field(), Some("layers[2].plies[0].thickness"));
+    let brass = MaterialRecord::of(&paritysim_laminate::library::by_name("brass").unwrap());
+    let mut piezo_half = brass.clone();
+    piezo_half.d31 = Some(1e-9);
+    let err = piezo_half.build("material").unwrap_err();
+    assert_eq!(err.field(), Some("material.max_field"));
+    assert_eq!(MaterialRecord::of(&brass.clone().build("").unwrap()), brass);
+}

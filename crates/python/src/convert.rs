@@ -1,8 +1,14 @@
-//! numpy <-> Rust helpers.
+//! The two generic conversions of the boundary: JSON text into a serde input record, and any
+//! `Serialize` result into Python objects (numeric arrays become numpy arrays).
 
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
 use paritysim_error::Error;
+use pyo3::IntoPyObjectExt;
 use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+use serde_json::Value;
 
 /// A contiguous copy-free view if possible, else an owned copy.
 pub fn to_vec(a: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
@@ -31,4 +37,113 @@ pub fn shaped<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let a = PyArray1::from_vec(py, flat);
     Ok(a.reshape(shape.to_vec())?.into_any())
+}
+
+/// Parses `text` as the record `T` (which denies unknown fields).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] on `field`: an unknown key is named with the nearest valid one
+/// (`paritysim_spec::schema::suggestion`), other mismatches carry serde's message.
+pub fn from_json<T: DeserializeOwned>(field: &str, text: &str) -> Result<T, Error> {
+    serde_json::from_str(text).map_err(|e| {
+        let msg = e.to_string();
+        // serde_json: "unknown field `k`, expected one of `a`, `b` at line 1 column 9".
+        let quoted: Vec<&str> = msg.split('`').skip(1).step_by(2).collect();
+        match quoted.split_first() {
+            Some((key, valid)) if msg.starts_with("unknown field") => Error::invalid(
+                if field.is_empty() {
+                    key.to_string()
+                } else {
+                    format!("{field}.{key}")
+                },
+                "<unknown field>",
+                paritysim_spec::schema::suggestion(key, valid.iter().copied()),
+            ),
+            _ => Error::invalid(
+                field.to_string(),
+                msg,
+                "a record matching the documented fields",
+            ),
+        }
+    })
+}
+
+/// Any serialisable result as Python objects: structs and maps become dicts, rectangular
+/// arrays of numbers (or of booleans) numpy arrays of that shape (`null` in a float array is
+/// NaN), other arrays lists, a non-finite scalar None.
+pub fn to_py<'py, T: Serialize>(py: Python<'py>, value: &T) -> PyResult<Bound<'py, PyAny>> {
+    let v = serde_json::to_value(value)
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+    value_to_py(py, &v)
+}
+
+fn value_to_py<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {
+    match v {
+        Value::Null => Ok(py.None().into_bound(py)),
+        Value::Bool(b) => b.into_bound_py_any(py),
+        Value::Number(n) => match n.as_i64() {
+            Some(i) => i.into_bound_py_any(py),
+            None => n.as_f64().into_bound_py_any(py),
+        },
+        Value::String(s) => s.into_bound_py_any(py),
+        Value::Array(items) => match numeric_array(py, v)? {
+            Some(a) => Ok(a),
+            None => {
+                let list: PyResult<Vec<_>> = items.iter().map(|x| value_to_py(py, x)).collect();
+                Ok(PyList::new(py, list?)?.into_any())
+            }
+        },
+        Value::Object(map) => {
+            let d = PyDict::new(py);
+            for (k, x) in map {
+                d.set_item(k, value_to_py(py, x)?)?;
+            }
+            Ok(d.into_any())
+        }
+    }
+}
+
+/// Collects the leaves of a rectangular nested array; false if it is ragged or holds strings
+/// or objects.
+fn leaves<'a>(
+    v: &'a Value,
+    depth: usize,
+    shape: &mut Vec<usize>,
+    out: &mut Vec<&'a Value>,
+) -> bool {
+    match v {
+        Value::Array(items) => {
+            if depth == shape.len() && out.is_empty() {
+                shape.push(items.len());
+            } else if shape.get(depth) != Some(&items.len()) {
+                return false;
+            }
+            items.iter().all(|x| leaves(x, depth + 1, shape, out))
+        }
+        Value::String(_) | Value::Object(_) => false,
+        _ => {
+            out.push(v);
+            depth == shape.len()
+        }
+    }
+}
+
+fn numeric_array<'py>(py: Python<'py>, v: &Value) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let (mut shape, mut out) = (Vec::new(), Vec::new());
+    if !leaves(v, 0, &mut shape, &mut out) {
+        return Ok(None);
+    }
+    let a = if !out.is_empty() && out.iter().all(|x| x.is_boolean()) {
+        let flat: Vec<bool> = out.iter().map(|x| x.as_bool() == Some(true)).collect();
+        PyArray1::from_vec(py, flat).reshape(shape)?.into_any()
+    } else if !out.is_empty() && out.iter().all(|x| x.as_i64().is_some()) {
+        let flat: Vec<i64> = out.iter().filter_map(|x| x.as_i64()).collect();
+        PyArray1::from_vec(py, flat).reshape(shape)?.into_any()
+    } else if out.iter().all(|x| x.is_number() || x.is_null()) {
+        let flat: Vec<f64> = out.iter().map(|x| x.as_f64().unwrap_or(f64::NAN)).collect();
+        PyArray1::from_vec(py, flat).reshape(shape)?.into_any()
+    } else {
+        return Ok(None);
+    };
+    Ok(Some(a))
 }

@@ -1,23 +1,12 @@
 //! Binding for Appendix A's per-wing dynamics terms (`Wing::terms`): `M`, `c`, `∇V`, `J6`.
 
-use nalgebra::{Matrix3, Vector3};
-use numpy::PyArray1;
-use paritysim_error::Error;
+use nalgebra::Vector3;
+use paritysim_dynamics::wing::WingTermsRecord;
+use paritysim_error::{Error, check_all_finite};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 
-use crate::convert::shaped;
+use crate::convert::to_py;
 use crate::errors::IntoPyResult;
-
-fn row_major(m: &Matrix3<f64>) -> Vec<f64> {
-    (0..3)
-        .flat_map(|i| (0..3).map(move |j| m[(i, j)]))
-        .collect()
-}
-
-fn vector<'py>(py: Python<'py>, v: &Vector3<f64>) -> Bound<'py, PyArray1<f64>> {
-    PyArray1::from_vec(py, v.as_slice().to_vec())
-}
 
 /// `Wing::terms` of wing `wing` of a JSON spec at `p = (φ, θ, ψ)`, `ṗ`: a dict of
 /// `mass` (M, A.36, 3×3, mg·mm²), `coriolis` (c, mN·mm), `spring_gradient` (∇V of the joint
@@ -35,7 +24,7 @@ fn dynamics_wing_terms<'py>(
     wing: usize,
     p: [f64; 3],
     p_dot: [f64; 3],
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<Bound<'py, PyAny>> {
     let device = crate::spec::device(spec).py_err()?;
     let n = device.n_wings();
     let w = device
@@ -44,30 +33,11 @@ fn dynamics_wing_terms<'py>(
         .get(wing)
         .ok_or_else(|| Error::invalid("wing", wing, format!("in [0, {n})")))
         .py_err()?;
-    for (name, v) in [("p", &p), ("p_dot", &p_dot)] {
-        if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-            return Err(Error::invalid(
-                format!("{name}[{i}]"),
-                v[i],
-                "a finite number",
-            ))
-            .py_err();
-        }
-    }
+    check_all_finite("p", &p)
+        .and_then(|()| check_all_finite("p_dot", &p_dot))
+        .py_err()?;
     let t = w.terms(&Vector3::from(p), &Vector3::from(p_dot)).py_err()?;
-    let out = PyDict::new(py);
-    out.set_item("mass", shaped(py, row_major(&t.mass), &[3, 3])?)?;
-    out.set_item("coriolis", vector(py, &t.coriolis))?;
-    out.set_item("spring_gradient", vector(py, &t.spring))?;
-    out.set_item("aero", vector(py, &t.aero))?;
-    out.set_item("j6", shaped(py, row_major(&t.j6), &[3, 3])?)?;
-    out.set_item("omega", vector(py, &t.omega))?;
-    out.set_item("jdot_pdot", vector(py, &t.jdot_pdot))?;
-    out.set_item("rotation", shaped(py, row_major(&t.rotation), &[3, 3])?)?;
-    out.set_item("theta_w", t.theta_w)?;
-    out.set_item("kinetic", t.kinetic)?;
-    out.set_item("potential", t.potential)?;
-    Ok(out)
+    to_py(py, &WingTermsRecord::from(&t))
 }
 
 /// Registers `dynamics_wing_terms`.

@@ -8,7 +8,7 @@ use super::hill::check_hill;
 
 /// The outcome of Brockett's sufficient condition for bounded solutions of
 /// `ẍ + g(t)ẋ + x = 0`, `g(t + T) = g(t)`, `|g| ≤ 2δ` (eqs. 2.56–2.58).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Brockett {
     /// δ (half the bound on |g|).
     pub delta: f64,

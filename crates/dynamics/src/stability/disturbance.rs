@@ -191,7 +191,7 @@ impl OdeSystem for RollDisturbance<'_> {
 }
 
 /// A device placed on the charts of §2.6–2.7, from its periodic orbit.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct DeviceLinearisation {
     /// Physical parameters read from the device and the orbit (mean of the two wings where
     /// they differ; T and L from the drivetrain Jacobian at rest: `J = [[−T, T hL], [−T, −T hR]]`,
@@ -367,8 +367,10 @@ pub fn linearise(
     })
 }
 
-/// Options of [`disturbance_response`].
-#[derive(Clone, Debug, PartialEq)]
+/// Options of [`disturbance_response`]; deserialises from a partial record (missing fields
+/// take the defaults, unknown ones are rejected).
+#[derive(Clone, Debug, PartialEq, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct DisturbanceOptions {
     /// Drive cycles simulated with the disturbance before measuring (transient decay).
     pub settle_cycles: usize,

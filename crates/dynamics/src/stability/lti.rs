@@ -7,7 +7,7 @@ use nalgebra::Complex;
 use paritysim_error::{Result, bail, check_finite, check_positive};
 
 /// The physical parameters of the linearised Drag PARITY model of §2.6.1 (units mg-mm-ms-rad).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct PhysicalParameters {
     /// Wing inertia about the stroke axis I (mg·mm²).
     pub inertia: f64,
@@ -16,6 +16,7 @@ pub struct PhysicalParameters {
     /// Transmission ratio T (rad/mm).
     pub transmission_ratio: f64,
     /// Whippletree arm L (mm).
+    #[serde(rename = "arm_length_mm")]
     pub arm_length: f64,
     /// Actuator stiffness K1 (mN/mm).
     pub k1: f64,
@@ -28,7 +29,7 @@ pub struct PhysicalParameters {
 }
 
 /// The non-dimensional parameters of eqs. 2.23–2.24.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct HillParameters {
     /// `β0 = 2ΩTA/I = 2ΩΦ/I` (docs/errata.md#7; the printed `2ΩA/I` lacks T).
     pub beta0: f64,
@@ -92,7 +93,7 @@ impl PhysicalParameters {
 
 /// Eq. 2.59: `τ/τ_d = κ0/(s² + β* s + κ0)` from a wing roll disturbance torque to the body roll
 /// torque, with `s` in rad/ms.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct LtiModel {
     /// Constant damping β* of the whippletree mode (1/ms).
     pub beta_star: f64,

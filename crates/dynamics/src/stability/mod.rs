@@ -39,6 +39,7 @@ pub mod brockett;
 pub mod disturbance;
 pub mod hill;
 pub mod lti;
+pub mod records;
 pub mod shooting;
 
 pub use brockett::*;

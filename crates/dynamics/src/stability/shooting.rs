@@ -11,10 +11,13 @@ use crate::integrate::{Integrator, Method, OdeSystem, RungeKutta, State};
 
 use super::*;
 
-/// Options of [`periodic_orbit`] and [`floquet`].
-#[derive(Clone, Debug, PartialEq)]
+/// Options of [`periodic_orbit`] and [`floquet`]; deserialises from a partial record (missing
+/// fields take the defaults, unknown ones are rejected).
+#[derive(Clone, Debug, PartialEq, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct ShootingOptions {
-    /// Runge-Kutta pair.
+    /// Runge-Kutta pair (`dop853` or `dopri5`).
+    #[serde(deserialize_with = "super::records::method_by_name")]
     pub method: Method,
     /// Relative tolerance of every period integration.
     pub rtol: f64,
@@ -42,6 +45,7 @@ pub struct ShootingOptions {
     pub fallback_cycles: usize,
     /// Initial state (full integrator layout); `None`: rest at the constraints' particular
     /// configuration, as [`crate::simulate()`].
+    #[serde(skip)]
     pub initial: Option<State>,
 }
 
