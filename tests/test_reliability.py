@@ -97,6 +97,9 @@ def test_reproducers_name_their_field() -> None:
         (lambda: ps.kinematics.drivetrain_map(ps.Drivetrain.linear_differential(3.05, 2.5), [1e308], 0.0), "q1"),
         (lambda: ps.kinematics.shoulder_pose("2.0", 1.0, 0.0, 0.0), "alpha2"),
         (lambda: ps.Planform.semi_ellipse(3, 3, segments=2.5), "segments"),
+        (lambda: ps.kinematics.drivetrain_map(ps.Drivetrain.linear_differential(3.05, 2.5), ["x"]), "q1"),
+        (lambda: ps.kinematics.drivetrain_map(ps.Drivetrain.linear_differential(3.05, 2.5), [{}]), "q1"),
+        (lambda: ps.stability.lti_transfer(1.0, 0.5, ["x"]), "frequency_hz"),
     ]
     for call, field in cases:
         with pytest.raises(ps.ParitysimError) as info:
@@ -109,3 +112,14 @@ def test_finest_documented_outline_is_exact() -> None:
     n = 10**6
     p = ps.Planform.semi_ellipse(3.0, 3.0, segments=n)
     assert p.area == pytest.approx(math.pi * 9.0 / 4.0 * n / math.pi * math.sin(math.pi / n), rel=1e-9)
+
+
+def test_lti_transfer_is_finite_at_extreme_magnitudes() -> None:
+    """Eq. 2.59 by its polar form: the textbook complex quotient under/overflowed to NaN."""
+    import numpy as np
+
+    tiny = ps.stability.lti_transfer(1e-300, 1e-300, [1e-300])
+    assert np.isfinite(tiny).all() and abs(tiny[0] - 1.0) < 1e-12  # κ0 / κ0 at f -> 0
+    huge = ps.stability.lti_transfer(1e308, 1e5, [53.0])
+    w = 2 * np.pi * 53.0 * 1e-3
+    assert np.isfinite(huge).all() and abs(huge[0]) == pytest.approx(1e5 / (1e308 * w), rel=1e-9)

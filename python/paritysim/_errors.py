@@ -38,3 +38,15 @@ def whole(field: str, value: Any, lo: int = 0, hi: int = 2**53) -> int:
     if not lo <= number <= hi:
         raise invalid(field, number, f"an integer in [{lo}, {hi}]")
     return number
+
+
+def reals(field: str, value: Any) -> Any:
+    """``np.asarray(value, float64)`` for a public array argument, or an
+    ``InvalidParameterError`` naming ``field`` (strings, dicts and ragged lists are not numbers)."""
+    import numpy as np
+
+    try:
+        return np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError) as exc:
+        shown = repr(value)
+        raise invalid(field, shown if len(shown) <= 60 else shown[:57] + "...", "a real number or an array of real numbers") from exc

@@ -11,7 +11,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _core
-from ._errors import real, whole
+from ._errors import invalid, real, reals
 from ._core import Drivetrain
 
 __all__ = ["Drivetrain", "drivetrain_map", "shoulder_map", "shoulder_partials", "shoulder_pose"]
@@ -20,8 +20,12 @@ ArrayLike = npt.ArrayLike
 FloatArray = npt.NDArray[np.float64]
 
 
-def _paired(a: ArrayLike, b: ArrayLike) -> tuple[FloatArray, FloatArray, tuple[int, ...]]:
-    x, y = np.broadcast_arrays(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64))
+def _paired(a: ArrayLike, b: ArrayLike, names: tuple[str, str]) -> tuple[FloatArray, FloatArray, tuple[int, ...]]:
+    x, y = reals(names[0], a), reals(names[1], b)
+    try:
+        x, y = np.broadcast_arrays(x, y)
+    except ValueError as exc:
+        raise invalid(f"{names[0]}, {names[1]}", f"shapes {x.shape} and {y.shape}", "arrays that broadcast together") from exc
     return np.ascontiguousarray(x).ravel(), np.ascontiguousarray(y).ravel(), x.shape
 
 
@@ -47,7 +51,7 @@ def shoulder_map(alpha2: float, alpha3: float, phi: ArrayLike, theta: ArrayLike)
     InvalidParameterError
         For ``alpha2``/``alpha3`` out of range or non-finite inputs.
     """
-    p, t, shape = _paired(phi, theta)
+    p, t, shape = _paired(phi, theta, ("phi", "theta"))
     out = _core.shoulder_map(real("alpha2", alpha2), real("alpha3", alpha3), p, t)
     return {k: v.reshape(shape) for k, v in out.items()}
 
@@ -72,7 +76,7 @@ def drivetrain_map(drivetrain: Any, q1: ArrayLike, q2: ArrayLike = 0.0) -> dict[
     Returns ``stroke_left``, ``stroke_right`` (rad), ``jacobian`` (..., 2, 2) and
     ``hessian`` (..., 2, 2, 2).
     """
-    a, b, shape = _paired(q1, q2)
+    a, b, shape = _paired(q1, q2, ("q1", "q2"))
     out = drivetrain.evaluate(a, b)
     return {
         "stroke_left": out["stroke_left"].reshape(shape),

@@ -32,7 +32,7 @@ import polars as pl
 from matplotlib.figure import Figure
 
 from . import _core
-from ._errors import invalid, real, whole
+from ._errors import invalid, real, reals, whole
 from .spec import Simulation
 
 __all__ = [
@@ -63,7 +63,7 @@ MARGINAL = "marginal"
 
 
 def _f64(x: Any, name: str) -> np.ndarray:
-    a = np.ascontiguousarray(np.atleast_1d(np.asarray(x, dtype=np.float64)))
+    a = np.ascontiguousarray(np.atleast_1d(reals(name, x)))
     if a.ndim != 1:
         raise invalid(name, f"array of shape {a.shape}", "a scalar or a 1-D array")
     return a

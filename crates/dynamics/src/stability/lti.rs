@@ -129,6 +129,14 @@ impl LtiModel {
         if den.norm() == 0.0 {
             bail!(Singular "eq. 2.59 is 0/0 at f = 0 Hz with kappa0 = 0");
         }
-        Ok(Complex::new(self.kappa0, 0.0) / den)
+        // κ0 / den by its polar form: the textbook quotient squares |den| and under- or
+        // overflows for extreme but finite inputs (1e-300 or 1e308 gave NaN).
+        let size = den.norm();
+        let h = (den / size).conj() * (self.kappa0 / size);
+        if !(h.re.is_finite() && h.im.is_finite()) {
+            bail!(invalid "beta_star, kappa0", format!("{}, {}", self.beta_star, self.kappa0),
+                "magnitudes whose transfer function is representable");
+        }
+        Ok(h)
     }
 }
