@@ -254,6 +254,11 @@ pub fn map_jacobian(
 /// [`Error::Integration`] when an integration fails or no method converges (with the best
 /// state and its residual).
 pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<PeriodicOrbit> {
+    // The per-point wall budget of `simulate` bounds a pathological orbit search too (an outer
+    // run's earlier deadline or cancel flag still applies).
+    let _budget =
+        crate::integrate::budget::Budget::new(Some(crate::simulate::DEFAULT_MAX_WALL_MS), None)
+            .enter();
     let period = drive_period(device)?;
     let integrator = options.validate(period)?;
     let n = device.n_dof();
