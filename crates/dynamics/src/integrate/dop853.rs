@@ -207,8 +207,6 @@ impl<const M: usize> Stepper<M> for Dop853<M> {
     const BETA: f64 = 0.0;
     const FAC_MIN: f64 = 0.333;
     const FAC_MAX: f64 = 6.0;
-    const EVALS_PER_ATTEMPT: usize = 11;
-    const DENSE_EVALS: usize = 3;
 
     fn attempt(
         &mut self,

@@ -66,8 +66,6 @@ impl<const M: usize> Stepper<M> for Dopri5<M> {
     const BETA: f64 = 0.04;
     const FAC_MIN: f64 = 0.2;
     const FAC_MAX: f64 = 10.0;
-    const EVALS_PER_ATTEMPT: usize = 6;
-    const DENSE_EVALS: usize = 0;
 
     fn attempt(
         &mut self,

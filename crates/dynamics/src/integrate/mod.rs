@@ -279,32 +279,18 @@ impl RungeKutta {
             controlled: 2 * n,
         };
         let c0 = compress::<M>(n, y0);
-        let (y, mut stats) = match self.method {
-            Method::Dop853 => drive(
-                &mut dop853::Dop853::<M>::new(),
-                &mut rhs,
-                &tol,
-                self.max_steps,
-                t0,
-                c0,
-                t_end,
-                times,
-                sink,
-                on_step,
-            )?,
-            Method::Dopri5 => drive(
-                &mut dopri5::Dopri5::<M>::new(),
-                &mut rhs,
-                &tol,
-                self.max_steps,
-                t0,
-                c0,
-                t_end,
-                times,
-                sink,
-                on_step,
-            )?,
-        };
+        let (y, mut stats) = drive_method(
+            self.method,
+            &mut rhs,
+            &tol,
+            self.max_steps,
+            t0,
+            c0,
+            t_end,
+            times,
+            sink,
+            on_step,
+        )?;
         stats.rhs_calls = rhs.calls;
         Ok((Rhs::<M>::expand(&rhs, &y), stats))
     }
@@ -351,12 +337,6 @@ pub(crate) trait Stepper<const M: usize> {
     const FAC_MIN: f64;
     /// See [`Self::FAC_MIN`].
     const FAC_MAX: f64;
-    /// Evaluations per trial step (after the first stage).
-    #[allow(dead_code)]
-    const EVALS_PER_ATTEMPT: usize;
-    /// Extra evaluations of the dense output.
-    #[allow(dead_code)]
-    const DENSE_EVALS: usize;
 
     /// One trial step of size `h` from `(t, y)` with `f0 = f(t, y)`; returns the scaled error
     /// (accept when ≤ 1) and keeps the stages.
@@ -497,6 +477,48 @@ fn initial_step<const M: usize>(
         (0.01 / der12).powf(1.0 / order as f64)
     };
     Ok((100.0 * h).min(h1).min(h_max))
+}
+
+/// [`drive`] with the stepper of `method`.
+#[allow(clippy::too_many_arguments)]
+fn drive_method<const M: usize>(
+    method: Method,
+    rhs: &mut dyn Rhs<M>,
+    tol: &Tolerances,
+    max_steps: usize,
+    t0: f64,
+    y0: [f64; M],
+    t_end: f64,
+    times: &[f64],
+    sink: &mut Sink<'_>,
+    on_step: &mut dyn FnMut(f64, &State),
+) -> Result<([f64; M], IntegrationStats)> {
+    match method {
+        Method::Dop853 => drive(
+            &mut dop853::Dop853::<M>::new(),
+            rhs,
+            tol,
+            max_steps,
+            t0,
+            y0,
+            t_end,
+            times,
+            sink,
+            on_step,
+        ),
+        Method::Dopri5 => drive(
+            &mut dopri5::Dopri5::<M>::new(),
+            rhs,
+            tol,
+            max_steps,
+            t0,
+            y0,
+            t_end,
+            times,
+            sink,
+            on_step,
+        ),
+    }
 }
 
 /// The integration loop shared by both pairs (Hairer's `DP86CO` / `DOPCOR`).

@@ -10,10 +10,7 @@
 use nalgebra::DMatrix;
 use paritysim_error::Result;
 
-use super::{
-    Method, OdeSystem, Rhs, RungeKutta, State, Tolerances, dop853::Dop853, dopri5::Dopri5, drive,
-    integration_error,
-};
+use super::{OdeSystem, Rhs, RungeKutta, State, Tolerances, drive_method, integration_error};
 
 /// Relative size of the directional difference step.
 const DIRECTIONAL_STEP: f64 = 1e-6;
@@ -137,32 +134,18 @@ impl RungeKutta {
             controlled: m,
         };
         let none = &mut |_: usize, _: f64, _: &State| Ok(());
-        let (c, _) = match self.method {
-            Method::Dop853 => drive(
-                &mut Dop853::<M>::new(),
-                &mut rhs,
-                &tol,
-                self.max_steps,
-                t0,
-                c0,
-                t1,
-                &[],
-                none,
-                &mut |_, _| {},
-            )?,
-            Method::Dopri5 => drive(
-                &mut Dopri5::<M>::new(),
-                &mut rhs,
-                &tol,
-                self.max_steps,
-                t0,
-                c0,
-                t1,
-                &[],
-                none,
-                &mut |_, _| {},
-            )?,
-        };
+        let (c, _) = drive_method(
+            self.method,
+            &mut rhs,
+            &tol,
+            self.max_steps,
+            t0,
+            c0,
+            t1,
+            &[],
+            none,
+            &mut |_, _| {},
+        )?;
         // Rows/columns of the active entries: coords 0..n_real, rates n..n + n_real.
         let index = |k: usize| if k < n_real { k } else { n + k - n_real };
         let phi = DMatrix::from_fn(2 * n_real, 2 * n_real, |i, j| {
@@ -174,6 +157,7 @@ impl RungeKutta {
 
 #[cfg(test)]
 mod tests {
+    use super::super::Method;
     use super::*;
 
     /// Damped Mathieu-like oscillator `ẍ + c ẋ + (a + b cos t) x = 0` (linear: the flow *is*
