@@ -64,31 +64,32 @@ def label_with_unit(column: str) -> str:
     return column
 
 
-def fig2_9(df: pl.DataFrame) -> Figure:
-    """Three contour panels of theta_w over (phi, theta); unreachable poses left blank.
+def fig2_9(df: pl.DataFrame, box_deg: dict[str, tuple[float, float]] | None = None) -> Figure:
+    """Contour panels of theta_w over (phi, theta), one per shoulder configuration of ``df``;
+    unreachable poses left blank. ``box_deg`` (``{"phi": (lo, hi), "theta": (lo, hi)}``) is
+    drawn on the (90°, 45°) panel.
 
     ``df`` is the output of :func:`paritysim.trials.fig2_9`.
     """
-    from .trials.section_2_3 import FIG2_9_BOX_DEG, FIG2_9_CONFIGS_DEG
-
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.8), constrained_layout=True)
+    configs = df.select("alpha2_deg", "alpha3_deg").unique(maintain_order=True).rows()
+    fig, axes = plt.subplots(1, len(configs), figsize=(5 * len(configs), 4.8), constrained_layout=True, squeeze=False)
     levels = np.arange(-90, 91, 10)
-    for ax, (a2, a3), label in zip(axes, FIG2_9_CONFIGS_DEG, "abc", strict=True):
+    for ax, (a2, a3), label in zip(axes[0], configs, "abcdefgh", strict=False):
         sub = df.filter((pl.col("alpha2_deg") == a2) & (pl.col("alpha3_deg") == a3))
         phi = np.unique(sub["phi_deg"].to_numpy())
         theta = np.unique(sub["theta_deg"].to_numpy())
         z = sub["theta_w_deg"].fill_null(np.nan).to_numpy().reshape(theta.size, phi.size)
         cs = ax.contourf(phi, theta, z, levels=levels, cmap="coolwarm", extend="both")
         ax.contour(phi, theta, z, levels=levels, colors="k", linewidths=0.4)
-        if (a2, a3) == (90.0, 45.0):
-            (p0, p1), (t0, t1) = FIG2_9_BOX_DEG["phi"], FIG2_9_BOX_DEG["theta"]
+        if box_deg is not None and (a2, a3) == (90.0, 45.0):
+            (p0, p1), (t0, t1) = box_deg["phi"], box_deg["theta"]
             ax.plot([p0, p1, p1, p0, p0], [t0, t0, t1, t1, t0], color="k", lw=2.0, label="walking box")
             ax.legend(loc="lower right")
         ax.set_title(f"({label}) $\\alpha_2$ = {a2:.0f}°, $\\alpha_3$ = {a3:.0f}°")
         ax.set_xlabel("input stroke $\\phi$ (deg)")
         ax.set_ylabel("input deviation $\\theta$ (deg)")
         ax.set_aspect("equal")
-    fig.colorbar(cs, ax=axes, label="wing deviation $\\theta_w$ (deg)")
+    fig.colorbar(cs, ax=axes[0].tolist(), label="wing deviation $\\theta_w$ (deg)")
     fig.suptitle("Fig. 2.9: spherical shoulder transmission map (blank: beyond the joint limit, eq. 2.10)")
     return fig
 

@@ -725,3 +725,14 @@ fn unreachable_stroke(e: Error, target: f64) -> Error {
         other => other,
     }
 }
+
+// The device is an ODE system of the integrator (the integrator itself knows no device).
+impl crate::integrate::OdeSystem for Device {
+    fn rhs(&self, t: f64, y: &State, dydt: &mut State) -> Result<()> {
+        Device::rhs(self, t, y, dydt)
+    }
+
+    fn n_active(&self) -> usize {
+        self.n_dof()
+    }
+}

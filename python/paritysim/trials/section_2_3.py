@@ -93,7 +93,7 @@ def _cli_fig2_9(out: Path) -> list[Path]:
     from ._io import write_claims, write_trial
 
     df = fig2_9()
-    written = write_trial(df, out, "fig2_9", plots.fig2_9(df))
+    written = write_trial(df, out, "fig2_9", plots.fig2_9(df, FIG2_9_BOX_DEG))
     return [*written, write_claims(out, "fig2.9", fig2_9_claims(df))]
 
 

@@ -76,16 +76,6 @@ pub trait OdeSystem {
     }
 }
 
-impl OdeSystem for crate::device::Device {
-    fn rhs(&self, t: f64, y: &State, dydt: &mut State) -> Result<()> {
-        crate::device::Device::rhs(self, t, y, dydt)
-    }
-
-    fn n_active(&self) -> usize {
-        self.n_dof()
-    }
-}
-
 /// Explicit Runge-Kutta pair.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Method {
