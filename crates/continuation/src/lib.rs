@@ -37,6 +37,7 @@
 //! # Ok::<(), paritysim_error::Error>(())
 //! ```
 
+mod bifurcation;
 mod branch;
 mod map;
 mod multipliers;
