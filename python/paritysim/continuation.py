@@ -132,7 +132,7 @@ class ContinuationResult:
             yb = values[k] if k + 1 >= len(values) else values[k] + (values[k + 1] - values[k]) * ((xb - x[k]) / (x[k + 1] - x[k]) if x[k + 1] != x[k] else 0.0)
             ax.plot([xb], [yb], "o", color="C3")
             ax.annotate(f"{row['kind']} {xb:.4g}", (xb, yb), textcoords="offset points", xytext=(5, 5), fontsize=8)
-        ax.set_xlabel(label_with_unit(self.path))
+        ax.set_xlabel(_path_label(self.spec, self.path))
         ax.set_ylabel(label_with_unit(y))
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
@@ -142,6 +142,15 @@ class ContinuationResult:
 
             save(fig, path)
         return fig
+
+
+def _path_label(spec: Simulation, path: str) -> str:
+    """``path (unit)`` with the unit the Rust spec declares for it (aliases: the plot label rules)."""
+    from .plots import label_with_unit
+
+    units = {row[0]: row[1] for row in _core.spec_paths(spec.to_json())}
+    unit = units.get(path, "")
+    return f"{path} ({unit})" if unit and unit != "1" else label_with_unit(path)
 
 
 def _current(spec: Simulation, path: str) -> float:

@@ -175,7 +175,7 @@ def _curve_figure(curve: pl.DataFrame, grid: pl.DataFrame, k_star: float):  # ty
 def _figure(branch: pl.DataFrame, bifurcations: pl.DataFrame, brute: pl.DataFrame):  # type: ignore[no-untyped-def]
     import matplotlib.pyplot as plt
 
-    from ..plots import label_with_unit
+    from ..continuation import _path_label
 
     fig, ax = plt.subplots(figsize=(7.5, 4.2), constrained_layout=True)
     stable = branch.filter(pl.col("stability") == "stable")
@@ -187,7 +187,7 @@ def _figure(branch: pl.DataFrame, bifurcations: pl.DataFrame, brute: pl.DataFram
         ax.axvline(row[PATH], color="C3", lw=0.8)
         ax.annotate(f"{row['kind']}: K2 = {row[PATH]:.5g}", (row[PATH], 1.0), textcoords="offset points", xytext=(6, 8), fontsize=8, color="C3")
     ax.axhline(1.0, color="k", lw=0.6)
-    ax.set_xlabel(label_with_unit(PATH) if "(" in label_with_unit(PATH) else f"{PATH} (mN·mm/rad)")
+    ax.set_xlabel(_path_label(drag_parity_spec(START), PATH))
     ax.set_ylabel("largest Floquet multiplier |μ|")
     ax.set_title("§3.3 linkage: whippletree stability boundary by continuation")
     ax.legend(fontsize=8)
