@@ -7,7 +7,8 @@ use serde::Serialize;
 
 use crate::{
     BladeElementModel, CoefficientModel, CoefficientSet, Error, LineMass, MassDistribution,
-    Planform, PlanformIntegrals, PointMass, Result, WingState, center_of_pressure,
+    NormalForceLaw, Omegas, Planform, PlanformIntegrals, PointMass, Result, WingState,
+    center_of_pressure,
 };
 
 fn arr(v: Vector3<f64>) -> [f64; 3] {
@@ -285,5 +286,63 @@ impl MomentSeries {
             );
         }
         Ok(s)
+    }
+}
+
+/// The inputs of a [`MomentSeries`] by name, as the bindings receive them.
+#[derive(Clone, Debug)]
+pub struct MomentRequest<'a> {
+    /// `[Ω1, Ω2, Ω3, Ω4]` (mg·mm²).
+    pub omegas: [f64; 4],
+    /// `½ρ∬z²dA` (mg·mm); enables the lift/drag outputs.
+    pub force: Option<f64>,
+    /// Coefficient model name ([`CoefficientSet::from_name`]).
+    pub model: &'a str,
+    /// Rotational damping coefficient.
+    pub rotational_damping: f64,
+    /// Normal force law name ([`NormalForceLaw::from_name`]).
+    pub normal_force_law: &'a str,
+    /// Paired columns `phi, theta, psi, phi_dot, theta_dot, psi_dot`.
+    pub columns: [&'a [f64]; 6],
+}
+
+impl MomentRequest<'_> {
+    /// Column names of [`MomentRequest::columns`], in order.
+    pub const COLUMNS: [&'static str; 6] =
+        ["phi", "theta", "psi", "phi_dot", "theta_dot", "psi_dot"];
+
+    /// Builds the model and the states and evaluates the series.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for an unknown name, a bad Ω, force or damping, or a
+    /// non-finite state; [`Error::Shape`] when the columns' lengths differ (naming both).
+    pub fn evaluate(&self) -> Result<MomentSeries> {
+        let set = CoefficientSet::from_name(self.model)?;
+        let law = NormalForceLaw::from_name(self.normal_force_law)?;
+        let [o1, o2, o3, o4] = self.omegas;
+        let mut o = Omegas::new(o1, o2, o3, o4)?;
+        if let Some(f) = self.force {
+            o = o.with_force(f)?;
+        }
+        let m = BladeElementModel::new(o, set)?
+            .with_rotational_damping(self.rotational_damping)?
+            .with_normal_force_law(law);
+        let n = self.columns[0].len();
+        for (name, col) in Self::COLUMNS.iter().zip(self.columns) {
+            paritysim_error::check_same_len(("phi", n), (name, col.len()))?;
+            paritysim_error::check_all_finite(name, col)?;
+        }
+        let [phi, theta, psi, phi_dot, theta_dot, psi_dot] = self.columns;
+        let states: Vec<WingState> = (0..n)
+            .map(|i| WingState {
+                phi: phi[i],
+                theta: theta[i],
+                psi: psi[i],
+                phi_dot: phi_dot[i],
+                theta_dot: theta_dot[i],
+                psi_dot: psi_dot[i],
+            })
+            .collect();
+        MomentSeries::of(&m, &states, self.force.is_some())
     }
 }

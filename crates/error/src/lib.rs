@@ -315,6 +315,20 @@ pub fn check_offset_mm(field: &'static str, value: f64) -> Result<f64> {
     check_plausible(field, value, (-hi, hi), "an offset", "mm")
 }
 
+/// Requires paired arguments of equal lengths, naming both (`(name, length)` each).
+///
+/// # Errors
+/// [`Error::Shape`] when the lengths differ.
+pub fn check_same_len(a: (&str, usize), b: (&str, usize)) -> Result<()> {
+    if a.1 != b.1 {
+        return Err(Error::Shape(format!(
+            "`{}` has {} elements but `{}` has {}; they must match",
+            a.0, a.1, b.0, b.1
+        )));
+    }
+    Ok(())
+}
+
 /// Requires every element of a slice to be finite; names the first bad index.
 pub fn check_all_finite(field: &'static str, values: &[f64]) -> Result<()> {
     match values.iter().position(|v| !v.is_finite()) {

@@ -31,6 +31,18 @@ pub struct ShoulderMap {
 }
 
 impl ShoulderMap {
+    /// [`ShoulderMap::of`] after checking the arrays pair up and are finite.
+    ///
+    /// # Errors
+    /// `Error::Shape` for unequal lengths, `Error::InvalidParameter` naming the first
+    /// non-finite element.
+    pub fn checked(sh: &SphericalShoulder, phi: &[f64], theta: &[f64]) -> Result<Self> {
+        paritysim_error::check_same_len(("phi", phi.len()), ("theta", theta.len()))?;
+        paritysim_error::check_all_finite("phi", phi)?;
+        paritysim_error::check_all_finite("theta", theta)?;
+        Ok(Self::of(sh, phi, theta))
+    }
+
     /// The map of `sh` over the pairs `phi[i]`, `theta[i]` (equal lengths).
     pub fn of(sh: &SphericalShoulder, phi: &[f64], theta: &[f64]) -> Self {
         let mut m = Self::default();
@@ -130,8 +142,10 @@ impl DrivetrainMap {
     /// `d` at each pair `q1[i]` (mm), `q2[i]` (rad).
     ///
     /// # Errors
-    /// As [`Drivetrain::evaluate`], naming the first unreachable index.
+    /// `Error::Shape` for unequal lengths; as [`Drivetrain::evaluate`], naming the first
+    /// unreachable index.
     pub fn of(d: &Drivetrain, q1: &[f64], q2: &[f64]) -> Result<Self> {
+        paritysim_error::check_same_len(("q1", q1.len()), ("q2", q2.len()))?;
         let mut m = Self::default();
         for (i, (&a, &b)) in q1.iter().zip(q2).enumerate() {
             let e = d.evaluate(a, b).map_err(|e| e.at_index(i, None))?;

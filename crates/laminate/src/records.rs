@@ -12,8 +12,8 @@ use crate::flexure::{
 };
 use crate::pcmems::{self, CURE_DELTA_T, CURE_TEMPERATURE_C, ROOM_TEMPERATURE_C};
 use crate::{
-    ActuatorConstants, Bimorph, Error, Layer, Layup, Material, MaterialClass, MaterialSpec, Piezo,
-    Ply, PlyStress, Response, Result,
+    ActuatorConstants, Bimorph, Error, Layer, Layup, Loads, Material, MaterialClass, MaterialSpec,
+    Piezo, Ply, PlyStress, Response, Result,
 };
 
 /// A number where JSON `null` stands for a non-finite value (JSON has no NaN; serde_json
@@ -475,4 +475,39 @@ impl CastellatedReport {
             strain_per_rad: j.flexure().max_strain(1.0)?,
         })
     }
+}
+
+/// A 3-vector argument named `name`: exactly 3 finite numbers.
+///
+/// # Errors
+/// [`Error::Shape`] for another length, [`Error::InvalidParameter`] for a non-finite entry.
+pub fn vector3(name: &'static str, v: &[f64]) -> Result<Vector3<f64>> {
+    let [x, y, z] = v[..] else {
+        return Err(Error::Shape(format!(
+            "`{name}` must have 3 elements, got {}",
+            v.len()
+        )));
+    };
+    paritysim_error::check_all_finite(name, v)?;
+    Ok(Vector3::new(x, y, z))
+}
+
+/// [`Loads`] from plain arguments: `n` (mN/mm) and `m` (mN) 3-vectors, `delta_t` (K) and per-layer
+/// `voltages` (V; empty for none).
+///
+/// # Errors
+/// As [`vector3`] for `n` and `m`.
+pub fn loads(n: &[f64], m: &[f64], delta_t: f64, voltages: &[f64]) -> Result<Loads> {
+    Ok(Loads {
+        n: vector3("n", n)?,
+        m: vector3("m", m)?,
+        delta_t,
+        voltages: voltages.to_vec(),
+    })
+}
+
+/// The 6×6 `[A B; B D]` matrix (A mN/mm, B mN, D mN·mm) of a layup, row-major.
+pub fn abd_rows(layup: &Layup) -> Vec<[f64; 6]> {
+    let m = layup.abd().matrix();
+    (0..6).map(|i| std::array::from_fn(|j| m[(i, j)])).collect()
 }

@@ -1,7 +1,7 @@
 //! The two generic conversions of the boundary: JSON text into a serde input record, and any
 //! `Serialize` result into Python objects (numeric arrays become numpy arrays).
 
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use paritysim_error::Error;
 use pyo3::IntoPyObjectExt;
 use pyo3::prelude::*;
@@ -10,11 +10,107 @@ use serde::Serialize;
 use serde::de::DeserializeOwned;
 use serde_json::Value;
 
+/// Defines the module's `#[pyfunction]`s and its `register` (which also adds `class`es,
+/// `const`ants and hand-written `extra` functions). Each body runs with the GIL released and
+/// returns a `paritysim_error::Result`; with `-> T` the value converts as `T`, without, it is a
+/// `Serialize` record converted by [`to_py`]. Array arguments are [`Floats`] / [`Table`].
+macro_rules! bindings {
+    (
+        $(class $class:ty;)*
+        $(const $const_name:literal = $const_value:expr;)*
+        $(extra $extra:ident;)*
+        $($(#[$attr:meta])* fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)? $body:block)*
+    ) => {
+        $(bindings!(@fn $(#[$attr])* $name($($arg: $ty),*) $(-> $ret)? $body);)*
+
+        /// Adds this module's functions, classes and constants.
+        pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+            $(m.add_class::<$class>()?;)*
+            $(m.add($const_name, $const_value)?;)*
+            $(m.add_function(wrap_pyfunction!($extra, m)?)?;)*
+            $(m.add_function(wrap_pyfunction!($name, m)?)?;)*
+            Ok(())
+        }
+    };
+    (@fn $(#[$attr:meta])* $name:ident($($arg:ident: $ty:ty),*) -> $ret:ty $body:block) => {
+        #[pyfunction]
+        $(#[$attr])*
+        fn $name(py: Python<'_>, $($arg: $ty),*) -> PyResult<$ret> {
+            $crate::errors::IntoPyResult::py_err(
+                py.detach(|| -> paritysim_error::Result<$ret> { $body }),
+            )
+        }
+    };
+    (@fn $(#[$attr:meta])* $name:ident($($arg:ident: $ty:ty),*) $body:block) => {
+        #[pyfunction]
+        $(#[$attr])*
+        fn $name<'py>(py: Python<'py>, $($arg: $ty),*) -> PyResult<Bound<'py, PyAny>> {
+            let out = py.detach(|| -> paritysim_error::Result<_> { $body });
+            $crate::convert::to_py(py, &$crate::errors::IntoPyResult::py_err(out)?)
+        }
+    };
+}
+pub(crate) use bindings;
+
 /// A contiguous copy-free view if possible, else an owned copy.
 pub fn to_vec(a: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
     match a.as_slice() {
         Ok(s) => s.to_vec(),
         Err(_) => a.as_array().iter().copied().collect(),
+    }
+}
+
+/// A float64 numpy vector argument, copied so the call can release the GIL.
+pub struct Floats(pub Vec<f64>);
+
+impl<'py> FromPyObject<'py> for Floats {
+    fn extract_bound(ob: &Bound<'py, PyAny>) -> PyResult<Self> {
+        Ok(Floats(to_vec(&ob.extract::<PyReadonlyArray1<'py, f64>>()?)))
+    }
+}
+
+impl std::ops::Deref for Floats {
+    type Target = Vec<f64>;
+    fn deref(&self) -> &Vec<f64> {
+        &self.0
+    }
+}
+
+/// A float64 numpy `(n, k)` matrix argument, copied row-major.
+pub struct Table {
+    data: Vec<f64>,
+    cols: usize,
+}
+
+impl<'py> FromPyObject<'py> for Table {
+    fn extract_bound(ob: &Bound<'py, PyAny>) -> PyResult<Self> {
+        let a = ob.extract::<PyReadonlyArray2<'py, f64>>()?;
+        let v = a.as_array();
+        Ok(Table {
+            data: v.iter().copied().collect(),
+            cols: v.ncols(),
+        })
+    }
+}
+
+impl Table {
+    /// The rows, requiring `N` columns.
+    ///
+    /// # Errors
+    /// [`Error::Shape`] naming the argument `name` when the column count differs.
+    pub fn rows<const N: usize>(&self, name: &str) -> Result<Vec<[f64; N]>, Error> {
+        if self.cols != N {
+            let n = self.data.len().checked_div(self.cols).unwrap_or(0);
+            let shape = [n, self.cols];
+            return Err(Error::Shape(format!(
+                "`{name}` must have shape (n, {N}), got {shape:?}"
+            )));
+        }
+        Ok(self
+            .data
+            .chunks_exact(N)
+            .map(|r| std::array::from_fn(|j| r[j]))
+            .collect())
     }
 }
 

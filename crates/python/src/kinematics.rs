@@ -6,56 +6,29 @@ use paritysim_kinematics::records::{DrivetrainMap, PartialsRecord, PoseRecord, S
 use paritysim_kinematics::{Drivetrain, SphericalShoulder};
 use pyo3::prelude::*;
 
-use crate::convert::{same_len, to_py, to_vec};
+use crate::convert::{Floats, bindings, to_py, to_vec};
 use crate::errors::IntoPyResult;
 
-/// Vectorised closed-form shoulder map over paired `phi`, `theta` arrays (rad):
-/// `records::ShoulderMap`. Where `reachable` is False (outside the joint limit of eq. 2.10, or
-/// a singular pose) the angle arrays hold NaN: that is the documented mask, not a silent
-/// failure.
-#[pyfunction]
-fn shoulder_map<'py>(
-    py: Python<'py>,
-    alpha2: f64,
-    alpha3: f64,
-    phi: PyReadonlyArray1<'py, f64>,
-    theta: PyReadonlyArray1<'py, f64>,
-) -> PyResult<Bound<'py, PyAny>> {
-    let sh = SphericalShoulder::new(alpha2, alpha3).py_err()?;
-    let (phi, theta) = (to_vec(&phi), to_vec(&theta));
-    same_len(("phi", phi.len()), ("theta", theta.len())).py_err()?;
-    paritysim_error::check_all_finite("phi", &phi).py_err()?;
-    paritysim_error::check_all_finite("theta", &theta).py_err()?;
-    to_py(py, &py.detach(|| ShoulderMap::of(&sh, &phi, &theta)))
-}
+bindings! {
+    class PyDrivetrain;
 
-/// One shoulder pose: `joint_angles (6,)`, `link_rotations (6, 3, 3)` (R_i^1), `wing_angles (3,)`.
-#[pyfunction]
-fn shoulder_pose(
-    py: Python<'_>,
-    alpha2: f64,
-    alpha3: f64,
-    phi: f64,
-    theta: f64,
-    psi: f64,
-) -> PyResult<Bound<'_, PyAny>> {
-    let sh = SphericalShoulder::new(alpha2, alpha3).py_err()?;
-    to_py(py, &PoseRecord::of(&sh, phi, theta, psi).py_err()?)
-}
+    /// Vectorised closed-form shoulder map over paired `phi`, `theta` arrays (rad). Where
+    /// `reachable` is False (outside the joint limit of eq. 2.10, or a singular pose) the angle
+    /// arrays hold NaN: the documented mask, not a silent failure.
+    fn shoulder_map(alpha2: f64, alpha3: f64, phi: Floats, theta: Floats) {
+        ShoulderMap::checked(&SphericalShoulder::new(alpha2, alpha3)?, &phi, &theta)
+    }
 
-/// Partials of γ2, γ3, γ5 w.r.t. (φ, θ) and the Jacobian J6 (A.9) at `(phi, theta, psi)`.
-#[pyfunction]
-#[pyo3(signature = (alpha2, alpha3, phi, theta, psi=0.0))]
-fn shoulder_partials(
-    py: Python<'_>,
-    alpha2: f64,
-    alpha3: f64,
-    phi: f64,
-    theta: f64,
-    psi: f64,
-) -> PyResult<Bound<'_, PyAny>> {
-    let sh = SphericalShoulder::new(alpha2, alpha3).py_err()?;
-    to_py(py, &PartialsRecord::of(&sh, phi, theta, psi).py_err()?)
+    /// One shoulder pose: `joint_angles (6,)`, `link_rotations (6, 3, 3)`, `wing_angles (3,)`.
+    fn shoulder_pose(alpha2: f64, alpha3: f64, phi: f64, theta: f64, psi: f64) {
+        PoseRecord::of(&SphericalShoulder::new(alpha2, alpha3)?, phi, theta, psi)
+    }
+
+    /// Partials of γ2, γ3, γ5 w.r.t. (φ, θ) and the Jacobian J6 (A.9) at `(phi, theta, psi)`.
+    #[pyo3(signature = (alpha2, alpha3, phi, theta, psi=0.0))]
+    fn shoulder_partials(alpha2: f64, alpha3: f64, phi: f64, theta: f64, psi: f64) {
+        PartialsRecord::of(&SphericalShoulder::new(alpha2, alpha3)?, phi, theta, psi)
+    }
 }
 
 /// A planar drivetrain mapping `(q1, q2)` (mm, rad) to stroke angles `(φL, φR)` (rad), built
@@ -97,8 +70,7 @@ impl PyDrivetrain {
         self.inner.dof()
     }
 
-    /// Evaluates over paired arrays `q1` (mm), `q2` (rad): `records::DrivetrainMap`
-    /// (`stroke_left`, `stroke_right` (n,), `jacobian` (n, 2, 2), `hessian` (n, 2, 2, 2)).
+    /// Evaluates over paired arrays `q1` (mm), `q2` (rad): `records::DrivetrainMap`.
     /// Raises `OutOfDomainError` naming the first unreachable index.
     fn evaluate<'py>(
         &self,
@@ -106,9 +78,7 @@ impl PyDrivetrain {
         q1: PyReadonlyArray1<'py, f64>,
         q2: PyReadonlyArray1<'py, f64>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (q1, q2) = (to_vec(&q1), to_vec(&q2));
-        same_len(("q1", q1.len()), ("q2", q2.len())).py_err()?;
-        let d = self.inner;
+        let (q1, q2, d) = (to_vec(&q1), to_vec(&q2), self.inner);
         to_py(py, &py.detach(|| DrivetrainMap::of(&d, &q1, &q2)).py_err()?)
     }
 
@@ -124,13 +94,4 @@ impl PyDrivetrain {
         let from_spec = slf.get_type().getattr("from_spec")?;
         Ok((from_spec, (slf.get().to_spec(),)))
     }
-}
-
-/// Adds the kinematics functions and classes.
-pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(shoulder_map, m)?)?;
-    m.add_function(wrap_pyfunction!(shoulder_pose, m)?)?;
-    m.add_function(wrap_pyfunction!(shoulder_partials, m)?)?;
-    m.add_class::<PyDrivetrain>()?;
-    Ok(())
 }

@@ -15,7 +15,7 @@ use paritysim_error::Result;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{from_json, same_len, to_py, to_vec};
+use crate::convert::{Floats, bindings, from_json, same_len, to_vec};
 use crate::errors::IntoPyResult;
 use crate::spec::device as parse_device;
 
@@ -28,42 +28,109 @@ fn options<T: serde::de::DeserializeOwned + Default>(json: Option<&str>, field: 
     json.map_or_else(|| Ok(T::default()), |j| from_json(field, j))
 }
 
-/// Monodromy matrix `M(t0)` of eq. 2.25 (`x'' + β0|cos t| x' + κ x = 0`, period π), 2×2.
-#[pyfunction]
-#[pyo3(signature = (beta0, kappa, t0 = -std::f64::consts::FRAC_PI_2))]
-fn stability_hill_monodromy<'py>(
-    py: Python<'py>,
-    beta0: f64,
-    kappa: f64,
-    t0: f64,
-) -> PyResult<Bound<'py, PyAny>> {
-    to_py(
-        py,
-        &rows2(&floquet::hill_monodromy(beta0, kappa, t0).py_err()?),
-    )
-}
+bindings! {
+    extra stability_chart;
+    extra stability_region;
+    extra stability_lti_transfer;
 
-/// Solution matrices `Π(t_i, t0)` of eq. 2.25 at each `t_i >= t0`, shape `(n, 2, 2)`.
-#[pyfunction]
-fn stability_hill_solution<'py>(
-    py: Python<'py>,
-    beta0: f64,
-    kappa: f64,
-    t0: f64,
-    t: PyReadonlyArray1<'py, f64>,
-) -> PyResult<Bound<'py, PyAny>> {
-    let t = to_vec(&t);
-    let m = py
-        .detach(|| hill_solutions(beta0, kappa, t0, &t))
-        .py_err()?;
-    to_py(py, &m)
-}
+    /// Monodromy matrix `M(t0)` of eq. 2.25 (`x'' + β0|cos t| x' + κ x = 0`, period π), 2×2.
+    #[pyo3(signature = (beta0, kappa, t0 = -std::f64::consts::FRAC_PI_2))]
+    fn stability_hill_monodromy(beta0: f64, kappa: f64, t0: f64) {
+        Ok(rows2(&floquet::hill_monodromy(beta0, kappa, t0)?))
+    }
 
-/// Floquet analysis of eq. 2.25 (`floquet::records::HillFloquetRecord`).
-#[pyfunction]
-fn stability_hill_floquet(py: Python<'_>, beta0: f64, kappa: f64) -> PyResult<Bound<'_, PyAny>> {
-    let f = floquet::hill_floquet(beta0, kappa).py_err()?;
-    to_py(py, &HillFloquetRecord::from(&f))
+    /// Solution matrices `Π(t_i, t0)` of eq. 2.25 at each `t_i >= t0`, shape `(n, 2, 2)`.
+    fn stability_hill_solution(beta0: f64, kappa: f64, t0: f64, t: Floats) {
+        hill_solutions(beta0, kappa, t0, &t)
+    }
+
+    /// Floquet analysis of eq. 2.25 (`floquet::records::HillFloquetRecord`).
+    fn stability_hill_floquet(beta0: f64, kappa: f64) {
+        Ok(HillFloquetRecord::from(&floquet::hill_floquet(beta0, kappa)?))
+    }
+
+    /// Brockett's criterion (eqs. 2.57-2.58) for `|g| <= 2 delta`, period T and `∫g dt`.
+    #[pyo3(signature = (delta, period, damping_integral = 0.0))]
+    fn stability_brockett(delta: f64, period: f64, damping_integral: f64) {
+        floquet::brockett(delta, period, damping_integral)
+    }
+
+    /// Brockett's criterion for eq. 2.25 after rescaling time by √κ (κ > 0).
+    fn stability_brockett_hill(beta0: f64, kappa: f64) {
+        floquet::brockett_hill(beta0, kappa)
+    }
+
+    /// (β0, κ1, κ2) of §2.6.1 with docs/errata.md#7's factors, and eq. 2.59's `beta_star`
+    /// (1/ms), `kappa0` (1/ms²) for sinusoidal flapping.
+    #[allow(clippy::too_many_arguments)]
+    fn stability_hill_parameters(
+        inertia: f64,
+        drag: f64,
+        transmission_ratio: f64,
+        arm_length_mm: f64,
+        k1: f64,
+        k2: f64,
+        stroke_amplitude: f64,
+        frequency_hz: f64,
+    ) {
+        HillParametersRecord::of(&PhysicalParameters {
+            inertia,
+            drag,
+            transmission_ratio,
+            arm_length: arm_length_mm,
+            k1,
+            k2,
+            stroke_amplitude,
+            frequency_hz,
+        })
+    }
+
+    /// Periodic orbit (shooting) and Floquet multipliers of a device spec (`FloquetRecord`).
+    /// `options_json`: a `ShootingOptions` record.
+    #[pyo3(signature = (spec, options_json = None))]
+    fn stability_floquet(spec: &str, options_json: Option<&str>) {
+        let device = parse_device(spec)?;
+        let opts: ShootingOptions = options(options_json, "options")?;
+        Ok(FloquetRecord::from(&floquet::floquet(&device, &opts)?))
+    }
+
+    /// Floquet analysis over balance-beam stiffnesses `k2` (mN·mm/rad), in parallel
+    /// (`BalanceSweepRecord`).
+    #[pyo3(signature = (spec, k2, options_json = None))]
+    fn stability_k2_sweep(spec: &str, k2: Floats, options_json: Option<&str>) {
+        let device = parse_device(spec)?;
+        let opts: ShootingOptions = options(options_json, "options")?;
+        let runs = floquet::balance_stiffness_sweep(device.spec(), &k2, &opts)?;
+        Ok(BalanceSweepRecord::of(&k2, &runs))
+    }
+
+    /// Places a fixed-wing Drag PARITY device spec on the charts of §2.6-2.7 from its
+    /// periodic orbit (`floquet::DeviceLinearisation`).
+    #[pyo3(signature = (spec, options_json = None, samples = 2000))]
+    fn stability_linearise(spec: &str, options_json: Option<&str>, samples: usize) {
+        let device = parse_device(spec)?;
+        let opts: ShootingOptions = options(options_json, "options")?;
+        floquet::linearise(&device, &floquet::periodic_orbit(&device, &opts)?, samples)
+    }
+
+    /// The body roll response of the nonlinear model to a sinusoidal wing roll disturbance
+    /// torque of `amplitude` (mN·mm) at each of `frequency_hz`, started on the periodic orbit
+    /// (`DisturbanceRecord`). `disturbance_json`: a `DisturbanceOptions` record.
+    #[pyo3(signature = (spec, frequency_hz, amplitude, options_json = None, disturbance_json = None))]
+    fn stability_disturbance_response(
+        spec: &str,
+        frequency_hz: Floats,
+        amplitude: f64,
+        options_json: Option<&str>,
+        disturbance_json: Option<&str>,
+    ) {
+        let device = parse_device(spec)?;
+        let opts: ShootingOptions = options(options_json, "options")?;
+        let dist: DisturbanceOptions = options(disturbance_json, "disturbance")?;
+        let orbit = floquet::periodic_orbit(&device, &opts)?;
+        let runs = floquet::disturbance_responses(&device, &orbit, &frequency_hz, amplitude, &dist)?;
+        Ok(DisturbanceRecord::of(&frequency_hz, amplitude, &runs))
+    }
 }
 
 /// The (β0, κ) grid `beta0 × kappa` (row-major, β0 outer) computed in parallel: flat arrays
@@ -120,55 +187,6 @@ fn stability_region<'py>(
     ))
 }
 
-/// Brockett's criterion (eqs. 2.57-2.58) for `|g| <= 2 delta`, period T and `∫g dt`.
-#[pyfunction]
-#[pyo3(signature = (delta, period, damping_integral = 0.0))]
-fn stability_brockett(
-    py: Python<'_>,
-    delta: f64,
-    period: f64,
-    damping_integral: f64,
-) -> PyResult<Bound<'_, PyAny>> {
-    to_py(
-        py,
-        &floquet::brockett(delta, period, damping_integral).py_err()?,
-    )
-}
-
-/// Brockett's criterion for eq. 2.25 after rescaling time by √κ (κ > 0).
-#[pyfunction]
-fn stability_brockett_hill(py: Python<'_>, beta0: f64, kappa: f64) -> PyResult<Bound<'_, PyAny>> {
-    to_py(py, &floquet::brockett_hill(beta0, kappa).py_err()?)
-}
-
-/// (β0, κ1, κ2) of §2.6.1 with docs/errata.md#7's factors, and eq. 2.59's `beta_star` (1/ms),
-/// `kappa0` (1/ms²) for sinusoidal flapping.
-#[pyfunction]
-#[allow(clippy::too_many_arguments)]
-fn stability_hill_parameters(
-    py: Python<'_>,
-    inertia: f64,
-    drag: f64,
-    transmission_ratio: f64,
-    arm_length_mm: f64,
-    k1: f64,
-    k2: f64,
-    stroke_amplitude: f64,
-    frequency_hz: f64,
-) -> PyResult<Bound<'_, PyAny>> {
-    let p = PhysicalParameters {
-        inertia,
-        drag,
-        transmission_ratio,
-        arm_length: arm_length_mm,
-        k1,
-        k2,
-        stroke_amplitude,
-        frequency_hz,
-    };
-    to_py(py, &HillParametersRecord::of(&p).py_err()?)
-}
-
 /// Eq. 2.59 `κ0/(s² + β* s + κ0)` at `s = 2πi f` (f in Hz, s in rad/ms), complex array.
 #[pyfunction]
 fn stability_lti_transfer<'py>(
@@ -189,105 +207,4 @@ fn stability_lti_transfer<'py>(
         .collect::<Result<Vec<_>>>()
         .py_err()?;
     Ok(PyArray1::from_vec(py, out))
-}
-
-// ------------------------------------------------------------------ the nonlinear model
-
-/// Periodic orbit (shooting) and Floquet multipliers of a device spec (`FloquetRecord`).
-/// `options_json`: a `ShootingOptions` record.
-#[pyfunction]
-#[pyo3(signature = (spec, options_json = None))]
-fn stability_floquet<'py>(
-    py: Python<'py>,
-    spec: &str,
-    options_json: Option<&str>,
-) -> PyResult<Bound<'py, PyAny>> {
-    let device = parse_device(spec).py_err()?;
-    let opts: ShootingOptions = options(options_json, "options").py_err()?;
-    let f = py.detach(|| floquet::floquet(&device, &opts)).py_err()?;
-    to_py(py, &FloquetRecord::from(&f))
-}
-
-/// Floquet analysis over balance-beam stiffnesses `k2` (mN·mm/rad), in parallel
-/// (`BalanceSweepRecord`).
-#[pyfunction]
-#[pyo3(signature = (spec, k2, options_json = None))]
-fn stability_k2_sweep<'py>(
-    py: Python<'py>,
-    spec: &str,
-    k2: PyReadonlyArray1<'py, f64>,
-    options_json: Option<&str>,
-) -> PyResult<Bound<'py, PyAny>> {
-    let device = parse_device(spec).py_err()?;
-    let opts: ShootingOptions = options(options_json, "options").py_err()?;
-    let k2 = to_vec(&k2);
-    let runs = py
-        .detach(|| floquet::balance_stiffness_sweep(device.spec(), &k2, &opts))
-        .py_err()?;
-    to_py(py, &BalanceSweepRecord::of(&k2, &runs))
-}
-
-/// Places a fixed-wing Drag PARITY device spec on the charts of §2.6-2.7 from its periodic
-/// orbit (`floquet::DeviceLinearisation`).
-#[pyfunction]
-#[pyo3(signature = (spec, options_json = None, samples = 2000))]
-fn stability_linearise<'py>(
-    py: Python<'py>,
-    spec: &str,
-    options_json: Option<&str>,
-    samples: usize,
-) -> PyResult<Bound<'py, PyAny>> {
-    let device = parse_device(spec).py_err()?;
-    let opts: ShootingOptions = options(options_json, "options").py_err()?;
-    let lin = py
-        .detach(|| -> Result<floquet::DeviceLinearisation> {
-            let orbit = floquet::periodic_orbit(&device, &opts)?;
-            floquet::linearise(&device, &orbit, samples)
-        })
-        .py_err()?;
-    to_py(py, &lin)
-}
-
-/// The body roll response of the nonlinear model to a sinusoidal wing roll disturbance torque
-/// of `amplitude` (mN·mm) at each of `frequency_hz`, started on the periodic orbit
-/// (`DisturbanceRecord`). `disturbance_json`: a `DisturbanceOptions` record.
-#[pyfunction]
-#[pyo3(signature = (spec, frequency_hz, amplitude, options_json = None, disturbance_json = None))]
-fn stability_disturbance_response<'py>(
-    py: Python<'py>,
-    spec: &str,
-    frequency_hz: PyReadonlyArray1<'py, f64>,
-    amplitude: f64,
-    options_json: Option<&str>,
-    disturbance_json: Option<&str>,
-) -> PyResult<Bound<'py, PyAny>> {
-    let device = parse_device(spec).py_err()?;
-    let opts: ShootingOptions = options(options_json, "options").py_err()?;
-    let dist: DisturbanceOptions = options(disturbance_json, "disturbance").py_err()?;
-    let freqs = to_vec(&frequency_hz);
-    let runs = py
-        .detach(|| -> Result<Vec<floquet::DisturbanceResponse>> {
-            let orbit = floquet::periodic_orbit(&device, &opts)?;
-            floquet::disturbance_responses(&device, &orbit, &freqs, amplitude, &dist)
-        })
-        .py_err()?;
-    to_py(py, &DisturbanceRecord::of(&freqs, amplitude, &runs))
-}
-
-/// Adds the stability functions to the module.
-pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(stability_hill_monodromy, m)?)?;
-    m.add_function(wrap_pyfunction!(stability_hill_solution, m)?)?;
-    m.add_function(wrap_pyfunction!(stability_hill_floquet, m)?)?;
-    m.add_function(wrap_pyfunction!(stability_chart, m)?)?;
-    m.add_function(wrap_pyfunction!(stability_region, m)?)?;
-    m.add_function(wrap_pyfunction!(stability_brockett, m)?)?;
-    m.add_function(wrap_pyfunction!(stability_brockett_hill, m)?)?;
-    m.add_function(wrap_pyfunction!(stability_hill_parameters, m)?)?;
-    m.add_function(wrap_pyfunction!(stability_lti_transfer, m)?)?;
-    m.add_function(wrap_pyfunction!(stability_floquet, m)?)?;
-    m.add_function(wrap_pyfunction!(stability_k2_sweep, m)?)?;
-    m.add_function(wrap_pyfunction!(stability_linearise, m)?)?;
-    m.add_function(wrap_pyfunction!(stability_disturbance_response, m)?)?;
-    Ok(())
 }
