@@ -91,14 +91,15 @@ class ContinuationResult:
 
         second_start = _current(self.spec, path) if start is None else real("start", start)
         step = None if max_step is None else real("max_step", max_step)
-        rows, reason = self._native.follow(int(bifurcation), path, second_start, real("stop", stop), step)
+        curve = self._native.follow(int(bifurcation), path, second_start, real("stop", stop), step)
         return pl.DataFrame(
             {
-                self.path: [r[0] for r in rows],
-                path: [r[1] for r in rows],
-                "spectral_radius": [max((math.hypot(*m) for m in r[2]), default=float("nan")) for r in rows],
-            }
-        ).with_columns(pl.lit(reason).alias("stop_reason"))
+                self.path: list(curve["first"]),
+                path: list(curve["second"]),
+                "spectral_radius": [max((math.hypot(*m) for m in ms), default=float("nan")) for ms in curve["multipliers"]],
+            },
+            schema={self.path: pl.Float64, path: pl.Float64, "spectral_radius": pl.Float64},
+        ).with_columns(pl.lit(curve["stop_reason"]).alias("stop_reason"))
 
     def plot(self, y: str = "spectral_radius", path: str | Path | None = None, ax: Any = None) -> Figure:
         """Branch diagram: ``y`` against the parameter, stable segments solid, unstable dashed,
@@ -197,33 +198,30 @@ def continuation(spec: Simulation, path: str, stop: float, *, start: float | Non
         raise invalid(unknown[0], "<unknown setting>", _core.spec_suggestion(unknown[0], list(SETTINGS)) or "one of: " + ", ".join(SETTINGS))
     first = _current(spec, path) if start is None else real("start", start)
     native = _core.continuation(spec.to_json(), path, first, real("stop", stop), json.dumps(settings))
-    mus = native.multipliers
-    states = native.states
-    diag = native.diagnostics
+    record = native.record  # paritysim_spec::continuation::BranchRecord
+    mus = record["multipliers"]
+    states = record["states"]
     columns: dict[str, Any] = {
-        path: native.parameter,
-        "stability": native.stability,
+        path: [float(v) for v in record["parameter"]],
+        "stability": record["stability"],
         "spectral_radius": [max((math.hypot(*m) for m in row), default=float("nan")) for row in mus],
         "multiplier_modulus": [[math.hypot(*m) for m in row] for row in mus],
         "multiplier_angle": [[math.atan2(m[1], m[0]) for m in row] for row in mus],
-        "iterations": [d[0] for d in diag],
-        "residual": [d[1] for d in diag],
-        "arclength": [d[2] for d in diag],
-        "drift": [d[3] for d in diag],
+        **{name: [v.item() for v in record[name]] for name in ("iterations", "residual", "arclength", "drift")},
     }
-    for k in range(len(states[0]) if states else 0):
-        columns[f"x{k}"] = [s[k] for s in states]
-    metric_rows = native.metrics
+    for k in range(len(states[0]) if len(states) else 0):
+        columns[f"x{k}"] = [float(s[k]) for s in states]
+    metric_rows = record["metrics"]
     names = list(dict.fromkeys(name for row in metric_rows for name, _ in row))
     for name in names:
         values = [dict(row).get(name) for row in metric_rows]
         columns[name] = [v if v is not None and math.isfinite(v) else None for v in values]
     branch = pl.DataFrame(columns, strict=False)
-    bif = native.bifurcations
+    bif = record["bifurcations"]
 
-    def critical(kind: str, ms: list[tuple[float, float]]) -> tuple[float, float]:
+    def critical(kind: str, ms: Any) -> tuple[float, float]:
         target = {"fold": 1.0, "branch_point": 1.0, "period_doubling": -1.0}.get(kind)
-        if not ms:
+        if len(ms) == 0:
             return (float("nan"), float("nan"))
         if target is None:  # Neimark-Sacker: the complex pair nearest the unit circle
             m = min((m for m in ms if abs(m[1]) > 0), key=lambda m: abs(math.hypot(*m) - 1.0), default=ms[0])
@@ -231,19 +229,19 @@ def continuation(spec: Simulation, path: str, stop: float, *, start: float | Non
             m = min(ms, key=lambda m: math.hypot(m[0] - target, m[1]))
         return (math.hypot(*m), math.atan2(m[1], m[0]))
 
-    crit = [critical(b[0], b[4]) for b in bif]
+    crit = [critical(b["kind"], b["multipliers"]) for b in bif]
     bifurcations = pl.DataFrame(
         {
-            "kind": [b[0] for b in bif],
-            path: [b[1] for b in bif],
-            "after": [b[2] for b in bif],
-            "located": [b[3] for b in bif],
+            "kind": [b["kind"] for b in bif],
+            path: [b["parameter"] for b in bif],
+            "after": [b["after"] for b in bif],
+            "located": [b["located"] for b in bif],
             "critical_modulus": [c[0] for c in crit],
             "critical_angle": [c[1] for c in crit],
         },
         schema={"kind": pl.String, path: pl.Float64, "after": pl.Int64, "located": pl.Boolean, "critical_modulus": pl.Float64, "critical_angle": pl.Float64},
     )
-    return ContinuationResult(path=path, spec=spec, branch=branch, bifurcations=bifurcations, stop_reason=native.stop_reason, map_evaluations=native.map_evaluations, _native=native)
+    return ContinuationResult(path=path, spec=spec, branch=branch, bifurcations=bifurcations, stop_reason=record["stop_reason"], map_evaluations=record["map_evaluations"], _native=native)
 
 
 # `paritysim.continuation` is this module and, called, the `continuation` function.

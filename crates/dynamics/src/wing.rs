@@ -253,6 +253,28 @@ impl From<&WingTerms> for WingTermsRecord {
     }
 }
 
+impl WingTermsRecord {
+    /// The terms of wing `wing` of `device` at `p = (φ, θ, ψ)`, `ṗ` (always the general terms,
+    /// never the stroke-plane closed form).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a wing index past the device's wings or a non-finite
+    /// `p` / `p_dot`; as [`Wing::terms`] (outside the joint limit, singular pose).
+    pub fn at(device: &crate::Device, wing: usize, p: [f64; 3], p_dot: [f64; 3]) -> Result<Self> {
+        let n = device.n_wings();
+        let w = device
+            .spec()
+            .wings
+            .get(wing)
+            .ok_or_else(|| Error::invalid("wing", wing, format!("in [0, {n})")))?;
+        paritysim_error::check_all_finite("p", &p)?;
+        paritysim_error::check_all_finite("p_dot", &p_dot)?;
+        Ok(Self::from(
+            &w.terms(&Vector3::from(p), &Vector3::from(p_dot))?,
+        ))
+    }
+}
+
 impl Wing {
     /// A wing with a full inertia tensor (mg·mm², frame 6, about the spherical centre).
     ///

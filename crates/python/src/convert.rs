@@ -114,17 +114,6 @@ impl Table {
     }
 }
 
-/// Requires equal lengths, naming both arguments.
-pub fn same_len(a: (&str, usize), b: (&str, usize)) -> Result<(), Error> {
-    if a.1 != b.1 {
-        return Err(Error::Shape(format!(
-            "`{}` has {} elements but `{}` has {}; they must match",
-            a.0, a.1, b.0, b.1
-        )));
-    }
-    Ok(())
-}
-
 /// Builds an `(n, d1, d2, ...)` array from a flat vector without copying it again.
 pub fn shaped<'py>(
     py: Python<'py>,

@@ -15,7 +15,7 @@ use paritysim_error::Result;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{Floats, bindings, from_json, same_len, to_vec};
+use crate::convert::{Floats, bindings, from_json, to_vec};
 use crate::errors::IntoPyResult;
 use crate::spec::device as parse_device;
 
@@ -179,7 +179,7 @@ fn stability_region<'py>(
     b: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray1<i64>>> {
     let (a, b) = (to_vec(&a), to_vec(&b));
-    same_len(("a", a.len()), ("b", b.len())).py_err()?;
+    paritysim_error::check_same_len(("a", a.len()), ("b", b.len())).py_err()?;
     let r = regions(&a, &b).py_err()?;
     Ok(PyArray1::from_vec(
         py,

@@ -4,15 +4,14 @@
 //! ([`paritysim_spec::sweep::SweepJob`]); this is the mechanical translation: blocking calls
 //! release the GIL, results are numpy arrays.
 
-use std::time::Duration;
-
 use numpy::PyArray1;
 use paritysim_dynamics::sweep::{THREADS_ENV, metric_names, resolve_threads, trajectory_columns};
-use paritysim_error::Error;
-use paritysim_spec::sweep::{KeptCycles, SweepJob, SweepOutcome, SweepPlan};
+use paritysim_spec::sweep::{
+    KeptCycles, SweepJob, SweepPlan, rows_from_json, timeout_from_seconds,
+};
 use pyo3::prelude::*;
 
-use crate::convert::shaped;
+use crate::convert::{bindings, shaped};
 use crate::errors::IntoPyResult;
 use crate::spec::{device, parse};
 
@@ -36,14 +35,10 @@ impl SweepRun {
         keep_cycle: bool,
         threads: Option<usize>,
     ) -> PyResult<Self> {
-        let base = parse(spec).py_err()?;
-        let rows: Vec<Vec<serde_json::Value>> = serde_json::from_str(rows)
-            .map_err(|e| Error::invalid("rows", e.to_string(), "a JSON list of rows"))
-            .py_err()?;
-        let plan =
-            SweepPlan::new(base, &names, rows, metrics.as_deref(), keep_cycle, threads).py_err()?;
+        let (base, rows) = (parse(spec).py_err()?, rows_from_json(rows).py_err()?);
+        let plan = SweepPlan::new(base, &names, rows, metrics.as_deref(), keep_cycle, threads);
         Ok(Self {
-            job: SweepJob::new(plan),
+            job: SweepJob::new(plan.py_err()?),
         })
     }
 
@@ -61,13 +56,7 @@ impl SweepRun {
     /// Waits up to `timeout` seconds (None: until done), GIL released; True when done.
     #[pyo3(signature = (timeout=None))]
     fn wait(&self, py: Python<'_>, timeout: Option<f64>) -> PyResult<bool> {
-        let timeout = match timeout {
-            None => None,
-            Some(t) if t.is_finite() && t >= 0.0 => Some(Duration::from_secs_f64(t)),
-            Some(t) => {
-                return Err(Error::invalid("timeout", t, "None or finite and >= 0 (s)")).py_err();
-            }
-        };
+        let timeout = timeout_from_seconds(timeout).py_err()?;
         py.detach(|| self.job.wait(timeout)).py_err()
     }
 
@@ -109,99 +98,53 @@ impl SweepRun {
 
     /// Waits for the run (starting it if needed), GIL released.
     fn result(&self, py: Python<'_>) -> PyResult<SweepResult> {
-        let outcome = py.detach(|| self.job.outcome()).py_err()?;
+        let o = py.detach(|| self.job.outcome()).py_err()?;
+        let shape = [o.finished.len(), self.job.plan().metrics().len()];
         Ok(SweepResult {
-            n_metrics: self.job.plan().metrics().len(),
-            outcome,
+            finished: PyArray1::from_vec(py, o.finished).unbind(),
+            ok: PyArray1::from_vec(py, o.ok).unbind(),
+            metrics: shaped(py, o.metrics, &shape)?.unbind(),
+            converged: PyArray1::from_vec(py, o.converged).unbind(),
+            cycles_run: PyArray1::from_vec(py, o.cycles_run).unbind(),
+            error: o.error,
+            error_kind: o.error_kind,
+            cycle: o.cycle,
         })
     }
 }
 
-/// The outcome of a `SweepRun`, one entry per point in input order.
-#[pyclass(module = "paritysim._core", frozen)]
+/// The outcome of a `SweepRun` (`paritysim_spec::sweep::SweepOutcome`), one entry per point
+/// in input order; `metrics` is `(points, metrics)`.
+#[pyclass(module = "paritysim._core", frozen, get_all)]
 pub struct SweepResult {
-    n_metrics: usize,
-    outcome: SweepOutcome,
+    finished: Py<PyArray1<bool>>,
+    ok: Py<PyArray1<bool>>,
+    metrics: Py<PyAny>,
+    converged: Py<PyArray1<bool>>,
+    cycles_run: Py<PyArray1<i64>>,
+    error: Vec<Option<String>>,
+    error_kind: Vec<Option<String>>,
+    cycle: Option<KeptCycles>,
 }
 
-#[pymethods]
-impl SweepResult {
-    /// Whether each point ran.
-    #[getter]
-    fn finished<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        PyArray1::from_slice(py, &self.outcome.finished)
+bindings! {
+    class SweepRun;
+    class SweepResult;
+    const "SWEEP_THREADS_ENV" = THREADS_ENV;
+
+    /// Metric names `simulate` reports for a JSON spec, in order.
+    fn sweep_metric_names(spec: &str) -> Vec<String> {
+        Ok(metric_names(&device(spec)?))
     }
 
-    /// Whether each point succeeded.
-    #[getter]
-    fn ok<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        PyArray1::from_slice(py, &self.outcome.ok)
+    /// Trajectory column names (without `time_ms`) recorded for a JSON spec, in order.
+    fn sweep_trajectory_columns(spec: &str) -> Vec<String> {
+        Ok(trajectory_columns(&device(spec)?))
     }
 
-    /// Metrics `(points, metrics)`, NaN where not ok.
-    #[getter]
-    fn metrics<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let n = self.outcome.finished.len();
-        shaped(py, self.outcome.metrics.clone(), &[n, self.n_metrics])
+    /// The thread count a sweep would use: `threads`, else `$PARITYSIM_THREADS`, else all cores.
+    #[pyo3(signature = (threads=None))]
+    fn sweep_resolve_threads(threads: Option<usize>) -> usize {
+        resolve_threads(threads)
     }
-
-    /// Steady state reached.
-    #[getter]
-    fn converged<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<bool>> {
-        PyArray1::from_slice(py, &self.outcome.converged)
-    }
-
-    /// Cycles before recording (-1 where not ok).
-    #[getter]
-    fn cycles_run<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
-        PyArray1::from_slice(py, &self.outcome.cycles_run)
-    }
-
-    /// Error messages (None where ok or not run).
-    #[getter]
-    fn error(&self) -> Vec<Option<String>> {
-        self.outcome.error.clone()
-    }
-
-    /// Error kinds (None where ok or not run).
-    #[getter]
-    fn error_kind(&self) -> Vec<Option<String>> {
-        self.outcome.error_kind.clone()
-    }
-
-    /// With `keep_cycle`: column -> per point the last cycle (None where not ok).
-    #[getter]
-    fn cycle(&self) -> Option<KeptCycles> {
-        self.outcome.cycle.clone()
-    }
-}
-
-/// Metric names `simulate` reports for a JSON spec, in order.
-#[pyfunction]
-fn sweep_metric_names(spec: &str) -> PyResult<Vec<String>> {
-    Ok(metric_names(&device(spec).py_err()?))
-}
-
-/// Trajectory column names (without `time_ms`) recorded for a JSON spec, in order.
-#[pyfunction]
-fn sweep_trajectory_columns(spec: &str) -> PyResult<Vec<String>> {
-    Ok(trajectory_columns(&device(spec).py_err()?))
-}
-
-/// The thread count a sweep would use: `threads`, else `$PARITYSIM_THREADS`, else all cores.
-#[pyfunction]
-#[pyo3(signature = (threads=None))]
-fn sweep_resolve_threads(threads: Option<usize>) -> PyResult<usize> {
-    resolve_threads(threads).py_err()
-}
-
-/// Adds the sweep classes and functions.
-pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_class::<SweepRun>()?;
-    m.add_class::<SweepResult>()?;
-    m.add("SWEEP_THREADS_ENV", THREADS_ENV)?;
-    m.add_function(wrap_pyfunction!(sweep_metric_names, m)?)?;
-    m.add_function(wrap_pyfunction!(sweep_trajectory_columns, m)?)?;
-    m.add_function(wrap_pyfunction!(sweep_resolve_threads, m)?)?;
-    Ok(())
 }

@@ -208,3 +208,196 @@ pub fn continue_bifurcation_path(
     );
     continue_fold_curve(&map, bifurcation, &start, 0, &options)
 }
+
+/// A multiplier as `[re, im]`.
+fn pair(m: &nalgebra::Complex<f64>) -> [f64; 2] {
+    [m.re, m.im]
+}
+
+/// A continued branch as plain columns (one entry per point), what crosses a language boundary.
+#[derive(Clone, Debug, Serialize)]
+pub struct BranchRecord {
+    /// The continued parameter.
+    pub parameter: Vec<f64>,
+    /// The orbit's integrated state (coordinates, then rates) at phase 0.
+    pub states: Vec<Vec<f64>>,
+    /// Non-trivial Floquet multipliers `[re, im]`, largest modulus first.
+    pub multipliers: Vec<Vec<[f64; 2]>>,
+    /// `stable`, `unstable` or `marginal`.
+    pub stability: Vec<&'static str>,
+    /// Newton iterations.
+    pub iterations: Vec<usize>,
+    /// Newton residual.
+    pub residual: Vec<f64>,
+    /// Scaled arclength.
+    pub arclength: Vec<f64>,
+    /// Cyclic drift.
+    pub drift: Vec<f64>,
+    /// Orbit metrics `(name, value)` (empty lists when not computed).
+    pub metrics: Vec<Vec<(String, f64)>>,
+    /// The bifurcations, in branch order.
+    pub bifurcations: Vec<BifurcationRecord>,
+    /// Why the branch ended.
+    pub stop_reason: String,
+    /// Period-map evaluations with the monodromy (the cost).
+    pub map_evaluations: usize,
+    /// Deprecation notes of the path.
+    pub notes: Vec<String>,
+}
+
+/// One bifurcation of a [`BranchRecord`].
+#[derive(Clone, Debug, Serialize)]
+pub struct BifurcationRecord {
+    /// `fold`, `period_doubling`, ...
+    pub kind: &'static str,
+    /// The parameter at the bifurcation.
+    pub parameter: f64,
+    /// Index of the branch point before it.
+    pub after: usize,
+    /// Whether it was located (not only bracketed).
+    pub located: bool,
+    /// Its multipliers `[re, im]`.
+    pub multipliers: Vec<[f64; 2]>,
+}
+
+/// A two-parameter bifurcation curve as columns.
+#[derive(Clone, Debug, Serialize)]
+pub struct CurveRecord {
+    /// The branch's parameter at each curve point.
+    pub first: Vec<f64>,
+    /// The second parameter.
+    pub second: Vec<f64>,
+    /// Multipliers `[re, im]` per point.
+    pub multipliers: Vec<Vec<[f64; 2]>>,
+    /// Why the curve ended.
+    pub stop_reason: String,
+}
+
+/// A continuation that ran: what it continued and its outcome, so a bifurcation can be
+/// followed further.
+#[derive(Clone, Debug)]
+pub struct ContinuationRun {
+    spec: Simulation,
+    path: String,
+    settings: ContinuationSettings,
+    outcome: ContinuationOutcome,
+}
+
+impl ContinuationRun {
+    /// [`continue_path`], kept with its inputs.
+    ///
+    /// # Errors
+    /// As [`continue_path`].
+    pub fn new(
+        spec: Simulation,
+        path: &str,
+        start: f64,
+        stop: f64,
+        settings: ContinuationSettings,
+    ) -> Result<Self> {
+        let outcome = continue_path(&spec, path, start, stop, &settings)?;
+        Ok(Self {
+            spec,
+            path: path.to_string(),
+            settings,
+            outcome,
+        })
+    }
+
+    /// The outcome.
+    pub fn outcome(&self) -> &ContinuationOutcome {
+        &self.outcome
+    }
+
+    /// The branch as columns.
+    pub fn record(&self) -> BranchRecord {
+        let b = &self.outcome.branch;
+        let column = |f: fn(&paritysim_continuation::BranchPoint) -> f64| -> Vec<f64> {
+            b.points.iter().map(f).collect()
+        };
+        BranchRecord {
+            parameter: column(|p| p.parameter),
+            states: b
+                .points
+                .iter()
+                .map(|p| p.state.as_slice().to_vec())
+                .collect(),
+            multipliers: b
+                .points
+                .iter()
+                .map(|p| p.multipliers.iter().map(pair).collect())
+                .collect(),
+            stability: b.points.iter().map(|p| p.stability.name()).collect(),
+            iterations: b.points.iter().map(|p| p.iterations).collect(),
+            residual: column(|p| p.residual),
+            arclength: column(|p| p.arclength),
+            drift: column(|p| p.drift),
+            metrics: self.outcome.metrics.clone(),
+            bifurcations: b
+                .bifurcations
+                .iter()
+                .map(|x| BifurcationRecord {
+                    kind: x.kind.name(),
+                    parameter: x.point.parameter,
+                    after: x.after,
+                    located: x.located,
+                    multipliers: x.point.multipliers.iter().map(pair).collect(),
+                })
+                .collect(),
+            stop_reason: format!("{:?}", b.stop_reason),
+            map_evaluations: b.map_evaluations,
+            notes: self.outcome.notes.clone(),
+        }
+    }
+
+    /// Follows bifurcation `index` (a fold or period doubling) in `second_path` from
+    /// `second_start` to `stop`; `max_step` (scaled arclength, the first step a quarter of
+    /// it) defaults to the branch's.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for an index past the bifurcations or `max_step` below
+    /// `min_step`; as [`continue_bifurcation_path`].
+    pub fn follow(
+        &self,
+        index: usize,
+        second_path: &str,
+        second_start: f64,
+        stop: f64,
+        max_step: Option<f64>,
+    ) -> Result<CurveRecord> {
+        let mut settings = self.settings.clone();
+        if let Some(step) = max_step {
+            if !(step.is_finite() && step >= settings.min_step) {
+                let allowed = format!(">= min_step = {}", settings.min_step);
+                return Err(Error::invalid("max_step", step, allowed));
+            }
+            settings.max_step = step;
+            settings.initial_step = (0.25 * step).max(settings.min_step);
+        }
+        let bifurcations = &self.outcome.branch.bifurcations;
+        let n = bifurcations.len();
+        let bif = bifurcations
+            .get(index)
+            .ok_or_else(|| Error::invalid("index", index, format!("a bifurcation index < {n}")))?;
+        let curve = continue_bifurcation_path(
+            &self.spec,
+            &self.path,
+            bif,
+            self.outcome.parameter_scale,
+            second_path,
+            second_start,
+            stop,
+            &settings,
+        )?;
+        Ok(CurveRecord {
+            first: curve.points.iter().map(|p| p.parameters.0).collect(),
+            second: curve.points.iter().map(|p| p.parameters.1).collect(),
+            multipliers: curve
+                .points
+                .iter()
+                .map(|p| p.multipliers.iter().map(pair).collect())
+                .collect(),
+            stop_reason: format!("{:?}", curve.stop_reason),
+        })
+    }
+}

@@ -22,6 +22,7 @@ pub mod paths;
 pub mod schema;
 pub mod spec;
 pub mod sweep;
+pub mod watch;
 pub mod wing;
 
 pub use actuator::{Actuator, DcOffset, Sampled, Sine, Waveform};

@@ -320,3 +320,22 @@ pub fn apply(spec: &Simulation, overrides: &[(&Parameter, &Value)]) -> Result<Si
     }
     crate::from_value(value).map(|(s, _)| s)
 }
+
+/// `spec` with `{path: value}` applied, the values a JSON object keyed by any spelling
+/// [`resolve_in`] accepts; also returns the deprecation notes of the paths.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] on `values` when it is not a JSON object, for an unknown path
+/// (with the nearest valid one); the typed errors of the resulting spec.
+pub fn apply_json(spec: &Simulation, values: &str) -> Result<(Simulation, Vec<String>)> {
+    let values: serde_json::Map<String, Value> = serde_json::from_str(values)
+        .map_err(|e| Error::invalid("values", e.to_string(), "a JSON object of path: value"))?;
+    let listed = spec_paths(spec);
+    let params = values
+        .keys()
+        .map(|k| resolve_in(spec, &listed, k))
+        .collect::<Result<Vec<_>>>()?;
+    let pairs: Vec<_> = params.iter().zip(values.values()).collect();
+    let out = apply(spec, &pairs)?;
+    Ok((out, params.into_iter().flat_map(|p| p.notes).collect()))
+}

@@ -421,3 +421,14 @@ fn check_plain(value: &Value, s: &Map<String, Value>, path: &str, problems: &mut
         _ => {}
     }
 }
+
+/// Defaults of the tagged-enum specs (`Drivetrain`, `Aero`, `Waveform`) as JSON text: the
+/// variant a table without `kind` takes, for the generated Python dataclasses.
+pub fn tagged_defaults_json() -> String {
+    serde_json::json!({
+        "Drivetrain": crate::Drivetrain::default(),
+        "Aero": crate::Aero::default(),
+        "Waveform": crate::Waveform::default(),
+    })
+    .to_string()
+}

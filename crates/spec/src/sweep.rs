@@ -436,3 +436,24 @@ fn run(plan: &SweepPlan, control: &SweepControl) -> Result<SweepOutcome> {
 pub fn run_plan(plan: SweepPlan) -> Result<SweepOutcome> {
     run(&plan, &SweepControl::new())
 }
+
+/// The rows of a sweep from JSON text (a list of rows of values, `null` keeping the base value).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] on `rows` when the text is not a JSON list of lists.
+pub fn rows_from_json(text: &str) -> Result<Vec<Vec<Value>>> {
+    serde_json::from_str(text)
+        .map_err(|e| Error::invalid("rows", e.to_string(), "a JSON list of rows"))
+}
+
+/// A wait timeout from seconds (`None`: no limit).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] on `timeout` when it is negative or not finite.
+pub fn timeout_from_seconds(timeout: Option<f64>) -> Result<Option<Duration>> {
+    match timeout {
+        None => Ok(None),
+        Some(t) if t.is_finite() && t >= 0.0 => Ok(Some(Duration::from_secs_f64(t))),
+        Some(t) => Err(Error::invalid("timeout", t, "None or finite and >= 0 (s)")),
+    }
+}
