@@ -73,6 +73,8 @@ def dynamics_wing_terms(spec: str, wing: int, p: Sequence[float], p_dot: Sequenc
 # --- aero (begin) ---
 AERO_AIR_DENSITY: float
 AERO_DEFAULT_ROTATIONAL_DAMPING: float
+AERO_DEFAULT_MODEL: str
+AERO_DEFAULT_NORMAL_FORCE_LAW: str
 def aero_planform_properties(points: _F64, density: float, closure_tolerance: float | None = None) -> dict[str, Any]: ...
 def aero_planform_rectangle(span: float, chord: float, root_offset: float, le_offset: float) -> _F64: ...
 def aero_planform_semi_ellipse(

@@ -61,7 +61,7 @@ def _flat(a: npt.ArrayLike) -> tuple[FloatArray, tuple[int, ...]]:
     return np.ascontiguousarray(x).ravel(), x.shape
 
 
-def coefficients(alpha: npt.ArrayLike, model: str = "dickinson1999") -> dict[str, FloatArray]:
+def coefficients(alpha: npt.ArrayLike, model: str = _core.AERO_DEFAULT_MODEL) -> dict[str, FloatArray]:
     """Force coefficients at angles of attack ``alpha`` (rad, each in [0, pi]), vectorised.
 
     ``model`` is ``"dickinson1999"`` (eqs. 3.5-3.6, extended past 90° by flat-plate symmetry)
@@ -93,9 +93,9 @@ def moments(
     theta_dot: npt.ArrayLike = 0.0,
     psi_dot: npt.ArrayLike = 0.0,
     *,
-    model: str = "dickinson1999",
+    model: str = _core.AERO_DEFAULT_MODEL,
     rotational_damping: float = DEFAULT_ROTATIONAL_DAMPING,
-    normal_force_law: str = "coefficient",
+    normal_force_law: str = _core.AERO_DEFAULT_NORMAL_FORCE_LAW,
 ) -> dict[str, FloatArray]:
     """Blade-element moments (eqs. 3.8-3.11) over broadcast wing states.
 

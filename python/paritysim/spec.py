@@ -296,21 +296,29 @@ class Drivetrain(_Tagged):
         self.kinematics()  # validates the lengths in Rust
 
     @classmethod
-    def hmf_four_bar(cls, crank_mm: float = 0.4, rod_mm: float = 0.8) -> Drivetrain:
-        """HMF four-bar (§2.3.1): 400 µm of actuator stroke gives 60° with the defaults."""
+    def hmf_four_bar(cls, crank_mm: float | None = None, rod_mm: float | None = None) -> Drivetrain:
+        """HMF four-bar (§2.3.1): 400 µm of actuator stroke gives 60° with the defaults (the Rust
+        core's; ``None`` takes them)."""
         return cls(kind="hmf_four_bar", crank_mm=crank_mm, rod_mm=rod_mm)  # type: ignore[call-arg]
 
     @classmethod
-    def linear_differential(cls, transmission_ratio: float, arm_length_mm: float, arm_ratio: float = 1.0, balance_spring: float = 0.0, **deprecated: float) -> Drivetrain:
+    def linear_differential(cls, transmission_ratio: float, arm_length_mm: float, arm_ratio: float | None = None, balance_spring: float | None = None, **deprecated: float) -> Drivetrain:
         """Eq. 2.15 with ratio T (rad/mm), mean arm L (mm), arm ratio hL/hR, spring K2."""
         balance_spring = _balance(balance_spring, deprecated)
         return cls(kind="linear_differential", transmission_ratio=transmission_ratio, arm_length_mm=arm_length_mm, arm_ratio=arm_ratio, balance_spring=balance_spring)  # type: ignore[call-arg]
 
     @classmethod
     def linkage_differential(
-        cls, crank_mm: float = 0.4, rod_mm: float = 0.8, whippletree_length_mm: float = 5.0, arm_ratio: float = 1.0, balance_spring: float = 0.0, **deprecated: float
+        cls,
+        crank_mm: float | None = None,
+        rod_mm: float | None = None,
+        whippletree_length_mm: float | None = None,
+        arm_ratio: float | None = None,
+        balance_spring: float | None = None,
+        **deprecated: float,
     ) -> Drivetrain:
-        """The Drag PARITY linkage (§3.3.2 lengths by default; arm ratio hL/hR of §2.4.2)."""
+        """The Drag PARITY linkage (§3.3.2 lengths by default; arm ratio hL/hR of §2.4.2). ``None``
+        takes the Rust core's default."""
         balance_spring = _balance(balance_spring, deprecated)
         return cls(kind="linkage_differential", crank_mm=crank_mm, rod_mm=rod_mm, whippletree_length_mm=whippletree_length_mm, arm_ratio=arm_ratio, balance_spring=balance_spring)  # type: ignore[call-arg]
 
@@ -334,7 +342,7 @@ class Drivetrain(_Tagged):
         return self.kinematics().evaluate(np.ascontiguousarray(q1, dtype=np.float64), np.ascontiguousarray(q2, dtype=np.float64))  # type: ignore[no-any-return]
 
 
-def _balance(value: float, deprecated: dict[str, float]) -> float:
+def _balance(value: float | None, deprecated: dict[str, float]) -> float | None:
     if "balance_stiffness" in deprecated:
         warnings.warn("balance_stiffness= is deprecated: use balance_spring=", DeprecationWarning, stacklevel=3)
         value = deprecated.pop("balance_stiffness")
@@ -356,7 +364,7 @@ class Actuator(_Node):
     with ``stiffness`` (mN/mm). ``dc_offset``: ``as_force`` or ``ignore`` (docs/errata.md#14)."""
 
     @classmethod
-    def from_laminate(cls, bimorph: Any, waveform: Waveform | None = None, dc_offset: str = "as_force") -> Actuator:
+    def from_laminate(cls, bimorph: Any, waveform: Waveform | None = None, dc_offset: str | None = None) -> Actuator:
         """An actuator whose constants come from laminate plate theory.
 
         ``bimorph`` is a :class:`paritysim.laminate.Bimorph` (or anything with ``stiffness`` in
@@ -367,7 +375,7 @@ class Actuator(_Node):
         if stiffness is None or force is None:  # ActuatorConstants
             stiffness, force = bimorph.stiffness_mn_per_mm, bimorph.force_per_volt_mn_per_v
         # The sign of d31 only sets the direction of q1; the engine takes the magnitude.
-        return cls(waveform=waveform or Waveform(), force_per_volt=abs(float(force)), stiffness=float(stiffness), dc_offset=dc_offset)  # type: ignore[call-arg]
+        return cls(waveform=waveform or Waveform(), force_per_volt=abs(float(force)), stiffness=float(stiffness), **({} if dc_offset is None else {"dc_offset": dc_offset}))  # type: ignore[arg-type]
 
 
 @_from_core

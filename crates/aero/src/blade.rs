@@ -151,6 +151,14 @@ pub enum NormalForceLaw {
 }
 
 impl NormalForceLaw {
+    /// The name [`NormalForceLaw::from_name`] reads.
+    pub fn name(self) -> &'static str {
+        match self {
+            NormalForceLaw::Coefficient => "coefficient",
+            NormalForceLaw::Unit => "unit",
+        }
+    }
+
     /// By name: `coefficient` or `unit`.
     ///
     /// # Errors

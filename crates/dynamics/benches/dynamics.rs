@@ -142,8 +142,8 @@ fn rotating(c: &mut Criterion) {
         ),
         actuator: Some(
             Actuator::new(
-                1.2,
-                467.0,
+                paritysim_dynamics::actuator::THESIS_FORCE_PER_VOLT,
+                paritysim_dynamics::actuator::THESIS_STIFFNESS,
                 Waveform::sine(100.0, 110.0, 100.0, 0.0).unwrap(),
                 paritysim_dynamics::DcOffset::Ignore,
             )

@@ -4,6 +4,7 @@
 //! Thesis values (§3.3.1): stiffness 467 mN/mm, 120 mN amplitude at 100 V (1.2 mN/V).
 
 use paritysim_error::{Error, Result, bail, check_finite, check_non_negative, check_positive};
+use paritysim_laminate::ActuatorConstants;
 
 /// How the DC part of the drive voltage enters (docs/errata.md#14: not specified by the thesis).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -160,10 +161,10 @@ impl Waveform {
     }
 }
 
-/// §3.3.1 actuator stiffness (mN/mm): the one place this number is written.
-pub const THESIS_STIFFNESS: f64 = 467.0;
-/// §3.3.1 blocked force per volt (mN/V): 120 mN at 100 V.
-pub const THESIS_FORCE_PER_VOLT: f64 = 1.2;
+/// §3.3.1 actuator stiffness (mN/mm), defined once by `paritysim_laminate::ActuatorConstants`.
+pub const THESIS_STIFFNESS: f64 = ActuatorConstants::THESIS.stiffness_mn_per_mm;
+/// §3.3.1 blocked force per volt (mN/V): 120 mN at 100 V, defined by the laminate crate.
+pub const THESIS_FORCE_PER_VOLT: f64 = ActuatorConstants::THESIS.force_per_volt_mn_per_v;
 
 /// Piezo actuator: `F(t) = force_per_volt · V(t)` in parallel with `stiffness` on `q1`.
 #[derive(Clone, Debug, PartialEq)]

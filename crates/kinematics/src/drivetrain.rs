@@ -252,12 +252,15 @@ impl LinkageDifferential {
         })
     }
 
+    /// The §3.3.2 whippletree length L0 (mm).
+    pub const THESIS_WHIPPLETREE_LENGTH_MM: f64 = 5.0;
+
     /// The §3.3.2 linkage: L0 = 5 mm, L2 = 0.8 mm, L3 = 0.4 mm, centred pivot.
     pub fn thesis() -> Self {
         Self {
             side: RodCrank::THESIS,
-            left_arm: 2.5,
-            right_arm: 2.5,
+            left_arm: Self::THESIS_WHIPPLETREE_LENGTH_MM / 2.0,
+            right_arm: Self::THESIS_WHIPPLETREE_LENGTH_MM / 2.0,
         }
     }
 

@@ -7,7 +7,7 @@
 use paritysim_aero::records::{
     ChordTable, CoefficientTable, InertiaReport, MomentRequest, PlanformReport, vertices,
 };
-use paritysim_aero::{CoefficientSet, CutEdge, Planform};
+use paritysim_aero::{CoefficientModel, CoefficientSet, CutEdge, NormalForceLaw, Planform};
 use paritysim_error::Result;
 use pyo3::prelude::*;
 
@@ -24,6 +24,8 @@ fn planform(points: &Table, closure_tolerance: Option<f64>) -> Result<Planform> 
 bindings! {
     const "AERO_AIR_DENSITY" = paritysim_aero::DEFAULT_AIR_DENSITY;
     const "AERO_DEFAULT_ROTATIONAL_DAMPING" = paritysim_aero::DEFAULT_ROTATIONAL_DAMPING;
+    const "AERO_DEFAULT_MODEL" = CoefficientSet::default().name();
+    const "AERO_DEFAULT_NORMAL_FORCE_LAW" = NormalForceLaw::default().name();
 
     /// Geometry and Ω1..Ω4 of an outline (`(n, 2)` `[z, x]` mm, closing edge implicit; with
     /// `closure_tolerance` mm a traced curve returning to its start) in air of `density` mg/mm³.

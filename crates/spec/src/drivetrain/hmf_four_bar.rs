@@ -23,8 +23,8 @@ pub struct HmfFourBar {
 impl Default for HmfFourBar {
     fn default() -> Self {
         Self {
-            crank_mm: 0.4,
-            rod_mm: 0.8,
+            crank_mm: RodCrank::THESIS.crank(),
+            rod_mm: RodCrank::THESIS.rod(),
         }
     }
 }

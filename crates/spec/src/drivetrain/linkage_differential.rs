@@ -32,9 +32,9 @@ pub struct LinkageDifferential {
 impl Default for LinkageDifferential {
     fn default() -> Self {
         Self {
-            crank_mm: 0.4,
-            rod_mm: 0.8,
-            whippletree_length_mm: 5.0,
+            crank_mm: RodCrank::THESIS.crank(),
+            rod_mm: RodCrank::THESIS.rod(),
+            whippletree_length_mm: Linkage::THESIS_WHIPPLETREE_LENGTH_MM,
             arm_ratio: 1.0,
             balance_spring: 0.0,
         }
