@@ -225,16 +225,58 @@ fn side(n_wings: usize, index: usize, rest: &str, name: &str) -> Result<Vec<Stri
     Ok(vec![format!("wings[{index}].{rest}")])
 }
 
+/// The shorthand spellings [`resolve_in`] accepts besides the canonical paths.
+fn aliases(paths: &[PathInfo]) -> Vec<String> {
+    let shorthand = [
+        "actuator.voltage_v",
+        "actuator.amplitude_v",
+        "actuator.frequency_hz",
+    ];
+    let mut out: Vec<String> = shorthand.into_iter().map(String::from).collect();
+    for p in paths {
+        for (index, side) in [(0, "left"), (1, "right")] {
+            if let Some(rest) = p.path.strip_prefix(&format!("wings[{index}].")) {
+                out.push(format!("wings.{side}.{rest}"));
+                if rest == "aero.omega1" {
+                    out.push(format!("wings.{side}.omega_ratio"));
+                    out.push(format!("wings[{index}].omega_ratio"));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// An unknown path: the nearest valid spelling, looked for first among the siblings of its
+/// last segment (`drivetrain.crank` -> `drivetrain.crank_mm`), then among all paths.
 fn unknown(name: &str, paths: &[PathInfo]) -> Error {
+    let aliases = aliases(paths);
     let valid: Vec<&str> = paths.iter().map(|p| p.path.as_str()).collect();
-    Error::invalid(
-        name.to_string(),
-        "<unknown parameter path>",
-        format!(
+    let spellings: Vec<&str> = valid
+        .iter()
+        .copied()
+        .chain(aliases.iter().map(String::as_str))
+        .collect();
+    let (parent, last) = name.rsplit_once('.').unwrap_or(("", name));
+    let siblings = spellings.iter().filter_map(|s| {
+        s.rsplit_once('.')
+            .filter(|(p, _)| *p == parent)
+            .map(|(_, l)| l)
+    });
+    let best = crate::schema::nearest(last, siblings)
+        .map(|l| format!("{parent}.{l}"))
+        .or_else(|| crate::schema::nearest(name, spellings.iter().copied()).map(String::from));
+    let allowed = match best {
+        Some(best) => format!(
+            "a parameter path of this spec; did you mean `{best}`? (valid: {})",
+            valid.join(", ")
+        ),
+        None => format!(
             "a parameter path of this spec; {}",
             suggestion(name, valid.iter().copied())
         ),
-    )
+    };
+    Error::invalid(name.to_string(), "<unknown parameter path>", allowed)
 }
 
 /// Sets `path` (canonical) in a spec value.

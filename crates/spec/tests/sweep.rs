@@ -66,6 +66,19 @@ fn unknown_paths_and_duplicate_targets_fail_before_running() {
         e.to_string().contains("did you mean `drivetrain.crank_mm`"),
         "{e}"
     );
+    // Shorthand spellings are suggested too, and siblings of the last segment come first.
+    for (typo, meant) in [
+        ("actuator.voltag_v", "actuator.voltage_v"),
+        ("wings.left.omega_rato", "wings.left.omega_ratio"),
+        ("wings[1].aero.omegga1", "wings[1].aero.omega1"),
+    ] {
+        let e = plan(&[typo]).unwrap_err();
+        assert!(
+            e.to_string().contains(&format!("did you mean `{meant}`")),
+            "{e}"
+        );
+        assert_eq!(e.field(), Some(typo));
+    }
     let e = plan(&["actuator.frequency_hz", "actuator.waveform.frequency_hz"]).unwrap_err();
     assert!(e.to_string().contains("same field"), "{e}");
     assert!(plan(&["wings.left.omega_ratio"]).is_ok());
