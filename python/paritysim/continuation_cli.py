@@ -42,7 +42,9 @@ def run_study(study: str | Path, out: str | Path) -> dict[str, Any]:
         data = tomllib.load(f)
     unknown = sorted(set(data) - set(_KEYS))
     if unknown:
-        raise invalid(unknown[0], "<unknown key>", "one of: " + ", ".join(_KEYS))
+        from . import _core
+
+        raise invalid(unknown[0], "<unknown key>", _core.spec_suggestion(unknown[0], list(_KEYS)))
     for key in ("spec", "path", "stop"):
         if key not in data:
             raise invalid(key, "<missing>", "given (see `paritysim continue --help`)")
