@@ -324,7 +324,11 @@ def k2_sweep(spec: Simulation | dict[str, Any], k2: Any, **options: Any) -> pl.D
     ).with_columns(pl.col("whippletree_radius", "slowest_decay_ms").fill_nan(None))
 
 
-def linearise(spec: Simulation | dict[str, Any], samples: int = 2000, **options: Any) -> dict[str, Any]:
+#: Orbit samples of `linearise` (its cycle averages), also used by `disturbance_response`.
+_LINEARISE_SAMPLES = 2000
+
+
+def linearise(spec: Simulation | dict[str, Any], samples: int = _LINEARISE_SAMPLES, **options: Any) -> dict[str, Any]:
     """Places a fixed-wing Drag PARITY device on the charts of §2.6-2.7 from its periodic orbit.
 
     Returns ``physical`` (inertia, drag Ω·C, T, L, K1, K2, stroke amplitude Φ, frequency),
@@ -368,7 +372,7 @@ def disturbance_response(
     lti = avg = np.full(freqs.size, np.nan + 0j)
     _, n_dof = _core.validate_spec(device)
     if n_dof == 2:  # eq. 2.59 models the whippletree mode of a 2-DOF (Drag PARITY) drivetrain
-        lin = _core.stability_linearise(device, _shooting(options), 2000)
+        lin = _core.stability_linearise(device, _shooting(options), _LINEARISE_SAMPLES)
         lti = lti_transfer(lin["lti"]["beta_star"], lin["lti"]["kappa0"], freqs)
         avg = lti_transfer(lin["lti_averaged"]["beta_star"], lin["lti_averaged"]["kappa0"], freqs)
     return pl.DataFrame(

@@ -25,7 +25,6 @@ bindings! {
     }
 
     /// Partials of γ2, γ3, γ5 w.r.t. (φ, θ) and the Jacobian J6 (A.9) at `(phi, theta, psi)`.
-    #[pyo3(signature = (alpha2, alpha3, phi, theta, psi=0.0))]
     fn shoulder_partials(alpha2: f64, alpha3: f64, phi: f64, theta: f64, psi: f64) {
         PartialsRecord::of(&SphericalShoulder::new(alpha2, alpha3)?, phi, theta, psi)
     }

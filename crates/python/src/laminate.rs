@@ -52,7 +52,6 @@ bindings! {
     }
 
     /// The cured 0-90-0 carbon-fibre layer (§4.4.2) of `thickness` mm at `angle` rad.
-    #[pyo3(signature = (name, thickness=0.1, angle=0.0))]
     fn laminate_cf_0_90_0(name: &str, thickness: f64, angle: f64) {
         Ok(LayerRecord::of(&Layer::cf_0_90_0(name, thickness, angle)?))
     }

@@ -34,7 +34,6 @@ bindings! {
     extra stability_lti_transfer;
 
     /// Monodromy matrix `M(t0)` of eq. 2.25 (`x'' + β0|cos t| x' + κ x = 0`, period π), 2×2.
-    #[pyo3(signature = (beta0, kappa, t0 = -std::f64::consts::FRAC_PI_2))]
     fn stability_hill_monodromy(beta0: f64, kappa: f64, t0: f64) {
         Ok(rows2(&floquet::hill_monodromy(beta0, kappa, t0)?))
     }
@@ -50,7 +49,6 @@ bindings! {
     }
 
     /// Brockett's criterion (eqs. 2.57-2.58) for `|g| <= 2 delta`, period T and `∫g dt`.
-    #[pyo3(signature = (delta, period, damping_integral = 0.0))]
     fn stability_brockett(delta: f64, period: f64, damping_integral: f64) {
         floquet::brockett(delta, period, damping_integral)
     }
@@ -106,7 +104,7 @@ bindings! {
 
     /// Places a fixed-wing Drag PARITY device spec on the charts of §2.6-2.7 from its
     /// periodic orbit (`floquet::DeviceLinearisation`).
-    #[pyo3(signature = (spec, options_json = None, samples = 2000))]
+    #[pyo3(signature = (spec, options_json, samples))]
     fn stability_linearise(spec: &str, options_json: Option<&str>, samples: usize) {
         let device = parse_device(spec)?;
         let opts: ShootingOptions = options(options_json, "options")?;
@@ -147,9 +145,7 @@ fn stability_chart<'py>(
         .detach(|| floquet::stability_chart(&beta0, &kappa))
         .py_err()?;
     // Up to 4M points: numpy columns straight from the vectors, not the generic converter.
-    let stable = c.region.iter().zip(&c.marginal);
-    let stable: Vec<bool> = stable.map(|(r, &m)| r.is_stable() && !m).collect();
-    let region: Vec<i64> = c.region.iter().map(|r| i64::from(r.index())).collect();
+    let (stable, region) = (c.stable(), c.region_numbers());
     let out = PyDict::new(py);
     for (name, column) in [
         ("beta0", c.beta0),

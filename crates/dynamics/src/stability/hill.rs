@@ -324,6 +324,19 @@ pub struct StabilityChart {
     pub marginal: Vec<bool>,
 }
 
+impl StabilityChart {
+    /// Whether each point is stable: Region I and not marginal.
+    pub fn stable(&self) -> Vec<bool> {
+        let points = self.region.iter().zip(&self.marginal);
+        points.map(|(r, &m)| r.is_stable() && !m).collect()
+    }
+
+    /// The region of each point as its number 1-4.
+    pub fn region_numbers(&self) -> Vec<i64> {
+        self.region.iter().map(|r| i64::from(r.index())).collect()
+    }
+}
+
 /// Largest number of points of one [`stability_chart`] call.
 pub const MAX_CHART_POINTS: usize = 4_000_000;
 
