@@ -1,5 +1,5 @@
-//! Running work on a worker thread while the calling thread polls for an interruption (the
-//! Python bindings poll for Ctrl-C): on an interruption the work's [`CancelFlag`] is set, the
+//! Running work on a worker thread while the calling thread polls for an interruption (a
+//! language binding polls for Ctrl-C): on an interruption the work's [`CancelFlag`] is set, the
 //! work stops at its next budget check, and the interruption is returned.
 
 use std::sync::mpsc::{RecvTimeoutError, channel};
