@@ -9,6 +9,7 @@ import _thread
 import threading
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -158,3 +159,39 @@ def test_cli_sweep_ctrl_c_exits_130_in_one_line_and_keeps_the_finished_rows(tmp_
 
     saved = pl.concat([pl.read_parquet(p) for p in parts.glob("part-*.parquet")])
     assert sorted(saved["point"].to_list()) == [0, 1] and (saved["status"] == "ok").all()
+
+
+def _slow_stability_calls() -> dict[str, Any]:
+    """Calls of ``ps.stability`` and ``ps.continuation`` that would run for tens of seconds
+    (the §3.4 devices at 1e-3 Hz, a 4M-point Hill chart) unless Ctrl-C stops them."""
+    import numpy as np
+
+    from paritysim import stability
+
+    hmf = ps.load_spec(EXAMPLES / "hmf.toml").with_paths({"actuator.frequency_hz": 1e-3})
+    parity = ps.load_spec(EXAMPLES / "drag_parity.toml").with_paths({"actuator.frequency_hz": 1e-3})
+    return {
+        "floquet": lambda: stability.floquet(hmf),
+        "k2_sweep": lambda: stability.k2_sweep(parity, [1.0, 2.0, 3.0, 4.0]),
+        "linearise": lambda: stability.linearise(parity),
+        "disturbance_response": lambda: stability.disturbance_response(parity, [10.0, 20.0], 0.1),
+        "stability_chart": lambda: stability.stability_chart(np.linspace(0.0, 3.0, 2000), np.linspace(-1.0, 30.0, 2000), brockett=False),
+        "continuation": lambda: ps.continuation(hmf, "actuator.waveform.frequency_hz", 2e-3, start=1e-3),
+    }
+
+
+@pytest.mark.parametrize("name", list(_slow_stability_calls()))
+def test_ctrl_c_interrupts_stability_and_continuation(name: str) -> None:
+    """SIGINT 0.3 s into each long analysis: the cancel flag installed by the bindings reaches
+    every integration (on every pool thread) and ``KeyboardInterrupt`` is raised; ignored, the
+    call would run to its 60 s budget or the end of the chart."""
+    call = _slow_stability_calls()[name]
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            call()
+    finally:
+        timer.cancel()
+    assert 0.3 <= time.monotonic() - start < 20.0

@@ -9,7 +9,7 @@ use paritysim_spec::continuation::{
 use pyo3::prelude::*;
 
 use crate::errors::IntoPyResult;
-use crate::spec::parse;
+use crate::spec::{cancellable, parse};
 
 type Complexes = Vec<(f64, f64)>;
 /// `(first parameter, second parameter, multipliers)` of each curve point.
@@ -156,20 +156,18 @@ impl ContinuationOutput {
             .get(index)
             .ok_or_else(|| Error::invalid("index", index, format!("a bifurcation index < {n}")))
             .py_err()?;
-        let curve: Curve = py
-            .detach(|| {
-                continue_bifurcation_path(
-                    &self.spec,
-                    &self.path,
-                    bif,
-                    self.outcome.parameter_scale,
-                    second_path,
-                    second_start,
-                    stop,
-                    &settings,
-                )
-            })
-            .py_err()?;
+        let curve: Curve = cancellable(py, || {
+            continue_bifurcation_path(
+                &self.spec,
+                &self.path,
+                bif,
+                self.outcome.parameter_scale,
+                second_path,
+                second_start,
+                stop,
+                &settings,
+            )
+        })?;
         let points = curve
             .points
             .iter()
@@ -197,9 +195,7 @@ fn continuation(
 ) -> PyResult<ContinuationOutput> {
     let spec = parse(json).py_err()?;
     let settings = settings(settings_json).py_err()?;
-    let outcome = py
-        .detach(|| continue_path(&spec, path, start, stop, &settings))
-        .py_err()?;
+    let outcome = cancellable(py, || continue_path(&spec, path, start, stop, &settings))?;
     Ok(ContinuationOutput {
         spec,
         path: path.to_string(),

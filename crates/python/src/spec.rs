@@ -7,6 +7,7 @@
 //! simulation).
 
 use numpy::PyArray1;
+use paritysim_dynamics::integrate::budget;
 use paritysim_dynamics::{CancelFlag, Device, SimulationResult};
 use paritysim_error::{Error, Result};
 use paritysim_spec::{Simulation, paths, schema};
@@ -222,6 +223,18 @@ pub(crate) fn interruptible<T: Send>(
         Some(e) => Err(e),
         None => out.py_err(),
     }
+}
+
+/// Runs a long core call like [`interruptible`], with a fresh cancel flag installed as the
+/// call's budget (`budget::cancellable`): Ctrl-C reaches every integration it makes, on any
+/// thread, and raises `KeyboardInterrupt`.
+pub(crate) fn cancellable<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> Result<T> + Send,
+) -> PyResult<T> {
+    let cancel = CancelFlag::new();
+    let flag = cancel.clone();
+    interruptible(py, &cancel, move || budget::cancellable(&flag, work))
 }
 
 /// Simulates a JSON spec on a worker thread (GIL released); Ctrl-C stops it within a few

@@ -17,7 +17,7 @@ use pyo3::types::PyDict;
 
 use crate::convert::{from_json, same_len, to_py, to_vec};
 use crate::errors::IntoPyResult;
-use crate::spec::device as parse_device;
+use crate::spec::{cancellable, device as parse_device};
 
 fn c64(z: Complex<f64>) -> Complex64 {
     Complex64::new(z.re, z.im)
@@ -53,9 +53,7 @@ fn stability_hill_solution<'py>(
     t: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let t = to_vec(&t);
-    let m = py
-        .detach(|| hill_solutions(beta0, kappa, t0, &t))
-        .py_err()?;
+    let m = cancellable(py, || hill_solutions(beta0, kappa, t0, &t))?;
     to_py(py, &m)
 }
 
@@ -76,9 +74,7 @@ fn stability_chart<'py>(
     kappa: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (beta0, kappa) = (to_vec(&beta0), to_vec(&kappa));
-    let c = py
-        .detach(|| floquet::stability_chart(&beta0, &kappa))
-        .py_err()?;
+    let c = cancellable(py, || floquet::stability_chart(&beta0, &kappa))?;
     // Up to 4M points: numpy columns straight from the vectors, not the generic converter.
     let stable = c.region.iter().zip(&c.marginal);
     let stable: Vec<bool> = stable.map(|(r, &m)| r.is_stable() && !m).collect();
@@ -204,7 +200,7 @@ fn stability_floquet<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let device = parse_device(spec).py_err()?;
     let opts: ShootingOptions = options(options_json, "options").py_err()?;
-    let f = py.detach(|| floquet::floquet(&device, &opts)).py_err()?;
+    let f = cancellable(py, || floquet::floquet(&device, &opts))?;
     to_py(py, &FloquetRecord::from(&f))
 }
 
@@ -221,9 +217,9 @@ fn stability_k2_sweep<'py>(
     let device = parse_device(spec).py_err()?;
     let opts: ShootingOptions = options(options_json, "options").py_err()?;
     let k2 = to_vec(&k2);
-    let runs = py
-        .detach(|| floquet::balance_stiffness_sweep(device.spec(), &k2, &opts))
-        .py_err()?;
+    let runs = cancellable(py, || {
+        floquet::balance_stiffness_sweep(device.spec(), &k2, &opts)
+    })?;
     to_py(py, &BalanceSweepRecord::of(&k2, &runs))
 }
 
@@ -239,12 +235,10 @@ fn stability_linearise<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let device = parse_device(spec).py_err()?;
     let opts: ShootingOptions = options(options_json, "options").py_err()?;
-    let lin = py
-        .detach(|| -> Result<floquet::DeviceLinearisation> {
-            let orbit = floquet::periodic_orbit(&device, &opts)?;
-            floquet::linearise(&device, &orbit, samples)
-        })
-        .py_err()?;
+    let lin = cancellable(py, || -> Result<floquet::DeviceLinearisation> {
+        let orbit = floquet::periodic_orbit(&device, &opts)?;
+        floquet::linearise(&device, &orbit, samples)
+    })?;
     to_py(py, &lin)
 }
 
@@ -265,12 +259,10 @@ fn stability_disturbance_response<'py>(
     let opts: ShootingOptions = options(options_json, "options").py_err()?;
     let dist: DisturbanceOptions = options(disturbance_json, "disturbance").py_err()?;
     let freqs = to_vec(&frequency_hz);
-    let runs = py
-        .detach(|| -> Result<Vec<floquet::DisturbanceResponse>> {
-            let orbit = floquet::periodic_orbit(&device, &opts)?;
-            floquet::disturbance_responses(&device, &orbit, &freqs, amplitude, &dist)
-        })
-        .py_err()?;
+    let runs = cancellable(py, || -> Result<Vec<floquet::DisturbanceResponse>> {
+        let orbit = floquet::periodic_orbit(&device, &opts)?;
+        floquet::disturbance_responses(&device, &orbit, &freqs, amplitude, &dist)
+    })?;
     to_py(py, &DisturbanceRecord::of(&freqs, amplitude, &runs))
 }
 
