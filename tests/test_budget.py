@@ -38,11 +38,13 @@ def test_simulate_names_the_wall_budget(hmf: ps.Simulation) -> None:
     with pytest.raises(ps.IntegrationError, match=r"options\.max_wall_ms") as info:
         ps.simulate(hmf.with_paths({"actuator.frequency_hz": 1e-3}), max_wall_ms=100.0)
     assert 0.0 < info.value.time < 1e6 * 300  # stopped partway through the transient
+    assert info.value.field == "options.max_wall_ms"
 
 
 def test_the_step_budget_names_max_steps(hmf: ps.Simulation) -> None:
-    with pytest.raises(ps.IntegrationError, match=r"options\.max_steps"):
+    with pytest.raises(ps.IntegrationError, match=r"options\.max_steps") as info:
         ps.simulate(hmf, max_steps=20)
+    assert info.value.field == "options.max_steps"
 
 
 @pytest.mark.parametrize("value", [0.0, -1.0, float("nan"), 1e9])

@@ -18,6 +18,10 @@ use paritysim_aero::{BladeElementModel, CoefficientSet};
 use paritysim_error::{Error, Result, check_finite, check_non_negative};
 use paritysim_kinematics::SphericalShoulder;
 
+/// Largest |entry| of a wing's inertia tensor (mg·mm²): the spec's documented range; a larger
+/// one is not an insect-scale wing and overflows the mass matrix into NaN (issue 14).
+pub const MAX_INERTIA_ENTRY: f64 = 1e5;
+
 /// A torsion spring at a shoulder joint: `τ = k (γ − γ0) + k3 (γ − γ0)³`.
 ///
 /// `k` in mN·mm/rad, `k3` in mN·mm/rad³ (a hardening law when `k3 > 0`), `γ0` in rad.
@@ -257,8 +261,8 @@ impl Wing {
     /// A wing with a full inertia tensor (mg·mm², frame 6, about the spherical centre).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `inertia` when it is non-finite, not symmetric or not
-    /// positive definite.
+    /// [`Error::InvalidParameter`] naming `inertia` when an entry is non-finite or beyond
+    /// ±[`MAX_INERTIA_ENTRY`], or the tensor is not symmetric or not positive definite.
     pub fn new(
         shoulder: SphericalShoulder,
         inertia: Matrix3<f64>,
@@ -266,11 +270,11 @@ impl Wing {
         aero: WingAero,
     ) -> Result<Self> {
         for (k, v) in inertia.iter().enumerate() {
-            if !v.is_finite() {
+            if !(v.is_finite() && v.abs() <= MAX_INERTIA_ENTRY) {
                 return Err(Error::invalid(
                     format!("inertia[{}][{}]", k % 3, k / 3),
                     v,
-                    "a finite number (mg mm^2)",
+                    format!("in [-{MAX_INERTIA_ENTRY:e}, {MAX_INERTIA_ENTRY:e}] mg mm^2"),
                 ));
             }
         }

@@ -101,6 +101,7 @@ fn class_of(err: &Error) -> Class {
         Error::Singular(_) => Class::Singular,
         Error::Integration { .. } => Class::Integration,
         Error::Cancelled => Class::Cancelled,
+        Error::Attributed { error, .. } => class_of(error),
     }
 }
 
@@ -175,7 +176,16 @@ fn build(py: Python<'_>, err: &Error) -> PyResult<PyErr> {
     let instance = t.classes[index].bind(py).call1((err.to_string(),))?;
     instance.setattr("kind", err.kind())?;
     instance.setattr("field", err.field())?;
-    match err {
+    if let Error::Attributed {
+        field,
+        value,
+        allowed,
+        ..
+    } = err
+    {
+        instance.setattr("problems", vec![(field.to_string(), value, allowed)])?;
+    }
+    match err.cause() {
         Error::Integration { time, state, .. } => {
             instance.setattr("time", *time)?;
             instance.setattr("state", state.clone())?;

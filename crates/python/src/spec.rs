@@ -241,11 +241,12 @@ pub(crate) fn cancellable<T: Send>(
 /// tens of milliseconds and raises `KeyboardInterrupt`.
 #[pyfunction]
 fn simulate(py: Python<'_>, json: &str) -> PyResult<SimulationOutput> {
-    let (device, mut options) = parse(json).and_then(|s| s.model()).py_err()?;
+    let spec = parse(json).py_err()?;
+    let (device, mut options) = spec.model().py_err()?;
     let cancel = CancelFlag::new();
     options.cancel = Some(cancel.clone());
     let result = interruptible(py, &cancel, || {
-        paritysim_dynamics::simulate(&device, &options)
+        paritysim_dynamics::simulate(&device, &options).map_err(|e| spec.attribute(e))
     })?;
     Ok(SimulationOutput { result })
 }
