@@ -22,6 +22,11 @@ use paritysim_kinematics::SphericalShoulder;
 /// one is not an insect-scale wing and overflows the mass matrix into NaN (issue 14).
 pub const MAX_INERTIA_ENTRY: f64 = 1e5;
 
+/// Smallest principal moment of a wing's inertia (mg·mm²): a million times below the thesis
+/// wings' smallest (about 1); a vanishing one makes the mass matrix numerically singular and
+/// the first step NaN or an underflow (issue 14).
+pub const MIN_PRINCIPAL_INERTIA: f64 = 1e-6;
+
 /// A torsion spring at a shoulder joint: `τ = k (γ − γ0) + k3 (γ − γ0)³`.
 ///
 /// `k` in mN·mm/rad, `k3` in mN·mm/rad³ (a hardening law when `k3 > 0`), `γ0` in rad.
@@ -262,7 +267,8 @@ impl Wing {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming `inertia` when an entry is non-finite or beyond
-    /// ±[`MAX_INERTIA_ENTRY`], or the tensor is not symmetric or not positive definite.
+    /// ±[`MAX_INERTIA_ENTRY`], or the tensor is not symmetric, not positive definite or has a
+    /// principal moment below [`MIN_PRINCIPAL_INERTIA`].
     pub fn new(
         shoulder: SphericalShoulder,
         inertia: Matrix3<f64>,
@@ -284,6 +290,14 @@ impl Wing {
                 "inertia",
                 format!("{inertia:?}"),
                 "a symmetric tensor",
+            ));
+        }
+        let smallest = inertia.symmetric_eigenvalues().min();
+        if inertia.cholesky().is_some() && smallest < MIN_PRINCIPAL_INERTIA {
+            return Err(Error::invalid(
+                "inertia",
+                format!("{:?}", inertia.symmetric_eigenvalues().as_slice()),
+                format!("principal moments of at least {MIN_PRINCIPAL_INERTIA:e} mg mm^2"),
             ));
         }
         if inertia.cholesky().is_none() {

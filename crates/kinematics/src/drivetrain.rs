@@ -37,8 +37,8 @@
 
 use nalgebra::{Matrix2, Vector2};
 use paritysim_error::{
-    Error, Result, bail, check_angle_rad, check_length_mm, check_offset_mm, check_positive,
-    plausible,
+    Error, Result, bail, check_angle_rad, check_in_closed, check_length_mm, check_offset_mm,
+    check_positive, plausible,
 };
 
 /// Result of evaluating a drivetrain at `(q1, q2)`.
@@ -89,11 +89,11 @@ impl RodCrank {
         rod: 0.8,
     };
 
-    /// Validates `crank > 0`, `rod > 0` (mm).
+    /// Validates both lengths against [`plausible::LENGTH_MM`] (mm).
     pub fn new(crank_mm: f64, rod_mm: f64) -> Result<Self> {
         Ok(Self {
-            crank: check_positive("crank_mm", crank_mm)?,
-            rod: check_positive("rod_mm", rod_mm)?,
+            crank: check_length_mm("crank_mm", crank_mm)?,
+            rod: check_length_mm("rod_mm", rod_mm)?,
         })
     }
 
@@ -242,9 +242,10 @@ impl LinearDifferential {
     /// `r = hL/hR` (1 = centred pivot): `φL = −T q1 + T hL q2`, `φR = −T q1 − T hR q2` with
     /// `hL = 2L r/(1+r)`, `hR = 2L/(1+r)`.
     pub fn new(transmission_ratio: f64, arm_length_mm: f64, arm_ratio: f64) -> Result<Self> {
-        check_positive("transmission_ratio", transmission_ratio)?;
+        // A vanishing ratio makes the Jacobian (det = -T^2 (hL + hR)) singular.
+        check_in_closed("transmission_ratio", transmission_ratio, 1e-6, 1e3)?;
         let (left_arm, right_arm) = split_arms(
-            2.0 * check_positive("arm_length_mm", arm_length_mm)?,
+            2.0 * check_length_mm("arm_length_mm", arm_length_mm)?,
             arm_ratio,
         )?;
         Ok(Self {
