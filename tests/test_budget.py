@@ -197,3 +197,18 @@ def test_ctrl_c_interrupts_stability_and_continuation(name: str) -> None:
     finally:
         timer.cancel()
     assert 0.3 <= time.monotonic() - start < 20.0
+
+
+def test_a_ten_percent_failing_sweep_returns_every_row(hmf: ps.Simulation) -> None:
+    """Done-when of issue 14: 40 points, every tenth invalid (each bad kind once): all 40 rows,
+    in order, the bad ones error rows naming the field, the others finite."""
+    import math
+
+    bad = iter([-1.0, 0.0, math.nan, 1e9])
+    values = [next(bad) if i % 10 == 9 else 100.0 + i for i in range(40)]
+    df = ps.sweep(hmf, {"actuator.frequency_hz": values}, metrics=["left_stroke_amplitude"], options={"max_cycles": 5, "samples_per_cycle": 40}, progress=False)
+    assert df["point"].to_list() == list(range(40))
+    failed = df.filter(df["status"] == "error")
+    assert failed["point"].to_list() == [9, 19, 29, 39] and failed["error"].str.contains("frequency_hz").all()
+    ok = df.filter(df["status"] == "ok")["left_stroke_amplitude"].to_list()
+    assert len(ok) == 36 and all(math.isfinite(v) and v > 0 for v in ok)
