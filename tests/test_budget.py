@@ -9,6 +9,7 @@ import _thread
 import threading
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -37,11 +38,13 @@ def test_simulate_names_the_wall_budget(hmf: ps.Simulation) -> None:
     with pytest.raises(ps.IntegrationError, match=r"options\.max_wall_ms") as info:
         ps.simulate(hmf.with_paths({"actuator.frequency_hz": 1e-3}), max_wall_ms=100.0)
     assert 0.0 < info.value.time < 1e6 * 300  # stopped partway through the transient
+    assert info.value.field == "options.max_wall_ms"
 
 
 def test_the_step_budget_names_max_steps(hmf: ps.Simulation) -> None:
-    with pytest.raises(ps.IntegrationError, match=r"options\.max_steps"):
+    with pytest.raises(ps.IntegrationError, match=r"options\.max_steps") as info:
         ps.simulate(hmf, max_steps=20)
+    assert info.value.field == "options.max_steps"
 
 
 @pytest.mark.parametrize("value", [0.0, -1.0, float("nan"), 1e9])
@@ -158,3 +161,54 @@ def test_cli_sweep_ctrl_c_exits_130_in_one_line_and_keeps_the_finished_rows(tmp_
 
     saved = pl.concat([pl.read_parquet(p) for p in parts.glob("part-*.parquet")])
     assert sorted(saved["point"].to_list()) == [0, 1] and (saved["status"] == "ok").all()
+
+
+def _slow_stability_calls() -> dict[str, Any]:
+    """Calls of ``ps.stability`` and ``ps.continuation`` that would run for tens of seconds
+    (the §3.4 devices at 1e-3 Hz, a 4M-point Hill chart) unless Ctrl-C stops them."""
+    import numpy as np
+
+    from paritysim import stability
+
+    hmf = ps.load_spec(EXAMPLES / "hmf.toml").with_paths({"actuator.frequency_hz": 1e-3})
+    parity = ps.load_spec(EXAMPLES / "drag_parity.toml").with_paths({"actuator.frequency_hz": 1e-3})
+    return {
+        "floquet": lambda: stability.floquet(hmf),
+        "k2_sweep": lambda: stability.k2_sweep(parity, [1.0, 2.0, 3.0, 4.0]),
+        "linearise": lambda: stability.linearise(parity),
+        "disturbance_response": lambda: stability.disturbance_response(parity, [10.0, 20.0], 0.1),
+        "stability_chart": lambda: stability.stability_chart(np.linspace(0.0, 3.0, 2000), np.linspace(-1.0, 30.0, 2000), brockett=False),
+        "continuation": lambda: ps.continuation(hmf, "actuator.waveform.frequency_hz", 2e-3, start=1e-3),
+    }
+
+
+@pytest.mark.parametrize("name", list(_slow_stability_calls()))
+def test_ctrl_c_interrupts_stability_and_continuation(name: str) -> None:
+    """SIGINT 0.3 s into each long analysis: the cancel flag installed by the bindings reaches
+    every integration (on every pool thread) and ``KeyboardInterrupt`` is raised; ignored, the
+    call would run to its 60 s budget or the end of the chart."""
+    call = _slow_stability_calls()[name]
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    start = time.monotonic()
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            call()
+    finally:
+        timer.cancel()
+    assert 0.3 <= time.monotonic() - start < 20.0
+
+
+def test_a_ten_percent_failing_sweep_returns_every_row(hmf: ps.Simulation) -> None:
+    """Done-when of issue 14: 40 points, every tenth invalid (each bad kind once): all 40 rows,
+    in order, the bad ones error rows naming the field, the others finite."""
+    import math
+
+    bad = iter([-1.0, 0.0, math.nan, 1e9])
+    values = [next(bad) if i % 10 == 9 else 100.0 + i for i in range(40)]
+    df = ps.sweep(hmf, {"actuator.frequency_hz": values}, metrics=["left_stroke_amplitude"], options={"max_cycles": 5, "samples_per_cycle": 40}, progress=False)
+    assert df["point"].to_list() == list(range(40))
+    failed = df.filter(df["status"] == "error")
+    assert failed["point"].to_list() == [9, 19, 29, 39] and failed["error"].str.contains("frequency_hz").all()
+    ok = df.filter(df["status"] == "ok")["left_stroke_amplitude"].to_list()
+    assert len(ok) == 36 and all(math.isfinite(v) and v > 0 for v in ok)

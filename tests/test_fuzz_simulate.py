@@ -72,9 +72,11 @@ def _run(spec: ps.Simulation) -> str:
         result = ps.simulate(spec)
     except ps.IntegrationError as exc:
         assert exc.time is not None and str(exc)  # it ran and failed somewhere, with where
+        # ... and names the field most responsible with its range (issue 14's done-when).
+        assert getattr(exc, "field", None) and exc.problems, f"integration error without a field: {exc!r}"
         return "ran: integration error"
     except (ps.ConstraintError, ps.SingularError, ps.OutOfDomainError) as exc:
-        assert str(exc)
+        assert getattr(exc, "field", None), f"model error without a field: {exc!r}"
         return "ran: model error"
     except ps.InvalidParameterError as exc:  # a cross-field condition checked when the model is built
         assert getattr(exc, "field", None), f"typed error without a field: {exc!r}"

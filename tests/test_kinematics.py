@@ -101,10 +101,10 @@ def test_drivetrain_pickles_and_reprs() -> None:
         (lambda: kin.shoulder_map(4.0, 0.0, [0.0], [0.0]), ps.InvalidParameterError, "alpha2"),
         (lambda: kin.shoulder_map(1.0, 1.2, [0.0], [0.0]), ps.InvalidParameterError, "alpha3"),
         (lambda: kin.shoulder_map(1.0, 0.2, [np.nan], [0.0]), ps.InvalidParameterError, "phi[0]"),
-        (lambda: kin.shoulder_pose(np.pi / 2, np.pi / 4, 1.4, 1.2), ps.OutOfDomainError, None),
+        (lambda: kin.shoulder_pose(np.pi / 2, np.pi / 4, 1.4, 1.2), ps.OutOfDomainError, "phi"),
         (lambda: ps.Drivetrain.hmf_four_bar(crank_mm=-1.0), ps.InvalidParameterError, "drivetrain.crank_mm"),
         (lambda: ps.Drivetrain.linkage_differential(arm_ratio=0.0), ps.InvalidParameterError, "drivetrain.arm_ratio"),
-        (lambda: kin.drivetrain_map(ps.Drivetrain.hmf_four_bar(), [0.0, 5.0]), ps.OutOfDomainError, None),
+        (lambda: kin.drivetrain_map(ps.Drivetrain.hmf_four_bar(), [0.0, 5.0]), ps.OutOfDomainError, "q1[1]"),
         (lambda: ps.Drivetrain.hmf_four_bar().evaluate(np.zeros(2), np.zeros(3)), ps.ShapeError, None),
     ],
 )

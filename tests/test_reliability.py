@@ -123,3 +123,93 @@ def test_lti_transfer_is_finite_at_extreme_magnitudes() -> None:
     huge = ps.stability.lti_transfer(1e308, 1e5, [53.0])
     w = 2 * np.pi * 53.0 * 1e-3
     assert np.isfinite(huge).all() and abs(huge[0]) == pytest.approx(1e5 / (1e308 * w), rel=1e-9)
+
+
+EXAMPLES = __import__("pathlib").Path(__file__).resolve().parents[1] / "examples"
+FAST = {"max_cycles": 5, "samples_per_cycle": 40}
+
+
+def test_reproducers_6_8_9_typed_named_or_absent(tmp_path: Any) -> None:
+    """Reproducers 6 (not a ParitysimError), 8 (absurd magnitudes failing late) and 9 (the NaN
+    phase lag of fixed wings)."""
+    spec = ps.load_spec(EXAMPLES / "hmf.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text('name = "x"\n[actuator\n')
+    cases: list[tuple[Callable[[], Any], str]] = [
+        (lambda: ps.load_spec(bad), "spec"),
+        (lambda: ps.Simulation.from_dict({"name": "x"}), "wings"),
+        (lambda: ps.simulate(spec, record_cyles=3), "record_cyles"),
+        (lambda: ps.simulate(spec.with_paths({"actuator.waveform.amplitude_v": 1e300})), "amplitude_v"),
+        (lambda: ps.simulate(spec.with_paths({"wings[0].aero.omega1": 1e300})), "omega1"),
+        (lambda: ps.simulate(42), "spec"),
+    ]
+    for call, field in cases:
+        with pytest.raises(ps.ParitysimError) as info:
+            call()
+        assert field in str(getattr(info.value, "field", "")), (field, info.value)
+    # A spec's dict runs like the spec (it raised AttributeError).
+    assert ps.simulate(spec.to_dict(), **FAST).metrics == ps.simulate(spec, **FAST).metrics
+    lags = {k: v for k, v in ps.simulate(spec, **FAST).metrics.items() if k.endswith("rotation_phase_lag")}
+    assert lags and all(v is None for v in lags.values())  # fixed wings: undefined, not NaN
+
+
+def test_a_rod_crank_driven_past_its_reach_names_the_amplitude_and_its_bound() -> None:
+    """Drag PARITY at 300 V: the rod top is lifted past the reach of the rod-crank during the
+    transient. The error keeps its class and `.time`/`.state` and names the amplitude; the
+    state where it stopped has q1 at the closed-form reach sqrt(L2² + 2 L2 L3) − L2, and the
+    allowed range is the static bound reach · stiffness / force_per_volt."""
+    import re
+
+    spec = ps.load_spec(EXAMPLES / "drag_parity.toml")
+    with pytest.raises(ps.IntegrationError) as info:
+        ps.simulate(spec.with_paths({"actuator.waveform.amplitude_v": 300.0}), **FAST)
+    err = info.value
+    assert err.field == "actuator.waveform.amplitude_v" and err.kind == "Integration"
+    crank, rod = spec.drivetrain.crank_mm, spec.drivetrain.rod_mm
+    reach = math.sqrt(rod**2 + 2 * rod * crank) - rod
+    assert abs(err.state[0]) == pytest.approx(reach, rel=1e-6)
+    field, value, allowed = err.problems[0]
+    bound = float(re.search(r"\|amplitude\| < ([0-9.]+) V", allowed).group(1))
+    assert bound == pytest.approx(reach * spec.actuator.stiffness / spec.actuator.force_per_volt, rel=1e-5)
+    assert (field, value) == ("actuator.waveform.amplitude_v", "300")
+    # The shipped drive (100 V) stays well inside it and runs.
+    assert spec.actuator.waveform.amplitude_v < bound
+    ps.simulate(spec, **FAST)
+
+
+def test_the_same_failure_in_a_sweep_row_names_the_amplitude() -> None:
+    spec = ps.load_spec(EXAMPLES / "drag_parity.toml")
+    df = ps.sweep(spec, {"actuator.waveform.amplitude_v": [100.0, 300.0]}, options=FAST, progress=False)
+    assert df["status"].to_list() == ["ok", "error"]
+    assert df["error_kind"][1] == "Integration" and "most responsible: `actuator.waveform.amplitude_v`" in df["error"][1]
+
+
+def test_shoulder_joint_limit_names_phi_with_the_eq_2_10_bound() -> None:
+    """Outside the joint limit the pose names ``phi`` and the bound |sin φ| <= |sin(α3 − α2) /
+    cos(θ + α2)|; just inside that bound the pose solves (the bound is the solver's limit)."""
+    alpha2, alpha3, theta = 1.0, 0.8, 0.3
+    bound = math.asin(abs(math.sin(alpha3 - alpha2) / math.cos(theta + alpha2)))
+    ps.kinematics.shoulder_pose(alpha2, alpha3, bound * (1 - 1e-9), theta)
+    with pytest.raises(ps.OutOfDomainError) as info:
+        ps.kinematics.shoulder_pose(alpha2, alpha3, bound * (1 + 1e-6), theta)
+    assert info.value.field == "phi" and f"{bound:.6f}" in info.value.problems[0][2]
+
+
+def test_degenerate_link_angles_and_arms_are_rejected_before_running() -> None:
+    hmf = ps.load_spec(EXAMPLES / "hmf.toml")
+    parity = ps.load_spec(EXAMPLES / "drag_parity.toml")
+    for spec, path, value in [
+        (parity, "wings[0].shoulder.alpha2", 1e-300),
+        (parity, "drivetrain.whippletree_length_mm", 5e-324),
+        (parity, "drivetrain.arm_ratio", 5e-324),
+        (hmf, "wings[0].inertia[0][0]", 1e308),
+    ]:
+        with pytest.raises(ps.InvalidParameterError) as info:
+            ps.simulate(spec.with_paths({path: value}), **FAST)
+        assert info.value.field == path, (path, info.value)
+
+
+def test_eq_2_59_at_zero_frequency_names_the_frequency() -> None:
+    with pytest.raises(ps.SingularError) as info:
+        ps.stability.lti_transfer(1.0, 0.0, [50.0, 0.0])
+    assert info.value.field == "frequency_hz[1]"

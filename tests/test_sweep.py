@@ -376,6 +376,40 @@ def test_dask_local_cluster_matches_local(parity: ps.Simulation) -> None:
     assert_same(local, remote)
 
 
+def test_ctrl_c_reaches_the_chunks_running_in_process_pool_workers(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """Two fast points then four that would integrate for minutes, one point per chunk on two
+    worker processes. Ctrl-C once the two fast rows are framed (a count, not a timer): pending
+    chunks are cancelled, the running ones see the stop file and stop inside integration, the
+    fast rows are checkpointed and `SweepInterrupted` is raised as in process; the workers are
+    free again at once (they did not run the slow points to the end)."""
+    hmf = ps.load_spec(EXAMPLES / "hmf.toml")
+    real = sweep_module._frame
+    framed: list[int] = []
+
+    def frame_then_interrupt(raw: Any, *args: Any) -> Any:
+        out = real(raw, *args)
+        framed.append(out.height)
+        if sum(framed) == 2 and len(framed) == 2:
+            _thread.interrupt_main()
+        return out
+
+    monkeypatch.setattr(sweep_module, "_frame", frame_then_interrupt)
+    checkpoint = tmp_path / "study.parquet"
+    values = [100.0, 110.0] + [1e-3] * 4
+    with cf.ProcessPoolExecutor(max_workers=2, mp_context=multiprocessing.get_context("spawn")) as pool:
+        with pytest.raises(sweep_module.SweepInterrupted) as stopped:
+            sweep(hmf, {"actuator.frequency_hz": values}, options={**FAST, "max_wall_ms": 600_000.0}, metrics=["left_stroke_amplitude"], executor=pool, chunk_size=1, checkpoint=checkpoint, progress=False)
+        interrupted = time.monotonic()
+        assert pool.submit(abs, -3).result(timeout=20) == 3
+        assert time.monotonic() - interrupted < 20.0  # the slow points would run for minutes
+    partial = stopped.value.result
+    assert partial["point"].to_list() == [0, 1] and (partial["status"] == "ok").all()
+    assert stopped.value.total == len(values)
+    saved = pl.concat([pl.read_parquet(f) for f in checkpoint.with_name("study.parquet.parts").glob("part-*.parquet")]).sort("point")
+    assert_same(saved, partial)
+    assert not list(Path(sweep_module.tempfile.gettempdir()).glob("paritysim-sweep-*/stop"))
+
+
 # ----------------------------------------------------------------------------- CLI
 
 

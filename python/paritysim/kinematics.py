@@ -59,7 +59,8 @@ def shoulder_map(alpha2: float, alpha3: float, phi: ArrayLike, theta: ArrayLike)
 def shoulder_pose(alpha2: float, alpha3: float, phi: float, theta: float, psi: float = 0.0) -> dict[str, np.ndarray]:
     """Joint angles (6,), link rotations R_i^1 (6, 3, 3) and wing angles (3,) at one pose.
 
-    Raises ``OutOfDomainError`` outside the joint limit.
+    Raises ``OutOfDomainError`` outside the joint limit, with ``.field == "phi"`` and the
+    stroke range eq. 2.10 allows at this ``theta`` in ``.problems``.
     """
     return _core.shoulder_pose(real("alpha2", alpha2), real("alpha3", alpha3), real("phi", phi), real("theta", theta), real("psi", psi))
 

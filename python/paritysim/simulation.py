@@ -13,6 +13,7 @@ import polars as pl
 from matplotlib.figure import Figure
 
 from . import _core
+from ._errors import invalid
 from .spec import Simulation
 
 __all__ = ["SimulationResult", "simulate"]
@@ -77,23 +78,29 @@ class SimulationResult:
         return fig
 
 
-def simulate(spec: Simulation, **option_overrides: Any) -> SimulationResult:
+def simulate(spec: Simulation | dict[str, Any], **option_overrides: Any) -> SimulationResult:
     """Run ``spec`` to periodic steady state (or for ``options.duration_ms``) in Rust.
 
-    ``option_overrides`` replace fields of ``spec.options`` for this run, e.g.
-    ``simulate(spec, record_cycles=3)``.
+    ``spec`` is a `Simulation` or its dict (``Simulation.to_dict()``). ``option_overrides``
+    replace fields of ``spec.options`` for this run, e.g. ``simulate(spec, record_cycles=3)``.
 
     Raises
     ------
     InvalidParameterError, ConstraintError, ShapeError
         For an invalid spec (the message names the field).
-    IntegrationError
-        When integration fails; ``.time`` and ``.state`` say where. Also when one integration
-        needs more than ``options.max_steps`` steps or the run takes longer than
-        ``options.max_wall_ms`` (default 60 000 ms); the message names the option.
+    IntegrationError, OutOfDomainError
+        When integration fails; ``.time`` and ``.state`` say where, and ``.field`` names the
+        field most responsible with ``.problems`` giving its allowed range (e.g. a drive
+        amplitude that moves the rod-crank past its reach). Also when one integration needs
+        more than ``options.max_steps`` steps or the run takes longer than
+        ``options.max_wall_ms`` (default 60 000 ms); ``.field`` names the option.
     KeyboardInterrupt
         On Ctrl-C: the run stops inside the integration (within about 20 ms).
     """
+    if isinstance(spec, dict):
+        spec = Simulation.from_dict(spec)
+    elif not isinstance(spec, Simulation):
+        raise invalid("spec", type(spec).__name__, "a paritysim.Simulation or its dict")
     if option_overrides:
         spec = spec.replace(options=spec.options.with_fields("options", **option_overrides))
     raw = _core.simulate(spec.to_json())

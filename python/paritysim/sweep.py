@@ -59,7 +59,11 @@ and writes the complete, ordered table to ``runs/study.parquet`` at the end; re-
 same call skips every point already there (points are matched by their parameter values, so an
 extended grid reuses the old points). ``executor=`` takes any ``concurrent.futures.Executor``
 (``ProcessPoolExecutor``, ``dask.distributed.Client.get_executor()``): chunks of points are sent
-to it and each runs on one engine thread.
+to it and each runs on one engine thread. Ctrl-C there cancels the pending chunks and stops the
+running ones inside integration through a stop file the workers poll every 20 ms (workers on
+the same machine or a shared filesystem; a remote worker that cannot see it finishes its
+chunk): their finished points are kept and checkpointed, and `SweepInterrupted` is raised as
+in process.
 """
 
 from __future__ import annotations
@@ -72,10 +76,13 @@ import json
 import logging
 import math
 import os
+import shutil
+import tempfile
 import uuid
 import warnings
 from collections import Counter
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -178,6 +185,9 @@ class _Chunk:
     metrics: list[str]
     keep_cycle: bool
     threads: int
+    # A file whose appearance asks the worker to stop (Ctrl-C in the submitting process reaches
+    # chunks already running in executor workers on the same machine); None: run to the end.
+    stop_file: str | None = None
 
 
 def _prepare(chunk: _Chunk) -> _core.SweepRun:
@@ -196,8 +206,27 @@ def _raw(result: _core.SweepResult) -> dict[str, Any]:
 
 
 def _run_chunk(chunk: _Chunk) -> dict[str, Any]:
-    """Runs a chunk to completion (executor workers call this)."""
-    return _raw(_prepare(chunk).result())
+    """Runs a chunk (executor workers call this) until it ends or it is asked to stop: the
+    chunk's ``stop_file`` appears (the submitter was interrupted) or this worker gets Ctrl-C.
+    A stopped chunk returns its finished points; the running ones count as not run."""
+    run = _prepare(chunk)
+    if chunk.stop_file is None:
+        return _raw(run.result())
+    run.start()
+    try:
+        while not run.wait(_STOP_POLL_S):
+            if os.path.exists(chunk.stop_file):
+                run.cancel()
+    except KeyboardInterrupt:
+        run.cancel()
+    return _raw(run.result())
+
+
+# How often an executor worker looks for its chunk's stop file (a stat call: negligible).
+_STOP_POLL_S = 0.02
+# How long an interrupted sweep waits for the chunks running in executor workers to stop and
+# hand back their finished points (they react within `_STOP_POLL_S` plus one budget check).
+_STOP_WAIT_S = 5.0
 
 
 def _failed_raw(n: int, n_metrics: int, cycle_columns: Sequence[str], exc: BaseException) -> dict[str, Any]:
@@ -686,6 +715,8 @@ def _run_executor(
     limit = max(2, 2 * workers)
     queue = iter(chunks)
     in_flight: dict[cf.Future[dict[str, Any]], list[int]] = {}
+    stop_dir = tempfile.mkdtemp(prefix="paritysim-sweep-")
+    stop_file = os.path.join(stop_dir, "stop")
     try:
         while True:
             while len(in_flight) < limit:
@@ -693,30 +724,42 @@ def _run_executor(
                 if points is None:
                     break
                 try:
-                    in_flight[executor.submit(_run_chunk, make(points))] = points
+                    chunk = dataclasses.replace(make(points), stop_file=stop_file)
+                    in_flight[executor.submit(_run_chunk, chunk)] = points
                 except Exception as exc:  # noqa: BLE001 - e.g. a broken pool: error rows
                     finished_chunk(frame(points, exc))
                     bar.update(len(points))
             if not in_flight:
                 return False
-            done, _ = cf.wait(list(in_flight), timeout=0.2, return_when=cf.FIRST_COMPLETED)
+            done, _ = cf.wait(list(in_flight), timeout=0.02, return_when=cf.FIRST_COMPLETED)  # Ctrl-C is seen between waits
             for fut in done:
-                points = in_flight.pop(fut)
+                points = in_flight[fut]
                 # A chunk whose worker raised or died (BrokenProcessPool...) is error rows.
                 error = fut.exception()
-                finished_chunk(frame(points, error if error is not None else fut.result()))
+                rows = frame(points, error if error is not None else fut.result())
+                # Popped only once framed: a Ctrl-C while framing collects it below.
+                del in_flight[fut]
+                finished_chunk(rows)
                 bar.update(len(points))
     except KeyboardInterrupt:
-        for fut in in_flight:
-            fut.cancel()
-        for fut, points in in_flight.items():
-            if fut.done() and not fut.cancelled() and fut.exception() is None:
-                finished_chunk(frame(points, fut.result()))
+        # Pending chunks are cancelled; running ones see the stop file, stop their points
+        # and return the finished ones, which are checkpointed like any finished chunk.
+        Path(stop_file).touch()
+        running = [fut for fut in in_flight if not fut.cancel()]
+        cf.wait(running, timeout=_STOP_WAIT_S)
+        for fut in running:
+            if fut.done() and fut.exception() is None:
+                finished_chunk(frame(in_flight[fut], fut.result()))
         return True
     except BaseException:
+        Path(stop_file).touch()
         for fut in in_flight:
             fut.cancel()
         raise
+    finally:
+        # A chunk still running past the wait keeps its stop file (it stops when it looks).
+        if all(fut.done() for fut in in_flight):
+            shutil.rmtree(stop_dir, ignore_errors=True)
 
 
 # ------------------------------------------------------------------------------ plotting

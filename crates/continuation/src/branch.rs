@@ -460,6 +460,8 @@ pub fn continue_orbits<M: PeriodMap>(
         });
         let (next, next_t) = match accepted {
             Ok(v) => v,
+            // The caller stopped the run: not a failed step to retry smaller.
+            Err(Error::Cancelled) => return Err(Error::Cancelled),
             Err(err) => {
                 h *= 0.5;
                 if h < options.min_step {

@@ -310,6 +310,7 @@ pub fn continue_fold_curve<M: PeriodMap>(
                     };
                 }
             }
+            Err(Error::Cancelled) => return Err(Error::Cancelled),
             other => {
                 h *= 0.5;
                 if h < options.min_step {

@@ -18,6 +18,15 @@ use paritysim_aero::{BladeElementModel, CoefficientSet};
 use paritysim_error::{Error, Result, check_finite, check_non_negative};
 use paritysim_kinematics::SphericalShoulder;
 
+/// Largest |entry| of a wing's inertia tensor (mg·mm²): the spec's documented range; a larger
+/// one is not an insect-scale wing and overflows the mass matrix into NaN (issue 14).
+pub const MAX_INERTIA_ENTRY: f64 = 1e5;
+
+/// Smallest principal moment of a wing's inertia (mg·mm²): a million times below the thesis
+/// wings' smallest (about 1); a vanishing one makes the mass matrix numerically singular and
+/// the first step NaN or an underflow (issue 14).
+pub const MIN_PRINCIPAL_INERTIA: f64 = 1e-6;
+
 /// A torsion spring at a shoulder joint: `τ = k (γ − γ0) + k3 (γ − γ0)³`.
 ///
 /// `k` in mN·mm/rad, `k3` in mN·mm/rad³ (a hardening law when `k3 > 0`), `γ0` in rad.
@@ -279,8 +288,9 @@ impl Wing {
     /// A wing with a full inertia tensor (mg·mm², frame 6, about the spherical centre).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `inertia` when it is non-finite, not symmetric or not
-    /// positive definite.
+    /// [`Error::InvalidParameter`] naming `inertia` when an entry is non-finite or beyond
+    /// ±[`MAX_INERTIA_ENTRY`], or the tensor is not symmetric, not positive definite or has a
+    /// principal moment below [`MIN_PRINCIPAL_INERTIA`].
     pub fn new(
         shoulder: SphericalShoulder,
         inertia: Matrix3<f64>,
@@ -288,11 +298,11 @@ impl Wing {
         aero: WingAero,
     ) -> Result<Self> {
         for (k, v) in inertia.iter().enumerate() {
-            if !v.is_finite() {
+            if !(v.is_finite() && v.abs() <= MAX_INERTIA_ENTRY) {
                 return Err(Error::invalid(
                     format!("inertia[{}][{}]", k % 3, k / 3),
                     v,
-                    "a finite number (mg mm^2)",
+                    format!("in [-{MAX_INERTIA_ENTRY:e}, {MAX_INERTIA_ENTRY:e}] mg mm^2"),
                 ));
             }
         }
@@ -302,6 +312,14 @@ impl Wing {
                 "inertia",
                 format!("{inertia:?}"),
                 "a symmetric tensor",
+            ));
+        }
+        let smallest = inertia.symmetric_eigenvalues().min();
+        if inertia.cholesky().is_some() && smallest < MIN_PRINCIPAL_INERTIA {
+            return Err(Error::invalid(
+                "inertia",
+                format!("{:?}", inertia.symmetric_eigenvalues().as_slice()),
+                format!("principal moments of at least {MIN_PRINCIPAL_INERTIA:e} mg mm^2"),
             ));
         }
         if inertia.cholesky().is_none() {

@@ -14,6 +14,7 @@
 //! | `Integration`        | `IntegrationError(ParitysimError, RuntimeError)`      |
 //! | `Cancelled`          | `CancelledError(ParitysimError)`                      |
 //! | `InvalidSpec`        | `InvalidParameterError` (with every problem listed)   |
+//! | `Attributed`         | the class of the wrapped error, with `.field` set     |
 //!
 //! Use [`ensure!`] / [`bail!`] and the `check_*` helpers so that every message names the
 //! offending field and the allowed range.
@@ -76,6 +77,20 @@ pub enum Error {
     /// Several invalid fields of one spec, every one with its dotted path and allowed range.
     #[error("{} problems in the spec: {}", .0.len(), Problem::list(.0))]
     InvalidSpec(Vec<Problem>),
+    /// A model failure that only shows while running (an integration, a pose), attributed to
+    /// the field most responsible for it and the range that avoids it. Its kind (and Python
+    /// class) is the wrapped error's; only [`Error::field`] differs.
+    #[error("{error}; most responsible: `{field}` = {value}: must be {allowed}")]
+    Attributed {
+        /// Dotted path of the responsible field.
+        field: Cow<'static, str>,
+        /// Its value, formatted.
+        value: String,
+        /// The range (computed, with the unit) that avoids the failure.
+        allowed: String,
+        /// The failure itself.
+        error: Box<Error>,
+    },
 }
 
 /// One invalid field of a spec: its dotted path, the value found and what is allowed.
@@ -137,14 +152,40 @@ impl Error {
             Error::Integration { .. } => "Integration",
             Error::Cancelled => "Cancelled",
             Error::InvalidSpec(_) => "InvalidParameter",
+            Error::Attributed { error, .. } => error.kind(),
         }
     }
 
-    /// The field named by an [`Error::InvalidParameter`], if any.
+    /// Attributes this error to `field` (see [`Error::Attributed`]).
+    pub fn attributed(
+        self,
+        field: impl Into<Cow<'static, str>>,
+        value: impl fmt::Display,
+        allowed: impl Into<String>,
+    ) -> Self {
+        Error::Attributed {
+            field: field.into(),
+            value: value.to_string(),
+            allowed: allowed.into(),
+            error: Box::new(self),
+        }
+    }
+
+    /// The error without its attribution ([`Error::Attributed`] unwrapped).
+    pub fn cause(&self) -> &Error {
+        match self {
+            Error::Attributed { error, .. } => error.cause(),
+            other => other,
+        }
+    }
+
+    /// The field named by an [`Error::InvalidParameter`] (the first of an [`Error::InvalidSpec`],
+    /// the attributed one of an [`Error::Attributed`]), if any.
     pub fn field(&self) -> Option<&str> {
         match self {
             Error::InvalidParameter { field, .. } => Some(field),
             Error::InvalidSpec(problems) => problems.first().map(|p| p.field.as_str()),
+            Error::Attributed { field, .. } => Some(field),
             _ => None,
         }
     }
@@ -175,6 +216,17 @@ impl Error {
                 value,
                 allowed,
             },
+            Error::Attributed {
+                field,
+                value,
+                allowed,
+                error,
+            } => Error::Attributed {
+                field: Cow::Owned(format!("{prefix}.{field}")),
+                value,
+                allowed,
+                error,
+            },
             other => other,
         }
     }
@@ -198,6 +250,17 @@ impl Error {
                 field: Cow::Owned(format!("{}[{index}]", array.unwrap_or(&field))),
                 value,
                 allowed,
+            },
+            Error::Attributed {
+                field,
+                value,
+                allowed,
+                error,
+            } => Error::Attributed {
+                field: Cow::Owned(format!("{}[{index}]", array.unwrap_or(&field))),
+                value,
+                allowed,
+                error,
             },
             other => other,
         }

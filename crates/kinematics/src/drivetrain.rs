@@ -36,7 +36,10 @@
 //! * **Biased pivot** (§2.4.2): arms `hL = L0 r/(1+r)`, `hR = L0/(1+r)` for arm ratio `r = hL/hR`.
 
 use nalgebra::{Matrix2, Vector2};
-use paritysim_error::{Error, Result, bail, check_angle_rad, check_offset_mm, check_positive};
+use paritysim_error::{
+    Error, Result, bail, check_angle_rad, check_in_closed, check_length_mm, check_offset_mm,
+    check_positive, plausible,
+};
 
 /// Result of evaluating a drivetrain at `(q1, q2)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -60,6 +63,10 @@ impl DrivetrainEval {
     }
 }
 
+/// What a rod-crank's out-of-domain error names (`what`): callers that attribute the failure
+/// to a spec field recognise it by this text.
+pub const ROD_CRANK: &str = "rod-crank linkage";
+
 /// One side's rod-crank (see the module sketch). Lengths in mm.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RodCrank {
@@ -82,11 +89,11 @@ impl RodCrank {
         rod: 0.8,
     };
 
-    /// Validates `crank > 0`, `rod > 0` (mm).
+    /// Validates both lengths against [`plausible::LENGTH_MM`] (mm).
     pub fn new(crank_mm: f64, rod_mm: f64) -> Result<Self> {
         Ok(Self {
-            crank: check_positive("crank_mm", crank_mm)?,
-            rod: check_positive("rod_mm", rod_mm)?,
+            crank: check_length_mm("crank_mm", crank_mm)?,
+            rod: check_length_mm("rod_mm", rod_mm)?,
         })
     }
 
@@ -100,6 +107,15 @@ impl RodCrank {
         self.rod
     }
 
+    /// Largest lift of the rod top along the rod (`dx = 0`) before the linkage toggles (mm):
+    /// the crank pivot and the rod top are at most `L2 + L3` apart (triangle inequality, the
+    /// `|k| < 1` of [`Self::solve`]), so `(L2 + dy)² + L3² < (L2 + L3)²`, i.e.
+    /// `dy < √(L2² + 2 L2 L3) − L2`.
+    pub fn reach(&self) -> f64 {
+        let (l3, l2) = (self.crank, self.rod);
+        (l2 * l2 + 2.0 * l2 * l3).sqrt() - l2
+    }
+
     /// Solves `|top − tip(β)| = rod` for the crank angle given the rod-top displacement
     /// `(dx, dy)` from rest, by implicit differentiation of
     /// `F = (X − L3 cos β)² + (Y − L3 sin β)² − L2²`.
@@ -111,7 +127,7 @@ impl RodCrank {
         // Beyond |k| = 1 the rod cannot reach; near it the linkage toggles (infinite gain).
         if k.is_nan() || k.abs() >= 1.0 - 1e-9 || !r.is_finite() {
             return Err(Error::OutOfDomain {
-                what: "rod-crank linkage".into(),
+                what: ROD_CRANK.into(),
                 detail: format!(
                     "rod top displaced by ({dx}, {dy}) mm cannot be reached by crank {l3} mm \
                      and rod {l2} mm (toggle or beyond)"
@@ -193,9 +209,17 @@ pub struct LinkageDifferential {
 
 /// Splits a whippletree of `length` (mm) into `(left, right)` arms with `ratio = left/right`.
 fn split_arms(length: f64, ratio: f64) -> Result<(f64, f64)> {
-    check_positive("whippletree_length_mm", length)?;
+    check_length_mm("whippletree_length_mm", length)?;
     check_positive("arm_ratio", ratio)?;
-    Ok((length * ratio / (1.0 + ratio), length / (1.0 + ratio)))
+    let arms = (length * ratio / (1.0 + ratio), length / (1.0 + ratio));
+    // A vanishing arm makes the drivetrain Jacobian singular at rest (q2 no longer moves it).
+    if arms.0.min(arms.1) < plausible::LENGTH_MM.0 {
+        bail!(invalid "arm_ratio", ratio, format!(
+            "such that both arms of the {length} mm whippletree are at least {:e} mm",
+            plausible::LENGTH_MM.0
+        ));
+    }
+    Ok(arms)
 }
 
 /// Limit on `|q2|`: beyond ±π/2 the whippletree folds over.
@@ -218,9 +242,10 @@ impl LinearDifferential {
     /// `r = hL/hR` (1 = centred pivot): `φL = −T q1 + T hL q2`, `φR = −T q1 − T hR q2` with
     /// `hL = 2L r/(1+r)`, `hR = 2L/(1+r)`.
     pub fn new(transmission_ratio: f64, arm_length_mm: f64, arm_ratio: f64) -> Result<Self> {
-        check_positive("transmission_ratio", transmission_ratio)?;
+        // A vanishing ratio makes the Jacobian (det = -T^2 (hL + hR)) singular.
+        check_in_closed("transmission_ratio", transmission_ratio, 1e-6, 1e3)?;
         let (left_arm, right_arm) = split_arms(
-            2.0 * check_positive("arm_length_mm", arm_length_mm)?,
+            2.0 * check_length_mm("arm_length_mm", arm_length_mm)?,
             arm_ratio,
         )?;
         Ok(Self {
@@ -292,6 +317,15 @@ impl Drivetrain {
         match self {
             Drivetrain::HmfFourBar(_) => 1,
             _ => 2,
+        }
+    }
+
+    /// The rod-crank of each side (the linkages), None for the linear map.
+    pub fn rod_crank(&self) -> Option<RodCrank> {
+        match self {
+            Drivetrain::HmfFourBar(d) => Some(d.side),
+            Drivetrain::LinkageDifferential(d) => Some(d.side),
+            Drivetrain::LinearDifferential(_) => None,
         }
     }
 

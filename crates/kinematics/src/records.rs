@@ -4,7 +4,8 @@
 use nalgebra::{Matrix2, Matrix3};
 use serde::Serialize;
 
-use crate::{Drivetrain, Result, SphericalShoulder};
+use crate::drivetrain::ROD_CRANK;
+use crate::{Drivetrain, Error, Result, SphericalShoulder};
 
 fn m2(m: &Matrix2<f64>) -> [[f64; 2]; 2] {
     [[m[(0, 0)], m[(0, 1)]], [m[(1, 0)], m[(1, 1)]]]
@@ -75,7 +76,9 @@ impl PoseRecord {
     /// # Errors
     /// As [`SphericalShoulder::pose`].
     pub fn of(sh: &SphericalShoulder, phi: f64, theta: f64, psi: f64) -> Result<Self> {
-        let pose = sh.pose(phi, theta, psi)?;
+        let pose = sh
+            .pose(phi, theta, psi)
+            .map_err(|e| sh.attribute_joint_limit(e, phi, theta))?;
         let w = pose.wing_angles;
         Ok(Self {
             joint_angles: pose.joint_angles,
@@ -110,7 +113,9 @@ impl PartialsRecord {
     /// # Errors
     /// As [`SphericalShoulder::pose`] and [`SphericalShoulder::partials`].
     pub fn of(sh: &SphericalShoulder, phi: f64, theta: f64, psi: f64) -> Result<Self> {
-        let pose = sh.pose(phi, theta, psi)?;
+        let pose = sh
+            .pose(phi, theta, psi)
+            .map_err(|e| sh.attribute_joint_limit(e, phi, theta))?;
         let p = sh.partials(phi, theta)?;
         let g = |v: nalgebra::Vector2<f64>| [v[0], v[1]];
         Ok(Self {
@@ -148,12 +153,32 @@ impl DrivetrainMap {
         paritysim_error::check_same_len(("q1", q1.len()), ("q2", q2.len()))?;
         let mut m = Self::default();
         for (i, (&a, &b)) in q1.iter().zip(q2).enumerate() {
-            let e = d.evaluate(a, b).map_err(|e| e.at_index(i, None))?;
+            let e = d
+                .evaluate(a, b)
+                .map_err(|e| attribute_reach(d, e, a, b).at_index(i, None))?;
             m.stroke_left.push(e.stroke[0]);
             m.stroke_right.push(e.stroke[1]);
             m.jacobian.push(m2(&e.jacobian));
             m.hessian.push([m2(&e.hessian[0]), m2(&e.hessian[1])]);
         }
         Ok(m)
+    }
+}
+
+/// Attributes a rod-crank that cannot reach the pose `(q1, q2)` to `q1` with the lift the
+/// linkage allows ([`crate::RodCrank::reach`]); other errors are returned unchanged.
+fn attribute_reach(d: &Drivetrain, err: Error, q1: f64, q2: f64) -> Error {
+    match (d.rod_crank(), &err) {
+        (Some(side), Error::OutOfDomain { what, .. }) if what == ROD_CRANK => {
+            let allowed = format!(
+                "a rod-top lift within the rod-crank's reach at q2 = {q2} rad: at most {:.6} mm \
+                 along the rod (sqrt(L2^2 + 2 L2 L3) - L2, crank {} mm, rod {} mm)",
+                side.reach(),
+                side.crank(),
+                side.rod()
+            );
+            err.attributed("q1", q1, allowed)
+        }
+        _ => err,
     }
 }

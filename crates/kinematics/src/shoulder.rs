@@ -28,6 +28,10 @@ use crate::rotation::{rot_axis, rot_x, rot_y, rot_z};
 /// Relative determinant below which the closure system is treated as singular.
 const SINGULAR_TOL: f64 = 1e-12;
 
+/// Smallest `alpha2` and `alpha2 - alpha3` (rad): the rest pose's closure determinant
+/// `sin(alpha2 - alpha3)` stays six orders above [`SINGULAR_TOL`].
+pub const MIN_LINK_ANGLE: f64 = 1e-6;
+
 /// Spherical five-bar shoulder parameterised by `α2, α3` (eq. 2.7).
 ///
 /// Construct with [`SphericalShoulder::new`]; it fails unless `0 <= α3 < α2 <= π` and
@@ -85,6 +89,14 @@ impl SphericalShoulder {
         if !(alpha2 > 0.0 && alpha2 <= PI) {
             bail!(invalid "alpha2", alpha2, "in (0, pi] rad");
         }
+        // At rest the closure of eq. 2.12 has determinant sin(alpha2 - alpha3): a vanishing
+        // link angle makes every pose singular.
+        if alpha2 < MIN_LINK_ANGLE {
+            bail!(invalid "alpha2", alpha2, format!("in [{MIN_LINK_ANGLE:e}, pi] rad (the closure is singular as alpha2 -> 0)"));
+        }
+        if alpha2 - alpha3 < MIN_LINK_ANGLE {
+            bail!(invalid "alpha3", alpha3, format!("<= alpha2 - {MIN_LINK_ANGLE:e} rad (alpha2 - alpha3 -> 0 makes the closure singular)"));
+        }
         if !(alpha3 >= 0.0 && alpha3 < alpha2) {
             bail!(invalid "alpha3", alpha3, format!("in [0, alpha2 = {alpha2}) rad"));
         }
@@ -133,6 +145,27 @@ impl SphericalShoulder {
     #[inline]
     pub fn is_reachable(&self, phi: f64, theta: f64) -> bool {
         self.sin_gamma3(phi, theta).abs() <= 1.0
+    }
+
+    /// Largest `|sin φ|` the joint limit of eq. 2.10 allows at deviation `theta`:
+    /// `|sin(α3 − α2) / cos(θ + α2)|` (infinite where `cos(θ + α2) = 0`: every stroke).
+    pub fn max_sin_stroke(&self, theta: f64) -> f64 {
+        (self.denominator / (theta + self.alpha2).cos()).abs()
+    }
+
+    /// Attributes an out-of-domain error of the pose at `(phi, theta)` to `phi` with the stroke
+    /// range eq. 2.10 allows at this `theta` (other errors are returned unchanged).
+    pub fn attribute_joint_limit(&self, err: Error, phi: f64, theta: f64) -> Error {
+        if !matches!(err, Error::OutOfDomain { .. }) || self.is_reachable(phi, theta) {
+            return err;
+        }
+        let bound = self.max_sin_stroke(theta).min(1.0);
+        let allowed = format!(
+            "within the joint limit of eq. 2.10 at theta = {theta} rad: |sin(phi)| <= {bound:.6}, \
+             i.e. |phi| <= {:.6} rad (mod pi)",
+            bound.asin()
+        );
+        err.attributed("phi", phi, allowed)
     }
 
     /// `(γ2, γ3, γ5)` from the closed form of eqs. 2.11–2.13 (γ3 in `[−π/2, π/2]`).

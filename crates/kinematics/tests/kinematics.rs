@@ -551,3 +551,41 @@ fn drivetrain_rejects_implausible_inputs() {
     let e = d.evaluate(0.2, 0.1).unwrap();
     assert!(e.stroke.iter().all(|s| s.is_finite()));
 }
+
+/// `RodCrank::reach` (triangle inequality) against the solver: just below the closed-form
+/// lift the linkage evaluates, just above it is out of its domain, for several proportions.
+#[test]
+fn rod_crank_reach_is_where_the_linkage_stops_solving() {
+    for (crank, rod) in [(0.4, 0.8), (0.4, 1.0), (0.3, 2.0), (1.0, 0.9)] {
+        let side = RodCrank::new(crank, rod).unwrap();
+        let reach = side.reach();
+        assert!((reach - ((rod * rod + 2.0 * rod * crank).sqrt() - rod)).abs() < 1e-15);
+        let d = Drivetrain::HmfFourBar(HmfFourBar::new(side));
+        assert!(
+            d.evaluate(reach * (1.0 - 1e-6), 0.0).is_ok(),
+            "{crank} {rod}"
+        );
+        let err = d.evaluate(reach * (1.0 + 1e-6), 0.0).unwrap_err();
+        assert_eq!(err.kind(), "OutOfDomain", "{err}");
+        assert_eq!(d.rod_crank(), Some(side));
+    }
+}
+
+/// An attributed error keeps its kind and names the field; `at_index` and `in_field` locate it.
+#[test]
+fn attributed_errors_keep_their_kind_and_name_the_field() {
+    let base = Error::OutOfDomain {
+        what: "x".into(),
+        detail: "y".into(),
+    };
+    let e = base.clone().attributed("q1", 2.0, "at most 1 mm");
+    assert_eq!(e.kind(), "OutOfDomain");
+    assert_eq!(e.field(), Some("q1"));
+    assert_eq!(e.cause(), &base);
+    assert!(
+        e.to_string()
+            .contains("most responsible: `q1` = 2: must be at most 1 mm")
+    );
+    assert_eq!(e.clone().at_index(3, None).field(), Some("q1[3]"));
+    assert_eq!(e.in_field("drivetrain").field(), Some("drivetrain.q1"));
+}

@@ -5,8 +5,7 @@ use paritysim_spec::continuation::{ContinuationRun, ContinuationSettings};
 use pyo3::prelude::*;
 
 use crate::convert::{bindings, from_json, to_py};
-use crate::errors::IntoPyResult;
-use crate::spec::parse;
+use crate::spec::{cancellable, parse};
 
 /// A continued branch, kept so that its bifurcations can be followed.
 #[pyclass(module = "paritysim._core", frozen)]
@@ -34,12 +33,15 @@ impl ContinuationOutput {
         max_step: Option<f64>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let run = &self.run;
-        let curve = py.detach(|| run.follow(index, second_path, second_start, stop, max_step));
-        to_py(py, &curve.py_err()?)
+        let curve = cancellable(py, || {
+            run.follow(index, second_path, second_start, stop, max_step)
+        })?;
+        to_py(py, &curve)
     }
 }
 
 bindings! {
+    run cancellable;
     class ContinuationOutput;
 
     /// Continues the periodic orbit of a JSON spec in `path` from `start` to `stop`.

@@ -11,17 +11,34 @@ use serde::de::DeserializeOwned;
 use serde_json::Value;
 
 /// Defines the module's `#[pyfunction]`s and its `register` (which also adds `class`es,
-/// `const`ants and hand-written `extra` functions). Each body runs with the GIL released and
-/// returns a `paritysim_error::Result`; with `-> T` the value converts as `T`, without, it is a
+/// `const`ants and hand-written `extra` functions). Each body runs with the GIL released (through
+/// `run`: [`detached`] by default, `crate::spec::cancellable` for long calls that Ctrl-C must
+/// stop) and returns a `paritysim_error::Result`; with `-> T` the value converts as `T`, without, it is a
 /// `Serialize` record converted by [`to_py`]. Array arguments are [`Floats`] / [`Table`].
 macro_rules! bindings {
+    (@fn $run:path; $(#[$attr:meta])* $name:ident($($arg:ident: $ty:ty),*) -> $ret:ty $body:block) => {
+        #[pyfunction]
+        $(#[$attr])*
+        fn $name(py: Python<'_>, $($arg: $ty),*) -> PyResult<$ret> {
+            $run(py, || -> paritysim_error::Result<$ret> { $body })
+        }
+    };
+    (@fn $run:path; $(#[$attr:meta])* $name:ident($($arg:ident: $ty:ty),*) $body:block) => {
+        #[pyfunction]
+        $(#[$attr])*
+        fn $name<'py>(py: Python<'py>, $($arg: $ty),*) -> PyResult<Bound<'py, PyAny>> {
+            let out = $run(py, || -> paritysim_error::Result<_> { $body })?;
+            $crate::convert::to_py(py, &out)
+        }
+    };
     (
+        run $run:path;
         $(class $class:ty;)*
         $(const $const_name:literal = $const_value:expr;)*
         $(extra $extra:ident;)*
         $($(#[$attr:meta])* fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)? $body:block)*
     ) => {
-        $(bindings!(@fn $(#[$attr])* $name($($arg: $ty),*) $(-> $ret)? $body);)*
+        $(bindings!(@fn $run; $(#[$attr])* $name($($arg: $ty),*) $(-> $ret)? $body);)*
 
         /// Adds this module's functions, classes and constants.
         pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -32,25 +49,20 @@ macro_rules! bindings {
             Ok(())
         }
     };
-    (@fn $(#[$attr:meta])* $name:ident($($arg:ident: $ty:ty),*) -> $ret:ty $body:block) => {
-        #[pyfunction]
-        $(#[$attr])*
-        fn $name(py: Python<'_>, $($arg: $ty),*) -> PyResult<$ret> {
-            $crate::errors::IntoPyResult::py_err(
-                py.detach(|| -> paritysim_error::Result<$ret> { $body }),
-            )
-        }
-    };
-    (@fn $(#[$attr:meta])* $name:ident($($arg:ident: $ty:ty),*) $body:block) => {
-        #[pyfunction]
-        $(#[$attr])*
-        fn $name<'py>(py: Python<'py>, $($arg: $ty),*) -> PyResult<Bound<'py, PyAny>> {
-            let out = py.detach(|| -> paritysim_error::Result<_> { $body });
-            $crate::convert::to_py(py, &$crate::errors::IntoPyResult::py_err(out)?)
-        }
+    // Without `run`: the GIL is released, Ctrl-C waits for the call (short calls).
+    ($($rest:tt)*) => {
+        bindings!(run $crate::convert::detached; $($rest)*);
     };
 }
 pub(crate) use bindings;
+
+/// Runs a short core call with the GIL released.
+pub(crate) fn detached<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> paritysim_error::Result<T> + Send,
+) -> PyResult<T> {
+    crate::errors::IntoPyResult::py_err(py.detach(work))
+}
 
 /// A contiguous copy-free view if possible, else an owned copy.
 pub fn to_vec(a: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {

@@ -22,6 +22,7 @@ fn class_name(err: &Error) -> &'static str {
         Error::Singular(_) => "SingularError",
         Error::Integration { .. } => "IntegrationError",
         Error::Cancelled => "CancelledError",
+        Error::Attributed { error, .. } => class_name(error),
     }
 }
 
@@ -53,7 +54,16 @@ fn build(py: Python<'_>, err: &Error) -> PyResult<PyErr> {
     let instance = class.call1((err.to_string(),))?;
     instance.setattr("kind", err.kind())?;
     instance.setattr("field", err.field())?;
-    match err {
+    if let Error::Attributed {
+        field,
+        value,
+        allowed,
+        ..
+    } = err
+    {
+        instance.setattr("problems", vec![(field.to_string(), value, allowed)])?;
+    }
+    match err.cause() {
         Error::Integration { time, state, .. } => {
             instance.setattr("time", *time)?;
             instance.setattr("state", state.clone())?;

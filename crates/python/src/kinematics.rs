@@ -47,7 +47,10 @@ impl PyDrivetrain {
     fn from_spec(json: &str) -> PyResult<Self> {
         let spec = paritysim_spec::drivetrain_from_json(json).py_err()?;
         Ok(Self {
-            inner: spec.kinematics().py_err()?,
+            inner: spec
+                .kinematics()
+                .map_err(|e| e.in_field("drivetrain"))
+                .py_err()?,
             spec,
         })
     }

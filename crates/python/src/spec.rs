@@ -7,6 +7,7 @@
 //! simulation).
 
 use numpy::PyArray1;
+use paritysim_dynamics::integrate::budget;
 use paritysim_dynamics::{CancelFlag, Device};
 use paritysim_error::Result;
 use paritysim_spec::watch::run_watched;
@@ -114,15 +115,28 @@ pub(crate) fn interruptible<T: Send>(
         .py_err()
 }
 
+/// Runs a long core call like [`interruptible`], with a fresh cancel flag installed as the
+/// call's budget (`budget::cancellable`): Ctrl-C reaches every integration it makes, on any
+/// thread, and raises `KeyboardInterrupt`.
+pub(crate) fn cancellable<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> Result<T> + Send,
+) -> PyResult<T> {
+    let cancel = CancelFlag::new();
+    let flag = cancel.clone();
+    interruptible(py, &cancel, move || budget::cancellable(&flag, work))
+}
+
 /// Simulates a JSON spec on a worker thread (GIL released); Ctrl-C stops it within a few
 /// tens of milliseconds and raises `KeyboardInterrupt`.
 #[pyfunction]
 fn simulate(py: Python<'_>, json: &str) -> PyResult<SimulationOutput> {
-    let (device, mut options) = parse(json).and_then(|s| s.model()).py_err()?;
+    let spec = parse(json).py_err()?;
+    let (device, mut options) = spec.model().py_err()?;
     let cancel = CancelFlag::new();
     options.cancel = Some(cancel.clone());
     let r = interruptible(py, &cancel, || {
-        paritysim_dynamics::simulate(&device, &options)
+        paritysim_dynamics::simulate(&device, &options).map_err(|e| spec.attribute(e))
     })?;
     let columns = PyDict::new(py);
     for (name, values) in r.trajectory.columns {

@@ -17,7 +17,7 @@ use pyo3::types::PyDict;
 
 use crate::convert::{Floats, bindings, from_json, to_vec};
 use crate::errors::IntoPyResult;
-use crate::spec::device as parse_device;
+use crate::spec::{cancellable, device as parse_device};
 
 fn c64(z: Complex<f64>) -> Complex64 {
     Complex64::new(z.re, z.im)
@@ -29,6 +29,7 @@ fn options<T: serde::de::DeserializeOwned + Default>(json: Option<&str>, field: 
 }
 
 bindings! {
+    run cancellable;
     extra stability_chart;
     extra stability_region;
     extra stability_lti_transfer;
@@ -141,9 +142,7 @@ fn stability_chart<'py>(
     kappa: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (beta0, kappa) = (to_vec(&beta0), to_vec(&kappa));
-    let c = py
-        .detach(|| floquet::stability_chart(&beta0, &kappa))
-        .py_err()?;
+    let c = cancellable(py, || floquet::stability_chart(&beta0, &kappa))?;
     // Up to 4M points: numpy columns straight from the vectors, not the generic converter.
     let (stable, region) = (c.stable(), c.region_numbers());
     let out = PyDict::new(py);

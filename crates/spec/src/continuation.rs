@@ -7,6 +7,7 @@ use paritysim_continuation::{
     continue_orbits,
 };
 use paritysim_dynamics::continuation::DevicePeriodMap;
+use paritysim_dynamics::integrate::budget;
 use paritysim_dynamics::simulate::orbit_metrics;
 use paritysim_dynamics::stability::{ShootingOptions, compact_state, expand_state, periodic_orbit};
 use paritysim_dynamics::{Device, SimulationOptions};
@@ -148,10 +149,12 @@ pub fn continue_path(
     let x0 = compact_state(first.n_dof(), &orbit.state);
     let branch = continue_orbits(&map, &x0, &[start], &options)?;
     let metrics = if settings.metrics {
+        let run_budget = budget::current();
         branch
             .points
             .par_iter()
             .map(|p| {
+                let _budget = run_budget.clone().map(budget::Budget::enter);
                 build(&[p.parameter])
                     .and_then(|d| {
                         orbit_metrics(&d, &expand_state(d.n_dof(), &p.state), &sim_options)

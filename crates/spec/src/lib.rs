@@ -13,6 +13,7 @@
 //! aero and constraints crates), never the reverse, so the engine stays free of serde.
 
 pub mod actuator;
+pub mod attribute;
 mod build;
 pub mod continuation;
 pub mod drivetrain;

@@ -414,13 +414,22 @@ fn run(plan: &SweepPlan, control: &SweepControl) -> Result<SweepOutcome> {
         .into_iter()
         .map(|slot| slot.unwrap_or(Err(Error::Cancelled)))
         .collect();
-    let slots = engine::run_points(
+    let mut slots = engine::run_points(
         &points,
         &plan.metrics,
         plan.keep_cycle,
         Some(plan.threads),
         control,
     )?;
+    // A point that failed while running names the field most responsible (its spec again).
+    for (i, slot) in slots.iter_mut().enumerate() {
+        if let Some(Err(e)) = slot
+            && e.field().is_none()
+            && let Ok(spec) = plan.point_spec(i)
+        {
+            *e = spec.attribute(e.clone());
+        }
+    }
     Ok(SweepOutcome::from_slots(
         &slots,
         plan.metrics.len(),

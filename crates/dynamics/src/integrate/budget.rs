@@ -112,6 +112,30 @@ impl Budget {
     }
 }
 
+/// The budget installed on the current thread (an outer run's), if any: hand it to
+/// [`carry`] inside parallel tasks so their integrations see the same deadline and cancel flag.
+pub fn current() -> Option<Budget> {
+    CURRENT.with(|c| c.borrow().clone())
+}
+
+/// Runs `work` under `budget` (from [`current`] on the spawning thread): a rayon task runs on
+/// another thread, where the thread-local budget of the run would otherwise be absent.
+pub fn carry<T>(budget: &Option<Budget>, work: impl FnOnce() -> T) -> T {
+    let _guard = budget.clone().map(Budget::enter);
+    work()
+}
+
+/// Runs `work` with `cancel` installed (no deadline of its own; an outer budget still
+/// applies): the one entry the bindings use to make any long call cancellable.
+///
+/// # Errors
+/// Those of `work`; [`Error::Cancelled`] when `cancel` is set before `work` starts.
+pub fn cancellable<T>(cancel: &CancelFlag, work: impl FnOnce() -> Result<T>) -> Result<T> {
+    let _guard = Budget::new(None, Some(cancel.clone())).enter();
+    check(0.0)?;
+    work()
+}
+
 /// Why the current thread's budget stops a run.
 pub(crate) enum Stop {
     Cancelled,

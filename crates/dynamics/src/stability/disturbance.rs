@@ -9,7 +9,7 @@ use paritysim_error::{Error, Result, bail, check_finite, check_positive};
 use rayon::prelude::*;
 
 use crate::device::{Device, DeviceSpec, Formulation, Transmission};
-use crate::integrate::{Integrator, Method, OdeSystem, RungeKutta, State};
+use crate::integrate::{Integrator, Method, OdeSystem, RungeKutta, State, budget};
 
 use super::*;
 
@@ -35,9 +35,11 @@ pub fn balance_stiffness_sweep(
     k2: &[f64],
     options: &ShootingOptions,
 ) -> Result<Vec<NonlinearFloquet>> {
+    let run_budget = budget::current();
     k2.par_iter()
         .enumerate()
         .map(|(i, &k)| {
+            let _budget = run_budget.clone().map(budget::Budget::enter);
             let run = || -> Result<NonlinearFloquet> {
                 let device = Device::new(with_balance_stiffness(spec, k)?)?;
                 floquet(&device, options)
@@ -477,7 +479,11 @@ pub fn disturbance_response(
         }
         Ok(acc.map(|a| a * (2.0 / n as f64)))
     };
-    let (plus, minus) = rayon::join(|| run(1.0), || run(-1.0));
+    let run_budget = budget::current();
+    let (plus, minus) = rayon::join(
+        || budget::carry(&run_budget, || run(1.0)),
+        || budget::carry(&run_budget, || run(-1.0)),
+    );
     let (plus, minus) = (plus?, minus?);
     // d(t) = A sin(ωt) has complex amplitude −iA under the same projection.
     let [first, transfer] =
@@ -510,10 +516,12 @@ pub fn disturbance_responses(
     amplitude: f64,
     options: &DisturbanceOptions,
 ) -> Result<Vec<DisturbanceResponse>> {
+    let run_budget = budget::current();
     frequencies_hz
         .par_iter()
         .enumerate()
         .map(|(i, &f)| {
+            let _budget = run_budget.clone().map(budget::Budget::enter);
             disturbance_response(device, orbit, f, amplitude, options)
                 .map_err(|e| e.at_index(i, Some("frequency_hz")))
         })

@@ -7,6 +7,8 @@ use nalgebra::{Complex, Matrix2};
 use paritysim_error::{Error, Result, bail, check_finite};
 use rayon::prelude::*;
 
+use crate::integrate::budget;
+
 /// Highest Taylor coefficient kept per step of the eq. 2.25 integrator. The solutions are
 /// entire, but `cos` grows like `cosh` off the real axis, so the Taylor coefficients decay
 /// only like `e^{|β0| cosh r} / r^n` (Cauchy); with steps `h = STEP/λ` the truncation stays at
@@ -360,10 +362,14 @@ pub fn stability_chart(beta0: &[f64], kappa: &[f64]) -> Result<StabilityChart> {
         check_hill(0.0, k).map_err(|e| e.at_index(j, Some("kappa")))?;
     }
     let nk = kappa.len();
+    // A chart of millions of points runs for seconds: each point checks the caller's budget
+    // (its cancel flag) on whichever pool thread computes it.
+    let run_budget = budget::current();
     let points: Vec<HillFloquet> = (0..n)
         .into_par_iter()
         .with_min_len(64)
         .map(|idx| {
+            budget::carry(&run_budget, || budget::check(0.0))?;
             hill_floquet(beta0[idx / nk], kappa[idx % nk]).map_err(|e| e.at_index(idx, None))
         })
         .collect::<Result<_>>()?;

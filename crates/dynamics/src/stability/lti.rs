@@ -119,7 +119,8 @@ impl LtiModel {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`](paritysim_error::Error::InvalidParameter) for a negative or non-finite frequency;
-    /// [`Error::Singular`](paritysim_error::Error::Singular) at ω = 0 when κ0 = 0 (0/0).
+    /// [`Error::Singular`](paritysim_error::Error::Singular) at ω = 0 when κ0 = 0 (0/0),
+    /// attributed to `frequency_hz`.
     pub fn transfer(&self, frequency_hz: f64) -> Result<Complex<f64>> {
         if !(frequency_hz.is_finite() && frequency_hz >= 0.0) {
             bail!(invalid "frequency_hz", frequency_hz, "finite and >= 0");
@@ -127,7 +128,15 @@ impl LtiModel {
         let w = 2.0 * PI * frequency_hz * 1e-3;
         let den = Complex::new(self.kappa0 - w * w, self.beta_star * w);
         if den.norm() == 0.0 {
-            bail!(Singular "eq. 2.59 is 0/0 at f = 0 Hz with kappa0 = 0");
+            return Err(paritysim_error::Error::Singular(format!(
+                "eq. 2.59 is 0/0 at f = {frequency_hz} Hz with kappa0 = {}",
+                self.kappa0
+            ))
+            .attributed(
+                "frequency_hz",
+                frequency_hz,
+                "> 0 Hz (large enough that 2 pi f beta_star does not underflow) when kappa0 = 0",
+            ));
         }
         // κ0 / den by its polar form: the textbook quotient squares |den| and under- or
         // overflows for extreme but finite inputs (1e-300 or 1e308 gave NaN).

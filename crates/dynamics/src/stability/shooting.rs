@@ -7,7 +7,7 @@ use paritysim_error::{Error, Result, bail, check_positive};
 use rayon::prelude::*;
 
 use crate::device::{Device, Formulation};
-use crate::integrate::{Integrator, Method, OdeSystem, RungeKutta, State};
+use crate::integrate::{Integrator, Method, OdeSystem, RungeKutta, State, budget};
 
 use super::*;
 
@@ -224,9 +224,11 @@ pub fn map_jacobian(
 ) -> Result<DMatrix<f64>> {
     let steps = fd_steps(n, y, fd_step);
     let base = compact(n, y);
+    let run_budget = budget::current();
     let columns: Vec<DVector<f64>> = (0..2 * n)
         .into_par_iter()
         .map(|j| {
+            let _budget = run_budget.clone().map(budget::Budget::enter);
             let mut plus = base.clone();
             let mut minus = base.clone();
             plus[j] += steps[j];
@@ -548,7 +550,11 @@ pub fn floquet(device: &Device, options: &ShootingOptions) -> Result<NonlinearFl
             options.fd_step,
         )
     };
-    let (monodromy, coarse) = rayon::join(variational, differences);
+    let run_budget = budget::current();
+    let (monodromy, coarse) = rayon::join(
+        || budget::carry(&run_budget, variational),
+        || budget::carry(&run_budget, differences),
+    );
     let (monodromy, coarse) = (monodromy?, coarse?);
     let monodromy_uncertainty = (&monodromy - coarse).amax();
     let multipliers = eigenvalues(&monodromy)?;
