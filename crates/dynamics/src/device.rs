@@ -142,6 +142,10 @@ pub struct Device {
     stroke_plane: [bool; 2],
 }
 
+/// Stroke angles `(φL, φR)`, their rates and the whippletree angle `q2` (see
+/// [`Device::stroke_state`]).
+pub type StrokeState = (Vector2<f64>, Vector2<f64>, f64);
+
 /// The drivetrain state recovered from the stroke angles.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct DriveState {
@@ -328,6 +332,21 @@ impl Device {
         (
             Vector2::new(y.coords[0], if two { y.coords[1] } else { 0.0 }),
             Vector2::new(y.rates[0], if two { y.rates[1] } else { 0.0 }),
+        )
+    }
+
+    /// `(φ, φ̇, q2)`: stroke angles, stroke rates and `q2` of a drivetrain-coordinate state (`None` for other
+    /// formulations): the forward map only.
+    ///
+    /// # Errors
+    /// A drivetrain evaluation outside the linkage's domain.
+    pub fn stroke_state(&self, y: &State) -> Option<Result<StrokeState>> {
+        self.stroke_only.as_ref()?;
+        let (q, q_dot) = self.drive_coordinates(y);
+        Some(
+            self.drivetrain()
+                .evaluate(q.x, q.y)
+                .map(|e| (e.stroke, e.jacobian * q_dot, q.y)),
         )
     }
 
@@ -563,9 +582,16 @@ impl Device {
             aero_power += tau_aero * phi_dot[k];
         }
         let q_ddot = if self.n_dof == 2 {
-            mass.lu()
-                .solve(&generalized)
-                .ok_or_else(|| singular_drive(&q))?
+            // Cramer's rule on the 2×2 symmetric positive mass matrix (a third of an LU's
+            // instructions in the right-hand side).
+            let det = mass[(0, 0)] * mass[(1, 1)] - mass[(0, 1)] * mass[(1, 0)];
+            if det == 0.0 || !det.is_finite() {
+                return Err(singular_drive(&q));
+            }
+            Vector2::new(
+                (mass[(1, 1)] * generalized.x - mass[(0, 1)] * generalized.y) / det,
+                (mass[(0, 0)] * generalized.y - mass[(1, 0)] * generalized.x) / det,
+            )
         } else {
             Vector2::new(generalized.x / mass[(0, 0)], 0.0)
         };

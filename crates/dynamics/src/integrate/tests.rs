@@ -64,6 +64,7 @@ fn step_and_dense_errors(
             0.0,
             y0,
             t_end,
+            None,
             &times,
             &mut |_, t, y| {
                 dense = dense.max(err(t, y));
