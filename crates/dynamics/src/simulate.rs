@@ -364,6 +364,12 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
     })
 }
 
+/// Shooting results whose largest Floquet multiplier exceeds `1 + UNSTABLE_MARGIN` are
+/// unstable orbits, which a run never settles on: [`SteadyState::Shooting`] then falls back to
+/// the transient (the margin covers the error of the Broyden-updated Jacobian; K2 = 0's neutral
+/// multiplier 1 stays a steady state).
+pub const UNSTABLE_MARGIN: f64 = 1e-2;
+
 /// What [`shooting_steady_state`] found.
 struct ShotSteadyState {
     state: State,
@@ -456,10 +462,24 @@ fn shooting_steady_state(
     };
     cycles += orbit.periods;
     let multipliers = crate::floquet::eigenvalues(&orbit.jacobian).unwrap_or_default();
+    if multipliers
+        .first()
+        .is_some_and(|m| m.norm() > 1.0 + UNSTABLE_MARGIN)
+    {
+        // An unstable orbit is not a state a run settles on: the transient decides.
+        return Ok(None);
+    }
+    let t = cycles as f64 * period;
+    if let Some((trajectory, _)) = &mut recorded {
+        // The window was integrated on the section t = 0; the drive is T-periodic, so it is
+        // the window after the cycles run, labelled as such.
+        for time in &mut trajectory.time {
+            *time += t;
+        }
+    }
     Ok(Some(ShotSteadyState {
         state: orbit.state,
-        // The recorded window starts on the section t = 0 of the grid.
-        t: if records { 0.0 } else { cycles as f64 * period },
+        t,
         cycles_run: cycles,
         residual: orbit.residual,
         jacobian: orbit.jacobian,
@@ -555,11 +575,11 @@ fn record_window(
     let mut metrics = MetricsAccumulator::new(device, period);
     let mut recorder = Recorder::new(columns, times.len());
     let mut sink = |i: usize, t: f64, y: &State| -> Result<()> {
+        // `stroke` is only set for drivetrain-coordinate devices (see `stroke_sampling`).
         if let Some(with_force) = stroke {
-            if let Some(sample) = StrokeSample::new(device, t, y, with_force) {
-                metrics.add_stroke(&sample?, i == n_samples);
-                return Ok(());
-            }
+            let sample = StrokeSample::of_stroke_device(device, t, y, with_force)?;
+            metrics.add_stroke(&sample, i == n_samples);
+            return Ok(());
         }
         let sample = Sample::new(device, t, y)?;
         metrics.add(&sample, i == n_samples);

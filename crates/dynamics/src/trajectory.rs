@@ -98,10 +98,19 @@ impl StrokeSample {
     /// # Errors
     /// A drivetrain evaluation outside the linkage's domain.
     pub fn new(device: &Device, time: f64, y: &State, with_force: bool) -> Option<Result<Self>> {
-        let (stroke, rate, q2) = match device.stroke_state(y)? {
-            Ok(s) => s,
-            Err(e) => return Some(Err(e)),
-        };
+        device.stroke_state(y)?.ok()?;
+        Some(Self::of_stroke_device(device, time, y, with_force))
+    }
+
+    /// [`Self::new`] for a device known to integrate drivetrain coordinates.
+    #[inline]
+    pub(crate) fn of_stroke_device(
+        device: &Device,
+        time: f64,
+        y: &State,
+        with_force: bool,
+    ) -> Result<Self> {
+        let (stroke, rate, q2) = device.stroke_state_unchecked(y)?;
         let wings = &device.spec().wings;
         let right = wings[1].aero().stroke_torque(rate.y);
         // The left wing's roll axis is mirrored through the sagittal plane.
@@ -110,13 +119,13 @@ impl StrokeSample {
             (Some(a), true) => a.force(time),
             _ => 0.0,
         };
-        Some(Ok(Self {
+        Ok(Self {
             time,
             stroke,
             roll_aero: [left, right],
             actuator_force,
             q2,
-        }))
+        })
     }
 }
 
