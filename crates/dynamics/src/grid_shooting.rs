@@ -33,6 +33,8 @@ pub(crate) struct GridOrbit {
     pub jacobian: DMatrix<f64>,
     /// Period integrations before the final one.
     pub periods: usize,
+    /// The step grid (from 0 to the period).
+    pub grid: Vec<f64>,
 }
 
 fn compact(n: usize, y: &State) -> DVector<f64> {
@@ -83,6 +85,7 @@ pub(crate) fn shoot(
     period: f64,
     y0: &State,
     guess: Option<&DMatrix<f64>>,
+    guess_grid: Option<&[f64]>,
     tol: f64,
     accept_tol: f64,
     max_newton: usize,
@@ -93,11 +96,27 @@ pub(crate) fn shoot(
     let n = device.n_dof();
     let m = 2 * n;
     let mut y = y0.without_work();
-    let first = match guess.filter(|j| j.shape() == (m, m)) {
-        Some(j) => chooser
+    let guess = guess.filter(|j| j.shape() == (m, m));
+    // A neighbour's grid is kept while every step's error estimate stays within the grid
+    // tolerances: the first map then costs one fixed-grid period instead of an adaptive one.
+    let inherited = match (guess, guess_grid) {
+        (Some(j), Some(grid)) if grid.first() == Some(&0.0) && grid.last() == Some(&period) => {
+            match chooser.integrate_on_grid_counted(device, grid, &y, &[], &mut |_, _, _| Ok(())) {
+                Ok((py, stats)) if stats.over_tolerance == 0 => {
+                    Some(Ok((py, j.clone(), grid.to_vec(), false)))
+                }
+                Err(Error::Cancelled) => Some(Err(Error::Cancelled)),
+                _ => None,
+            }
+        }
+        _ => None,
+    };
+    let first = match (inherited, guess) {
+        (Some(done), _) => done,
+        (None, Some(j)) => chooser
             .advance_with_steps(device, 0.0, &y, period)
             .map(|(py, grid)| (py, j.clone(), grid, false)),
-        None => chooser
+        (None, None) => chooser
             .flow_with_sensitivity_and_steps(device, 0.0, &y, period)
             .map(|(py, j, grid)| (py, j, grid, true)),
     };
@@ -160,6 +179,7 @@ pub(crate) fn shoot(
                 residual: res_new,
                 jacobian: jac,
                 periods: periods - 1,
+                grid,
             }));
         }
         if res_new >= res || res_new.is_nan() {

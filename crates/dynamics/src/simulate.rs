@@ -90,6 +90,9 @@ pub struct SimulationOptions {
     /// neighbour's [`SimulationResult::monodromy`] in a sweep chain): shooting then skips the
     /// warm-up and the variational period. Ignored by the transient.
     pub shooting_jacobian: Option<nalgebra::DMatrix<f64>>,
+    /// With [`Self::shooting_jacobian`]: a neighbour's step grid over one period
+    /// ([`SimulationResult::step_grid`]), reused while its steps meet the tolerances.
+    pub shooting_grid: Option<Vec<f64>>,
     /// Wall-clock budget of one run (ms; None: unlimited), checked inside integration: past
     /// it the run fails with an [`Error::Integration`] naming `options.max_wall_ms`.
     pub max_wall_ms: Option<f64>,
@@ -120,6 +123,7 @@ impl Default for SimulationOptions {
             metrics: None,
             steady_state: SteadyState::Transient,
             shooting_jacobian: None,
+            shooting_grid: None,
             max_wall_ms: Some(DEFAULT_MAX_WALL_MS),
             cancel: None,
         }
@@ -154,6 +158,8 @@ pub struct SimulationResult {
     /// The Jacobian of the stroboscopic map the shooting ended with (exact or
     /// Broyden-updated; `None` for transient runs): the multipliers are its eigenvalues.
     pub monodromy: Option<nalgebra::DMatrix<f64>>,
+    /// The shooting's step grid over one period (empty for transient runs).
+    pub step_grid: Vec<f64>,
 }
 
 fn validate(options: &SimulationOptions) -> Result<()> {
@@ -269,6 +275,7 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
     let mut residual = f64::NAN;
     let mut multipliers = Vec::new();
     let mut monodromy = None;
+    let mut step_grid = Vec::new();
     // The recorded window when the shooting's last period already was it.
     let mut recorded: Option<(Trajectory, Vec<(String, f64)>)> = None;
     let stroke = stroke_sampling(device, options.metrics.as_deref(), &columns);
@@ -284,6 +291,7 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
                         (found.state, found.t, found.cycles_run, found.residual, true);
                     multipliers = found.multipliers;
                     monodromy = Some(found.jacobian);
+                    step_grid = found.grid;
                     recorded = found.recorded;
                     transient_needed = false;
                 }
@@ -361,6 +369,7 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
         steady_state: y,
         multipliers,
         monodromy,
+        step_grid,
     })
 }
 
@@ -378,6 +387,7 @@ struct ShotSteadyState {
     cycles_run: usize,
     residual: f64,
     jacobian: nalgebra::DMatrix<f64>,
+    grid: Vec<f64>,
     multipliers: Vec<nalgebra::Complex<f64>>,
     /// The recorded window, when the last Newton period recorded it.
     recorded: Option<(Trajectory, Vec<(String, f64)>)>,
@@ -452,6 +462,7 @@ fn shooting_steady_state(
         period,
         &y,
         guess,
+        options.shooting_grid.as_deref(),
         tol,
         options.steady_tol,
         20,
@@ -483,6 +494,7 @@ fn shooting_steady_state(
         cycles_run: cycles,
         residual: orbit.residual,
         jacobian: orbit.jacobian,
+        grid: orbit.grid,
         multipliers,
         recorded,
     }))

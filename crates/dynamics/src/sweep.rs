@@ -258,6 +258,8 @@ pub struct PointOutput {
     pub steady_state: Option<(Vec6, Vec6)>,
     /// The shooting's Jacobian of the stroboscopic map (the next point's Newton guess).
     pub monodromy: Option<nalgebra::DMatrix<f64>>,
+    /// The shooting's step grid (the next point's, while it meets the tolerances).
+    pub step_grid: Vec<f64>,
 }
 
 /// Simulates one point and keeps what the sweep asked for.
@@ -317,11 +319,18 @@ pub fn run_point(
         residual: result.residual,
         steady_state: device.coordinates(&result.steady_state).ok(),
         monodromy: result.monodromy,
+        step_grid: result.step_grid,
     })
 }
 
-/// A converged point of a continuation chain: its index, `(p, ṗ)` and shooting Jacobian.
-type Converged = (usize, (Vec6, Vec6), Option<nalgebra::DMatrix<f64>>);
+/// A converged point of a continuation chain: its index, `(p, ṗ)`, shooting Jacobian and step
+/// grid.
+type Converged = (
+    usize,
+    (Vec6, Vec6),
+    Option<nalgebra::DMatrix<f64>>,
+    Vec<f64>,
+);
 
 /// The start of point `i` of a chain from its converged predecessors: the secant (linear)
 /// extrapolation `2 y₁ − y₀` of state and Jacobian when the two previous points converged
@@ -332,7 +341,7 @@ fn predict(
     i: usize,
 ) -> (Option<(Vec6, Vec6)>, Option<nalgebra::DMatrix<f64>>) {
     match previous {
-        [.., (i0, s0, j0), (i1, s1, j1)] if *i1 + 1 == i && *i0 + 2 == i => {
+        [.., (i0, s0, j0, _), (i1, s1, j1, _)] if *i1 + 1 == i && *i0 + 2 == i => {
             let state = (2.0 * s1.0 - s0.0, 2.0 * s1.1 - s0.1);
             let jacobian = match (j0, j1) {
                 (Some(a), Some(b)) if a.shape() == b.shape() => Some(2.0 * b - a),
@@ -340,7 +349,7 @@ fn predict(
             };
             (Some(state), jacobian)
         }
-        [.., (_, s1, j1)] => (Some(*s1), j1.clone()),
+        [.., (_, s1, j1, _)] => (Some(*s1), j1.clone()),
         [] => (None, None),
     }
 }
@@ -384,6 +393,10 @@ pub fn run_points(
         let mut out = Vec::with_capacity(range.len());
         for i in range {
             let (guess, jacobian) = predict(&previous, i);
+            let grid = previous
+                .last()
+                .map(|c| c.3.clone())
+                .filter(|g| !g.is_empty());
             let result = match &points[i] {
                 Ok((device, options)) => {
                     let started = match guess {
@@ -391,6 +404,7 @@ pub fn run_points(
                             let options = SimulationOptions {
                                 initial: Some(initial),
                                 shooting_jacobian: jacobian,
+                                shooting_grid: grid,
                                 ..options.clone()
                             };
                             run_point(device, &options, metric_names, keep_cycle)
@@ -412,7 +426,7 @@ pub fn run_points(
                     if previous.len() == 2 {
                         previous.remove(0);
                     }
-                    previous.push((i, state, o.monodromy.clone()));
+                    previous.push((i, state, o.monodromy.clone(), o.step_grid.clone()));
                 }
             }
             out.push(result);

@@ -230,6 +230,18 @@ impl LinearDifferential {
         })
     }
 
+    /// Eq. 2.15 at `(q1, q2)`: constant Jacobian, no second derivatives.
+    #[inline]
+    pub fn evaluate(&self, q1: f64, q2: f64) -> DrivetrainEval {
+        let t = self.transmission_ratio;
+        let j = Matrix2::new(-t, t * self.left_arm, -t, -t * self.right_arm);
+        DrivetrainEval {
+            stroke: j * Vector2::new(q1, q2),
+            jacobian: j,
+            hessian: [Matrix2::zeros(); 2],
+        }
+    }
+
     /// `T` (rad/mm).
     pub fn transmission_ratio(&self) -> f64 {
         self.transmission_ratio
@@ -316,6 +328,16 @@ impl Drivetrain {
             check_offset_mm("q1", q1)?;
             check_angle_rad("q2", q2)?;
         }
+        // The linear map inline (it sits in every right-hand side and sample); the linkages,
+        // with their trigonometry and Newton solves, out of line.
+        match self {
+            Drivetrain::LinearDifferential(d) => Ok(d.evaluate(q1, q2)),
+            _ => self.evaluate_linkage(q1, q2),
+        }
+    }
+
+    #[inline(never)]
+    fn evaluate_linkage(&self, q1: f64, q2: f64) -> Result<DrivetrainEval> {
         match self {
             Drivetrain::HmfFourBar(d) => {
                 let (phi, grad, hess) = d.side.side_stroke(q1, 0.0, 0.0, 1.0)?;
@@ -326,15 +348,6 @@ impl Drivetrain {
                     stroke: Vector2::new(phi, phi),
                     jacobian: j,
                     hessian: [h, h],
-                })
-            }
-            Drivetrain::LinearDifferential(d) => {
-                let t = d.transmission_ratio;
-                let j = Matrix2::new(-t, t * d.left_arm, -t, -t * d.right_arm);
-                Ok(DrivetrainEval {
-                    stroke: j * Vector2::new(q1, q2),
-                    jacobian: j,
-                    hessian: [Matrix2::zeros(); 2],
                 })
             }
             Drivetrain::LinkageDifferential(d) => {
@@ -349,6 +362,7 @@ impl Drivetrain {
                     hessian: [hl, hr],
                 })
             }
+            Drivetrain::LinearDifferential(d) => Ok(d.evaluate(q1, q2)),
         }
     }
 }

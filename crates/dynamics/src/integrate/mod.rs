@@ -97,6 +97,9 @@ pub struct IntegrationStats {
     pub rejected: usize,
     /// Accepted steps on which the dense output was prepared (a sample fell inside).
     pub dense_steps: usize,
+    /// Fixed-grid steps whose local error estimate exceeded the tolerances (always 0 for
+    /// adaptive runs, which reject such steps): 0 means the grid still suits the solution.
+    pub over_tolerance: usize,
 }
 
 /// Receives the samples of an integration: `(index in times, time, state)`.
@@ -265,6 +268,23 @@ impl RungeKutta {
         times: &[f64],
         sink: &mut Sink<'_>,
     ) -> Result<State> {
+        self.integrate_on_grid_counted(system, grid, y0, times, sink)
+            .map(|(y, _)| y)
+    }
+
+    /// [`Self::integrate_on_grid`] with the step counters; `over_tolerance` counts the steps
+    /// whose local error estimate exceeds this integrator's tolerances.
+    ///
+    /// # Errors
+    /// As [`Self::integrate_on_grid`].
+    pub fn integrate_on_grid_counted(
+        &self,
+        system: &dyn OdeSystem,
+        grid: &[f64],
+        y0: &State,
+        times: &[f64],
+        sink: &mut Sink<'_>,
+    ) -> Result<(State, IntegrationStats)> {
         check_grid(grid)?;
         let (t0, t_end) = (grid[0], grid[grid.len() - 1]);
         self.dispatch(
@@ -277,7 +297,6 @@ impl RungeKutta {
             sink,
             &mut |_, _| {},
         )
-        .map(|(y, _)| y)
     }
 
     /// Checks the interval and samples, then runs [`Self::solve`] on the array size of the
@@ -725,6 +744,9 @@ fn drive_on_grid<const M: usize, S: Stepper<M>>(
                 &rhs.expand(&y),
                 "non-finite state on a fixed step",
             ));
+        }
+        if err > 1.0 {
+            stats.over_tolerance += 1;
         }
         stats.accepted += 1;
         stepper.new_derivative(rhs, t_new, &mut f1)?;
