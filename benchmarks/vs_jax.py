@@ -12,6 +12,8 @@ residual of 1e-11 at rtol 1e-12; checked against a 1e-12 long transient on a few
 The script peers run a fixed number of cycles from rest (``--cycles``), as a script would.
 
 Run:  python benchmarks/vs_jax.py [--grid 32] [--cycles 60] [--scipy-points 4] [--repeat 3]
+      python benchmarks/vs_jax.py --scale 100000   # peak RSS of 100,000 Table 3.2 points, and
+                                                   # the 1- vs 2-thread speedup (same results?)
 JAX and diffrax are the optional ``bench`` extra (``pip install -e .[bench]``); without them
 the JAX rows are skipped and the script says so.
 """
@@ -47,7 +49,7 @@ def spec(rtol: float = 1e-8, atol: float = 1e-10, samples: int = 4000, steady_st
     return ps.Simulation(
         wings=(wing(OMEGA_R), wing(OMEGA_R)),
         configuration=ps.Configuration("drag_parity_fixed"),
-        drivetrain=ps.Drivetrain.linear_differential(T_RATIO, ARM, balance_stiffness=0.0),
+        drivetrain=ps.Drivetrain.linear_differential(T_RATIO, ARM, balance_spring=0.0),
         actuator=ps.Actuator(ps.Waveform(amplitude_v=AMPLITUDE_V, frequency_hz=FREQUENCY_HZ), FORCE_PER_VOLT, K1),
         options=ps.Options(rtol=rtol, atol=atol, samples_per_cycle=samples, steady_state=steady_state),
     )
@@ -175,6 +177,37 @@ def timed(f: Callable[[], np.ndarray]) -> tuple[float, np.ndarray]:
     return time.perf_counter() - start, out
 
 
+def scale(points: int, threads: int) -> None:
+    """Peak memory of a large metrics-only sweep, then 1 vs 2 threads on the 32 × 32 grid."""
+    import resource
+
+    side = int(math.ceil(math.sqrt(points)))
+    ratios, k2s = np.linspace(0.3, 1.0, side), np.linspace(0.0, 100.0, side)
+    start = time.perf_counter()
+    out = ps_sweep(ratios, k2s, spec(), threads)
+    wall = time.perf_counter() - start
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    print(f"[scale] {len(out)} points, Table 3.2 metrics (shooting, 4000 samples): {wall:.1f} s wall "
+          f"({wall / len(out) * 1e3:.3f} ms/pt, {threads} threads); peak RSS {rss:.0f} MB (target < 300 MB)")  # fmt: skip
+    ratios, k2s = np.linspace(0.3, 1.0, 32), np.linspace(0.0, 100.0, 32)
+    def cpu() -> float:
+        r = resource.getrusage(resource.RUSAGE_SELF)
+        return r.ru_utime + r.ru_stime
+
+    def run(n: int) -> tuple[float, float, np.ndarray]:
+        c0 = cpu()
+        wall, out = timed(lambda: ps_sweep(ratios, k2s, spec(), n))
+        return wall, cpu() - c0, out
+
+    rounds = [(run(1), run(2)) for _ in range(3)]
+    t1 = statistics.median(r[0][0] for r in rounds)
+    t2 = statistics.median(r[1][0] for r in rounds)
+    cores = statistics.median(r[1][1] / r[1][0] for r in rounds)
+    same = all(np.array_equal(a[2], b[2]) for a, b in rounds)
+    print(f"[threads] 1024 points: 1 thread {t1:.2f} s, 2 threads {t2:.2f} s -> speedup {t1 / t2:.2f}x (target >= 1.8; "
+          f"medians of 3 interleaved rounds; the 2-thread runs got {cores:.2f} cores); bit-identical: {same}")  # fmt: skip
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--grid", type=int, default=32, help="points per axis")
@@ -184,7 +217,11 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--rtol", type=float, default=1e-8)
+    parser.add_argument("--scale", type=int, default=0, help="run only the memory / thread-scaling check with this many points")
     args = parser.parse_args()
+    if args.scale:
+        scale(args.scale, args.threads)
+        return
     atol = args.rtol * 1e-2
     ratios = np.linspace(0.3, 1.0, args.grid)
     k2s = np.linspace(0.0, 100.0, args.grid)

@@ -142,6 +142,10 @@ pub struct Device {
     stroke_plane: [bool; 2],
 }
 
+/// Stroke angles `(φL, φR)`, their rates and the whippletree angle `q2` (see
+/// [`Device::stroke_state`]).
+pub type StrokeState = (Vector2<f64>, Vector2<f64>, f64);
+
 /// The drivetrain state recovered from the stroke angles.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct DriveState {
@@ -329,6 +333,21 @@ impl Device {
             Vector2::new(y.coords[0], if two { y.coords[1] } else { 0.0 }),
             Vector2::new(y.rates[0], if two { y.rates[1] } else { 0.0 }),
         )
+    }
+
+    /// `(φ, φ̇, q2)`: stroke angles, stroke rates and `q2` of a drivetrain-coordinate state
+    /// (the forward map only); `None` for other formulations.
+    pub fn stroke_state(&self, y: &State) -> Option<Result<StrokeState>> {
+        self.stroke_only.as_ref()?;
+        Some(self.stroke_state_unchecked(y))
+    }
+
+    /// [`Self::stroke_state`] for a device known to integrate drivetrain coordinates.
+    #[inline]
+    pub(crate) fn stroke_state_unchecked(&self, y: &State) -> Result<StrokeState> {
+        let (q, q_dot) = self.drive_coordinates(y);
+        let e = self.drivetrain().evaluate(q.x, q.y)?;
+        Ok((e.stroke, e.jacobian * q_dot, q.y))
     }
 
     /// Actuator force `F(t)`, drivetrain load `Q = (F − K1 q1, −K2 q2)` and its spring energy
@@ -549,25 +568,34 @@ impl Device {
         let phi_dot = eval.jacobian * q_dot;
         let h = eval.velocity_product(&q_dot);
         let (force, load, potential) = self.drive_load(t, &q);
-        let mut mass = Matrix2::zeros();
-        let mut generalized = load;
+        // M_q = Σ_k I_k J_kᵀ J_k and Q = load + Σ_k J_kᵀ τ_k in scalars (J_k = row k of J):
+        // the nalgebra 2×2 temporaries cost more than the arithmetic here.
+        let j = &eval.jacobian;
+        let (mut m00, mut m01, mut m11) = (0.0, 0.0, 0.0);
+        let (mut g0, mut g1) = (load.x, load.y);
         let mut aero_power = 0.0;
         for k in 0..2 {
             let wing = &self.spec.wings[k];
-            let row = eval.jacobian.row(k).transpose();
+            let (a, b) = (j[(k, 0)], j[(k, 1)]);
             let inertia = fast.stroke_inertia[k];
             let tau_aero = wing.aero().stroke_torque(phi_dot[k]);
             let tau = tau_aero - wing.springs()[0].torque(eval.stroke[k]) - inertia * h[k];
-            mass += row * row.transpose() * inertia;
-            generalized += row * tau;
+            m00 += inertia * a * a;
+            m01 += inertia * a * b;
+            m11 += inertia * b * b;
+            g0 += a * tau;
+            g1 += b * tau;
             aero_power += tau_aero * phi_dot[k];
         }
         let q_ddot = if self.n_dof == 2 {
-            mass.lu()
-                .solve(&generalized)
-                .ok_or_else(|| singular_drive(&q))?
+            // Cramer's rule on the 2×2 symmetric positive mass matrix.
+            let det = m00 * m11 - m01 * m01;
+            if det == 0.0 || !det.is_finite() {
+                return Err(singular_drive(&q));
+            }
+            Vector2::new((m11 * g0 - m01 * g1) / det, (m00 * g1 - m01 * g0) / det)
         } else {
-            Vector2::new(generalized.x / mass[(0, 0)], 0.0)
+            Vector2::new(g0 / m00, 0.0)
         };
         Ok(DrivetrainStep {
             eval,

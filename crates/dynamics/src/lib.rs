@@ -18,6 +18,7 @@
 pub mod actuator;
 pub mod continuation;
 pub mod device;
+mod grid_shooting;
 pub mod integrate;
 pub mod metrics;
 pub mod simulate;

@@ -22,7 +22,7 @@
 use std::f64::consts::{PI, TAU};
 
 use crate::device::Device;
-use crate::trajectory::Sample;
+use crate::trajectory::{Sample, StrokeSample};
 
 const AXES: [&str; 3] = ["roll", "yaw", "pitch"];
 
@@ -43,9 +43,15 @@ impl Default for Range {
 }
 
 impl Range {
+    /// Ignores NaN, as `f64::min`/`max` do (plain comparisons: fewer instructions per sample).
+    #[inline]
     fn add(&mut self, v: f64) {
-        self.lo = self.lo.min(v);
-        self.hi = self.hi.max(v);
+        if v < self.lo {
+            self.lo = v;
+        }
+        if v > self.hi {
+            self.hi = v;
+        }
     }
     fn span(&self) -> f64 {
         self.hi - self.lo
@@ -64,6 +70,7 @@ struct Stats {
 }
 
 impl Stats {
+    #[inline]
     fn add(&mut self, v: f64, in_body: bool) {
         self.range.add(v);
         if in_body {
@@ -106,6 +113,50 @@ pub struct MetricsAccumulator {
     last_time: f64,
     work_actuator: f64,
     work_aero: f64,
+    /// Fed with [`StrokeSample`]s only: the metrics outside [`is_stroke_metric`] are NaN.
+    stroke_only: bool,
+}
+
+/// The per-sample values every metric path shares.
+struct Core {
+    time: f64,
+    phi: [f64; 2],
+    psi: [f64; 2],
+    roll_aero: [f64; 2],
+    force: f64,
+    q2: f64,
+}
+
+/// Metrics a [`StrokeSample`] suffices for (fixed wings in drivetrain coordinates): stroke
+/// angles, drag roll torques, Table 3.2, `q2_amplitude`, `actuator_force_peak` (the rotation
+/// metrics are those of ψ ≡ 0).
+pub fn is_stroke_metric(name: &str) -> bool {
+    const WING: [&str; 8] = [
+        "stroke_amplitude",
+        "stroke_peak_to_peak",
+        "stroke_mean",
+        "rotation_amplitude",
+        "rotation_mean",
+        "rotation_phase_lag",
+        "roll_aero_peak",
+        "roll_aero_mean",
+    ];
+    const DEVICE: [&str; 7] = [
+        "actuator_force_peak",
+        "q2_amplitude",
+        "delta_tau_peak",
+        "tau_l_peak",
+        "tau_r_peak",
+        "imbalance_instantaneous_pct",
+        "imbalance_peak_pct",
+    ];
+    let wing = ["left_", "right_", "wing_"]
+        .iter()
+        .find_map(|p| name.strip_prefix(p));
+    match wing {
+        Some(rest) => WING.contains(&rest),
+        None => DEVICE.contains(&name),
+    }
 }
 
 impl MetricsAccumulator {
@@ -125,17 +176,44 @@ impl MetricsAccumulator {
             last_time: 0.0,
             work_actuator: 0.0,
             work_aero: 0.0,
+            stroke_only: false,
         }
+    }
+
+    fn add_core(&mut self, c: &Core, body: bool) {
+        if body {
+            self.body_samples += 1;
+        }
+        self.first_time.get_or_insert(c.time);
+        self.last_time = c.time;
+        for w in 0..self.n_wings {
+            let acc = &mut self.wings[w];
+            acc.phi.add(c.phi[w], body);
+            acc.psi.add(c.psi[w], body);
+            acc.roll_aero.add(c.roll_aero[w], body);
+        }
+        if self.n_wings == 2 {
+            self.delta_tau.add(c.roll_aero[0] + c.roll_aero[1]);
+        }
+        self.force.add(c.force);
+        self.q2.add(c.q2);
     }
 
     /// Adds a sample; `closing` marks the sample that closes the window (left out of means).
     pub fn add(&mut self, s: &Sample, closing: bool) {
         let body = !closing;
-        if body {
-            self.body_samples += 1;
-        }
-        self.first_time.get_or_insert(s.time);
-        self.last_time = s.time;
+        let p = &s.eval.p;
+        self.add_core(
+            &Core {
+                time: s.time,
+                phi: [p[0], p[3]],
+                psi: [p[2], p[5]],
+                roll_aero: [s.aero[0].x, s.aero[1].x],
+                force: s.eval.drive.actuator_force,
+                q2: s.eval.drive.q.y,
+            },
+            body,
+        );
         let (cos, sin) = if body && self.period.is_some() {
             let (s_, c_) = (self.omega * s.time).sin_cos();
             (c_, s_)
@@ -144,11 +222,7 @@ impl MetricsAccumulator {
         };
         for w in 0..self.n_wings {
             let acc = &mut self.wings[w];
-            let phi = s.eval.p[3 * w];
-            let psi = s.eval.p[3 * w + 2];
-            acc.phi.add(phi, body);
-            acc.psi.add(psi, body);
-            acc.roll_aero.add(s.aero[w].x, body);
+            let (phi, psi) = (p[3 * w], p[3 * w + 2]);
             let torque = s.wing_torque(w);
             for (k, stats) in acc.torque.iter_mut().enumerate() {
                 stats.add(torque[k], body);
@@ -158,16 +232,40 @@ impl MetricsAccumulator {
             acc.psi_f.0 += psi * cos;
             acc.psi_f.1 -= psi * sin;
         }
-        if self.n_wings == 2 {
-            self.delta_tau.add(s.aero[0].x + s.aero[1].x);
-        }
         for (k, stats) in self.total.iter_mut().enumerate() {
             stats.add(s.total[k], body);
         }
-        self.force.add(s.eval.drive.actuator_force);
-        self.q2.add(s.eval.drive.q.y);
         self.work_actuator = s.state.work_actuator;
         self.work_aero = s.state.work_aero;
+    }
+
+    /// Adds a stroke-only sample (see [`is_stroke_metric`]); an accumulator fed this way reports
+    /// NaN for every other metric. The rotation Fourier sums are skipped: ψ ≡ 0, so the phase
+    /// lag is undefined (NaN) on either path.
+    #[inline]
+    pub fn add_stroke(&mut self, s: &StrokeSample, closing: bool) {
+        let body = !closing;
+        if self.first_time.is_none() {
+            self.stroke_only = true;
+            self.first_time = Some(s.time);
+            // ψ ≡ 0: one zero gives the rotation metrics their (zero) range and mean.
+            for acc in &mut self.wings {
+                acc.psi.range.add(0.0);
+            }
+        }
+        if body {
+            self.body_samples += 1;
+        }
+        self.last_time = s.time;
+        // Stroke-only devices have two wings.
+        let [left, right] = &mut self.wings;
+        left.phi.add(s.stroke.x, body);
+        right.phi.add(s.stroke.y, body);
+        left.roll_aero.add(s.roll_aero[0], body);
+        right.roll_aero.add(s.roll_aero[1], body);
+        self.delta_tau.add(s.roll_aero[0] + s.roll_aero[1]);
+        self.force.add(s.actuator_force);
+        self.q2.add(s.q2);
     }
 
     /// The metrics, names as documented in the module.
@@ -247,6 +345,13 @@ impl MetricsAccumulator {
             };
             out.push(("imbalance_instantaneous_pct".into(), percent(delta)));
             out.push(("imbalance_peak_pct".into(), percent(tau_r - tau_l)));
+        }
+        if self.stroke_only {
+            for (name, value) in &mut out {
+                if !is_stroke_metric(name) {
+                    *value = f64::NAN;
+                }
+            }
         }
         out
     }

@@ -8,7 +8,7 @@ use crate::device::Device;
 use crate::integrate::budget::{Budget, CancelFlag};
 use crate::integrate::{Integrator, Method, RungeKutta, State};
 use crate::metrics::MetricsAccumulator;
-use crate::trajectory::{Recorder, Sample, select_columns};
+use crate::trajectory::{Recorder, Sample, StrokeSample, select_columns};
 pub use crate::trajectory::{Trajectory, record};
 
 /// An instantaneous velocity change.
@@ -39,10 +39,15 @@ pub enum SteadyState {
     /// default).
     #[default]
     Transient,
-    /// Newton shooting on the stroboscopic map with forward sensitivities
-    /// ([`crate::floquet::periodic_orbit`]) after `min_cycles` of warm-up; residual
-    /// `≤ min(steady_tol / 100, 10 rtol)`. Falls back to [`SteadyState::Transient`] when Newton fails.
-    /// The Floquet multipliers come with the result.
+    /// Newton shooting on the stroboscopic map retraced on a frozen step grid
+    /// ([`crate::grid_shooting`]): warm-up of up to `min_cycles` (none with
+    /// [`SimulationOptions::shooting_jacobian`]), one adaptive period at `rtol / 100` that picks
+    /// the grid (with the variational equations when no Jacobian is given), Newton steps with
+    /// Broyden updates; the last Newton period is the recorded window. Converged when the
+    /// predicted state error and the residual are `≤ min(steady_tol / 100, rtol / 10)` (or the
+    /// residual `≤ steady_tol` along a neutral direction). Falls back to
+    /// [`SteadyState::Transient`] when Newton fails. The residual and the Floquet multipliers
+    /// (of the final Jacobian estimate) come with the result.
     Shooting,
 }
 
@@ -75,8 +80,19 @@ pub struct SimulationOptions {
     pub duration_ms: Option<f64>,
     /// Trajectory columns to build (`None`: all of them; `Some(vec![])`: none, metrics only).
     pub columns: Option<Vec<String>>,
+    /// Metrics the caller reads (`None`: all). When no column is built, the device integrates
+    /// drivetrain coordinates and every name passes [`crate::metrics::is_stroke_metric`], the
+    /// samples are [`crate::trajectory::StrokeSample`]s and the other metrics come back NaN.
+    pub metrics: Option<Vec<String>>,
     /// How the periodic steady state is found (driven devices).
     pub steady_state: SteadyState,
+    /// A guess of the stroboscopic map's Jacobian at `initial` (`2n × 2n`, e.g. a converged
+    /// neighbour's [`SimulationResult::monodromy`] in a sweep chain): shooting then skips the
+    /// warm-up and the variational period. Ignored by the transient.
+    pub shooting_jacobian: Option<nalgebra::DMatrix<f64>>,
+    /// With [`Self::shooting_jacobian`]: a neighbour's step grid over one period
+    /// ([`SimulationResult::step_grid`]), reused while its steps meet the tolerances.
+    pub shooting_grid: Option<Vec<f64>>,
     /// Wall-clock budget of one run (ms; None: unlimited), checked inside integration: past
     /// it the run fails with an [`Error::Integration`] naming `options.max_wall_ms`.
     pub max_wall_ms: Option<f64>,
@@ -104,7 +120,10 @@ impl Default for SimulationOptions {
             perturbation: None,
             duration_ms: None,
             columns: None,
+            metrics: None,
             steady_state: SteadyState::Transient,
+            shooting_jacobian: None,
+            shooting_grid: None,
             max_wall_ms: Some(DEFAULT_MAX_WALL_MS),
             cancel: None,
         }
@@ -136,6 +155,11 @@ pub struct SimulationResult {
     /// [`crate::stability::floquet`] for multipliers at the orbit itself). Newton shooting
     /// only; empty otherwise.
     pub multipliers: Vec<nalgebra::Complex<f64>>,
+    /// The Jacobian of the stroboscopic map the shooting ended with (exact or
+    /// Broyden-updated; `None` for transient runs): the multipliers are its eigenvalues.
+    pub monodromy: Option<nalgebra::DMatrix<f64>>,
+    /// The shooting's step grid over one period (empty for transient runs).
+    pub step_grid: Vec<f64>,
 }
 
 fn validate(options: &SimulationOptions) -> Result<()> {
@@ -250,36 +274,26 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
     let mut converged = false;
     let mut residual = f64::NAN;
     let mut multipliers = Vec::new();
+    let mut monodromy = None;
+    let mut step_grid = Vec::new();
+    // The recorded window when the shooting's last period already was it.
+    let mut recorded: Option<(Trajectory, Vec<(String, f64)>)> = None;
+    let stroke = stroke_sampling(device, options.metrics.as_deref(), &columns);
     let period = device.period();
     let (window, n_samples) = match period {
         Some(period) => {
             let mut transient_needed = true;
             if options.steady_state == SteadyState::Shooting {
-                let shooting = crate::floquet::ShootingOptions {
-                    method: options.method,
-                    rtol: options.rtol,
-                    atol: options.atol,
-                    max_steps: options.max_steps,
-                    t0: 0.0,
-                    warmup_cycles: options.min_cycles,
-                    warmup_tol: 1e-3,
-                    max_newton: 20,
-                    // Below the integration's own noise (~rtol) Newton cannot improve the map.
-                    tol: (1e-2 * options.steady_tol).min(10.0 * options.rtol),
-                    fallback_cycles: 0,
-                    initial: Some(y),
-                    ..Default::default()
-                };
-                if let Ok(orbit) = crate::floquet::periodic_orbit(device, &shooting) {
-                    y = orbit.state;
-                    cycles_run = orbit.cycles_simulated;
-                    t = cycles_run as f64 * period;
-                    residual = orbit.residual;
-                    converged = true;
+                if let Some(found) = shooting_steady_state(
+                    device, options, &recording, &transient, period, &y, &columns, stroke,
+                )? {
+                    (y, t, cycles_run, residual, converged) =
+                        (found.state, found.t, found.cycles_run, found.residual, true);
+                    multipliers = found.multipliers;
+                    monodromy = Some(found.jacobian);
+                    step_grid = found.grid;
+                    recorded = found.recorded;
                     transient_needed = false;
-                    if let Some(m) = &orbit.monodromy {
-                        multipliers = crate::floquet::eigenvalues(m).unwrap_or_default();
-                    }
                 }
             }
             if transient_needed {
@@ -326,17 +340,25 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
     };
     // Work integrals restart in the recorded window.
     y = y.without_work();
-    let (trajectory, metrics) = record_window(
-        device,
-        &recording,
-        t,
-        &y,
-        window,
-        n_samples,
-        period,
-        options.perturbation,
-        columns,
-    )?;
+    let (trajectory, metrics) = match recorded {
+        Some(done) => done,
+        None => {
+            let (trajectory, metrics, _) = record_window(
+                device,
+                &recording,
+                t,
+                &y,
+                window,
+                n_samples,
+                period,
+                options.perturbation,
+                columns,
+                stroke,
+                None,
+            )?;
+            (trajectory, metrics)
+        }
+    };
     Ok(SimulationResult {
         trajectory,
         metrics,
@@ -346,7 +368,136 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
         residual,
         steady_state: y,
         multipliers,
+        monodromy,
+        step_grid,
     })
+}
+
+/// Shooting results whose largest Floquet multiplier exceeds `1 + UNSTABLE_MARGIN` are
+/// unstable orbits, which a run never settles on: [`SteadyState::Shooting`] then falls back to
+/// the transient (the margin covers the error of the Broyden-updated Jacobian; K2 = 0's neutral
+/// multiplier 1 stays a steady state).
+pub const UNSTABLE_MARGIN: f64 = 1e-2;
+
+/// What [`shooting_steady_state`] found.
+struct ShotSteadyState {
+    state: State,
+    /// Start of the recorded window.
+    t: f64,
+    cycles_run: usize,
+    residual: f64,
+    jacobian: nalgebra::DMatrix<f64>,
+    grid: Vec<f64>,
+    multipliers: Vec<nalgebra::Complex<f64>>,
+    /// The recorded window, when the last Newton period recorded it.
+    recorded: Option<(Trajectory, Vec<(String, f64)>)>,
+}
+
+/// [`SteadyState::Shooting`]: warm-up (without a neighbour's Jacobian), then Newton on the
+/// frozen grid ([`crate::grid_shooting`]); the final Newton period records the window when it
+/// is one plain cycle. `Ok(None)`: not converged (the caller runs the transient).
+#[allow(clippy::too_many_arguments)]
+fn shooting_steady_state(
+    device: &Device,
+    options: &SimulationOptions,
+    recording: &RungeKutta,
+    transient: &RungeKutta,
+    period: f64,
+    y0: &State,
+    columns: &[crate::trajectory::Column],
+    stroke: Option<bool>,
+) -> Result<Option<ShotSteadyState>> {
+    let mut y = *y0;
+    let mut cycles = 0;
+    let guess = options.shooting_jacobian.as_ref();
+    if guess.is_none() {
+        // Far from the orbit Newton's model is poor: settle the fast modes first.
+        while cycles < options.min_cycles {
+            crate::integrate::budget::check(cycles as f64 * period)?;
+            let Ok(next) = transient.advance(device, 0.0, &y, period) else {
+                break;
+            };
+            let change = state_change(&next, &y);
+            y = next.without_work();
+            cycles += 1;
+            if change < 1e-3 {
+                break;
+            }
+        }
+    }
+    // Below the integration's own accuracy (~rtol) a tighter orbit changes nothing.
+    let tol = (1e-2 * options.steady_tol).min(0.1 * options.rtol);
+    let n_samples = options.samples_per_cycle;
+    let records = options.record_cycles == 1 && options.perturbation.is_none();
+    let mut recorded = None;
+    let mut finish = |grid: &[f64], y: &State| -> Result<State> {
+        if !records {
+            return transient.integrate_on_grid(device, grid, y, &[], &mut |_, _, _| Ok(()));
+        }
+        // Stroke samples read no work integral: the lighter state suffices.
+        let integrator = if stroke.is_some() {
+            transient
+        } else {
+            recording
+        };
+        let (trajectory, metrics, end) = record_window(
+            device,
+            integrator,
+            grid[0],
+            y,
+            period,
+            n_samples,
+            Some(period),
+            None,
+            columns.to_vec(),
+            stroke,
+            Some(grid),
+        )?;
+        recorded = Some((trajectory, metrics));
+        Ok(end)
+    };
+    let Some(orbit) = crate::grid_shooting::shoot(
+        device,
+        transient,
+        period,
+        &y,
+        guess,
+        options.shooting_grid.as_deref(),
+        tol,
+        options.steady_tol,
+        20,
+        &mut finish,
+    )?
+    else {
+        return Ok(None);
+    };
+    cycles += orbit.periods;
+    let multipliers = crate::floquet::eigenvalues(&orbit.jacobian).unwrap_or_default();
+    if multipliers
+        .first()
+        .is_some_and(|m| m.norm() > 1.0 + UNSTABLE_MARGIN)
+    {
+        // An unstable orbit is not a state a run settles on: the transient decides.
+        return Ok(None);
+    }
+    let t = cycles as f64 * period;
+    if let Some((trajectory, _)) = &mut recorded {
+        // The window was integrated on the section t = 0; the drive is T-periodic, so it is
+        // the window after the cycles run, labelled as such.
+        for time in &mut trajectory.time {
+            *time += t;
+        }
+    }
+    Ok(Some(ShotSteadyState {
+        state: orbit.state,
+        t,
+        cycles_run: cycles,
+        residual: orbit.residual,
+        jacobian: orbit.jacobian,
+        grid: orbit.grid,
+        multipliers,
+        recorded,
+    }))
 }
 
 /// The metrics of one drive period recorded from `state` at `t = 0` (a state on the section
@@ -371,7 +522,8 @@ pub fn orbit_metrics(
         options.atol,
         options.max_steps,
     )?;
-    let (_, metrics) = record_window(
+    let stroke = stroke_sampling(device, options.metrics.as_deref(), &[]);
+    let (_, metrics, _) = record_window(
         device,
         &integrator,
         0.0,
@@ -381,9 +533,28 @@ pub fn orbit_metrics(
         Some(period),
         None,
         Vec::new(),
+        stroke,
+        None,
     )?;
     Ok(metrics)
 }
+
+/// How samples are taken when only stroke metrics are read (see
+/// [`SimulationOptions::metrics`]): `Some(with_force)`, else `None` (full samples).
+fn stroke_sampling(
+    device: &Device,
+    metrics: Option<&[String]>,
+    columns: &[crate::trajectory::Column],
+) -> Option<bool> {
+    let metrics = metrics?;
+    let lean = columns.is_empty()
+        && device.formulation() == crate::device::Formulation::DrivetrainCoordinates
+        && metrics.iter().all(|m| crate::metrics::is_stroke_metric(m));
+    lean.then(|| metrics.iter().any(|m| m == "actuator_force_peak"))
+}
+
+/// A recorded window: its columns, its metrics and the state at its end.
+type Recorded = (Trajectory, Vec<(String, f64)>, State);
 
 /// Integrates the recorded window from `(t_start, y)`, evaluating each of the `n_samples + 1`
 /// samples once: it feeds the metrics and the asked columns, nothing else is kept.
@@ -398,7 +569,9 @@ fn record_window(
     period: Option<f64>,
     perturbation: Option<Perturbation>,
     columns: Vec<crate::trajectory::Column>,
-) -> Result<(Trajectory, Vec<(String, f64)>)> {
+    stroke: Option<bool>,
+    grid: Option<&[f64]>,
+) -> Result<Recorded> {
     // The last sample is exactly the window's end: t_start + window·k/n can round one ulp past
     // it.
     let t_end = t_start + window;
@@ -414,15 +587,20 @@ fn record_window(
     let mut metrics = MetricsAccumulator::new(device, period);
     let mut recorder = Recorder::new(columns, times.len());
     let mut sink = |i: usize, t: f64, y: &State| -> Result<()> {
+        // `stroke` is only set for drivetrain-coordinate devices (see `stroke_sampling`).
+        if let Some(with_force) = stroke {
+            let sample = StrokeSample::of_stroke_device(device, t, y, with_force)?;
+            metrics.add_stroke(&sample, i == n_samples);
+            return Ok(());
+        }
         let sample = Sample::new(device, t, y)?;
         metrics.add(&sample, i == n_samples);
         recorder.push(&sample)
     };
-    match perturbation {
-        None => {
-            integrator.integrate_with(device, t_start, y, t_end, &times, &mut sink)?;
-        }
-        Some(kick) => {
+    let end = match (perturbation, grid) {
+        (None, Some(grid)) => integrator.integrate_on_grid(device, grid, y, &times, &mut sink)?,
+        (None, None) => integrator.integrate_with(device, t_start, y, t_end, &times, &mut sink)?,
+        (Some(kick), _) => {
             let t_kick = t_start + kick.phase * period.unwrap_or(window);
             let split = times.partition_point(|&s| s < t_kick);
             let y_kick = if t_kick > t_start {
@@ -435,10 +613,10 @@ fn record_window(
             let after = &times[split..];
             // Sample indices continue after the kick.
             let mut shifted = |i: usize, t: f64, y: &State| sink(i + split, t, y);
-            integrator.integrate_with(device, t_kick, &y_kicked, t_end, after, &mut shifted)?;
+            integrator.integrate_with(device, t_kick, &y_kicked, t_end, after, &mut shifted)?
         }
-    }
-    Ok((recorder.finish(), metrics.finish()))
+    };
+    Ok((recorder.finish(), metrics.finish(), end))
 }
 
 fn apply_kick(device: &Device, t: f64, y: &State, kick: Perturbation) -> Result<State> {

@@ -256,6 +256,10 @@ pub struct PointOutput {
     /// `(p, ṗ)` at the start of the recorded window: the next point's initial guess in a
     /// continuation chain.
     pub steady_state: Option<(Vec6, Vec6)>,
+    /// The shooting's Jacobian of the stroboscopic map (the next point's Newton guess).
+    pub monodromy: Option<nalgebra::DMatrix<f64>>,
+    /// The shooting's step grid (the next point's, while it meets the tolerances).
+    pub step_grid: Vec<f64>,
 }
 
 /// Simulates one point and keeps what the sweep asked for.
@@ -271,9 +275,10 @@ pub fn run_point(
     let result = if keep_cycle {
         simulate(device, options)?
     } else {
-        // Metrics only: no trajectory column is built.
+        // Metrics only: no trajectory column is built, only the asked metrics are computed.
         let options = SimulationOptions {
             columns: Some(Vec::new()),
+            metrics: Some(metric_names.to_vec()),
             ..options.clone()
         };
         simulate(device, &options)?
@@ -313,7 +318,40 @@ pub fn run_point(
         cycle,
         residual: result.residual,
         steady_state: device.coordinates(&result.steady_state).ok(),
+        monodromy: result.monodromy,
+        step_grid: result.step_grid,
     })
+}
+
+/// A converged point of a continuation chain: its index, `(p, ṗ)`, shooting Jacobian and step
+/// grid.
+type Converged = (
+    usize,
+    (Vec6, Vec6),
+    Option<nalgebra::DMatrix<f64>>,
+    Vec<f64>,
+);
+
+/// The start of point `i` of a chain from its converged predecessors: the secant (linear)
+/// extrapolation `2 y₁ − y₀` of state and Jacobian when the two previous points converged
+/// (neighbours along a grid axis: the first Newton residual falls by the parameter step
+/// once more), else the last converged state and Jacobian.
+fn predict(
+    previous: &[Converged],
+    i: usize,
+) -> (Option<(Vec6, Vec6)>, Option<nalgebra::DMatrix<f64>>) {
+    match previous {
+        [.., (i0, s0, j0, _), (i1, s1, j1, _)] if *i1 + 1 == i && *i0 + 2 == i => {
+            let state = (2.0 * s1.0 - s0.0, 2.0 * s1.1 - s0.1);
+            let jacobian = match (j0, j1) {
+                (Some(a), Some(b)) if a.shape() == b.shape() => Some(2.0 * b - a),
+                _ => j1.clone(),
+            };
+            (Some(state), jacobian)
+        }
+        [.., (_, s1, j1, _)] => (Some(*s1), j1.clone()),
+        [] => (None, None),
+    }
 }
 
 /// Points per continuation chain (see [`run_points`]); fixed, so results do not depend on the
@@ -350,15 +388,23 @@ pub fn run_points(
     let chains = run_indexed(n_chains, threads, control, |c| {
         let range = c * CHAIN_LENGTH..((c + 1) * CHAIN_LENGTH).min(points.len());
         let last = range.end - 1;
-        let mut guess: Option<(Vec6, Vec6)> = None;
+        // The last two converged points of the chain: (index, (p, ṗ), Jacobian).
+        let mut previous: Vec<Converged> = Vec::with_capacity(2);
         let mut out = Vec::with_capacity(range.len());
         for i in range {
+            let (guess, jacobian) = predict(&previous, i);
+            let grid = previous
+                .last()
+                .map(|c| c.3.clone())
+                .filter(|g| !g.is_empty());
             let result = match &points[i] {
                 Ok((device, options)) => {
                     let started = match guess {
                         Some(initial) if continued(i) => {
                             let options = SimulationOptions {
                                 initial: Some(initial),
+                                shooting_jacobian: jacobian,
+                                shooting_grid: grid,
                                 ..options.clone()
                             };
                             run_point(device, &options, metric_names, keep_cycle)
@@ -376,8 +422,11 @@ pub fn run_points(
                 Err(e) => Err(e.clone()),
             };
             if let Ok(o) = &result {
-                if o.converged {
-                    guess = o.steady_state;
+                if let (true, Some(state)) = (o.converged, o.steady_state) {
+                    if previous.len() == 2 {
+                        previous.remove(0);
+                    }
+                    previous.push((i, state, o.monodromy.clone(), o.step_grid.clone()));
                 }
             }
             out.push(result);

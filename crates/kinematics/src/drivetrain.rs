@@ -255,6 +255,18 @@ impl LinearDifferential {
         })
     }
 
+    /// Eq. 2.15 at `(q1, q2)`: constant Jacobian, no second derivatives.
+    #[inline]
+    pub fn evaluate(&self, q1: f64, q2: f64) -> DrivetrainEval {
+        let t = self.transmission_ratio;
+        let j = Matrix2::new(-t, t * self.left_arm, -t, -t * self.right_arm);
+        DrivetrainEval {
+            stroke: j * Vector2::new(q1, q2),
+            jacobian: j,
+            hessian: [Matrix2::zeros(); 2],
+        }
+    }
+
     /// `T` (rad/mm).
     pub fn transmission_ratio(&self) -> f64 {
         self.transmission_ratio
@@ -344,9 +356,25 @@ impl Drivetrain {
     /// [`Error::InvalidParameter`] unless `|q1| <=` [`paritysim_error::plausible::OFFSET_MM`] and
     /// `|q2| <=` [`paritysim_error::plausible::ANGLE_RAD`]; [`Error::OutOfDomain`] when a linkage
     /// cannot reach the pose (rod too short, toggle) or `|q2| >= π/2`.
+    #[inline]
     pub fn evaluate(&self, q1: f64, q2: f64) -> Result<DrivetrainEval> {
-        check_offset_mm("q1", q1)?;
-        check_angle_rad("q2", q2)?;
+        // The checks build their errors out of line: this sits in every right-hand side.
+        if !(q1.abs() <= paritysim_error::plausible::OFFSET_MM
+            && q2.abs() <= paritysim_error::plausible::ANGLE_RAD)
+        {
+            check_offset_mm("q1", q1)?;
+            check_angle_rad("q2", q2)?;
+        }
+        // The linear map inline (it sits in every right-hand side and sample); the linkages,
+        // with their trigonometry and Newton solves, out of line.
+        match self {
+            Drivetrain::LinearDifferential(d) => Ok(d.evaluate(q1, q2)),
+            _ => self.evaluate_linkage(q1, q2),
+        }
+    }
+
+    #[inline(never)]
+    fn evaluate_linkage(&self, q1: f64, q2: f64) -> Result<DrivetrainEval> {
         match self {
             Drivetrain::HmfFourBar(d) => {
                 let (phi, grad, hess) = d.side.side_stroke(q1, 0.0, 0.0, 1.0)?;
@@ -357,15 +385,6 @@ impl Drivetrain {
                     stroke: Vector2::new(phi, phi),
                     jacobian: j,
                     hessian: [h, h],
-                })
-            }
-            Drivetrain::LinearDifferential(d) => {
-                let t = d.transmission_ratio;
-                let j = Matrix2::new(-t, t * d.left_arm, -t, -t * d.right_arm);
-                Ok(DrivetrainEval {
-                    stroke: j * Vector2::new(q1, q2),
-                    jacobian: j,
-                    hessian: [Matrix2::zeros(); 2],
                 })
             }
             Drivetrain::LinkageDifferential(d) => {
@@ -380,6 +399,7 @@ impl Drivetrain {
                     hessian: [hl, hr],
                 })
             }
+            Drivetrain::LinearDifferential(d) => Ok(d.evaluate(q1, q2)),
         }
     }
 }

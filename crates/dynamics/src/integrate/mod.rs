@@ -97,6 +97,9 @@ pub struct IntegrationStats {
     pub rejected: usize,
     /// Accepted steps on which the dense output was prepared (a sample fell inside).
     pub dense_steps: usize,
+    /// Fixed-grid steps whose local error estimate exceeded the tolerances (always 0 for
+    /// adaptive runs, which reject such steps): 0 means the grid still suits the solution.
+    pub over_tolerance: usize,
 }
 
 /// Receives the samples of an integration: `(index in times, time, state)`.
@@ -194,6 +197,14 @@ impl RungeKutta {
         self
     }
 
+    /// The same integrator with both tolerances scaled by `factor` (in (0, 1]).
+    pub fn tightened(mut self, factor: f64) -> Self {
+        let factor = factor.clamp(f64::MIN_POSITIVE, 1.0);
+        self.rtol *= factor;
+        self.atol *= factor;
+        self
+    }
+
     /// The method.
     pub fn method(&self) -> Method {
         self.method
@@ -211,6 +222,96 @@ impl RungeKutta {
         t_end: f64,
         times: &[f64],
         sink: &mut Sink<'_>,
+    ) -> Result<(State, IntegrationStats)> {
+        self.dispatch(system, t0, y0, t_end, None, times, sink, &mut |_, _| {})
+    }
+
+    /// The state at `t_end` and the times of the accepted steps (ending with `t_end`): the grid
+    /// [`Self::integrate_on_grid`] retraces.
+    ///
+    /// # Errors
+    /// As [`Integrator::integrate_with`].
+    pub fn advance_with_steps(
+        &self,
+        system: &dyn OdeSystem,
+        t0: f64,
+        y0: &State,
+        t_end: f64,
+    ) -> Result<(State, Vec<f64>)> {
+        let mut grid = vec![t0];
+        let (y, _) = self.dispatch(
+            system,
+            t0,
+            y0,
+            t_end,
+            None,
+            &[],
+            &mut |_, _, _| Ok(()),
+            &mut |t, _| grid.push(t),
+        )?;
+        Ok((y, grid))
+    }
+
+    /// Integrates on the fixed steps between consecutive `grid` times (no error control, no
+    /// rejected step: e.g. the grid an adaptive run chose, see [`Self::advance_with_steps`]),
+    /// sampling `times` (within the grid's span) through `sink`. On a fixed grid the flow is a
+    /// smooth function of `y0`: Newton on it converges to round-off.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a grid that is not increasing or has fewer than two
+    /// times, or samples outside it; otherwise as [`Integrator::integrate_with`].
+    pub fn integrate_on_grid(
+        &self,
+        system: &dyn OdeSystem,
+        grid: &[f64],
+        y0: &State,
+        times: &[f64],
+        sink: &mut Sink<'_>,
+    ) -> Result<State> {
+        self.integrate_on_grid_counted(system, grid, y0, times, sink)
+            .map(|(y, _)| y)
+    }
+
+    /// [`Self::integrate_on_grid`] with the step counters; `over_tolerance` counts the steps
+    /// whose local error estimate exceeds this integrator's tolerances.
+    ///
+    /// # Errors
+    /// As [`Self::integrate_on_grid`].
+    pub fn integrate_on_grid_counted(
+        &self,
+        system: &dyn OdeSystem,
+        grid: &[f64],
+        y0: &State,
+        times: &[f64],
+        sink: &mut Sink<'_>,
+    ) -> Result<(State, IntegrationStats)> {
+        check_grid(grid)?;
+        let (t0, t_end) = (grid[0], grid[grid.len() - 1]);
+        self.dispatch(
+            system,
+            t0,
+            y0,
+            t_end,
+            Some(grid),
+            times,
+            sink,
+            &mut |_, _| {},
+        )
+    }
+
+    /// Checks the interval and samples, then runs [`Self::solve`] on the array size of the
+    /// system (adaptive, or on `grid`).
+    #[allow(clippy::too_many_arguments)]
+    fn dispatch(
+        &self,
+        system: &dyn OdeSystem,
+        t0: f64,
+        y0: &State,
+        t_end: f64,
+        grid: Option<&[f64]>,
+        times: &[f64],
+        sink: &mut Sink<'_>,
+        on_step: &mut dyn FnMut(f64, &State),
     ) -> Result<(State, IntegrationStats)> {
         if t_end.is_nan() || t_end <= t0 || !t0.is_finite() || !t_end.is_finite() {
             return Err(Error::invalid("t_end", t_end, format!("> t0 = {t0}")));
@@ -232,7 +333,7 @@ impl RungeKutta {
         };
         macro_rules! go {
             ($m:literal) => {
-                self.solve::<$m>(system, n, t0, y0, t_end, times, sink, &mut |_, _| {})
+                self.solve::<$m>(system, n, t0, y0, t_end, grid, times, sink, on_step)
             };
         }
         match (n, self.work) {
@@ -253,6 +354,7 @@ impl RungeKutta {
         t0: f64,
         y0: &State,
         t_end: f64,
+        grid: Option<&[f64]>,
         times: &[f64],
         sink: &mut Sink<'_>,
         on_step: &mut dyn FnMut(f64, &State),
@@ -269,18 +371,21 @@ impl RungeKutta {
             controlled: 2 * n,
         };
         let c0 = compress::<M>(n, y0);
-        let (y, mut stats) = drive_method(
-            self.method,
-            &mut rhs,
-            &tol,
-            self.max_steps,
-            t0,
-            c0,
-            t_end,
-            times,
-            sink,
-            on_step,
-        )?;
+        let (y, mut stats) = match grid {
+            None => drive_method(
+                self.method,
+                &mut rhs,
+                &tol,
+                self.max_steps,
+                t0,
+                c0,
+                t_end,
+                times,
+                sink,
+                on_step,
+            )?,
+            Some(grid) => drive_method_on_grid(self.method, &mut rhs, &tol, grid, c0, times, sink)?,
+        };
         stats.rhs_calls = rhs.calls;
         Ok((Rhs::<M>::expand(&rhs, &y), stats))
     }
@@ -511,6 +616,149 @@ fn drive_method<const M: usize>(
     }
 }
 
+/// A step grid: at least two finite, strictly increasing times.
+pub(crate) fn check_grid(grid: &[f64]) -> Result<()> {
+    if grid.len() < 2 {
+        return Err(Error::invalid("grid", grid.len(), "at least two times"));
+    }
+    if let Some(i) = (1..grid.len()).find(|&i| grid[i] <= grid[i - 1] || !grid[i].is_finite()) {
+        return Err(Error::invalid(
+            format!("grid[{i}]"),
+            grid[i],
+            format!("finite and > grid[{}] = {}", i - 1, grid[i - 1]),
+        ));
+    }
+    Ok(())
+}
+
+/// [`drive_on_grid`] with the stepper of `method`.
+pub(crate) fn drive_method_on_grid<const M: usize>(
+    method: Method,
+    rhs: &mut dyn Rhs<M>,
+    tol: &Tolerances,
+    grid: &[f64],
+    y0: [f64; M],
+    times: &[f64],
+    sink: &mut Sink<'_>,
+) -> Result<([f64; M], IntegrationStats)> {
+    match method {
+        Method::Dop853 => drive_on_grid(
+            &mut dop853::Dop853::<M>::new(),
+            rhs,
+            tol,
+            grid,
+            y0,
+            times,
+            sink,
+        ),
+        Method::Dopri5 => drive_on_grid(
+            &mut dopri5::Dopri5::<M>::new(),
+            rhs,
+            tol,
+            grid,
+            y0,
+            times,
+            sink,
+        ),
+    }
+}
+
+/// Emits the samples that fall inside the accepted step `[t, t_new)` from its interpolant
+/// (prepared only when one does), then those at `t_new` from the step's end value.
+#[allow(clippy::too_many_arguments)]
+fn sample_step<const M: usize, S: Stepper<M>>(
+    stepper: &mut S,
+    rhs: &mut dyn Rhs<M>,
+    t: f64,
+    y: &[f64; M],
+    f0: &[f64; M],
+    f1: &[f64; M],
+    h: f64,
+    t_new: f64,
+    times: &[f64],
+    next: &mut usize,
+    sink: &mut Sink<'_>,
+    stats: &mut IntegrationStats,
+) -> Result<State> {
+    if *next < times.len() && times[*next] < t_new {
+        stepper.prepare_dense(rhs, t, y, f0, f1, h)?;
+        stats.dense_steps += 1;
+        let mut sample = [0.0; M];
+        while *next < times.len() && times[*next] < t_new {
+            stepper.dense((times[*next] - t) / h, &mut sample);
+            let state = rhs.expand(&sample);
+            if !state.is_finite() {
+                return Err(integration_error(times[*next], &state, "non-finite state"));
+            }
+            sink(*next, times[*next], &state)?;
+            *next += 1;
+        }
+    }
+    let state = rhs.expand(stepper.y1());
+    if !state.is_finite() {
+        return Err(integration_error(t_new, &state, "non-finite state"));
+    }
+    while *next < times.len() && times[*next] <= t_new {
+        sink(*next, times[*next], &state)?;
+        *next += 1;
+    }
+    Ok(state)
+}
+
+/// Fixed steps between consecutive `grid` times; the error estimate is not used.
+fn drive_on_grid<const M: usize, S: Stepper<M>>(
+    stepper: &mut S,
+    rhs: &mut dyn Rhs<M>,
+    tol: &Tolerances,
+    grid: &[f64],
+    y0: [f64; M],
+    times: &[f64],
+    sink: &mut Sink<'_>,
+) -> Result<([f64; M], IntegrationStats)> {
+    let mut stats = IntegrationStats::default();
+    let mut y = y0;
+    let mut next = 0;
+    let t0 = grid[0];
+    if next < times.len() && times[next] <= t0 {
+        let state = rhs.expand(&y);
+        while next < times.len() && times[next] <= t0 {
+            sink(next, times[next], &state)?;
+            next += 1;
+        }
+    }
+    let mut f0 = [0.0; M];
+    let mut f1 = [0.0; M];
+    rhs.eval(t0, &y, &mut f0)?;
+    for (k, pair) in grid.windows(2).enumerate() {
+        let (t, t_new) = (pair[0], pair[1]);
+        if k % budget::CHECK_EVERY == 0 {
+            if let Err(stop) = budget::check_current() {
+                return Err(budget::stop_error(stop, t, rhs.expand(&y).to_vec()));
+            }
+        }
+        let h = t_new - t;
+        let err = stepper.attempt(rhs, t, &y, &f0, h, tol)?;
+        if !err.is_finite() {
+            return Err(integration_error(
+                t,
+                &rhs.expand(&y),
+                "non-finite state on a fixed step",
+            ));
+        }
+        if err > 1.0 {
+            stats.over_tolerance += 1;
+        }
+        stats.accepted += 1;
+        stepper.new_derivative(rhs, t_new, &mut f1)?;
+        sample_step(
+            stepper, rhs, t, &y, &f0, &f1, h, t_new, times, &mut next, sink, &mut stats,
+        )?;
+        y = *stepper.y1();
+        f0 = f1;
+    }
+    Ok((y, stats))
+}
+
 /// The integration loop shared by both pairs (Hairer's `DP86CO` / `DOPCOR`).
 #[allow(clippy::too_many_arguments)]
 fn drive<const M: usize, S: Stepper<M>>(
@@ -545,7 +793,6 @@ fn drive<const M: usize, S: Stepper<M>>(
     let mut fac_old: f64 = 1e-4;
     let mut rejected_last = false;
     let mut f1 = [0.0; M];
-    let mut sample = [0.0; M];
     loop {
         let attempts = stats.accepted + stats.rejected;
         if attempts >= max_steps {
@@ -587,31 +834,13 @@ fn drive<const M: usize, S: Stepper<M>>(
             stats.accepted += 1;
             let t_new = if last { t_end } else { t + h };
             stepper.new_derivative(rhs, t_new, &mut f1)?;
-            if next < times.len() && times[next] < t_new {
-                stepper.prepare_dense(rhs, t, &y, &f0, &f1, h)?;
-                stats.dense_steps += 1;
-                while next < times.len() && times[next] < t_new {
-                    stepper.dense((times[next] - t) / h, &mut sample);
-                    let state = rhs.expand(&sample);
-                    if !state.is_finite() {
-                        return Err(integration_error(times[next], &state, "non-finite state"));
-                    }
-                    sink(next, times[next], &state)?;
-                    next += 1;
-                }
-            }
+            let state = sample_step(
+                stepper, rhs, t, &y, &f0, &f1, h, t_new, times, &mut next, sink, &mut stats,
+            )?;
             y = *stepper.y1();
             f0 = f1;
             t = t_new;
-            let state = rhs.expand(&y);
-            if !state.is_finite() {
-                return Err(integration_error(t, &state, "non-finite state"));
-            }
             on_step(t, &state);
-            while next < times.len() && times[next] <= t {
-                sink(next, times[next], &state)?;
-                next += 1;
-            }
             if last {
                 return Ok((y, stats));
             }

@@ -64,6 +64,7 @@ fn step_and_dense_errors(
             0.0,
             y0,
             t_end,
+            None,
             &times,
             &mut |_, t, y| {
                 dense = dense.max(err(t, y));
@@ -378,5 +379,75 @@ fn the_step_budget_names_the_option() {
             )
         }
         other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn a_fixed_grid_retraces_the_adaptive_steps_and_its_dense_output() {
+    // On the grid an adaptive run chose, the fixed-step integration takes the same steps (up
+    // to the rounding of `h = t_{k+1} − t_k`): same end state and dense samples to round-off;
+    // and it is a smooth map of y0 (here linear: no step-sequence jump).
+    let w = 1.7;
+    let system = Oscillator(w);
+    let rk = RungeKutta::new(Method::Dop853, 1e-8, 1e-10, 100_000)
+        .unwrap()
+        .with_work(false);
+    let y0 = start(0.3, -0.8);
+    let t_end = 7.3;
+    let (adaptive, grid) = rk.advance_with_steps(&system, 0.0, &y0, t_end).unwrap();
+    assert_eq!(grid[0], 0.0);
+    assert_eq!(*grid.last().unwrap(), t_end);
+    assert!(grid.len() > 5);
+    let times: Vec<f64> = (0..=50).map(|k| t_end * k as f64 / 50.0).collect();
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    let y_adaptive = rk
+        .integrate_with(&system, 0.0, &y0, t_end, &times, &mut |_, _, y| {
+            a.push(*y);
+            Ok(())
+        })
+        .unwrap();
+    let y_grid = rk
+        .integrate_on_grid(&system, &grid, &y0, &times, &mut |_, _, y| {
+            b.push(*y);
+            Ok(())
+        })
+        .unwrap();
+    let close = |p: &State, q: &State| {
+        (p.coords[0] - q.coords[0]).abs() < 1e-14 && (p.rates[0] - q.rates[0]).abs() < 1e-14
+    };
+    assert!(close(&y_grid, &adaptive) && close(&y_grid, &y_adaptive));
+    assert_eq!(a.len(), b.len());
+    assert!(a.iter().zip(&b).all(|(p, q)| close(p, q)));
+    // Linear system: the fixed-grid map is exactly linear up to round-off.
+    let scale = 1e-3;
+    let y1 = rk
+        .integrate_on_grid(
+            &system,
+            &grid,
+            &start(0.3 * scale, -0.8 * scale),
+            &[],
+            &mut |_, _, _| Ok(()),
+        )
+        .unwrap();
+    assert!((y1.coords[0] - scale * y_grid.coords[0]).abs() < 1e-15);
+    assert!((y1.rates[0] - scale * y_grid.rates[0]).abs() < 1e-15);
+    // And it integrates the oscillator to the adaptive run's accuracy.
+    let exact = 0.3 * (w * t_end).cos() - 0.8 / w * (w * t_end).sin();
+    assert!((y_grid.coords[0] - exact).abs() < 1e-7);
+}
+
+#[test]
+fn a_bad_grid_is_rejected_with_its_index() {
+    let rk = RungeKutta::new(Method::Dopri5, 1e-8, 1e-10, 1000).unwrap();
+    let y0 = start(1.0, 0.0);
+    for (grid, field) in [
+        (vec![0.0], "grid"),
+        (vec![0.0, 1.0, 1.0], "grid[2]"),
+        (vec![0.0, f64::NAN], "grid[1]"),
+    ] {
+        let e = rk
+            .integrate_on_grid(&Oscillator(1.0), &grid, &y0, &[], &mut |_, _, _| Ok(()))
+            .unwrap_err();
+        assert!(format!("{e}").contains(field), "{e}");
     }
 }

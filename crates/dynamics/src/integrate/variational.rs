@@ -10,7 +10,10 @@
 use nalgebra::DMatrix;
 use paritysim_error::Result;
 
-use super::{OdeSystem, Rhs, RungeKutta, State, Tolerances, drive_method, integration_error};
+use super::{
+    OdeSystem, Rhs, RungeKutta, State, Tolerances, check_grid, drive_method, drive_method_on_grid,
+    integration_error,
+};
 
 /// Relative size of the directional difference step.
 const DIRECTIONAL_STEP: f64 = 1e-6;
@@ -98,14 +101,66 @@ impl RungeKutta {
                 format!("> t0 = {t0}"),
             ));
         }
+        self.sensitivity_any(system, t0, y0, t1, None)
+            .map(|(y, phi, _)| (y, phi))
+    }
+
+    /// [`Self::flow_with_sensitivity`] that also returns the accepted step times (from `t0`
+    /// to `t1`): the grid on which [`RungeKutta::integrate_on_grid`] retraces the same map.
+    ///
+    /// # Errors
+    /// As [`Self::flow_with_sensitivity`].
+    pub fn flow_with_sensitivity_and_steps(
+        &self,
+        system: &dyn OdeSystem,
+        t0: f64,
+        y0: &State,
+        t1: f64,
+    ) -> Result<(State, DMatrix<f64>, Vec<f64>)> {
+        if t1.is_nan() || t1 <= t0 {
+            return Err(paritysim_error::Error::invalid(
+                "t_end",
+                t1,
+                format!("> t0 = {t0}"),
+            ));
+        }
+        self.sensitivity_any(system, t0, y0, t1, None)
+    }
+
+    /// The flow and its sensitivity on the fixed steps of `grid` (see
+    /// [`RungeKutta::integrate_on_grid`]): the exact derivative of that map.
+    ///
+    /// # Errors
+    /// [`paritysim_error::Error::InvalidParameter`] for a bad grid; integration errors.
+    pub fn flow_with_sensitivity_on_grid(
+        &self,
+        system: &dyn OdeSystem,
+        grid: &[f64],
+        y0: &State,
+    ) -> Result<(State, DMatrix<f64>)> {
+        check_grid(grid)?;
+        let (t0, t1) = (grid[0], grid[grid.len() - 1]);
+        self.sensitivity_any(system, t0, y0, t1, Some(grid))
+            .map(|(y, phi, _)| (y, phi))
+    }
+
+    fn sensitivity_any(
+        &self,
+        system: &dyn OdeSystem,
+        t0: f64,
+        y0: &State,
+        t1: f64,
+        grid: Option<&[f64]>,
+    ) -> Result<(State, DMatrix<f64>, Vec<f64>)> {
         let n_real = system.n_active().clamp(1, 6);
         match n_real {
-            1..=2 => self.sensitivity::<20>(system, 2, n_real, t0, y0, t1),
-            3..=4 => self.sensitivity::<72>(system, 4, n_real, t0, y0, t1),
-            _ => self.sensitivity::<156>(system, 6, n_real, t0, y0, t1),
+            1..=2 => self.sensitivity::<20>(system, 2, n_real, t0, y0, t1, grid),
+            3..=4 => self.sensitivity::<72>(system, 4, n_real, t0, y0, t1, grid),
+            _ => self.sensitivity::<156>(system, 6, n_real, t0, y0, t1, grid),
         }
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn sensitivity<const M: usize>(
         &self,
         system: &dyn OdeSystem,
@@ -114,7 +169,8 @@ impl RungeKutta {
         t0: f64,
         y0: &State,
         t1: f64,
-    ) -> Result<(State, DMatrix<f64>)> {
+        grid: Option<&[f64]>,
+    ) -> Result<(State, DMatrix<f64>, Vec<f64>)> {
         let m = 2 * n;
         debug_assert_eq!(M, m + m * m);
         let mut c0 = [0.0; M];
@@ -134,24 +190,28 @@ impl RungeKutta {
             controlled: m,
         };
         let none = &mut |_: usize, _: f64, _: &State| Ok(());
-        let (c, _) = drive_method(
-            self.method,
-            &mut rhs,
-            &tol,
-            self.max_steps,
-            t0,
-            c0,
-            t1,
-            &[],
-            none,
-            &mut |_, _| {},
-        )?;
+        let mut steps = vec![t0];
+        let (c, _) = match grid {
+            None => drive_method(
+                self.method,
+                &mut rhs,
+                &tol,
+                self.max_steps,
+                t0,
+                c0,
+                t1,
+                &[],
+                none,
+                &mut |t, _| steps.push(t),
+            )?,
+            Some(grid) => drive_method_on_grid(self.method, &mut rhs, &tol, grid, c0, &[], none)?,
+        };
         // Rows/columns of the active entries: coords 0..n_real, rates n..n + n_real.
         let index = |k: usize| if k < n_real { k } else { n + k - n_real };
         let phi = DMatrix::from_fn(2 * n_real, 2 * n_real, |i, j| {
             c[m + index(j) * m + index(i)]
         });
-        Ok((to_state(n, &c[..m]), phi))
+        Ok((to_state(n, &c[..m]), phi, steps))
     }
 }
 

@@ -153,3 +153,89 @@ fn continuation_sweeps_agree_with_cold_starts_and_any_thread_count() {
         cycles(&cold)
     );
 }
+
+#[test]
+fn stroke_samples_give_the_metrics_of_full_samples() {
+    // Two formulations of the same samples: the full model evaluation (mass matrix, body
+    // torques through the wing rotations) and the stroke-only sample (forward map and drag
+    // torque about the stroke axis). Linear map and rod-crank linkage, both Table 3.2 and the
+    // stroke metrics.
+    // K2 = 500: the linkage's whippletree mode is stable there (docs/findings.md#3).
+    let linkage = parity_device(0.6 * 31.3, 500.0, "drag_parity_fixed", Formulation::Auto);
+    for device in [linear_parity(0.6 * 31.3, Formulation::Auto), linkage] {
+        let names: Vec<String> = [
+            "delta_tau_peak",
+            "tau_l_peak",
+            "tau_r_peak",
+            "imbalance_instantaneous_pct",
+            "imbalance_peak_pct",
+            "left_stroke_amplitude",
+            "right_stroke_mean",
+            "left_roll_aero_mean",
+            "right_rotation_amplitude",
+            "q2_amplitude",
+            "actuator_force_peak",
+        ]
+        .map(String::from)
+        .to_vec();
+        let full = simulate(&device, &shooting()).unwrap();
+        let lean = simulate(
+            &device,
+            &SimulationOptions {
+                metrics: Some(names.clone()),
+                ..shooting()
+            },
+        )
+        .unwrap();
+        for name in &names {
+            let (a, b) = (metric(&lean, name), metric(&full, name));
+            assert!(
+                (a - b).abs() <= 1e-12 * (1.0 + b.abs()),
+                "{name}: stroke {a} vs full {b}"
+            );
+        }
+        // Metrics the stroke samples cannot give are NaN, not a wrong number.
+        assert!(metric(&lean, "roll_total_peak").is_nan());
+        assert!(metric(&full, "roll_total_peak").is_finite());
+    }
+}
+
+#[test]
+fn shooting_at_default_tolerances_finds_a_slow_mode_orbit_to_1e_7() {
+    // K2 = 3.2 on the linear map: whippletree multiplier 0.98. With the adaptive map Newton
+    // stalled near rtol and the transient fallback stopped 5e-6 off the orbit; on the frozen
+    // grid the default-option result is within 1e-7 of an rtol-1e-12 long transient.
+    let device = parity_device_with(
+        0.684 * 31.3,
+        3.2,
+        "drag_parity_fixed",
+        Formulation::Auto,
+        Drivetrain::LinearDifferential(
+            paritysim_kinematics::drivetrain::LinearDifferential::new(2.5, 2.5, 1.0).unwrap(),
+        ),
+    );
+    let fast = simulate(&device, &shooting()).unwrap();
+    let reference = simulate(
+        &device,
+        &SimulationOptions {
+            steady_state: SteadyState::Transient,
+            steady_tol: 1e-12,
+            max_cycles: 20_000,
+            rtol: 1e-12,
+            atol: 1e-14,
+            ..shooting()
+        },
+    )
+    .unwrap();
+    assert!(fast.converged && reference.converged);
+    assert!(fast.multipliers[0].norm() > 0.95, "{:?}", fast.multipliers);
+    let tau_r = metric(&reference, "tau_r_peak");
+    for name in ["delta_tau_peak", "tau_r_peak", "tau_l_peak"] {
+        let (a, b) = (metric(&fast, name), metric(&reference, name));
+        assert!((a - b).abs() <= 1e-7 * tau_r, "{name}: {a} vs {b}");
+    }
+    for name in ["imbalance_instantaneous_pct", "imbalance_peak_pct"] {
+        let (a, b) = (metric(&fast, name), metric(&reference, name));
+        assert!((a - b).abs() <= 1e-5, "{name}: {a} vs {b}");
+    }
+}

@@ -1,0 +1,212 @@
+//! The periodic steady state of [`crate::SteadyState::Shooting`]: Newton on the stroboscopic
+//! map retraced on a frozen step grid.
+//!
+//! Why a frozen grid: an adaptive integrator's map `P(y)` is only piecewise smooth in `y` (the
+//! step sequence jumps when `y` changes), so Newton stalls near `rtol` (measured: at rtol 1e-8
+//! on the §3.3 device the residual halved per iteration from 9e-9 and the transient fallback
+//! took over, leaving the state 5e-6 off the orbit of a slow whippletree mode, μ = 0.98). On the
+//! steps the first adaptive period chose, `P` is a fixed explicit Runge–Kutta map, smooth in
+//! `y`: Newton converges to round-off in one or two steps, without rejected steps or error
+//! estimates, and the orbit is the fixed point of exactly the map the recorded window retraces.
+//!
+//! Per point: one adaptive period (with the variational equations unless a converged
+//! neighbour's Jacobian is given), Newton steps with Broyden updates of the Jacobian, each
+//! trial one fixed-grid period; the last trial is the recorded window itself (`finish`), started
+//! once the predicted error of the next iterate (step × observed contraction) is below `tol`.
+//! The residual of that recorded period is reported.
+
+use nalgebra::{DMatrix, DVector};
+use paritysim_error::{Error, Result};
+
+use crate::device::Device;
+use crate::integrate::{RungeKutta, State};
+
+/// A periodic orbit found on a frozen grid.
+#[derive(Clone, Debug)]
+pub(crate) struct GridOrbit {
+    /// The state on the section (work integrals zero).
+    pub state: State,
+    /// `‖P(y) − y‖∞ / (1 + ‖y‖∞)` of the final period.
+    pub residual: f64,
+    /// The last Jacobian estimate of the map (exact or Broyden-updated): the next point's
+    /// guess in a continuation chain, and its eigenvalues the Floquet multipliers.
+    pub jacobian: DMatrix<f64>,
+    /// Period integrations before the final one.
+    pub periods: usize,
+    /// The step grid (from 0 to the period).
+    pub grid: Vec<f64>,
+}
+
+fn compact(n: usize, y: &State) -> DVector<f64> {
+    DVector::from_fn(
+        2 * n,
+        |i, _| if i < n { y.coords[i] } else { y.rates[i - n] },
+    )
+}
+
+fn expand(n: usize, v: &DVector<f64>) -> State {
+    let mut y = State::default();
+    for i in 0..n {
+        y.coords[i] = v[i];
+        y.rates[i] = v[n + i];
+    }
+    y
+}
+
+/// `(P(y) − y, ‖P(y) − y‖∞ / (1 + ‖y‖∞))`.
+fn residual(n: usize, y: &State, py: &State) -> (DVector<f64>, f64) {
+    let (yv, pv) = (compact(n, y), compact(n, py));
+    let f = pv - &yv;
+    let r = f.amax() / (1.0 + yv.amax());
+    (f, r)
+}
+
+/// Tolerances of the adaptive period that picks the grid, relative to the run's: the fixed-grid
+/// maps then need no rejected steps and the orbit and its recorded window are accurate to about
+/// the run's `rtol` (on the §3.3 grid at rtol 1e-8, the grid at the run's own tolerance left
+/// torques 3.5e-7 off the rtol-1e-12 reference, amplified by slow multipliers up to 0.98).
+pub(crate) const GRID_TOLERANCE_FACTOR: f64 = 1e-2;
+
+/// Newton on the frozen-grid map from `y0` on the section `t = 0`, to a state whose predicted
+/// error (relative to `1 + ‖y‖∞`) is below `tol`; `finish(grid, y)` integrates the final
+/// period (recording it) and returns its end state. The final period is accepted when its
+/// residual is below `tol`, or below `accept_tol` with a negligible further Newton step (the
+/// residual then lies along a neutral direction: a cyclic coordinate such as `q2` at K2 = 0
+/// drifting by a constant per period). `Ok(None)` when Newton does not converge within
+/// `max_newton` steps or a trial leaves the model's domain (the caller falls back to the
+/// transient).
+///
+/// # Errors
+/// Only from `finish` (e.g. a failing recorded sample) or a cancelled run.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn shoot(
+    device: &Device,
+    integrator: &RungeKutta,
+    period: f64,
+    y0: &State,
+    guess: Option<&DMatrix<f64>>,
+    guess_grid: Option<&[f64]>,
+    tol: f64,
+    accept_tol: f64,
+    max_newton: usize,
+    finish: &mut dyn FnMut(&[f64], &State) -> Result<State>,
+) -> Result<Option<GridOrbit>> {
+    let rk = integrator.with_work(false);
+    let chooser = rk.tightened(GRID_TOLERANCE_FACTOR);
+    let n = device.n_dof();
+    let m = 2 * n;
+    let mut y = y0.without_work();
+    let guess = guess.filter(|j| j.shape() == (m, m));
+    // A neighbour's grid is kept while every step's error estimate stays within the grid
+    // tolerances: the first map then costs one fixed-grid period instead of an adaptive one.
+    let inherited = match (guess, guess_grid) {
+        (Some(j), Some(grid)) if grid.first() == Some(&0.0) && grid.last() == Some(&period) => {
+            match chooser.integrate_on_grid_counted(device, grid, &y, &[], &mut |_, _, _| Ok(())) {
+                Ok((py, stats)) if stats.over_tolerance == 0 => {
+                    Some(Ok((py, j.clone(), grid.to_vec(), false)))
+                }
+                Err(Error::Cancelled) => Some(Err(Error::Cancelled)),
+                _ => None,
+            }
+        }
+        _ => None,
+    };
+    let first = match (inherited, guess) {
+        (Some(done), _) => done,
+        (None, Some(j)) => chooser
+            .advance_with_steps(device, 0.0, &y, period)
+            .map(|(py, grid)| (py, j.clone(), grid, false)),
+        (None, None) => chooser
+            .flow_with_sensitivity_and_steps(device, 0.0, &y, period)
+            .map(|(py, j, grid)| (py, j, grid, true)),
+    };
+    let (py, mut jac, grid, mut fresh) = match first {
+        Ok(v) => v,
+        Err(Error::Cancelled) => return Err(Error::Cancelled),
+        Err(_) => return Ok(None),
+    };
+    let mut periods = 1;
+    let (mut f, mut res) = residual(n, &y, &py);
+    let eye = DMatrix::<f64>::identity(m, m);
+    let mut last_step: Option<f64> = None;
+    let mut iterations = 0;
+    // Least squares: a neutral direction (multiplier 1, e.g. K2 = 0 on the linear map, where
+    // every constant q2 is an orbit) is left where it is.
+    let newton_step = |jac: &DMatrix<f64>, f: &DVector<f64>| {
+        let svd = (jac - &eye).svd(true, true);
+        let cutoff = 1e-10 * svd.singular_values.max().max(f64::MIN_POSITIVE);
+        svd.solve(&(-f), cutoff).ok()
+    };
+    while iterations < max_newton {
+        iterations += 1;
+        let Some(delta) = newton_step(&jac, &f) else {
+            return Ok(None);
+        };
+        let scale = 1.0 + compact(n, &y).amax();
+        let step = delta.amax() / scale;
+        // The next iterate's error: the step times the contraction seen so far (Newton's
+        // quadratic model after a fresh Jacobian; unknown, so 1, after a neighbour's).
+        let contraction = match last_step {
+            Some(s) => step / s,
+            None if fresh => step,
+            None => 1.0,
+        }
+        .min(1.0);
+        let y_new = expand(n, &(compact(n, &y) + &delta));
+        let last = contraction * step <= tol || step <= 1e-3 * tol;
+        let trial = if last {
+            finish(&grid, &y_new)
+        } else {
+            rk.integrate_on_grid(device, &grid, &y_new, &[], &mut |_, _, _| Ok(()))
+        };
+        let p_new = match trial {
+            Ok(p) => p,
+            Err(Error::Cancelled) => return Err(Error::Cancelled),
+            // `finish` failing is the recorded window's error: report it.
+            Err(e) if last => return Err(e),
+            Err(_) => return Ok(None),
+        };
+        periods += 1;
+        let (f_new, res_new) = residual(n, &y_new, &p_new);
+        let neutral = || {
+            res_new <= accept_tol
+                && newton_step(&jac, &f_new)
+                    .is_some_and(|d| d.amax() / (1.0 + compact(n, &y_new).amax()) <= tol)
+        };
+        if last && (res_new <= tol || neutral()) {
+            return Ok(Some(GridOrbit {
+                state: y_new,
+                residual: res_new,
+                jacobian: jac,
+                periods: periods - 1,
+                grid,
+            }));
+        }
+        if res_new >= res || res_new.is_nan() {
+            if fresh {
+                return Ok(None);
+            }
+            // A stale (neighbour's or updated) Jacobian that no longer descends: the exact
+            // one at the current iterate, on the same grid.
+            match rk.flow_with_sensitivity_on_grid(device, &grid, &y) {
+                Ok((_, j)) => jac = j,
+                Err(Error::Cancelled) => return Err(Error::Cancelled),
+                Err(_) => return Ok(None),
+            }
+            periods += 1;
+            fresh = true;
+            last_step = None;
+            continue;
+        }
+        // Good Broyden: the secant condition on the step just taken.
+        let s_dot = delta.dot(&delta);
+        if s_dot > 0.0 {
+            let mismatch = (&f_new - &f) - (&jac - &eye) * &delta;
+            jac += mismatch * delta.transpose() / s_dot;
+        }
+        fresh = false;
+        (y, f, res) = (y_new, f_new, res_new);
+        last_step = Some(step);
+    }
+    Ok(None)
+}
