@@ -228,12 +228,12 @@ pub(crate) fn interruptible<T: Send>(
 /// tens of milliseconds and raises `KeyboardInterrupt`.
 #[pyfunction]
 fn simulate(py: Python<'_>, json: &str) -> PyResult<SimulationOutput> {
-    let (device, mut options) = parse(json).and_then(|s| s.model()).py_err()?;
+    let spec = parse(json).py_err()?;
+    let (device, mut options) = spec.model().py_err()?;
     let cancel = CancelFlag::new();
     options.cancel = Some(cancel.clone());
-    let result = interruptible(py, &cancel, || {
-        paritysim_dynamics::simulate(&device, &options)
-    })?;
+    // A spec with a moving body flies (paritysim-flight); otherwise the fixed-body engine.
+    let result = interruptible(py, &cancel, || spec.run(&device, &options))?;
     Ok(SimulationOutput { result })
 }
 

@@ -7,14 +7,14 @@
 use std::time::Duration;
 
 use numpy::PyArray1;
-use paritysim_dynamics::sweep::{THREADS_ENV, metric_names, resolve_threads, trajectory_columns};
+use paritysim_dynamics::sweep::{THREADS_ENV, resolve_threads};
 use paritysim_error::Error;
 use paritysim_spec::sweep::{KeptCycles, SweepJob, SweepOutcome, SweepPlan};
 use pyo3::prelude::*;
 
 use crate::convert::shaped;
 use crate::errors::IntoPyResult;
-use crate::spec::{device, parse};
+use crate::spec::parse;
 
 /// A batch of sweep points running on a background thread.
 #[pyclass(module = "paritysim._core", frozen)]
@@ -179,13 +179,15 @@ impl SweepResult {
 /// Metric names `simulate` reports for a JSON spec, in order.
 #[pyfunction]
 fn sweep_metric_names(spec: &str) -> PyResult<Vec<String>> {
-    Ok(metric_names(&device(spec).py_err()?))
+    let spec = parse(spec).py_err()?;
+    spec.device().and_then(|d| spec.metric_names(&d)).py_err()
 }
 
 /// Trajectory column names (without `time_ms`) recorded for a JSON spec, in order.
 #[pyfunction]
 fn sweep_trajectory_columns(spec: &str) -> PyResult<Vec<String>> {
-    Ok(trajectory_columns(&device(spec).py_err()?))
+    let spec = parse(spec).py_err()?;
+    spec.device().and_then(|d| spec.column_names(&d)).py_err()
 }
 
 /// The thread count a sweep would use: `threads`, else `$PARITYSIM_THREADS`, else all cores.

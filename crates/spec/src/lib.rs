@@ -13,9 +13,11 @@
 //! aero and constraints crates), never the reverse, so the engine stays free of serde.
 
 pub mod actuator;
+pub mod body;
 mod build;
 pub mod continuation;
 pub mod drivetrain;
+pub mod flight;
 pub mod migrate;
 pub mod options;
 pub mod paths;
@@ -25,6 +27,7 @@ pub mod sweep;
 pub mod wing;
 
 pub use actuator::{Actuator, DcOffset, Sampled, Sine, Waveform};
+pub use body::{Body, BodyMode};
 pub use build::options as engine_options;
 pub use drivetrain::{Drivetrain, DrivetrainConfig};
 pub use options::{Options, Perturbation};

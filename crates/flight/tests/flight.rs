@@ -1,0 +1,189 @@
+//! Validation of the free-flight model (issue 17): conservation laws, the heavy-body limit,
+//! gimbals against the free body, mirror symmetry.
+
+mod common;
+
+use common::*;
+use nalgebra::{UnitQuaternion, Vector3};
+use paritysim_dynamics::{SimulationOptions, State, simulate};
+use paritysim_flight::model::{Inputs, STATE_LEN};
+use paritysim_flight::{Body, BodyMode, FlightModel, Release, Schedule, fly, integrate_flight};
+
+fn column<'a>(r: &'a paritysim_dynamics::SimulationResult, name: &str) -> &'a [f64] {
+    r.trajectory
+        .column(name)
+        .unwrap_or_else(|| panic!("no column {name}"))
+}
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |m, x| m.max(x.abs()))
+}
+
+#[test]
+fn vacuum_free_flight_conserves_momentum_and_energy() {
+    let device = vacuum_device();
+    let body = Body {
+        gravity: Vector3::zeros(),
+        wing_mass: [0.8, 0.7],
+        wing_center_of_mass: [v(-1.0, 0.0, 6.0), v(-0.8, 0.1, 5.5)],
+        center_of_mass: v(0.3, -0.2, 0.1),
+        inertia: nalgebra::Matrix3::new(160.0, 5.0, -3.0, 5.0, 1700.0, 8.0, -3.0, 8.0, 1650.0),
+        ..hmf_body(BodyMode::Free)
+    };
+    let model = FlightModel::new(&device, body, Vec::new()).unwrap();
+    let mut wings = State::default();
+    // x = (φL, ψL, φR, ψR)-like null-space coordinates: start away from rest with rates.
+    for i in 0..model.n_dof() {
+        wings.coords[i] = 0.2 * (i as f64 + 1.0) / 4.0;
+        wings.rates[i] = 0.05 * (1.0 - i as f64 * 0.6);
+    }
+    let attitude = UnitQuaternion::from_euler_angles(0.3, -0.2, 0.5);
+    let y0 = model.state(
+        &attitude,
+        &v(1.0, 2.0, -1.0),
+        &v(0.01, -0.02, 0.005),
+        &v(0.003, -0.004, 0.002),
+        &wings,
+    );
+    let t_end = 100.0 / 0.110; // 100 wingbeats at 110 Hz (ms)
+    let times: Vec<f64> = (0..=100).map(|k| t_end * k as f64 / 100.0).collect();
+    let mut evals = Vec::new();
+    integrate_flight(
+        &model,
+        &tight(),
+        &Inputs::default(),
+        0.0,
+        &y0,
+        t_end,
+        &times,
+        &mut |_, t, y: &[f64; STATE_LEN]| {
+            evals.push(model.evaluate(t, y, &Inputs::default())?);
+            Ok(())
+        },
+    )
+    .unwrap();
+    let (p0, l0) = (evals[0].momentum, evals[0].angular_momentum);
+    let e0 = evals[0].kinetic + evals[0].potential;
+    assert!(
+        p0.norm() > 0.1 && l0.norm() > 1.0,
+        "a test that moves: {p0:?} {l0:?}"
+    );
+    let mut worst = [0.0f64; 3];
+    for e in &evals {
+        worst[0] = worst[0].max((e.momentum - p0).norm() / p0.norm());
+        worst[1] = worst[1].max((e.angular_momentum - l0).norm() / l0.norm());
+        worst[2] = worst[2].max(((e.kinetic + e.potential) - e0).abs() / e0);
+    }
+    // The wings really move relative to the body (energy sloshes between springs and motion).
+    let ke: Vec<f64> = evals.iter().map(|e| e.kinetic).collect();
+    assert!(max_abs(&ke) > 1.5 * ke.iter().cloned().fold(f64::INFINITY, f64::min));
+    eprintln!(
+        "relative drift: momentum {:.2e}, angular momentum {:.2e}, energy {:.2e}",
+        worst[0], worst[1], worst[2]
+    );
+    assert!(worst[0] < 1e-10, "linear momentum drift {}", worst[0]);
+    assert!(worst[1] < 1e-10, "angular momentum drift {}", worst[1]);
+    assert!(worst[2] < 1e-10, "energy drift {}", worst[2]);
+}
+
+fn options(record_cycles: usize) -> SimulationOptions {
+    SimulationOptions {
+        record_cycles,
+        samples_per_cycle: 100,
+        ..SimulationOptions::default()
+    }
+}
+
+#[test]
+fn heavy_body_reproduces_the_fixed_device() {
+    let device = device_3_4(
+        wing_3_4(false, 1.0, 2.533928021702924),
+        wing_3_4(true, 1.0, 2.533928021702924),
+        0.0,
+    );
+    // Tight enough that the integration error stays below the physics compared.
+    let opts = SimulationOptions {
+        rtol: 1e-11,
+        atol: 1e-13,
+        ..options(3)
+    };
+    let fixed = simulate(&device, &opts).unwrap();
+    let heavy = Body {
+        gravity: Vector3::zeros(),
+        ..hmf_body(BodyMode::Free)
+    }
+    .scaled(1e6);
+    for (body, tol) in [
+        (heavy.clone(), 1e-6),
+        (
+            Body {
+                mode: BodyMode::Clamped,
+                ..heavy
+            },
+            1e-7,
+        ),
+    ] {
+        let mode = body.mode;
+        let model = FlightModel::new(&device, body, Vec::new()).unwrap();
+        let flight = fly(&model, &opts, &Release::default(), &Schedule::default()).unwrap();
+        for name in [
+            "left_phi",
+            "left_psi",
+            "right_phi",
+            "right_psi",
+            "q2",
+            "left_roll_aero",
+            "right_yaw_aero",
+            "roll_total",
+            "yaw_total",
+            "pitch_total",
+            "left_roll_inertial",
+            "right_pitch_inertial",
+        ] {
+            let (a, b) = (column(&fixed, name), column(&flight, name));
+            // Net torques cancel (PARITY with K2 = 0): measure them against one wing's torque.
+            let scale = if let Some(axis) = name.strip_suffix("_total") {
+                max_abs(column(&fixed, &format!("left_{axis}_aero")))
+            } else {
+                max_abs(a)
+            };
+            let err = a
+                .iter()
+                .zip(b)
+                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+            eprintln!(
+                "{mode:?} {name}: max |diff| / max |fixed| = {:.2e}",
+                err / scale
+            );
+            assert!(
+                err <= tol * scale,
+                "{mode:?} {name}: {err} vs scale {scale}"
+            );
+        }
+        // The heavy body barely moves but does move.
+        if mode == BodyMode::Free {
+            let roll = max_abs(column(&flight, "body_omega_roll"));
+            assert!(roll > 0.0 && roll < 1e-8, "heavy body roll rate {roll}");
+        }
+    }
+}
+
+#[test]
+fn probe_lift() {
+    let device = symmetric_3_4();
+    for mode in [BodyMode::Clamped, BodyMode::Free] {
+        let model = FlightModel::new(&device, hmf_body(mode), Vec::new()).unwrap();
+        let r = fly(
+            &model,
+            &options(5),
+            &Release::default(),
+            &Schedule::default(),
+        )
+        .unwrap();
+        for (k, v) in &r.metrics {
+            if k.starts_with("body_") || k.starts_with("lift") {
+                eprintln!("{mode:?} {k} = {v}");
+            }
+        }
+    }
+}
