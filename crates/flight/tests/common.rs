@@ -130,3 +130,27 @@ pub fn hmf_body(mode: paritysim_flight::BodyMode) -> paritysim_flight::Body {
         wing_center_of_mass: [Vector3::zeros(); 2],
     }
 }
+
+/// A §3.3-like stroke-only PARITY device (fixed wings, drag torques), right wing cut to 60 %.
+pub fn drag_only_1cut() -> Device {
+    let shoulder = SphericalShoulder::new(std::f64::consts::FRAC_PI_2, 0.0).unwrap();
+    let wing = |omega1: f64| {
+        Wing::stroke_only(shoulder, 29.0, WingAero::stroke_drag(omega1, 1.0).unwrap()).unwrap()
+    };
+    Device::new(DeviceSpec {
+        wings: vec![wing(31.3), wing(0.6 * 31.3)],
+        constraints: Constraints::configuration("drag_parity_fixed").unwrap(),
+        transmission: Some(Transmission::new(linear_differential(), 0.5).unwrap()),
+        actuator: Some(
+            Actuator::new(
+                1.2,
+                467.0,
+                Waveform::sine(100.0, 110.0, 0.0, 0.0).unwrap(),
+                DcOffset::Ignore,
+            )
+            .unwrap(),
+        ),
+        formulation: Formulation::Auto,
+    })
+    .unwrap()
+}

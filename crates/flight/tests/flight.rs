@@ -168,22 +168,131 @@ fn heavy_body_reproduces_the_fixed_device() {
     }
 }
 
+fn max_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+}
+
 #[test]
-fn probe_lift() {
-    let device = symmetric_3_4();
-    for mode in [BodyMode::Clamped, BodyMode::Free] {
+fn roll_gimbal_equals_the_free_body_of_a_roll_only_device() {
+    // Stroke-only wings with isotropic inertia and torque-only drag push on the body about
+    // the roll axis only: the free body must not yaw or pitch, and must roll like the gimbal.
+    let device = drag_only_1cut();
+    let opts = SimulationOptions {
+        rtol: 1e-10,
+        atol: 1e-12,
+        ..options(10)
+    };
+    let run = |mode| {
         let model = FlightModel::new(&device, hmf_body(mode), Vec::new()).unwrap();
-        let r = fly(
-            &model,
-            &options(5),
-            &Release::default(),
-            &Schedule::default(),
-        )
-        .unwrap();
-        for (k, v) in &r.metrics {
-            if k.starts_with("body_") || k.starts_with("lift") {
-                eprintln!("{mode:?} {k} = {v}");
-            }
-        }
+        fly(&model, &opts, &Release::default(), &Schedule::default()).unwrap()
+    };
+    let (free, roll) = (run(BodyMode::Free), run(BodyMode::Roll));
+    let rate = max_abs(column(&roll, "body_omega_roll"));
+    // PARITY balances most of the imbalance: the residual roll rate is small but not zero.
+    assert!(rate > 1e-5, "the 1-Cut device rolls: {rate}");
+    for axis in ["yaw", "pitch"] {
+        let other = max_abs(column(&free, &format!("body_omega_{axis}")));
+        assert!(
+            other < 1e-12 * rate.max(1.0),
+            "free body {axis} rate {other}"
+        );
+    }
+    for name in [
+        "body_roll",
+        "body_omega_roll",
+        "left_phi",
+        "right_phi",
+        "q2",
+    ] {
+        let d = max_diff(column(&free, name), column(&roll, name));
+        let scale = max_abs(column(&roll, name));
+        eprintln!("{name}: free vs roll gimbal {d:.2e} of {scale:.3e}");
+        // Both runs integrate O(1) wing angles at rtol 1e-10: that bounds the agreement.
+        assert!(d <= 1e-8 * scale.max(1.0), "{name}: {d} vs {scale}");
+    }
+}
+
+#[test]
+fn roll_pitch_yaw_gimbal_of_a_symmetric_device_only_pitches() {
+    let device = symmetric_3_4();
+    let opts = SimulationOptions {
+        rtol: 1e-10,
+        atol: 1e-12,
+        ..options(5)
+    };
+    let run = |mode| {
+        let model = FlightModel::new(&device, hmf_body(mode), Vec::new()).unwrap();
+        fly(&model, &opts, &Release::default(), &Schedule::default()).unwrap()
+    };
+    let (rpy, pitch) = (run(BodyMode::RollPitchYaw), run(BodyMode::Pitch));
+    let scale = max_abs(column(&pitch, "body_omega_pitch"));
+    assert!(scale > 1e-4, "the symmetric device pitches: {scale}");
+    for axis in ["roll", "yaw"] {
+        let other = max_abs(column(&rpy, &format!("body_omega_{axis}")));
+        assert!(other < 1e-9 * scale, "{axis} rate {other} (by symmetry 0)");
+    }
+    for name in [
+        "body_pitch",
+        "body_omega_pitch",
+        "left_phi",
+        "right_psi",
+        "q2",
+    ] {
+        let d = max_diff(column(&rpy, name), column(&pitch, name));
+        let s = max_abs(column(&pitch, name)).max(1e-3);
+        eprintln!("{name}: rpy vs pitch gimbal {:.2e}", d / s);
+        assert!(d <= 1e-8 * s, "{name}: {d} vs {s}");
+    }
+}
+
+#[test]
+fn mirrored_asymmetry_gives_the_mirrored_flight() {
+    let hinge = 2.533928021702924;
+    let (whole, cut) = (wing_3_4(false, 1.0, hinge), wing_3_4(false, 0.7, hinge));
+    let right_cut = device_3_4(whole.clone(), cut.clone(), 0.1);
+    let left_cut = device_3_4(cut, whole, 0.1);
+    let opts = SimulationOptions {
+        rtol: 1e-10,
+        atol: 1e-12,
+        ..options(4)
+    };
+    let run = |device: &paritysim_dynamics::Device| {
+        let model = FlightModel::new(device, hmf_body(BodyMode::Free), Vec::new()).unwrap();
+        fly(&model, &opts, &Release::default(), &Schedule::default()).unwrap()
+    };
+    let (a, b) = (run(&right_cut), run(&left_cut));
+    // Sagittal mirror z -> -z: polar z components and axial x, y components change sign.
+    let flips = [
+        ("body_roll", -1.0),
+        ("body_yaw", -1.0),
+        ("body_pitch", 1.0),
+        ("body_omega_roll", -1.0),
+        ("body_omega_yaw", -1.0),
+        ("body_omega_pitch", 1.0),
+        ("body_x", 1.0),
+        ("body_y", 1.0),
+        ("body_z", -1.0),
+        ("body_vz", -1.0),
+        ("body_torque_roll", -1.0),
+        ("body_force_z", -1.0),
+        ("q2", -1.0),
+    ];
+    let roll = max_abs(column(&a, "body_omega_roll"));
+    assert!(roll > 1e-4, "the asymmetric device rolls: {roll}");
+    for (name, sign) in flips {
+        let (x, y) = (column(&a, name), column(&b, name));
+        let s = max_abs(x).max(1e-6);
+        let d = x
+            .iter()
+            .zip(y)
+            .fold(0.0f64, |m, (p, q)| m.max((p - sign * q).abs()));
+        eprintln!("{name}: mirror mismatch {:.2e} of {s:.3e}", d / s);
+        assert!(d <= 1e-6 * s, "{name}: {d} vs {s}");
+    }
+    for (l, r) in [("left_phi", "right_phi"), ("left_psi", "right_psi")] {
+        let d = max_diff(column(&a, l), column(&b, r));
+        assert!(d <= 1e-6 * max_abs(column(&a, l)), "{l} vs {r}: {d}");
     }
 }
