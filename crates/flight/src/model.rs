@@ -100,6 +100,9 @@ pub struct FlightModel {
     axial: [Matrix3<f64>; 2],
     shoulder: [Vector3<f64>; 2],
     active: Vec<usize>,
+    /// Wings whose deviation the constraints hold at zero on an α2 = 90° shoulder: closed-form
+    /// terms ([`Wing::stroke_plane_terms`], as the device uses them).
+    stroke_plane: [bool; 2],
 }
 
 /// Everything at one instant (what the samples are built from).
@@ -245,6 +248,16 @@ impl FlightModel {
             }
             shoulder[k] = body.shoulders[si] - body.center_of_mass;
         }
+        let mut stroke_plane = [false; 2];
+        {
+            let c = &device.spec().constraints;
+            for (k, wing) in device.spec().wings.iter().enumerate() {
+                let row = 3 * k + 1;
+                let held = (0..c.n_free()).all(|j| c.null_basis()[(row, j)].abs() <= 1e-12)
+                    && c.particular()[row] == 0.0;
+                stroke_plane[k] = held && wing.has_closed_form_stroke_plane();
+            }
+        }
         let active = body
             .mode
             .active()
@@ -268,6 +281,7 @@ impl FlightModel {
             axial,
             shoulder,
             active,
+            stroke_plane,
         })
     }
 
@@ -366,7 +380,7 @@ impl FlightModel {
         inputs: &Inputs,
         dydt: &mut [f64; STATE_LEN],
     ) -> Result<()> {
-        let e = self.evaluate(t, y, inputs)?;
+        let e = self.evaluate_with(t, y, inputs, false)?;
         *dydt = [0.0; STATE_LEN];
         // q̇ = ½ q ⊗ (0, Ω) on the stored (unnormalised) quaternion.
         let (w, a, b, c) = (y[0], y[1], y[2], y[3]);
@@ -437,6 +451,19 @@ impl FlightModel {
     /// # Errors
     /// As [`Self::rhs`].
     pub fn evaluate(&self, t: f64, y: &[f64; STATE_LEN], inputs: &Inputs) -> Result<FlightEval> {
+        self.evaluate_with(t, y, inputs, true)
+    }
+
+    /// [`Self::evaluate`]; the reactions on the airframe and the per-wing shoulder torques
+    /// only when `reactions` (samples, not the right-hand side).
+    #[inline(always)]
+    fn evaluate_with(
+        &self,
+        t: f64,
+        y: &[f64; STATE_LEN],
+        inputs: &Inputs,
+        reactions: bool,
+    ) -> Result<FlightEval> {
         let attitude =
             UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(y[0], y[1], y[2], y[3]));
         let r_b = *attitude.to_rotation_matrix().matrix();
@@ -488,7 +515,12 @@ impl FlightModel {
             let o = 3 * k;
             let pw = Vector3::new(p[o], p[o + 1], p[o + 2]);
             let vw = Vector3::new(p_dot[o], p_dot[o + 1], p_dot[o + 2]);
-            let mut terms = self.device.spec().wings[k].terms(&pw, &vw)?;
+            let wing = &self.device.spec().wings[k];
+            let mut terms = if self.stroke_plane[k] {
+                wing.stroke_plane_terms(&pw, &vw)
+            } else {
+                wing.terms(&pw, &vw)?
+            };
             potential += terms.potential;
             for i in 0..3 {
                 generalized_p[o + i] -= terms.spring[i];
@@ -606,7 +638,7 @@ impl FlightModel {
         let mut wing_torque = Vector3::zeros();
         let mut aero_torque = [Vector3::zeros(); 2];
         let mut inertial_torque = [Vector3::zeros(); 2];
-        for k in 0..self.n_wings {
+        for k in (0..self.n_wings).filter(|_| reactions) {
             let (pk, ak) = (&self.polar[k], &self.axial[k]);
             let r = wings[k].rotation;
             let s = self.shoulder[k];
