@@ -39,7 +39,7 @@ def test_free_flight_reports_attitude_position_and_body_metrics() -> None:
 def test_fixed_body_section_changes_nothing() -> None:
     plain = ps.load_spec(EXAMPLES / "drag_parity.toml")
     plain = plain.replace(options=dataclasses.replace(plain.options, max_cycles=5, samples_per_cycle=40))
-    fixed = plain.with_paths({"body.mode": "fixed", "body.mass_mg": 90.0})
+    fixed = plain.replace(body=ps.spec.Body(mode="fixed", mass_mg=90.0))
     a, b = ps.simulate(plain), ps.simulate(fixed)
     assert a.metrics == b.metrics
     assert a.trajectory.equals(b.trajectory)
