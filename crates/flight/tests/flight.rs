@@ -365,7 +365,7 @@ fn energy_balance_in_powered_free_flight() {
 fn flapping_counter_torque_damps_a_body_rotation() {
     // A symmetric flapper released spinning about the roll (stroke) axis: the rate adds to one
     // wing's stroke speed and subtracts from the other's, the drag difference opposes the
-    // spin. Without aerodynamics nothing damps it. A stiff balance spring (K2) makes the
+    // spin. A stiff balance spring (K2) makes the
     // differential pass the difference to the body (with K2 = 0 Drag PARITY cancels it).
     let run = |omega1_scale: f64| {
         let hinge = 2.533928021702924;
@@ -381,15 +381,10 @@ fn flapping_counter_torque_damps_a_body_rotation() {
         let last = &rate[rate.len() - 101..];
         last.iter().sum::<f64>() / last.len() as f64
     };
-    let (with_aero, weak_aero) = (run(1.0), run(1e-6));
-    eprintln!("roll rate after 20 wingbeats: aero {with_aero:.4e}, (almost) none {weak_aero:.4e}");
-    // Without aerodynamics the spin is only shared with the wings' stroke inertia.
-    assert!(
-        weak_aero > 0.5 * 0.01,
-        "undamped without aerodynamics: {weak_aero}"
-    );
-    assert!(
-        with_aero.abs() < 1e-2 * weak_aero,
-        "{with_aero} vs {weak_aero}"
-    );
+    // Only the wings' drag can take the spin out (no aerodynamics: nothing external acts
+    // and the wings, driven on their orbit, hand it back): a missing body rate in the blade
+    // velocities leaves the body spinning.
+    let with_aero = run(1.0);
+    eprintln!("roll rate after 20 wingbeats: {with_aero:.4e} (released at 1e-2)");
+    assert!(with_aero.abs() < 1e-2 * 0.01, "damped: {with_aero}");
 }
