@@ -83,6 +83,7 @@ fn body_fields_are_validated_with_their_path_and_listed_as_paths() {
     ))
     .unwrap()
     .0;
+    assert!(spec.model().is_err(), "validation builds the flight model");
     let device = spec.device().unwrap();
     match spec.flight(&device) {
         Err(Error::InvalidParameter { field, .. }) => assert_eq!(field, "body.inertia"),
