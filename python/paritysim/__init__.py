@@ -44,7 +44,7 @@ if TYPE_CHECKING:  # what type checkers see; at run time the names below load la
     from .continuation import ContinuationResult
     from .planform import Planform
     from .simulation import SimulationResult, simulate
-    from .spec import Actuator, Aero, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, Springs, TunableHinge, Waveform, Wing, load_spec, spec_paths
+    from .spec import Actuator, Aero, Body, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, Springs, TunableHinge, Waveform, Wing, load_spec, spec_paths
     from .sweep import grid, sweep
 
 #: Lazily loaded submodules.
@@ -58,7 +58,7 @@ _NAMES = {
     "SimulationResult": "simulation",
     "simulate": "simulation",
     "grid": "sweep",
-    **{n: "spec" for n in ("Actuator", "Aero", "Configuration", "Drivetrain", "Options", "Shoulder", "Simulation", "Spring", "Springs", "TunableHinge", "Waveform", "Wing", "load_spec", "spec_paths")},
+    **{n: "spec" for n in ("Actuator", "Aero", "Body", "Configuration", "Drivetrain", "Options", "Shoulder", "Simulation", "Spring", "Springs", "TunableHinge", "Waveform", "Wing", "load_spec", "spec_paths")},
 }
 
 
@@ -82,6 +82,7 @@ def __dir__() -> list[str]:
 __all__ = [
     "Actuator",
     "Aero",
+    "Body",
     "CalibrationResult",
     "ContinuationResult",
     "CancelledError",

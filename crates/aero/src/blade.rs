@@ -505,13 +505,24 @@ impl<C: CoefficientModel> BladeElementModel<C> {
     /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) (`omegas.force`) if the model has no force parameter (built
     /// from [`Omegas::new`] without [`Omegas::with_force`]).
     pub fn loads(&self, state: &WingState) -> Result<AeroLoads> {
+        self.loads_omega(&state.angular_velocity(), &state.rotation())
+    }
+
+    /// [`Self::loads`] from the wing-frame angular velocity `ω` (rad/ms) and the rotation
+    /// `R_6^1` (wing frame to body frame), e.g. an effective `ω` that includes body motion.
+    /// Allocation-free.
+    ///
+    /// # Errors
+    /// As [`Self::loads`].
+    #[inline]
+    pub fn loads_omega(&self, omega: &Vector3<f64>, rot: &Matrix3<f64>) -> Result<AeroLoads> {
         let Some(force) = self.omegas.force else {
             bail!(invalid "omegas.force", "None",
                 "set: build Omegas from a Planform or call Omegas::with_force");
         };
-        let omega = state.angular_velocity();
+        let omega = *omega;
+        let rot = *rot;
         let moments = self.moments_omega(&omega);
-        let rot = state.rotation();
         let damping_torque = rot * Vector3::new(0.0, 0.0, moments.rotational_damping);
         let (wx, wy) = (omega.x, omega.y);
         let w2 = wx * wx + wy * wy;

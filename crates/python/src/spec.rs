@@ -136,7 +136,8 @@ fn simulate(py: Python<'_>, json: &str) -> PyResult<SimulationOutput> {
     let cancel = CancelFlag::new();
     options.cancel = Some(cancel.clone());
     let r = interruptible(py, &cancel, || {
-        paritysim_dynamics::simulate(&device, &options).map_err(|e| spec.attribute(e))
+        // A spec with a moving body flies (paritysim-flight); otherwise the fixed-body engine.
+        spec.run(&device, &options).map_err(|e| spec.attribute(e))
     })?;
     let columns = PyDict::new(py);
     for (name, values) in r.trajectory.columns {

@@ -5,7 +5,7 @@
 //! release the GIL, results are numpy arrays.
 
 use numpy::PyArray1;
-use paritysim_dynamics::sweep::{THREADS_ENV, metric_names, resolve_threads, trajectory_columns};
+use paritysim_dynamics::sweep::{THREADS_ENV, resolve_threads};
 use paritysim_spec::sweep::{
     KeptCycles, SweepJob, SweepPlan, rows_from_json, timeout_from_seconds,
 };
@@ -13,7 +13,7 @@ use pyo3::prelude::*;
 
 use crate::convert::{bindings, shaped};
 use crate::errors::IntoPyResult;
-use crate::spec::{device, parse};
+use crate::spec::parse;
 
 /// A batch of sweep points running on a background thread.
 #[pyclass(module = "paritysim._core", frozen)]
@@ -134,12 +134,14 @@ bindings! {
 
     /// Metric names `simulate` reports for a JSON spec, in order.
     fn sweep_metric_names(spec: &str) -> Vec<String> {
-        Ok(metric_names(&device(spec)?))
+        let spec = parse(spec)?;
+        spec.metric_names(&spec.device()?)
     }
 
     /// Trajectory column names (without `time_ms`) recorded for a JSON spec, in order.
     fn sweep_trajectory_columns(spec: &str) -> Vec<String> {
-        Ok(trajectory_columns(&device(spec)?))
+        let spec = parse(spec)?;
+        spec.column_names(&spec.device()?)
     }
 
     /// The thread count a sweep would use: `threads`, else `$PARITYSIM_THREADS`, else all cores.

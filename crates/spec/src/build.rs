@@ -26,6 +26,8 @@ impl Simulation {
     /// drivetrain driving untied wings), with the dotted field path.
     pub fn model(&self) -> Result<(Device, SimulationOptions)> {
         let device = self.device()?;
+        // A flying spec's body is checked here too (its errors name `body.` fields).
+        self.flight(&device)?;
         let options = options(&self.options, device.n_coords())?;
         Ok((device, options))
     }

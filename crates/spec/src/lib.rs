@@ -14,9 +14,11 @@
 
 pub mod actuator;
 pub mod attribute;
+pub mod body;
 mod build;
 pub mod continuation;
 pub mod drivetrain;
+pub mod flight;
 pub mod migrate;
 pub mod options;
 pub mod paths;
@@ -27,6 +29,7 @@ pub mod watch;
 pub mod wing;
 
 pub use actuator::{Actuator, DcOffset, Sampled, Sine, Waveform};
+pub use body::{Body, BodyMode};
 pub use build::options as engine_options;
 pub use drivetrain::{Drivetrain, DrivetrainConfig};
 pub use options::{Options, Perturbation};

@@ -4,6 +4,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::actuator::Actuator;
+use crate::body::Body;
 use crate::drivetrain::Drivetrain;
 use crate::options::Options;
 use crate::wing::Wing;
@@ -70,6 +71,9 @@ pub struct Simulation {
     /// One or two wings, left first (eq. 3.21).
     #[schemars(length(min = 1, max = 2))]
     pub wings: Vec<Wing>,
+    /// The airframe (absent: the fixed body of the torque stand).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<Body>,
     /// Integration and steady-state options.
     #[serde(default)]
     pub options: Options,

@@ -857,3 +857,117 @@ fn drive<const M: usize, S: Stepper<M>>(
         }
     }
 }
+
+/// Receives the samples of [`integrate_array`]: `(index in times, time, state)`.
+pub type ArraySink<'a, const M: usize> = dyn FnMut(usize, f64, &[f64; M]) -> Result<()> + 'a;
+
+/// The right-hand side of [`integrate_array`]: writes `f(t, y)`.
+pub type ArrayRhs<'a, const M: usize> = dyn FnMut(f64, &[f64; M], &mut [f64; M]) -> Result<()> + 'a;
+
+/// Integrates a plain array system `ẏ = f(t, y)` of `M` entries with the same Dormand–Prince
+/// pairs, step control, dense output and budget checks as [`RungeKutta`] (for models whose
+/// state does not fit [`State`], e.g. the free-flying airframe of `paritysim-flight`). Every
+/// entry takes part in the error norm. Samples at `times` (sorted, within `[t0, t_end]`) go
+/// to `sink`; returns the state at `t_end`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for bad tolerances, `t_end <= t0` or times out of order;
+/// [`Error::Integration`] (time and the first 12 entries of the state) for step-size
+/// underflow, the step limit, a failing right-hand side or the thread's wall-time budget;
+/// [`Error::Cancelled`]; whatever `sink` returns.
+#[allow(clippy::too_many_arguments)]
+pub fn integrate_array<const M: usize>(
+    method: Method,
+    rtol: f64,
+    atol: f64,
+    max_steps: usize,
+    f: &mut ArrayRhs<'_, M>,
+    t0: f64,
+    y0: &[f64; M],
+    t_end: f64,
+    times: &[f64],
+    sink: &mut ArraySink<'_, M>,
+) -> Result<([f64; M], IntegrationStats)> {
+    RungeKutta::new(method, rtol, atol, max_steps)?;
+    if t_end.is_nan() || t_end <= t0 || !t0.is_finite() || !t_end.is_finite() {
+        return Err(Error::invalid("t_end", t_end, format!("> t0 = {t0}")));
+    }
+    if let Some(i) = (0..times.len())
+        .find(|&i| !(times[i] >= t0 && times[i] <= t_end) || (i > 0 && times[i] < times[i - 1]))
+    {
+        return Err(Error::invalid(
+            format!("times[{i}]"),
+            times[i],
+            format!("sorted and within [{t0}, {t_end}]"),
+        ));
+    }
+    // The stepper hands samples over as `State`s: the array rides alongside in `last`.
+    let last = std::cell::RefCell::new([0.0; M]);
+    let mut rhs = ArrayAdapter {
+        f,
+        last: &last,
+        calls: 0,
+    };
+    let tol = Tolerances {
+        rtol,
+        atol,
+        controlled: M,
+    };
+    let mut state_sink = |i: usize, t: f64, _: &State| -> Result<()> {
+        let y = *last.borrow();
+        if y.iter().any(|v| !v.is_finite()) {
+            return Err(Error::Integration {
+                time: t,
+                state: y.to_vec(),
+                reason: "non-finite state".into(),
+            });
+        }
+        sink(i, t, &y)
+    };
+    let (y, mut stats) = drive_method(
+        method,
+        &mut rhs,
+        &tol,
+        max_steps,
+        t0,
+        *y0,
+        t_end,
+        times,
+        &mut state_sink,
+        &mut |_, _| {},
+    )?;
+    stats.rhs_calls = rhs.calls;
+    Ok((y, stats))
+}
+
+/// [`Rhs`] of a plain array system; `expand` keeps the array in `last` for the sink.
+struct ArrayAdapter<'a, 'f, const M: usize> {
+    f: &'a mut ArrayRhs<'f, M>,
+    last: &'a std::cell::RefCell<[f64; M]>,
+    calls: usize,
+}
+
+impl<const M: usize> Rhs<M> for ArrayAdapter<'_, '_, M> {
+    #[inline]
+    fn eval(&mut self, t: f64, y: &[f64; M], dydt: &mut [f64; M]) -> Result<()> {
+        self.calls += 1;
+        (self.f)(t, y, dydt).map_err(|e| match e {
+            e @ (Error::Integration { .. } | Error::Cancelled) => e,
+            e => Error::Integration {
+                time: t,
+                state: y.to_vec(),
+                reason: format!("the model failed: {e}"),
+            },
+        })
+    }
+
+    fn expand(&self, c: &[f64; M]) -> State {
+        *self.last.borrow_mut() = *c;
+        let mut y = State::default();
+        let k = M.min(MAX_DOF);
+        y.coords[..k].copy_from_slice(&c[..k]);
+        let r = M.saturating_sub(MAX_DOF).min(MAX_DOF);
+        y.rates[..r].copy_from_slice(&c[MAX_DOF..MAX_DOF + r]);
+        y
+    }
+}

@@ -1,0 +1,793 @@
+//! The coupled body + wing equations of motion (Kane's equations on one set of
+//! generalized speeds).
+//!
+//! Generalized speeds `u = (V, Ω, ẋ)`: `V` the velocity of the body's centre of mass `B`
+//! (world frame), `Ω` the body angular velocity (body frame), `ẋ` the wing null-space rates
+//! (`p = p₀ + N x`, eq. 3.21 with the constraints `C p = c0` of §3.2.5). Every rigid body `i`
+//! (the airframe and each wing) has a velocity Jacobian for its centre of mass `v_i = J_v u`
+//! (world) and its angular velocity `ω_i = J_ω u` (own frame), and accelerations
+//! `a_i = J_v u̇ + a_i⁰`, `α_i = J_ω u̇ + α_i⁰` with exact velocity-product terms. Then
+//!
+//! ```text
+//! Σ_i [J_vᵀ m_i J_v + J_ωᵀ I_i J_ω] u̇ = Σ_i J_vᵀ (F_i − m_i a_i⁰) + J_ωᵀ (τ_i − I_i α_i⁰ − ω_i × I_i ω_i) + Q
+//! ```
+//!
+//! the Euler-Lagrange equations of the total kinetic energy (so momentum and energy are
+//! conserved exactly by the continuous system), with `Q` the joint springs (A.6), the
+//! drivetrain `τ_φ = J⁻ᵀ Q_q` of the fixed device (massless, body-mounted: unchanged) and
+//! the mechanisms, all acting on `ẋ` only (internal forces).
+//!
+//! Wing `k` (frame 6, `R = R_6^1`, `w = J6 ṗ`, `G = J6 N_k`; `P` the wing frame-1 to body map,
+//! `I` or the sagittal mirror `diag(1, 1, −1)`, and `A = det(P) P` its action on axial
+//! vectors; `s` the shoulder relative to `B`, `c` the wing's centre of mass in frame 6,
+//! `ρ = s + P R c`, `R_b` body to world):
+//!
+//! ```text
+//! ω⁶ = Rᵀ A Ω + w                      J_ω = [0, Rᵀ A, G]      α⁰ = −w × (Rᵀ A Ω) + J̇6 ṗ
+//! v_c = V + R_b (Ω × ρ + P R (w × c))  J_v = [I, −R_b[ρ]×, −R_b P R [c]× G]
+//! a⁰ = R_b (Ω × (Ω × ρ) + 2 Ω × ρ̇ + P R (J̇6ṗ × c + w × (w × c))),   ρ̇ = P R (w × c)
+//! ```
+//!
+//! The wing inertia of the spec is about the shoulder; about its centre of mass it is
+//! `I − m (|c|² 1 − c cᵀ)`. Body modes lock entries of `(V, Ω)` (a gimbal about `B` is a
+//! holonomic constraint on them) by dropping their rows and columns.
+
+use std::ops::AddAssign;
+
+use nalgebra::{Matrix2, Matrix3, SMatrix, SVector, UnitQuaternion, Vector2, Vector3, Vector6};
+use paritysim_constraints::{Mat6, Vec6};
+use paritysim_dynamics::device::{DeviceSpec, DriveState, Formulation};
+use paritysim_dynamics::wing::WingTerms;
+use paritysim_dynamics::{Device, State, Wing, WingAero};
+use paritysim_error::{Error, Result};
+
+use crate::aero::{Wrench, wrench};
+use crate::body::{Body, BodyMode};
+use crate::mechanisms::{DriveCoordinate, Mechanism};
+
+/// Length of the flight state array:
+/// `[quaternion (w, x, y, z), position (3), x (6), V (3), Ω (3), ẋ (6), work_actuator, work_aero]`.
+pub const STATE_LEN: usize = 27;
+/// Index of the quaternion.
+pub const QUAT: usize = 0;
+/// Index of the position of `B` (world, mm).
+pub const POS: usize = 4;
+/// Index of the wing null-space coordinates.
+pub const X: usize = 7;
+/// Index of `V` (world, mm/ms).
+pub const VEL: usize = 13;
+/// Index of `Ω` (body frame, rad/ms).
+pub const OMEGA: usize = 16;
+/// Index of `ẋ`.
+pub const XDOT: usize = 19;
+/// Index of the actuator work (µJ).
+pub const WORK_ACTUATOR: usize = 25;
+/// Index of the aerodynamic work (µJ).
+pub const WORK_AERO: usize = 26;
+
+const NU: usize = 12;
+type MatU = SMatrix<f64, NU, NU>;
+type VecU = SVector<f64, NU>;
+type Jac = SMatrix<f64, 3, NU>;
+
+/// Slow inputs held during an integration leg (set points + controller outputs).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Inputs {
+    /// Whippletree bias torque (mN·mm).
+    pub q2_bias: f64,
+    /// Added actuator force (mN).
+    pub actuator_offset: f64,
+    /// Relative actuator amplitude change.
+    pub actuator_gain: f64,
+}
+
+/// The flight model: the device (null-space form, body-mounted drivetrain), the wings'
+/// aerodynamics and the body. Immutable, `Send + Sync`.
+#[derive(Clone, Debug)]
+pub struct FlightModel {
+    /// The device as given (its aerodynamics, its formulation): steady states on the clamped
+    /// body.
+    source: Device,
+    device: Device,
+    aero: [WingAero; 2],
+    body: Body,
+    mechanisms: Vec<Mechanism>,
+    n_wings: usize,
+    n: usize,
+    basis: Mat6,
+    inertia_cm: [Matrix3<f64>; 2],
+    polar: [Matrix3<f64>; 2],
+    axial: [Matrix3<f64>; 2],
+    shoulder: [Vector3<f64>; 2],
+    active: Vec<usize>,
+    /// Wings whose deviation the constraints hold at zero on an α2 = 90° shoulder: closed-form
+    /// terms ([`Wing::stroke_plane_terms`], as the device uses them).
+    stroke_plane: [bool; 2],
+}
+
+/// Everything at one instant (what the samples are built from).
+#[derive(Clone, Copy, Debug)]
+pub struct FlightEval {
+    /// Wing configuration, rates, accelerations.
+    pub p: Vec6,
+    /// `ṗ`.
+    pub p_dot: Vec6,
+    /// `p̈`.
+    pub p_ddot: Vec6,
+    /// Per-wing terms (aero fields: the flight wrench).
+    pub wings: [WingTerms; 2],
+    /// Drivetrain state (stroke torques include mechanisms and inputs).
+    pub drive: DriveState,
+    /// Attitude (body to world).
+    pub attitude: UnitQuaternion<f64>,
+    /// Position of `B` (world, mm).
+    pub position: Vector3<f64>,
+    /// `V` (world, mm/ms).
+    pub velocity: Vector3<f64>,
+    /// `Ω` (body, rad/ms).
+    pub omega: Vector3<f64>,
+    /// `V̇` (world) and `Ω̇` (body).
+    pub body_accel: Vector6<f64>,
+    /// Per wing: aerodynamic torque about the shoulder (body frame, mN·mm).
+    pub aero_torque: [Vector3<f64>; 2],
+    /// Per wing: inertial reaction torque about the shoulder (body frame, mN·mm).
+    pub inertial_torque: [Vector3<f64>; 2],
+    /// Total aerodynamic force on the wings (body frame, mN).
+    pub aero_force: Vector3<f64>,
+    /// Force the wings exert on the airframe (body frame, mN): aerodynamic + gravity on the
+    /// wings − their inertial forces.
+    pub wing_force: Vector3<f64>,
+    /// Torque the wings exert on the airframe about `B` (body frame, mN·mm).
+    pub wing_torque: Vector3<f64>,
+    /// Kinetic energy of body + wings (µJ).
+    pub kinetic: f64,
+    /// Springs + drivetrain springs (µJ).
+    pub potential: f64,
+    /// Gravity potential `−Σ m g · r` (µJ).
+    pub gravity_potential: f64,
+    /// Total linear momentum (world, mg·mm/ms).
+    pub momentum: Vector3<f64>,
+    /// Total angular momentum about the world origin (world, mg·mm²/ms).
+    pub angular_momentum: Vector3<f64>,
+    /// Aerodynamic power on the system (µJ/ms).
+    pub aero_power: f64,
+    /// Actuator power (µJ/ms).
+    pub actuator_power: f64,
+}
+
+fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
+}
+
+impl FlightModel {
+    /// Builds the flight model of `device` on `body`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a bad body, a wing whose inertia about its centre of
+    /// mass is not positive definite; the device's own errors when rebuilt in null-space form.
+    pub fn new(source: &Device, body: Body, mechanisms: Vec<Mechanism>) -> Result<Self> {
+        body.validate()?;
+        let device = source;
+        let spec = device.spec();
+        let n_wings = spec.wings.len();
+        let mut aero = [WingAero::None, WingAero::None];
+        let mut wings = Vec::with_capacity(n_wings);
+        for (k, w) in spec.wings.iter().enumerate() {
+            aero[k] = match w.aero() {
+                WingAero::BladeElement(m) if m.omegas().force.is_none() => {
+                    let omegas = m
+                        .omegas()
+                        .with_force(m.omegas().omega1 / body.force_radius)?;
+                    WingAero::BladeElement(
+                        paritysim_aero::BladeElementModel::new(omegas, *m.coefficient_model())?
+                            .with_rotational_damping(m.rotational_damping())?
+                            .with_normal_force_law(m.normal_force_law()),
+                    )
+                }
+                other => other.clone(),
+            };
+            // The flight model evaluates aerodynamics itself (with body motion).
+            let mut bare = Wing::new(*w.shoulder(), *w.inertia(), *w.springs(), WingAero::None)?;
+            if let Some(h) = w.tunable_hinge() {
+                bare = bare.with_tunable_hinge(*h);
+            }
+            wings.push(bare);
+        }
+        for m in &mechanisms {
+            let two = spec
+                .transmission
+                .as_ref()
+                .is_some_and(|t| t.kinematics().dof() == 2);
+            if m.coordinate() == DriveCoordinate::Q2 && !two {
+                return Err(Error::invalid(
+                    "body.mechanisms.coordinate",
+                    "\"q2\"",
+                    "q1 unless the drivetrain has a whippletree (2 DOF)",
+                ));
+            }
+            if spec.transmission.is_none() {
+                return Err(Error::Constraint(
+                    "body mechanisms act on the drivetrain: the device has none".into(),
+                ));
+            }
+        }
+        let device = Device::new(DeviceSpec {
+            wings,
+            constraints: spec.constraints.clone(),
+            transmission: spec.transmission.clone(),
+            actuator: spec.actuator.clone(),
+            formulation: Formulation::NullSpace,
+        })?;
+        let mut inertia_cm = [Matrix3::identity(); 2];
+        let mut polar = [Matrix3::identity(); 2];
+        let mut axial = [Matrix3::identity(); 2];
+        let mut shoulder = [Vector3::zeros(); 2];
+        let mirror = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, -1.0));
+        for k in 0..n_wings {
+            let m = body.wing_mass[k];
+            let c = body.wing_center_of_mass[k];
+            let i_c = *device.spec().wings[k].inertia()
+                - (Matrix3::identity() * c.norm_squared() - c * c.transpose()) * m;
+            if i_c.cholesky().is_none() {
+                return Err(Error::invalid(
+                    format!("body.wing_mass_mg[{k}]"),
+                    m,
+                    "small enough that the wing's inertia about its centre of mass stays positive definite",
+                ));
+            }
+            inertia_cm[k] = i_c;
+            // Body index of the shoulder: with two wings the first is the (mirrored) left.
+            let (si, left) = if n_wings == 2 {
+                (k, k == 0)
+            } else {
+                (1, false)
+            };
+            if left {
+                polar[k] = mirror;
+                axial[k] = -mirror;
+            }
+            shoulder[k] = body.shoulders[si] - body.center_of_mass;
+        }
+        let mut stroke_plane = [false; 2];
+        {
+            let c = &device.spec().constraints;
+            for (k, wing) in device.spec().wings.iter().enumerate() {
+                let row = 3 * k + 1;
+                let held = (0..c.n_free()).all(|j| c.null_basis()[(row, j)].abs() <= 1e-12)
+                    && c.particular()[row] == 0.0;
+                stroke_plane[k] = held && wing.has_closed_form_stroke_plane();
+            }
+        }
+        let active = body
+            .mode
+            .active()
+            .iter()
+            .enumerate()
+            .filter(|(_, a)| **a)
+            .map(|(i, _)| i)
+            .chain(6..6 + device.n_dof())
+            .collect();
+        Ok(Self {
+            source: source.clone(),
+            n: device.n_dof(),
+            basis: *device.spec().constraints.null_basis(),
+            device,
+            aero,
+            body,
+            mechanisms,
+            n_wings,
+            inertia_cm,
+            polar,
+            axial,
+            shoulder,
+            active,
+            stroke_plane,
+        })
+    }
+
+    /// The device in null-space form (aerodynamics stripped: the flight model owns them).
+    pub fn device(&self) -> &Device {
+        &self.device
+    }
+
+    /// The device as given (aerodynamics included, any formulation).
+    pub fn source(&self) -> &Device {
+        &self.source
+    }
+
+    /// A device state of [`Self::source`] as a state of [`Self::device`] (null-space form).
+    ///
+    /// # Errors
+    /// As [`Device::coordinates`] and [`Device::state_from`].
+    pub fn convert_state(&self, source_state: &State) -> Result<State> {
+        let (p, p_dot) = self.source.coordinates(source_state)?;
+        self.device.state_from(&p, &p_dot)
+    }
+
+    /// The body.
+    pub fn body(&self) -> &Body {
+        &self.body
+    }
+
+    /// The same model with another body mode.
+    pub fn with_mode(&self, mode: BodyMode) -> Self {
+        let mut out = self.clone();
+        out.body.mode = mode;
+        out.active = mode
+            .active()
+            .iter()
+            .enumerate()
+            .filter(|(_, a)| **a)
+            .map(|(i, _)| i)
+            .chain(6..6 + self.n)
+            .collect();
+        out
+    }
+
+    /// Total mass of body and wings (mg).
+    pub fn total_mass(&self) -> f64 {
+        self.body.mass + self.body.wing_mass[..self.n_wings].iter().sum::<f64>()
+    }
+
+    /// Number of wing null-space coordinates.
+    pub fn n_dof(&self) -> usize {
+        self.n
+    }
+
+    /// A flight state: attitude, position, velocity and rate of the body, and a device state
+    /// (null-space coordinates, as [`Device::state_from`] makes them).
+    pub fn state(
+        &self,
+        attitude: &UnitQuaternion<f64>,
+        position: &Vector3<f64>,
+        velocity: &Vector3<f64>,
+        omega: &Vector3<f64>,
+        wings: &State,
+    ) -> [f64; STATE_LEN] {
+        let mut y = [0.0; STATE_LEN];
+        let q = attitude.quaternion();
+        y[QUAT..QUAT + 4].copy_from_slice(&[q.w, q.i, q.j, q.k]);
+        y[POS..POS + 3].copy_from_slice(position.as_slice());
+        let active = self.body.mode.active();
+        for i in 0..3 {
+            y[VEL + i] = if active[i] { velocity[i] } else { 0.0 };
+            y[OMEGA + i] = if active[3 + i] { omega[i] } else { 0.0 };
+        }
+        y[X..X + self.n].copy_from_slice(&wings.coords[..self.n]);
+        y[XDOT..XDOT + self.n].copy_from_slice(&wings.rates[..self.n]);
+        y
+    }
+
+    /// The device state inside a flight state.
+    pub fn wing_state(&self, y: &[f64; STATE_LEN]) -> State {
+        let mut s = State::default();
+        s.coords[..self.n].copy_from_slice(&y[X..X + self.n]);
+        s.rates[..self.n].copy_from_slice(&y[XDOT..XDOT + self.n]);
+        s.work_actuator = y[WORK_ACTUATOR];
+        s.work_aero = y[WORK_AERO];
+        s
+    }
+
+    /// The right-hand side on the flight state.
+    ///
+    /// # Errors
+    /// Model errors (shoulder domain, drivetrain reach, a singular mass matrix).
+    #[inline]
+    pub fn rhs(
+        &self,
+        t: f64,
+        y: &[f64; STATE_LEN],
+        inputs: &Inputs,
+        dydt: &mut [f64; STATE_LEN],
+    ) -> Result<()> {
+        let e = self.evaluate_with(t, y, inputs, false)?;
+        *dydt = [0.0; STATE_LEN];
+        // q̇ = ½ q ⊗ (0, Ω) on the stored (unnormalised) quaternion.
+        let (w, a, b, c) = (y[0], y[1], y[2], y[3]);
+        let (ox, oy, oz) = (e.omega.x, e.omega.y, e.omega.z);
+        dydt[0] = 0.5 * (-a * ox - b * oy - c * oz);
+        dydt[1] = 0.5 * (w * ox + b * oz - c * oy);
+        dydt[2] = 0.5 * (w * oy + c * ox - a * oz);
+        dydt[3] = 0.5 * (w * oz + a * oy - b * ox);
+        for i in 0..3 {
+            dydt[POS + i] = e.velocity[i];
+            dydt[VEL + i] = e.body_accel[i];
+            dydt[OMEGA + i] = e.body_accel[3 + i];
+        }
+        dydt[X..X + self.n].copy_from_slice(&y[XDOT..XDOT + self.n]);
+        let x_ddot = self.basis.transpose() * e.p_ddot;
+        for i in 0..self.n {
+            dydt[XDOT + i] = x_ddot[i];
+        }
+        dydt[WORK_ACTUATOR] = e.actuator_power;
+        dydt[WORK_AERO] = e.aero_power;
+        Ok(())
+    }
+
+    /// Extra drivetrain load `ΔQ = (ΔF, τ_q2)` from the inputs and mechanisms, mapped to the
+    /// stroke angles: `τ_φ = J⁻ᵀ ΔQ`.
+    fn extra_stroke_torque(
+        &self,
+        drive: &DriveState,
+        inputs: &Inputs,
+        r_b: &Matrix3<f64>,
+        omega: &Vector3<f64>,
+    ) -> Result<(Vector2<f64>, f64)> {
+        let Some(tr) = &self.device.spec().transmission else {
+            return Ok((Vector2::zeros(), 0.0));
+        };
+        let mut dq = Vector2::new(
+            inputs.actuator_offset + inputs.actuator_gain * drive.actuator_force,
+            inputs.q2_bias,
+        );
+        let g = &self.body.gravity;
+        for m in &self.mechanisms {
+            match m.coordinate() {
+                DriveCoordinate::Q1 => dq.x += m.force(r_b, omega, g, drive.q.x),
+                DriveCoordinate::Q2 => dq.y += m.force(r_b, omega, g, drive.q.y),
+            }
+        }
+        if dq == Vector2::zeros() {
+            return Ok((Vector2::zeros(), 0.0));
+        }
+        let kin = tr.kinematics();
+        let jac = kin.evaluate(drive.q.x, drive.q.y)?.jacobian;
+        let tau = if kin.dof() == 1 {
+            Vector2::new(dq.x / jac[(0, 0)], 0.0)
+        } else {
+            let jt: Matrix2<f64> = jac.transpose();
+            jt.lu().solve(&dq).ok_or_else(|| {
+                Error::Singular(format!(
+                    "drivetrain Jacobian is singular at q = {:?}",
+                    drive.q
+                ))
+            })?
+        };
+        Ok((tau, dq.dot(&drive.q_dot)))
+    }
+
+    /// Full evaluation at `(t, y)`.
+    ///
+    /// # Errors
+    /// As [`Self::rhs`].
+    pub fn evaluate(&self, t: f64, y: &[f64; STATE_LEN], inputs: &Inputs) -> Result<FlightEval> {
+        self.evaluate_with(t, y, inputs, true)
+    }
+
+    /// [`Self::evaluate`]; the reactions on the airframe and the per-wing shoulder torques
+    /// only when `reactions` (samples, not the right-hand side).
+    #[inline(always)]
+    fn evaluate_with(
+        &self,
+        t: f64,
+        y: &[f64; STATE_LEN],
+        inputs: &Inputs,
+        reactions: bool,
+    ) -> Result<FlightEval> {
+        let attitude =
+            UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(y[0], y[1], y[2], y[3]));
+        let r_b = *attitude.to_rotation_matrix().matrix();
+        let position = Vector3::new(y[POS], y[POS + 1], y[POS + 2]);
+        let velocity = Vector3::new(y[VEL], y[VEL + 1], y[VEL + 2]);
+        let omega = Vector3::new(y[OMEGA], y[OMEGA + 1], y[OMEGA + 2]);
+        let (p, p_dot) = self.device.coordinates(&self.wing_state(y))?;
+        let mut drive = self.device.drive(t, &p, &p_dot)?;
+        let (extra, extra_power) = self.extra_stroke_torque(&drive, inputs, &r_b, &omega)?;
+        drive.stroke_torque += extra;
+        let g = self.body.gravity;
+
+        let mut mass = MatU::zeros();
+        let mut force = VecU::zeros();
+        // The airframe.
+        let mb = self.body.mass;
+        let jb = self.body.inertia;
+        let h_b = jb * omega;
+        for i in 0..3 {
+            mass[(i, i)] += mb;
+        }
+        mass.fixed_view_mut::<3, 3>(3, 3).add_assign(&jb);
+        let gyro = omega.cross(&h_b);
+        force.fixed_rows_mut::<3>(0).add_assign(&(g * mb));
+        force.fixed_rows_mut::<3>(3).add_assign(&(-gyro));
+        let mut kinetic = 0.5 * mb * velocity.norm_squared() + 0.5 * omega.dot(&h_b);
+        let mut momentum = velocity * mb;
+        let mut angular_momentum = position.cross(&(velocity * mb)) + r_b * h_b;
+        let mut gravity_potential = -mb * g.dot(&position);
+
+        // Joint springs and the drivetrain on p, reduced by Nᵀ.
+        let mut generalized_p = Vec6::zeros();
+        generalized_p[0] += drive.stroke_torque.x;
+        if self.n_wings == 2 {
+            generalized_p[3] += drive.stroke_torque.y;
+        }
+        let mut wings = [empty_terms(); 2];
+        let mut jw = [(Matrix3::zeros(), SMatrix::<f64, 3, 6>::zeros()); 2];
+        let mut bias_w = [Vector3::zeros(); 2];
+        let mut jv = [Jac::zeros(); 2];
+        let mut bias_v = [Vector3::zeros(); 2];
+        let mut omega6 = [Vector3::zeros(); 2];
+        let mut wrenches = [Wrench::default(); 2];
+        let mut aero_power = 0.0;
+        let mut potential = drive.potential;
+        let mut aero_force = Vector3::zeros();
+        for k in 0..self.n_wings {
+            let o = 3 * k;
+            let pw = Vector3::new(p[o], p[o + 1], p[o + 2]);
+            let vw = Vector3::new(p_dot[o], p_dot[o + 1], p_dot[o + 2]);
+            let wing = &self.device.spec().wings[k];
+            let mut terms = if self.stroke_plane[k] {
+                wing.stroke_plane_terms(&pw, &vw)
+            } else {
+                wing.terms(&pw, &vw)?
+            };
+            potential += terms.potential;
+            for i in 0..3 {
+                generalized_p[o + i] -= terms.spring[i];
+            }
+            let r = terms.rotation;
+            let w = terms.omega;
+            let (pk, ak) = (&self.polar[k], &self.axial[k]);
+            let nk = self.basis.fixed_view::<3, 6>(o, 0);
+            let gk: SMatrix<f64, 3, 6> = terms.j6 * nk;
+            let rt_a = r.transpose() * ak;
+            let om_local = rt_a * omega;
+            let om6 = om_local + w;
+            omega6[k] = om6;
+            // Angular Jacobian (frame 6) J_ω = [0, Rᵀ A, G], assembled by blocks.
+            jw[k] = (rt_a, gk);
+            bias_w[k] = -w.cross(&om_local) + terms.jdot_pdot;
+            let ic = self.inertia_cm[k];
+            let h6 = ic * om6;
+            let ic_g = ic * gk;
+            let cross: SMatrix<f64, 3, 6> = rt_a.transpose() * ic_g;
+            mass.fixed_view_mut::<3, 3>(3, 3)
+                .add_assign(&(rt_a.transpose() * ic * rt_a));
+            mass.fixed_view_mut::<3, 6>(3, 6).add_assign(&cross);
+            mass.fixed_view_mut::<6, 3>(6, 3)
+                .add_assign(&cross.transpose());
+            mass.fixed_view_mut::<6, 6>(6, 6)
+                .add_assign(&(gk.transpose() * ic_g));
+            let euler = ic * bias_w[k] + om6.cross(&h6);
+            force
+                .fixed_rows_mut::<3>(3)
+                .add_assign(&(-(rt_a.transpose() * euler)));
+            force
+                .fixed_rows_mut::<6>(6)
+                .add_assign(&(-(gk.transpose() * euler)));
+            kinetic += 0.5 * om6.dot(&h6);
+            angular_momentum += r_b * (ak * (r * h6));
+            // Linear Jacobian of the wing's centre of mass (world).
+            let m = self.body.wing_mass[k];
+            let c = self.body.wing_center_of_mass[k];
+            let s = self.shoulder[k];
+            let prc = pk * (r * c);
+            let rho = s + prc;
+            if m > 0.0 {
+                let rho_dot = pk * (r * w.cross(&c));
+                let mut jl = Jac::zeros();
+                jl.fixed_view_mut::<3, 3>(0, 0)
+                    .copy_from(&Matrix3::identity());
+                jl.fixed_view_mut::<3, 3>(0, 3)
+                    .copy_from(&(-r_b * skew(&rho)));
+                let jx: SMatrix<f64, 3, 6> = -r_b * pk * r * skew(&c) * gk;
+                jl.fixed_view_mut::<3, 6>(0, 6).copy_from(&jx);
+                let a0 = r_b
+                    * (omega.cross(&omega.cross(&rho))
+                        + omega.cross(&rho_dot) * 2.0
+                        + pk * (r * (terms.jdot_pdot.cross(&c) + w.cross(&w.cross(&c)))));
+                jv[k] = jl;
+                bias_v[k] = a0;
+                mass += jl.transpose() * jl * m;
+                force += jl.transpose() * (g * m - a0 * m);
+                let v_c = velocity + r_b * (omega.cross(&rho) + rho_dot);
+                kinetic += 0.5 * m * v_c.norm_squared();
+                momentum += v_c * m;
+                let r_c = position + r_b * rho;
+                angular_momentum += r_c.cross(&(v_c * m));
+                gravity_potential -= m * g.dot(&r_c);
+            }
+            // Aerodynamics: wrench at the shoulder.
+            let v_sh_body = r_b.transpose() * velocity + omega.cross(&s);
+            let v6 = r.transpose() * (pk * v_sh_body);
+            let wr = wrench(&self.aero[k], &om6, &v6, &r, self.body.force_radius)?;
+            wrenches[k] = wr;
+            let f_body = pk * wr.force;
+            let tau_body = ak * wr.torque;
+            aero_force += f_body;
+            force.fixed_rows_mut::<3>(0).add_assign(&(r_b * f_body));
+            force
+                .fixed_rows_mut::<3>(3)
+                .add_assign(&(s.cross(&f_body) + tau_body));
+            let tau6 = r.transpose() * wr.torque;
+            let gx: SVector<f64, 6> = gk.transpose() * tau6;
+            force.fixed_rows_mut::<6>(6).add_assign(&gx);
+            aero_power += f_body.dot(&v_sh_body) + tau_body.dot(&(ak * (r * om6)));
+            terms.aero = terms.j6.transpose() * tau6;
+            terms.aero_frame6 = tau6;
+            wings[k] = terms;
+        }
+        let reduced: SVector<f64, 6> = self.basis.transpose() * generalized_p;
+        force.fixed_rows_mut::<6>(6).add_assign(&reduced);
+
+        // Solve on the active speeds (Cholesky on the active block only).
+        let na = self.active.len();
+        let mut u_dot = VecU::zeros();
+        if na > 0 {
+            let mut m_a = [0.0; NU * NU];
+            let mut f_a = [0.0; NU];
+            for (i, &ii) in self.active.iter().enumerate() {
+                f_a[i] = force[ii];
+                for (j, &jj) in self.active.iter().enumerate() {
+                    m_a[i * NU + j] = mass[(ii, jj)];
+                }
+            }
+            if !solve_spd(&mut m_a, &mut f_a, na) {
+                return Err(Error::Singular(format!(
+                    "flight mass matrix is not positive definite at p = {:?}",
+                    p.as_slice()
+                )));
+            }
+            for (i, &ii) in self.active.iter().enumerate() {
+                u_dot[ii] = f_a[i];
+            }
+        }
+        let mut x_ddot = Vec6::zeros();
+        for i in 0..self.n {
+            x_ddot[i] = u_dot[6 + i];
+        }
+        let p_ddot = self.basis * x_ddot;
+        let body_accel = Vector6::from_fn(|i, _| u_dot[i]);
+
+        // Reactions of the wings on the airframe (body frame), and per-wing shoulder torques.
+        let mut wing_force = Vector3::zeros();
+        let mut wing_torque = Vector3::zeros();
+        let mut aero_torque = [Vector3::zeros(); 2];
+        let mut inertial_torque = [Vector3::zeros(); 2];
+        for k in (0..self.n_wings).filter(|_| reactions) {
+            let (pk, ak) = (&self.polar[k], &self.axial[k]);
+            let r = wings[k].rotation;
+            let s = self.shoulder[k];
+            let omega_dot = Vector3::new(u_dot[3], u_dot[4], u_dot[5]);
+            let x_dd = SVector::<f64, 6>::from_fn(|i, _| u_dot[6 + i]);
+            let alpha6 = jw[k].0 * omega_dot + jw[k].1 * x_dd + bias_w[k];
+            let om6 = omega6[k];
+            // About the shoulder, with the inertia about the shoulder (the fixed-body torques).
+            let i_s = self.device.spec().wings[k].inertia();
+            let inertial6 = -(i_s * alpha6 + om6.cross(&(i_s * om6)));
+            inertial_torque[k] = ak * (r * inertial6);
+            aero_torque[k] = ak * wrenches[k].torque;
+            let f_aero = pk * wrenches[k].force;
+            // Newton-Euler of the wing about its centre of mass.
+            let m = self.body.wing_mass[k];
+            let rho = s + pk * (r * self.body.wing_center_of_mass[k]);
+            let a_c = r_b.transpose() * (jv[k] * u_dot + bias_v[k]);
+            let f_on_body = f_aero + (r_b.transpose() * g - a_c) * m;
+            let ic = self.inertia_cm[k];
+            let dh = ak * (r * (ic * alpha6 + om6.cross(&(ic * om6))));
+            // τ about B of the wing on the body = external wrench on the wing − its rate of
+            // change of angular momentum about B (body frame, B accelerating with the body).
+            let t_on_body =
+                s.cross(&f_aero) + aero_torque[k] + rho.cross(&((r_b.transpose() * g) * m))
+                    - rho.cross(&(a_c * m))
+                    - dh;
+            wing_force += f_on_body;
+            wing_torque += t_on_body;
+        }
+        let actuator_power = drive.actuator_force * drive.q_dot.x + extra_power;
+        Ok(FlightEval {
+            p,
+            p_dot,
+            p_ddot,
+            wings,
+            drive,
+            attitude,
+            position,
+            velocity,
+            omega,
+            body_accel,
+            aero_torque,
+            inertial_torque,
+            aero_force,
+            wing_force,
+            wing_torque,
+            kinetic,
+            potential,
+            gravity_potential,
+            momentum,
+            angular_momentum,
+            aero_power,
+            actuator_power,
+        })
+    }
+}
+
+/// Solves `A x = b` for a symmetric positive definite `A` (the leading `n × n` block of a
+/// row-major `NU × NU` array) by an in-place Cholesky factorisation; `b` becomes `x`. False
+/// when `A` is not positive definite.
+#[inline]
+fn solve_spd(a: &mut [f64; NU * NU], b: &mut [f64; NU], n: usize) -> bool {
+    for j in 0..n {
+        let mut d = a[j * NU + j];
+        for k in 0..j {
+            d -= a[j * NU + k] * a[j * NU + k];
+        }
+        if d.is_nan() || d <= 0.0 {
+            return false;
+        }
+        let d = d.sqrt();
+        a[j * NU + j] = d;
+        for i in j + 1..n {
+            let mut v = a[i * NU + j];
+            for k in 0..j {
+                v -= a[i * NU + k] * a[j * NU + k];
+            }
+            a[i * NU + j] = v / d;
+        }
+    }
+    for i in 0..n {
+        let mut v = b[i];
+        for k in 0..i {
+            v -= a[i * NU + k] * b[k];
+        }
+        b[i] = v / a[i * NU + i];
+    }
+    for i in (0..n).rev() {
+        let mut v = b[i];
+        for k in i + 1..n {
+            v -= a[k * NU + i] * b[k];
+        }
+        b[i] = v / a[i * NU + i];
+    }
+    true
+}
+
+fn empty_terms() -> WingTerms {
+    WingTerms {
+        mass: Matrix3::identity(),
+        coriolis: Vector3::zeros(),
+        spring: Vector3::zeros(),
+        aero: Vector3::zeros(),
+        aero_frame6: Vector3::zeros(),
+        j6: Matrix3::identity(),
+        omega: Vector3::zeros(),
+        jdot_pdot: Vector3::zeros(),
+        rotation: Matrix3::identity(),
+        theta_w: 0.0,
+        potential: 0.0,
+        kinetic: 0.0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cholesky_solve_matches_nalgebra() {
+        let n = 7;
+        let b = SMatrix::<f64, 7, 7>::from_fn(|i, j| ((i * 7 + j) as f64 * 0.37).sin());
+        let spd = b * b.transpose() + SMatrix::<f64, 7, 7>::identity() * 0.5;
+        let rhs = SVector::<f64, 7>::from_fn(|i, _| (i as f64).cos());
+        let expected = spd.cholesky().unwrap().solve(&rhs);
+        let mut a = [0.0; NU * NU];
+        let mut x = [0.0; NU];
+        for i in 0..n {
+            x[i] = rhs[i];
+            for j in 0..n {
+                a[i * NU + j] = spd[(i, j)];
+            }
+        }
+        assert!(solve_spd(&mut a, &mut x, n));
+        for i in 0..n {
+            assert!(
+                (x[i] - expected[i]).abs() < 1e-12,
+                "{i}: {} vs {}",
+                x[i],
+                expected[i]
+            );
+        }
+        let mut bad = [0.0; NU * NU];
+        bad[0] = -1.0;
+        assert!(!solve_spd(&mut bad, &mut [1.0; NU], 1));
+    }
+}

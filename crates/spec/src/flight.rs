@@ -1,0 +1,245 @@
+//! From a spec's `body` section to the flight model (`paritysim-flight`), and one entry point
+//! that runs any spec: the fixed-body engine or free flight.
+
+use nalgebra::{Matrix3, UnitQuaternion, Vector3};
+use paritysim_dynamics::sweep::PointOutput;
+use paritysim_dynamics::{Device, SimulationOptions, SimulationResult, Trajectory};
+use paritysim_error::Result;
+use paritysim_flight::run::{Release, Schedule};
+use paritysim_flight::{
+    Body as EngineBody, BodyMode as EngineMode, Control as EngineControl,
+    ControlInput as EngineInput, DriveCoordinate as EngineCoordinate, FlightModel,
+    Mechanism as EngineMechanism, SetPoint as EngineSetPoint,
+};
+
+use crate::body::{Axis, Body, BodyMode, ControlInput, DriveCoordinate, Mechanism};
+use crate::spec::Simulation;
+
+/// A flight run: model, release state and slow inputs.
+#[derive(Clone, Debug)]
+pub struct Flight {
+    /// The coupled model.
+    pub model: FlightModel,
+    /// Initial body state.
+    pub release: Release,
+    /// Set points and controller.
+    pub schedule: Schedule,
+}
+
+fn v3(a: &[f64; 3]) -> Vector3<f64> {
+    Vector3::new(a[0], a[1], a[2])
+}
+
+fn input(i: ControlInput) -> EngineInput {
+    match i {
+        ControlInput::Q2Bias => EngineInput::Q2Bias,
+        ControlInput::ActuatorOffset => EngineInput::ActuatorOffset,
+        ControlInput::ActuatorGain => EngineInput::ActuatorGain,
+    }
+}
+
+fn coordinate(c: DriveCoordinate) -> EngineCoordinate {
+    match c {
+        DriveCoordinate::Q1 => EngineCoordinate::Q1,
+        DriveCoordinate::Q2 => EngineCoordinate::Q2,
+    }
+}
+
+/// The engine body of a spec body.
+pub fn engine_body(b: &Body) -> EngineBody {
+    EngineBody {
+        mode: match b.mode {
+            BodyMode::Fixed => EngineMode::Fixed,
+            BodyMode::Clamped => EngineMode::Clamped,
+            BodyMode::Roll => EngineMode::Roll,
+            BodyMode::Yaw => EngineMode::Yaw,
+            BodyMode::Pitch => EngineMode::Pitch,
+            BodyMode::RollPitchYaw => EngineMode::RollPitchYaw,
+            BodyMode::Free => EngineMode::Free,
+        },
+        mass: b.mass_mg,
+        inertia: Matrix3::from_fn(|i, j| b.inertia[i][j]),
+        center_of_mass: v3(&b.center_of_mass_mm),
+        shoulders: [v3(&b.shoulders_mm[0]), v3(&b.shoulders_mm[1])],
+        gravity: v3(&b.gravity_mm_per_ms2),
+        force_radius: b.force_radius_mm,
+        wing_mass: b.wing_mass_mg,
+        wing_center_of_mass: [
+            v3(&b.wing_center_of_mass_mm[0]),
+            v3(&b.wing_center_of_mass_mm[1]),
+        ],
+    }
+}
+
+impl Simulation {
+    /// Whether the spec flies (a `body` section with a mode other than `fixed`).
+    pub fn flies(&self) -> bool {
+        self.body
+            .as_ref()
+            .is_some_and(|b| b.mode != BodyMode::Fixed)
+    }
+
+    /// The flight model of a spec whose body is not fixed (None otherwise).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the `body.` field; the device's errors.
+    pub fn flight(&self, device: &Device) -> Result<Option<Flight>> {
+        let Some(b) = self.body.as_ref().filter(|_| self.flies()) else {
+            return Ok(None);
+        };
+        let mechanisms = b
+            .mechanisms
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                match m {
+                    Mechanism::GravityPendulum(p) => EngineMechanism::pendulum(
+                        coordinate(p.coordinate),
+                        p.moment_mg_mm,
+                        v3(&p.direction),
+                        v3(&p.axis),
+                    ),
+                    Mechanism::RateElement(r) => {
+                        EngineMechanism::rate(coordinate(r.coordinate), r.gain, v3(&r.axis))
+                    }
+                }
+                .map_err(|e| e.in_field(&format!("body.mechanisms[{i}]")))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let model = FlightModel::new(device, engine_body(b), mechanisms)?;
+        let set_points = b
+            .set_points
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                EngineSetPoint::new(input(s.input), s.times_ms.clone(), s.values.clone())
+                    .map_err(|e| e.in_field(&format!("body.set_points[{i}]")))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let control = b.control.as_ref().map(|c| EngineControl {
+            input: input(c.input),
+            axis: match c.axis {
+                Axis::Roll => 0,
+                Axis::Yaw => 1,
+                Axis::Pitch => 2,
+            },
+            target: c.target_rad,
+            kp: c.kp,
+            kd: c.kd,
+            rate_hz: c.rate_hz,
+            limit: c.limit,
+        });
+        if let Some(c) = &control {
+            c.validate()?;
+        }
+        let [roll, yaw, pitch] = b.initial_attitude_rad;
+        let attitude = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), roll)
+            * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), yaw)
+            * UnitQuaternion::from_axis_angle(&Vector3::z_axis(), pitch);
+        Ok(Some(Flight {
+            model,
+            release: Release {
+                attitude,
+                omega: v3(&b.initial_rates_rad_per_ms),
+                velocity: v3(&b.initial_velocity_mm_per_ms),
+            },
+            schedule: Schedule {
+                set_points,
+                control,
+            },
+        }))
+    }
+
+    /// Runs the spec: the engine's [`paritysim_dynamics::simulate`] for a fixed body, free
+    /// flight ([`paritysim_flight::fly`]) otherwise. `device` and `options` are those of
+    /// [`Simulation::model`] (the caller may set a cancel flag on the options).
+    ///
+    /// # Errors
+    /// As [`Simulation::flight`] and the run itself.
+    pub fn run(&self, device: &Device, options: &SimulationOptions) -> Result<SimulationResult> {
+        match self.flight(device)? {
+            None => paritysim_dynamics::simulate(device, options),
+            Some(f) => paritysim_flight::fly(&f.model, options, &f.release, &f.schedule),
+        }
+    }
+
+    /// Metric names [`Simulation::run`] reports.
+    ///
+    /// # Errors
+    /// As [`Simulation::flight`].
+    pub fn metric_names(&self, device: &Device) -> Result<Vec<String>> {
+        Ok(match self.flight(device)? {
+            None => paritysim_dynamics::sweep::metric_names(device),
+            Some(f) => paritysim_flight::flight_metrics(&f.model),
+        })
+    }
+
+    /// Trajectory column names [`Simulation::run`] records.
+    ///
+    /// # Errors
+    /// As [`Simulation::flight`].
+    pub fn column_names(&self, device: &Device) -> Result<Vec<String>> {
+        Ok(match self.flight(device)? {
+            None => paritysim_dynamics::sweep::trajectory_columns(device),
+            Some(f) => paritysim_flight::flight_columns(&f.model),
+        })
+    }
+}
+
+/// One sweep point of a flying spec: [`Simulation::run`] and what the sweep keeps (the
+/// engine's [`PointOutput`]: selected metrics, the last recorded wingbeat when asked).
+///
+/// # Errors
+/// As [`Simulation::run`].
+pub fn run_point(
+    spec: &Simulation,
+    device: &Device,
+    options: &SimulationOptions,
+    metric_names: &[String],
+    keep_cycle: bool,
+) -> Result<PointOutput> {
+    let options = SimulationOptions {
+        columns: if keep_cycle { None } else { Some(Vec::new()) },
+        ..options.clone()
+    };
+    let result = spec.run(device, &options)?;
+    let metrics = metric_names
+        .iter()
+        .map(|name| {
+            result
+                .metrics
+                .iter()
+                .find(|(n, _)| n == name)
+                .map_or(f64::NAN, |(_, v)| *v)
+        })
+        .collect();
+    let cycle = keep_cycle.then(|| {
+        let traj = result.trajectory;
+        let len = traj.time.len();
+        let keep = if result.period_ms.is_finite() {
+            (options.samples_per_cycle + 1).min(len)
+        } else {
+            len
+        };
+        let start = len - keep;
+        Trajectory {
+            time: traj.time[start..].to_vec(),
+            columns: traj
+                .columns
+                .into_iter()
+                .map(|(name, v)| (name, v[start..].to_vec()))
+                .collect(),
+        }
+    });
+    Ok(PointOutput {
+        metrics,
+        converged: result.converged,
+        cycles_run: result.cycles_run,
+        cycle,
+        residual: result.residual,
+        steady_state: None,
+        // No neighbour chaining for flying points: each starts from its own clamped orbit.
+        monodromy: None,
+        step_grid: Vec::new(),
+    })
+}
