@@ -66,11 +66,11 @@ def trajectory_3d(frames: Mapping[str, pl.DataFrame], *, title: str = "", arrows
 
     fig = plt.figure(figsize=(7.5, 6.5), constrained_layout=True)
     ax = fig.add_subplot(projection="3d")
-    span = 1.0
+    span = 1.0  # the horizontal extent: arrows scaled to it stay readable after a long fall
     for df in frames.values():
-        for c in ("body_x", "body_y", "body_z"):
+        for c in ("body_y", "body_z"):
             span = max(span, float(np.ptp(df[c].to_numpy())))
-    length = arrow_mm if arrow_mm is not None else 0.08 * span
+    length = arrow_mm if arrow_mm is not None else 0.1 * span
     for i, (label, df) in enumerate(frames.items()):
         x, y, z = (df[c].to_numpy() for c in ("body_x", "body_y", "body_z"))
         # World axes drawn as (y, z, x) so the world x ("up") is the plot's vertical.
@@ -121,7 +121,7 @@ def animate(df: pl.DataFrame, path: str | Path, *, shoulders_mm: tuple[tuple[flo
     t = df["time_ms"].to_numpy() - df["time_ms"][0]
     phi = {s: df[f"{s}_phi"].to_numpy() for s in ("left", "right")}
     psi = {s: df[f"{s}_psi"].to_numpy() for s in ("left", "right")}
-    fig = plt.figure(figsize=(4.5, 4.5))
+    fig = plt.figure(figsize=(4.5, 4.5), constrained_layout=True)
     ax = fig.add_subplot(projection="3d")
     half = 0.6 * (body_mm + span_mm)
 
@@ -143,13 +143,17 @@ def animate(df: pl.DataFrame, path: str | Path, *, shoulders_mm: tuple[tuple[flo
         ax.plot(body[:, 1], body[:, 2], body[:, 0], color="k", lw=3)
         for side, colour in (("left", "C0"), ("right", "C3")):
             w = world(wing(side, i))
-            ax.plot(w[:, 1], w[:, 2], w[:, 0], color=colour, lw=1.5)
+            ax.plot(w[:, 1], w[:, 2], w[:, 0], color=colour, lw=2)
         ax.set_xlim(c[1] - half, c[1] + half)
         ax.set_ylim(c[2] - half, c[2] + half)
         ax.set_zlim(c[0] - half, c[0] + half)
-        ax.set_xlabel("y")
-        ax.set_ylabel("z")
-        ax.set_zlabel("x (up)")
+        ax.grid(False)  # plain panes: a small GIF
+        for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+            axis.pane.fill = False
+        ax.set_xlabel("y (mm)", fontsize=7)
+        ax.set_ylabel("z (mm)", fontsize=7)
+        ax.set_zlabel("x, up (mm)", fontsize=7)
+        ax.tick_params(labelsize=6)
         ax.set_title(f"{title}\nt = {t[i]:.1f} ms" if title else f"t = {t[i]:.1f} ms", fontsize=8)
 
     anim = FuncAnimation(fig, draw, frames=len(idx))
