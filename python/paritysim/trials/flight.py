@@ -385,7 +385,7 @@ def eq_5_1_claims(df: pl.DataFrame) -> list[Claim]:
 
 def _per_wingbeat(n: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Means of ``v`` over each whole wingbeat (``n`` in wingbeats), at the wingbeats' middles."""
-    k = np.floor(n[:-1]).astype(int)
+    k = np.floor(n[:-1] + 1e-9).astype(int)  # a sample on a wingbeat boundary opens the next one
     beats = np.unique(k)
     return beats + 0.5, np.array([v[:-1][k == b].mean() for b in beats])
 
