@@ -243,7 +243,7 @@ def trim_claims(df: pl.DataFrame, tol: float) -> list[Claim]:
             Claim.holds(
                 f"trim ({label}): lift = weight and zero {'pitch and yaw' if 'pivot' in label else 'pitch'} torque",
                 bool(r["converged"]),
-                computed=f"amplitude {r['amplitude_v']:.2f} V, DC {r['offset_v']:+.3f} V"
+                computed=f"amplitude {r['amplitude_v']:.2f} V, DC {r['offset_v']:+.2g} V"
                 + (f", hL/hR {r['arm_ratio']:.4f}" if "pivot" in label else "")
                 + f"; lift − weight {r['residual_lift']:+.1e} mN, pitch {r['residual_pitch']:+.1e}, yaw {r['residual_yaw']:+.2g}, roll {r['residual_roll']:+.1e} mN·mm",
                 criterion=f"each solved residual / scale < {tol:g} (scale: weight {r['weight_mn']:.3f} mN; × 12 mm for torques)",
@@ -374,7 +374,7 @@ def eq_5_1_claims(df: pl.DataFrame) -> list[Claim]:
             computed=", ".join(f"q3 = {q:g}: {1e3 * rows[q]['roll_rate_first_half']:+.2f} rad/s (first half) → {1e3 * rows[q]['roll_rate_last_quarter']:+.2f} rad/s (last quarter)" for q in biased),
             criterion="the last quarter's mean rate keeps its sign and > 20 % of the first half's",
             thesis="(issue 17's expectation)",
-            note="a finite turn, not a rate: the thesis' own caveat (§2.4.2) that a constant torque-ratio bias gives no average roll torque",
+            note="cf. §2.4.2: a constant torque-ratio bias 'does not lead to an average roll torque'",
         ),
     ]
     return claims
@@ -506,8 +506,8 @@ def report_section(out: Path) -> str:
             "**Not in the thesis**: every thesis trial holds the body on a torque stand. Here the §3.4 device flies on the default "
             "HMF-class airframe of the spec's `body` section (60 mg, box inertia, shoulders 6 mm above the centre of mass; "
             "`crates/spec/src/body.rs` states sources and assumptions), with coupled body and wing dynamics (`crates/flight`). "
-            "There are no thesis numbers to compare with: each claim is a physical expectation stated before the run, with a "
-            "computed verdict. Axes as the thesis names them: roll about the stroke axis x̂ (the drag-torque axis Drag PARITY "
+            "There are no thesis numbers to compare with: each claim is a physical expectation (some sharpened after first runs, "
+            "e.g. the inverted pendulum's instability), and every verdict is computed on this run. Axes as the thesis names them: roll about the stroke axis x̂ (the drag-torque axis Drag PARITY "
             "regulates), yaw about the wing normal ŷ (lift asymmetry), pitch about the span ẑ.",
             "",
             "### Hover trim",
