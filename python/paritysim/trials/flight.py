@@ -224,6 +224,8 @@ def eq_5_1(**overrides: Any) -> tuple[pl.DataFrame, pl.DataFrame]:
                 stand_peak_ratio=float(np.abs(left).max() / np.abs(right).max()),
                 roll_rate_first_half=float(w[:half].mean()),
                 roll_rate_last_quarter=float(w[quarter:].mean()),
+                q2_first_wingbeat=float(df["q2"].to_numpy()[: p.samples_per_cycle].mean()),
+                q2_last_quarter=float(df["q2"].to_numpy()[:-1][quarter:].mean()),
                 roll_rate_mean=float(r.metrics["body_omega_roll_mean"]),
                 roll_final_deg=float(np.degrees(flight.twist_angle(df, "roll")[-1])),
             )
@@ -374,7 +376,9 @@ def eq_5_1_claims(df: pl.DataFrame) -> list[Claim]:
             computed=", ".join(f"q3 = {q:g}: {1e3 * rows[q]['roll_rate_first_half']:+.2f} rad/s (first half) → {1e3 * rows[q]['roll_rate_last_quarter']:+.2f} rad/s (last quarter)" for q in biased),
             criterion="the last quarter's mean rate keeps its sign and > 20 % of the first half's",
             thesis="(issue 17's expectation)",
-            note="cf. §2.4.2: a constant torque-ratio bias 'does not lead to an average roll torque'",
+            note="cf. §2.4.2: a constant torque-ratio bias 'does not lead to an average roll torque'. The turn comes with the whippletree's slow drift "
+            "(no balance spring): q2 " + ", ".join(f"{rows[q]['q2_first_wingbeat']:+.3f} → {rows[q]['q2_last_quarter']:+.3f} rad (q3 = {q:g})" for q in biased)
+            + "; a shift of q2 turns both wings' stroke means the same way about x̂ (a likely mechanism, not separately tested)",
         ),
     ]
     return claims
