@@ -38,6 +38,7 @@ from . import _core
 __all__ = [
     "Actuator",
     "Aero",
+    "Body",
     "Configuration",
     "Drivetrain",
     "Options",
@@ -122,7 +123,8 @@ def _from_core(cls: type) -> type:
         if ref in _MODELS and isinstance(default, dict):
             setattr(cls, key, field(default_factory=functools.partial(_build_known, ref, default)))
         else:
-            setattr(cls, key, default)
+            # Lists (vectors, tensors) as tuples: frozen and hashable like every spec value.
+            setattr(cls, key, _tuples(default) if isinstance(default, list) else default)
     cls.__annotations__ = annotations
     built = dataclass(frozen=True)(cls)
     names = [key for key, *_ in specs]
@@ -144,7 +146,7 @@ def _from_core(cls: type) -> type:
     return built
 
 
-_MODELS = {"Simulation", "Wing", "Shoulder", "Spring", "Springs", "Aero", "TunableHinge", "Drivetrain", "Waveform", "Actuator", "Configuration", "Options"}
+_MODELS = {"Simulation", "Wing", "Shoulder", "Spring", "Springs", "Aero", "TunableHinge", "Drivetrain", "Waveform", "Actuator", "Configuration", "Options", "Body"}
 
 
 def _build_known(name: str, data: Any) -> Any:
@@ -374,6 +376,14 @@ class Actuator(_Node):
 class Configuration(_Node):
     """Constraints ``C p = c0``: a Table 3.1 ``name`` or explicit ``rows`` / ``c0``; neither:
     unconstrained."""
+
+
+@_from_core
+class Body(_Node):
+    """The airframe (issue 17, beyond the thesis): ``mode`` = ``fixed`` (the torque stand,
+    unchanged results) | ``clamped`` | ``roll`` | ``yaw`` | ``pitch`` | ``roll_pitch_yaw`` |
+    ``free``; mass, inertia, centre of mass, shoulders, gravity, mechanisms, set points and a PD
+    controller as plain data (see docs/flight.md)."""
 
 
 @_from_core

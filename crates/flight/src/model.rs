@@ -100,6 +100,9 @@ pub struct FlightModel {
     axial: [Matrix3<f64>; 2],
     shoulder: [Vector3<f64>; 2],
     active: Vec<usize>,
+    /// Wings whose deviation the constraints hold at zero on an α2 = 90° shoulder: closed-form
+    /// terms ([`Wing::stroke_plane_terms`], as the device uses them).
+    stroke_plane: [bool; 2],
 }
 
 /// Everything at one instant (what the samples are built from).
@@ -245,6 +248,16 @@ impl FlightModel {
             }
             shoulder[k] = body.shoulders[si] - body.center_of_mass;
         }
+        let mut stroke_plane = [false; 2];
+        {
+            let c = &device.spec().constraints;
+            for (k, wing) in device.spec().wings.iter().enumerate() {
+                let row = 3 * k + 1;
+                let held = (0..c.n_free()).all(|j| c.null_basis()[(row, j)].abs() <= 1e-12)
+                    && c.particular()[row] == 0.0;
+                stroke_plane[k] = held && wing.has_closed_form_stroke_plane();
+            }
+        }
         let active = body
             .mode
             .active()
@@ -268,6 +281,7 @@ impl FlightModel {
             axial,
             shoulder,
             active,
+            stroke_plane,
         })
     }
 
@@ -366,7 +380,7 @@ impl FlightModel {
         inputs: &Inputs,
         dydt: &mut [f64; STATE_LEN],
     ) -> Result<()> {
-        let e = self.evaluate(t, y, inputs)?;
+        let e = self.evaluate_with(t, y, inputs, false)?;
         *dydt = [0.0; STATE_LEN];
         // q̇ = ½ q ⊗ (0, Ω) on the stored (unnormalised) quaternion.
         let (w, a, b, c) = (y[0], y[1], y[2], y[3]);
@@ -437,6 +451,19 @@ impl FlightModel {
     /// # Errors
     /// As [`Self::rhs`].
     pub fn evaluate(&self, t: f64, y: &[f64; STATE_LEN], inputs: &Inputs) -> Result<FlightEval> {
+        self.evaluate_with(t, y, inputs, true)
+    }
+
+    /// [`Self::evaluate`]; the reactions on the airframe and the per-wing shoulder torques
+    /// only when `reactions` (samples, not the right-hand side).
+    #[inline(always)]
+    fn evaluate_with(
+        &self,
+        t: f64,
+        y: &[f64; STATE_LEN],
+        inputs: &Inputs,
+        reactions: bool,
+    ) -> Result<FlightEval> {
         let attitude =
             UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(y[0], y[1], y[2], y[3]));
         let r_b = *attitude.to_rotation_matrix().matrix();
@@ -448,7 +475,6 @@ impl FlightModel {
         let (extra, extra_power) = self.extra_stroke_torque(&drive, inputs, &r_b, &omega)?;
         drive.stroke_torque += extra;
         let g = self.body.gravity;
-        let n = self.n;
 
         let mut mass = MatU::zeros();
         let mut force = VecU::zeros();
@@ -475,7 +501,7 @@ impl FlightModel {
             generalized_p[3] += drive.stroke_torque.y;
         }
         let mut wings = [empty_terms(); 2];
-        let mut jw = [Jac::zeros(); 2];
+        let mut jw = [(Matrix3::zeros(), SMatrix::<f64, 3, 6>::zeros()); 2];
         let mut bias_w = [Vector3::zeros(); 2];
         let mut jv = [Jac::zeros(); 2];
         let mut bias_v = [Vector3::zeros(); 2];
@@ -488,7 +514,12 @@ impl FlightModel {
             let o = 3 * k;
             let pw = Vector3::new(p[o], p[o + 1], p[o + 2]);
             let vw = Vector3::new(p_dot[o], p_dot[o + 1], p_dot[o + 2]);
-            let mut terms = self.device.spec().wings[k].terms(&pw, &vw)?;
+            let wing = &self.device.spec().wings[k];
+            let mut terms = if self.stroke_plane[k] {
+                wing.stroke_plane_terms(&pw, &vw)
+            } else {
+                wing.terms(&pw, &vw)?
+            };
             potential += terms.potential;
             for i in 0..3 {
                 generalized_p[o + i] -= terms.spring[i];
@@ -502,17 +533,27 @@ impl FlightModel {
             let om_local = rt_a * omega;
             let om6 = om_local + w;
             omega6[k] = om6;
-            // Angular Jacobian (frame 6).
-            let mut j = Jac::zeros();
-            j.fixed_view_mut::<3, 3>(0, 3).copy_from(&rt_a);
-            j.fixed_view_mut::<3, 6>(0, 6).copy_from(&gk);
-            jw[k] = j;
+            // Angular Jacobian (frame 6) J_ω = [0, Rᵀ A, G], assembled by blocks.
+            jw[k] = (rt_a, gk);
             bias_w[k] = -w.cross(&om_local) + terms.jdot_pdot;
             let ic = self.inertia_cm[k];
             let h6 = ic * om6;
-            let jt_ic = j.transpose() * ic;
-            mass += jt_ic * j;
-            force -= jt_ic * bias_w[k] + j.transpose() * om6.cross(&h6);
+            let ic_g = ic * gk;
+            let cross: SMatrix<f64, 3, 6> = rt_a.transpose() * ic_g;
+            mass.fixed_view_mut::<3, 3>(3, 3)
+                .add_assign(&(rt_a.transpose() * ic * rt_a));
+            mass.fixed_view_mut::<3, 6>(3, 6).add_assign(&cross);
+            mass.fixed_view_mut::<6, 3>(6, 3)
+                .add_assign(&cross.transpose());
+            mass.fixed_view_mut::<6, 6>(6, 6)
+                .add_assign(&(gk.transpose() * ic_g));
+            let euler = ic * bias_w[k] + om6.cross(&h6);
+            force
+                .fixed_rows_mut::<3>(3)
+                .add_assign(&(-(rt_a.transpose() * euler)));
+            force
+                .fixed_rows_mut::<6>(6)
+                .add_assign(&(-(gk.transpose() * euler)));
             kinetic += 0.5 * om6.dot(&h6);
             angular_momentum += r_b * (ak * (r * h6));
             // Linear Jacobian of the wing's centre of mass (world).
@@ -568,32 +609,28 @@ impl FlightModel {
         let reduced: SVector<f64, 6> = self.basis.transpose() * generalized_p;
         force.fixed_rows_mut::<6>(6).add_assign(&reduced);
 
-        // Solve on the active speeds.
+        // Solve on the active speeds (Cholesky on the active block only).
         let na = self.active.len();
         let mut u_dot = VecU::zeros();
         if na > 0 {
-            let mut m_a = MatU::identity();
-            let mut f_a = VecU::zeros();
+            let mut m_a = [0.0; NU * NU];
+            let mut f_a = [0.0; NU];
             for (i, &ii) in self.active.iter().enumerate() {
                 f_a[i] = force[ii];
                 for (j, &jj) in self.active.iter().enumerate() {
-                    m_a[(i, j)] = mass[(ii, jj)];
+                    m_a[i * NU + j] = mass[(ii, jj)];
                 }
             }
-            let sol = m_a
-                .cholesky()
-                .ok_or_else(|| {
-                    Error::Singular(format!(
-                        "flight mass matrix is not positive definite at p = {:?}",
-                        p.as_slice()
-                    ))
-                })?
-                .solve(&f_a);
+            if !solve_spd(&mut m_a, &mut f_a, na) {
+                return Err(Error::Singular(format!(
+                    "flight mass matrix is not positive definite at p = {:?}",
+                    p.as_slice()
+                )));
+            }
             for (i, &ii) in self.active.iter().enumerate() {
-                u_dot[ii] = sol[i];
+                u_dot[ii] = f_a[i];
             }
         }
-        let _ = n;
         let mut x_ddot = Vec6::zeros();
         for i in 0..self.n {
             x_ddot[i] = u_dot[6 + i];
@@ -606,11 +643,13 @@ impl FlightModel {
         let mut wing_torque = Vector3::zeros();
         let mut aero_torque = [Vector3::zeros(); 2];
         let mut inertial_torque = [Vector3::zeros(); 2];
-        for k in 0..self.n_wings {
+        for k in (0..self.n_wings).filter(|_| reactions) {
             let (pk, ak) = (&self.polar[k], &self.axial[k]);
             let r = wings[k].rotation;
             let s = self.shoulder[k];
-            let alpha6 = jw[k] * u_dot + bias_w[k];
+            let omega_dot = Vector3::new(u_dot[3], u_dot[4], u_dot[5]);
+            let x_dd = SVector::<f64, 6>::from_fn(|i, _| u_dot[6 + i]);
+            let alpha6 = jw[k].0 * omega_dot + jw[k].1 * x_dd + bias_w[k];
             let om6 = omega6[k];
             // About the shoulder, with the inertia about the shoulder (the fixed-body torques).
             let i_s = self.device.spec().wings[k].inertia();
@@ -662,6 +701,46 @@ impl FlightModel {
     }
 }
 
+/// Solves `A x = b` for a symmetric positive definite `A` (the leading `n × n` block of a
+/// row-major `NU × NU` array) by an in-place Cholesky factorisation; `b` becomes `x`. False
+/// when `A` is not positive definite.
+#[inline]
+fn solve_spd(a: &mut [f64; NU * NU], b: &mut [f64; NU], n: usize) -> bool {
+    for j in 0..n {
+        let mut d = a[j * NU + j];
+        for k in 0..j {
+            d -= a[j * NU + k] * a[j * NU + k];
+        }
+        if d.is_nan() || d <= 0.0 {
+            return false;
+        }
+        let d = d.sqrt();
+        a[j * NU + j] = d;
+        for i in j + 1..n {
+            let mut v = a[i * NU + j];
+            for k in 0..j {
+                v -= a[i * NU + k] * a[j * NU + k];
+            }
+            a[i * NU + j] = v / d;
+        }
+    }
+    for i in 0..n {
+        let mut v = b[i];
+        for k in 0..i {
+            v -= a[i * NU + k] * b[k];
+        }
+        b[i] = v / a[i * NU + i];
+    }
+    for i in (0..n).rev() {
+        let mut v = b[i];
+        for k in i + 1..n {
+            v -= a[k * NU + i] * b[k];
+        }
+        b[i] = v / a[i * NU + i];
+    }
+    true
+}
+
 fn empty_terms() -> WingTerms {
     WingTerms {
         mass: Matrix3::identity(),
@@ -676,5 +755,39 @@ fn empty_terms() -> WingTerms {
         theta_w: 0.0,
         potential: 0.0,
         kinetic: 0.0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cholesky_solve_matches_nalgebra() {
+        let n = 7;
+        let b = SMatrix::<f64, 7, 7>::from_fn(|i, j| ((i * 7 + j) as f64 * 0.37).sin());
+        let spd = b * b.transpose() + SMatrix::<f64, 7, 7>::identity() * 0.5;
+        let rhs = SVector::<f64, 7>::from_fn(|i, _| (i as f64).cos());
+        let expected = spd.cholesky().unwrap().solve(&rhs);
+        let mut a = [0.0; NU * NU];
+        let mut x = [0.0; NU];
+        for i in 0..n {
+            x[i] = rhs[i];
+            for j in 0..n {
+                a[i * NU + j] = spd[(i, j)];
+            }
+        }
+        assert!(solve_spd(&mut a, &mut x, n));
+        for i in 0..n {
+            assert!(
+                (x[i] - expected[i]).abs() < 1e-12,
+                "{i}: {} vs {}",
+                x[i],
+                expected[i]
+            );
+        }
+        let mut bad = [0.0; NU * NU];
+        bad[0] = -1.0;
+        assert!(!solve_spd(&mut bad, &mut [1.0; NU], 1));
     }
 }

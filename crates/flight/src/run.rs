@@ -534,3 +534,19 @@ pub fn released(model: &FlightModel, wings: &State) -> [f64; STATE_LEN] {
     let r = Release::default();
     model.state(&r.attitude, &Vector3::zeros(), &r.velocity, &r.omega, wings)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn euler_angles_invert_the_xyz_composition() {
+        for (roll, yaw, pitch) in [(0.3, -0.4, 1.1), (-2.5, 0.2, -0.7), (0.0, 1.2, 3.0)] {
+            let q = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), roll)
+                * UnitQuaternion::from_axis_angle(&Vector3::y_axis(), yaw)
+                * UnitQuaternion::from_axis_angle(&Vector3::z_axis(), pitch);
+            let a = euler_angles(&q);
+            assert!((a - Vector3::new(roll, yaw, pitch)).amax() < 1e-12, "{a:?}");
+        }
+    }
+}

@@ -240,16 +240,12 @@ pub struct Body {
 
 impl Default for Body {
     fn default() -> Self {
-        let m = 60.0;
-        let box_inertia = |a: f64, b: f64| m * (a * a + b * b) / 12.0;
+        // 60 mg box (module docs): m(2.4² + 5²)/12 = 153.8, m(18² + 5²)/12 = 1745,
+        // m(18² + 2.4²)/12 = 1648.8 mg·mm².
         Self {
             mode: BodyMode::Fixed,
-            mass_mg: m,
-            inertia: [
-                [box_inertia(2.4, 5.0), 0.0, 0.0],
-                [0.0, box_inertia(18.0, 5.0), 0.0],
-                [0.0, 0.0, box_inertia(18.0, 2.4)],
-            ],
+            mass_mg: 60.0,
+            inertia: [[153.8, 0.0, 0.0], [0.0, 1745.0, 0.0], [0.0, 0.0, 1648.8]],
             center_of_mass_mm: [0.0; 3],
             shoulders_mm: [[6.0, 0.0, -1.5], [6.0, 0.0, 1.5]],
             gravity_mm_per_ms2: [-9.81e-3, 0.0, 0.0],

@@ -2,7 +2,8 @@
 //! that runs any spec: the fixed-body engine or free flight.
 
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
-use paritysim_dynamics::{Device, SimulationOptions, SimulationResult};
+use paritysim_dynamics::sweep::PointOutput;
+use paritysim_dynamics::{Device, SimulationOptions, SimulationResult, Trajectory};
 use paritysim_error::Result;
 use paritysim_flight::run::{Release, Schedule};
 use paritysim_flight::{
@@ -183,4 +184,59 @@ impl Simulation {
             Some(f) => paritysim_flight::flight_columns(&f.model),
         })
     }
+}
+
+/// One sweep point of a flying spec: [`Simulation::run`] and what the sweep keeps (the
+/// engine's [`PointOutput`]: selected metrics, the last recorded wingbeat when asked).
+///
+/// # Errors
+/// As [`Simulation::run`].
+pub fn run_point(
+    spec: &Simulation,
+    device: &Device,
+    options: &SimulationOptions,
+    metric_names: &[String],
+    keep_cycle: bool,
+) -> Result<PointOutput> {
+    let options = SimulationOptions {
+        columns: if keep_cycle { None } else { Some(Vec::new()) },
+        ..options.clone()
+    };
+    let result = spec.run(device, &options)?;
+    let metrics = metric_names
+        .iter()
+        .map(|name| {
+            result
+                .metrics
+                .iter()
+                .find(|(n, _)| n == name)
+                .map_or(f64::NAN, |(_, v)| *v)
+        })
+        .collect();
+    let cycle = keep_cycle.then(|| {
+        let traj = result.trajectory;
+        let len = traj.time.len();
+        let keep = if result.period_ms.is_finite() {
+            (options.samples_per_cycle + 1).min(len)
+        } else {
+            len
+        };
+        let start = len - keep;
+        Trajectory {
+            time: traj.time[start..].to_vec(),
+            columns: traj
+                .columns
+                .into_iter()
+                .map(|(name, v)| (name, v[start..].to_vec()))
+                .collect(),
+        }
+    });
+    Ok(PointOutput {
+        metrics,
+        converged: result.converged,
+        cycles_run: result.cycles_run,
+        cycle,
+        residual: result.residual,
+        steady_state: None,
+    })
 }

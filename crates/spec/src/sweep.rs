@@ -13,9 +13,7 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use paritysim_dynamics::sweep::{
-    self as engine, PointOutput, SweepControl, metric_names, resolve_threads, trajectory_columns,
-};
+use paritysim_dynamics::sweep::{self as engine, PointOutput, SweepControl, resolve_threads};
 use paritysim_dynamics::{Device, SimulationOptions};
 use paritysim_error::{Error, Result};
 use serde_json::Value;
@@ -81,13 +79,13 @@ impl SweepPlan {
             )));
         }
         let device = base.device()?;
-        let valid = metric_names(&device);
+        let valid = base.metric_names(&device)?;
         let metrics = engine::select(
             "metrics",
             metrics.map(<[String]>::to_vec).as_deref(),
             &valid,
         )?;
-        let columns = trajectory_columns(&device);
+        let columns = base.column_names(&device)?;
         Ok(Self {
             base,
             parameters,
@@ -406,6 +404,20 @@ impl Drop for SweepJob {
 }
 
 fn run(plan: &SweepPlan, control: &SweepControl) -> Result<SweepOutcome> {
+    if plan.base.flies() {
+        // Free-flight points (paritysim-flight): built and run on the pool, no chains.
+        let slots = engine::run_indexed(plan.len(), plan.threads, control, |i| {
+            let spec = plan.point_spec(i)?;
+            let (device, options) = spec.model()?;
+            crate::flight::run_point(&spec, &device, &options, &plan.metrics, plan.keep_cycle)
+        })?;
+        return Ok(SweepOutcome::from_slots(
+            &slots,
+            plan.metrics.len(),
+            &plan.columns,
+            plan.keep_cycle,
+        ));
+    }
     // Points are built on the pool too (validation and model construction are per point).
     let points: Vec<Result<(Device, SimulationOptions)>> =
         engine::run_indexed(plan.len(), plan.threads, &SweepControl::new(), |i| {

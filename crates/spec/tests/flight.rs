@@ -102,3 +102,33 @@ fn body_fields_are_validated_with_their_path_and_listed_as_paths() {
         assert!(listed.iter().any(|l| l == p), "{p} not in {listed:?}");
     }
 }
+
+#[test]
+fn sweeps_run_flying_specs() {
+    use paritysim_spec::sweep::{SweepPlan, run_plan};
+    // Clamped: the airframe mass does not enter the dynamics, only the weight, so doubling
+    // it halves lift / weight exactly; a bad point is an error row.
+    let base = from_toml(&with_body("mode = \"clamped\"")).unwrap().0;
+    let names = vec!["body.mass_mg".to_string()];
+    let rows = vec![vec![60.0.into()], vec![120.0.into()], vec![(-5.0).into()]];
+    let metrics = vec![
+        "lift_to_weight".to_string(),
+        "body_force_x_mean".to_string(),
+    ];
+    let plan = SweepPlan::new(base.clone(), &names, rows, Some(&metrics), false, Some(2)).unwrap();
+    let out = run_plan(plan).unwrap();
+    assert_eq!(out.ok, vec![true, true, false]);
+    let (a, b) = (out.metrics[0], out.metrics[2]);
+    assert!(a > 1.0 && (a / b - 2.0).abs() < 1e-12, "{a} {b}");
+    assert_eq!(out.metrics[1].to_bits(), out.metrics[3].to_bits());
+    // The same point through Simulation::run.
+    let (device, options) = base.model().unwrap();
+    let direct = base.run(&device, &options).unwrap();
+    let ltw = direct
+        .metrics
+        .iter()
+        .find(|(n, _)| n == "lift_to_weight")
+        .unwrap()
+        .1;
+    assert_eq!(ltw.to_bits(), a.to_bits());
+}
