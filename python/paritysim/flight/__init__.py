@@ -36,25 +36,34 @@ __all__ = ["AXES", "Trim", "body_of", "tilt_angle", "trim", "twist_angle", "with
 AXES = {"roll": 0, "yaw": 1, "pitch": 2}
 
 
+def _plain_body(body: Any) -> dict[str, Any]:
+    """A body section (``ps.spec.Body`` or a mapping) as a plain dict."""
+    if body is None:
+        return {}
+    return dict(body.to_dict()) if hasattr(body, "to_dict") else dict(body)
+
+
 def body_of(spec: Simulation) -> dict[str, Any]:
     """The spec's ``body`` section as plain data with every default filled in (canonicalised
     in Rust); an empty dict without a body section."""
     if getattr(spec, "body", None) is None:
         return {}
     canonical = Simulation.from_dict(spec.to_dict())
-    return dict(canonical.body)
+    return _plain_body(canonical.body)
 
 
 def with_body(spec: Simulation, **fields: Any) -> Simulation:
     """A copy of ``spec`` with ``body`` fields replaced (e.g. ``mode="free"``,
-    ``mass_mg=80.0``, ``mechanisms=[{"kind": "gravity_pendulum", "moment_mg_mm": 100.0}]``).
+    ``mass_mg=80.0``, ``mechanisms=[{"kind": "gravity_pendulum", "moment_mg_mm": 100.0}]``);
+    a spec without a body section gets one (defaults for the fields not given). The result's
+    ``body`` is a :class:`paritysim.spec.Body`.
 
     Raises
     ------
     InvalidParameterError
         For an unknown field or a value out of range (raised in Rust, naming ``body.<field>``).
     """
-    body = dict(getattr(spec, "body", None) or {})
+    body = _plain_body(getattr(spec, "body", None))
     body.update(fields)
     return Simulation.from_dict({**spec.to_dict(), "body": body})
 
