@@ -39,7 +39,7 @@ from ._core import (
 logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 if TYPE_CHECKING:  # what type checkers see; at run time the names below load lazily
-    from . import aero, claims, devices, dynamics, kinematics, laminate, planform, plots, spec, stability, trials
+    from . import aero, claims, devices, dynamics, flight, kinematics, laminate, planform, plots, spec, stability, trials
     from .calibration import CalibrationResult, calibrate
     from .continuation import ContinuationResult
     from .planform import Planform
@@ -48,7 +48,7 @@ if TYPE_CHECKING:  # what type checkers see; at run time the names below load la
     from .sweep import grid, sweep
 
 #: Lazily loaded submodules.
-_SUBMODULES = ("aero", "calibration", "claims", "continuation", "devices", "dynamics", "kinematics", "laminate", "planform", "plots", "simulation", "spec", "stability", "sweep", "trials")
+_SUBMODULES = ("aero", "calibration", "claims", "continuation", "devices", "dynamics", "flight", "kinematics", "laminate", "planform", "plots", "simulation", "spec", "stability", "sweep", "trials")
 #: Lazily loaded names -> the submodule defining them.
 _NAMES = {
     "CalibrationResult": "calibration",

@@ -1,0 +1,555 @@
+"""Beyond the thesis: the §3.4 device in flight (issue 17).
+
+Every thesis trial holds the body on a torque stand. Here the §3.4 device (Table 3.3 wings,
+linear differential, ``section_3_4``'s pinned hinge) is mounted on the default HMF-class
+airframe of the spec's ``body`` section (60 mg; box inertia; shoulders 6 mm above the centre of
+mass: ``crates/spec/src/body.rs`` gives the sources and assumptions) and released:
+
+1. **Hover trim** (``flight.trim``): actuator amplitude and DC offset for lift = weight and zero
+   pitch torque, HMF and Drag PARITY, Uncut wings; for PARITY also with the pivot (arm ratio,
+   the q3 of eq. 5.1) as a third knob against the lift-asymmetry (yaw) torque.
+2. **1-Cut right wing, open loop**, HMF vs PARITY at their Uncut trim: body roll on a roll
+   gimbal and body yaw on a yaw gimbal over ``wingbeats`` wingbeats, plus the free body.
+   Single-axis gimbals because the free body (and the ball joint) tumbles within a few dozen
+   wingbeats whatever the drivetrain (the open-loop hover is unstable, reported as a claim),
+   which would hide the roll/yaw response to the cut that the thesis' torques predict.
+3. The same with a **gravity pendulum on the PARITY pivot** (``body.mechanisms``), both signs
+   of its moment.
+4. **Eq. 5.1 in flight**: the symmetric device (both wings the Table 3.3 left wing), PARITY
+   trimmed, whippletree pivot biased to ``τL/τR = q3`` (arm ratio ``hL/hR = 1/q3``, §2.4.2),
+   on the torque stand (mean and peak roll torques) and on the roll gimbal (mean roll rate).
+
+All numbers are computed here; the thesis has no flight results to compare with, so every claim
+is a physical expectation stated before the run, with its computed verdict.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import polars as pl
+
+from ..claims import Claim
+from ._io import results, write_claims, write_trial
+
+DRIVETRAINS = ("HMF", "PARITY")
+GIMBALS = ("roll", "yaw")
+
+
+@dataclass(frozen=True)
+class Params:
+    """The flight studies (mg-mm-ms-rad-V)."""
+
+    wingbeats: int = 100
+    samples_per_cycle: int = 20
+    pendulum_moment_mg_mm: float = 1000.0  # m·l of the pivot pendulum: deliberately large (10 mg on 100 mm), to give it authority
+    q3: tuple[float, ...] = (0.5, 2.0)  # τL/τR set points of eq. 5.1
+    tilt_limit_deg: float = 30.0  # "tumbled": the stroke axis tipped this far
+    animation_wingbeats: int = 12
+    animation_frames: int = 60
+
+
+def params(**overrides: Any) -> Params:
+    """:class:`Params` with overrides (unknown names raise ``InvalidParameterError``)."""
+    names = {f.name for f in dataclasses.fields(Params)}
+    unknown = sorted(set(overrides) - names)
+    if unknown:
+        from .._errors import invalid
+
+        raise invalid(unknown[0], overrides[unknown[0]], f"one of {', '.join(sorted(names))}")
+    return Params(**overrides)
+
+
+# ---------------------------------------------------------------- devices
+
+
+def device_3_4(drivetrain: str, trial: str):  # type: ignore[no-untyped-def]
+    """The §3.4 device (``section_3_4.device`` with its pinned hinge)."""
+    from . import section_3_4 as s34
+
+    p = s34.params()
+    return s34.device(p, drivetrain, trial, hinge=s34.hinge_stiffness(p))
+
+
+def symmetric_device(drivetrain: str = "PARITY", q3: float = 1.0):  # type: ignore[no-untyped-def]
+    """The §3.4 device with both wings the Table 3.3 left wing; whippletree arm ratio
+    ``hL/hR = 1/q3`` (so the stand sees ``τL/τR = q3``, eq. 5.1)."""
+    spec = device_3_4(drivetrain, "Uncut")
+    left = spec.wings[0]
+    spec = spec.replace(wings=(left, left), name=f"symmetric §3.4 {drivetrain}, q3 = {q3:g}")
+    return spec.with_paths({"drivetrain.arm_ratio": 1.0 / q3}) if drivetrain == "PARITY" else spec
+
+
+@functools.lru_cache(maxsize=8)
+def _trim(drivetrain: str, pivot: bool = False, symmetric: bool = False):  # type: ignore[no-untyped-def]
+    from .. import flight
+    from ..flight.trim import AMPLITUDE, OFFSET
+
+    spec = symmetric_device(drivetrain) if symmetric else device_3_4(drivetrain, "Uncut")
+    if pivot:
+        return flight.trim(spec, knobs=(AMPLITUDE, OFFSET, "drivetrain.arm_ratio"))
+    return flight.trim(spec)
+
+
+def _fly(spec, mode: str, wingbeats: int, samples: int, **body: Any):  # type: ignore[no-untyped-def]
+    from .. import flight
+    from ..simulation import simulate
+
+    return simulate(flight.with_body(spec, mode=mode, **body), record_cycles=wingbeats, samples_per_cycle=samples)
+
+
+def _trimmed(spec, drivetrain: str):  # type: ignore[no-untyped-def]
+    """``spec`` driven with the Uncut device's amplitude/DC trim of ``drivetrain``."""
+    return spec.replace(actuator=_trim(drivetrain).spec.actuator)
+
+
+def _time_to(angle_rad: np.ndarray, t: np.ndarray, limit_deg: float) -> float:
+    """Time (ms after release) at which |angle| first exceeds ``limit_deg``; NaN if never."""
+    over = np.flatnonzero(np.abs(np.degrees(angle_rad)) > limit_deg)
+    return float(t[over[0]] - t[0]) if over.size else math.nan
+
+
+# ---------------------------------------------------------------- studies
+
+
+def hover_trim() -> pl.DataFrame:
+    """Study 1: one row per trim (HMF, PARITY, PARITY with the pivot as third knob) of the
+    Uncut §3.4 device: knob values, residuals (mN, mN·mm), scaled residuals, runs."""
+    rows = []
+    for label, (d, pivot) in {"HMF": ("HMF", False), "PARITY": ("PARITY", False), "PARITY + pivot": ("PARITY", True)}.items():
+        tr = _trim(d, pivot)
+        rows.append(
+            dict(
+                trim=label,
+                amplitude_v=tr.knobs["actuator.waveform.amplitude_v"],
+                offset_v=tr.knobs["actuator.waveform.offset_v"],
+                arm_ratio=tr.knobs.get("drivetrain.arm_ratio", 1.0),
+                weight_mn=tr.weight_mn,
+                lift_mn=tr.lift_mn,
+                **{f"residual_{k}": v for k, v in tr.residuals.items()},
+                **{f"scaled_{k}": v for k, v in tr.scaled.items()},
+                solved=",".join(tr.solved),
+                converged=tr.converged,
+                runs=tr.evaluations,
+            )
+        )
+    return pl.DataFrame(rows)
+
+
+def _attitude_frame(result, study: str, case: str, mode: str) -> pl.DataFrame:  # type: ignore[no-untyped-def]
+    from .. import flight
+
+    df = result.trajectory
+    t = df["time_ms"].to_numpy()
+    return pl.DataFrame(
+        {
+            "study": study,
+            "case": case,
+            "mode": mode,
+            "wingbeat": (t - t[0]) / result.period_ms,
+            "time_ms": t - t[0],
+            "roll_deg": np.degrees(flight.twist_angle(df, "roll")),
+            "yaw_deg": np.degrees(flight.twist_angle(df, "yaw")),
+            "pitch_deg": np.degrees(flight.twist_angle(df, "pitch")),
+            "tilt_deg": np.degrees(flight.tilt_angle(df)),
+            "omega_roll": df["body_omega_roll"].to_numpy(),
+            "x_mm": df["body_x"].to_numpy(),
+            "y_mm": df["body_y"].to_numpy(),
+            "z_mm": df["body_z"].to_numpy(),
+        }
+    )
+
+
+def cut_wing(**overrides: Any) -> tuple[pl.DataFrame, dict[str, Any]]:
+    """Studies 2 and 3: the 1-Cut device at its drivetrain's Uncut trim on the roll and yaw
+    gimbals (and free: HMF and PARITY), HMF, PARITY and PARITY with the pivot pendulum
+    (±moment). Returns the
+    long attitude frame and the free-flight trajectories (for the pictures)."""
+    p = params(**overrides)
+    n, s = p.wingbeats, p.samples_per_cycle
+    frames, free = [], {}
+    cases: dict[str, tuple[str, list[dict[str, Any]]]] = {
+        "HMF": ("HMF", []),
+        "PARITY": ("PARITY", []),
+        "PARITY + pendulum (+)": ("PARITY", [{"kind": "gravity_pendulum", "moment_mg_mm": p.pendulum_moment_mg_mm}]),
+        "PARITY + pendulum (−)": ("PARITY", [{"kind": "gravity_pendulum", "moment_mg_mm": -p.pendulum_moment_mg_mm}]),
+    }
+    for case, (d, mechanisms) in cases.items():
+        spec = _trimmed(device_3_4(d, "1-Cut"), d)
+        study = "pendulum" if mechanisms else "cut"
+        for mode in (*GIMBALS, *(() if mechanisms else ("free",))):
+            r = _fly(spec, mode, n, s, mechanisms=mechanisms)
+            frames.append(_attitude_frame(r, study, case, mode))
+            if mode == "free":
+                free[case] = r
+    return pl.concat(frames), free
+
+
+def eq_5_1(**overrides: Any) -> tuple[pl.DataFrame, pl.DataFrame]:
+    """Study 4: per q3 (and 1), the symmetric PARITY at its trim: stand cycle-mean and peak
+    roll torques per wing, the stand's peak ratio τL/τR, and on the roll gimbal the mean roll
+    rate over the first half and the last quarter of the run and the final roll (twist) angle.
+    Returns that table and the roll-gimbal attitude traces."""
+    from .. import flight
+    from ..simulation import simulate
+
+    p = params(**overrides)
+    actuator = _trim("PARITY", symmetric=True).spec.actuator
+    rows, traces = [], []
+    for q3 in (1.0, *p.q3):
+        spec = symmetric_device("PARITY", q3).replace(actuator=actuator)
+        stand = simulate(flight.with_body(spec, mode="clamped"))
+        cyc = stand.cycle[:-1]
+        left = (cyc["left_roll_aero"] + cyc["left_roll_inertial"]).to_numpy()
+        right = (cyc["right_roll_aero"] + cyc["right_roll_inertial"]).to_numpy()
+        r = _fly(spec, "roll", p.wingbeats, p.samples_per_cycle)
+        df = r.trajectory
+        traces.append(_attitude_frame(r, "eq5.1", f"q3 = {q3:g}", "roll").with_columns(pl.lit(q3).alias("q3")))
+        w = df["body_omega_roll"].to_numpy()[:-1]  # whole wingbeats (the last sample closes one)
+        half, quarter = len(w) // 2, 3 * len(w) // 4
+        rows.append(
+            dict(
+                q3=q3,
+                arm_ratio=1.0 / q3,
+                stand_roll_mean=float(stand.metrics["body_torque_roll_mean"]),
+                stand_yaw_mean=float(stand.metrics["body_torque_yaw_mean"]),
+                stand_peak_left=float(np.abs(left).max()),
+                stand_peak_right=float(np.abs(right).max()),
+                stand_peak_ratio=float(np.abs(left).max() / np.abs(right).max()),
+                roll_rate_first_half=float(w[:half].mean()),
+                roll_rate_last_quarter=float(w[quarter:].mean()),
+                q2_first_wingbeat=float(df["q2"].to_numpy()[: p.samples_per_cycle].mean()),
+                q2_last_quarter=float(df["q2"].to_numpy()[:-1][quarter:].mean()),
+                roll_rate_mean=float(r.metrics["body_omega_roll_mean"]),
+                roll_final_deg=float(np.degrees(flight.twist_angle(df, "roll")[-1])),
+            )
+        )
+    return pl.DataFrame(rows), pl.concat(traces)
+
+
+# ---------------------------------------------------------------- claims
+
+
+def trim_claims(df: pl.DataFrame, tol: float) -> list[Claim]:
+    """Study 1's claims on :func:`hover_trim`'s table."""
+    by = {r["trim"]: r for r in df.iter_rows(named=True)}
+    out = []
+    for label, r in by.items():
+        out.append(
+            Claim.holds(
+                f"trim ({label}): lift = weight and zero {'pitch and yaw' if 'pivot' in label else 'pitch'} torque",
+                bool(r["converged"]),
+                computed=f"amplitude {r['amplitude_v']:.2f} V, DC {r['offset_v']:+.2g} V"
+                + (f", hL/hR {r['arm_ratio']:.4f}" if "pivot" in label else "")
+                + f"; lift − weight {r['residual_lift']:+.1e} mN, pitch {r['residual_pitch']:+.1e}, yaw {r['residual_yaw']:+.2g}, roll {r['residual_roll']:+.1e} mN·mm",
+                criterion=f"each solved residual / scale < {tol:g} (scale: weight {r['weight_mn']:.3f} mN; × 12 mm for torques)",
+                thesis="(beyond the thesis)",
+            )
+        )
+    h, pv = by["HMF"], by["PARITY + pivot"]
+    out.append(
+        Claim.holds(
+            "one actuator cannot trim the lift-asymmetry (yaw) torque of the Uncut wings; the PARITY pivot (q3) can",
+            abs(h["scaled_yaw"]) > 100 * tol and abs(pv["scaled_yaw"]) < tol,
+            computed=f"yaw at trim: HMF {h['residual_yaw']:+.3f}, PARITY {by['PARITY']['residual_yaw']:+.3f}, PARITY + pivot {pv['residual_yaw']:+.1e} mN·mm",
+            criterion=f"|HMF yaw| / scale > {100 * tol:g} and |PARITY + pivot yaw| / scale < {tol:g}",
+            thesis="(beyond the thesis)",
+        )
+    )
+    return out
+
+
+def _summary(df: pl.DataFrame, limit: float) -> dict[tuple[str, str], dict[str, float]]:
+    out = {}
+    for (case, mode), sub in df.group_by(["case", "mode"]):
+        t = sub["time_ms"].to_numpy()
+        out[(case, mode)] = {
+            "max_roll": float(np.abs(sub["roll_deg"]).max()),
+            "final_roll": float(sub["roll_deg"][-1]),
+            "max_yaw": float(np.abs(sub["yaw_deg"]).max()),
+            "t_yaw": _time_to(np.radians(sub["yaw_deg"].to_numpy()), t, limit),
+            "t_tilt": _time_to(np.radians(sub["tilt_deg"].to_numpy()), t, limit),
+        }
+    return out
+
+
+def cut_claims(df: pl.DataFrame, p: Params) -> tuple[list[Claim], dict[str, float]]:
+    """Studies 2 and 3: claims on :func:`cut_wing`'s attitude frame and the numbers the report
+    quotes."""
+    s = _summary(df, p.tilt_limit_deg)
+    hmf, par = s[("HMF", "roll")], s[("PARITY", "roll")]
+    ratio = par["max_roll"] / hmf["max_roll"]
+    ty = {c: s[(c, "yaw")]["t_yaw"] for c in ("HMF", "PARITY", "PARITY + pendulum (+)", "PARITY + pendulum (−)")}
+    tt = {c: s[(c, "free")]["t_tilt"] for c in DRIVETRAINS}
+    lim = f"{p.tilt_limit_deg:g}°"
+    fmt = lambda v: "never" if not math.isfinite(v) else f"{v:.0f} ms"  # noqa: E731
+    plus, minus = "PARITY + pendulum (+)", "PARITY + pendulum (−)"
+    claims = [
+        Claim.holds(
+            "Drag PARITY holds the roll of a 1-Cut airframe (roll gimbal, open loop)",
+            ratio < 0.5,
+            computed=f"max |roll| over {p.wingbeats} wingbeats: HMF {hmf['max_roll']:.2f}°, PARITY {par['max_roll']:.2f}° (ratio {ratio:.2f})",
+            criterion="PARITY / HMF < 0.5",
+            thesis="§3.4: PARITY balances the roll torques (Fig. 3.11)",
+        ),
+        Claim.holds(
+            "Drag PARITY slows the yaw divergence of a 1-Cut airframe (yaw gimbal, open loop)",
+            math.isfinite(ty["HMF"]) and (not math.isfinite(ty["PARITY"]) or ty["PARITY"] > 1.2 * ty["HMF"]),
+            computed=f"time to |yaw| > {lim}: HMF {fmt(ty['HMF'])}, PARITY {fmt(ty['PARITY'])}",
+            criterion="PARITY's time > 1.2 × HMF's",
+            thesis="§3.4: mean yaw imbalance reduced 71 % (1-Cut)",
+        ),
+        Claim.holds(
+            "neither drivetrain keeps the free 1-Cut airframe upright open loop",
+            all(math.isfinite(tt[c]) for c in ("HMF", "PARITY")),
+            computed=f"time to tilt > {lim}: HMF {fmt(tt['HMF'])}, PARITY {fmt(tt['PARITY'])}",
+            criterion=f"tilt exceeds {lim} within {p.wingbeats} wingbeats for both",
+            thesis="(beyond the thesis: hover is open-loop unstable)",
+        ),
+        Claim.holds(
+            f"a hanging pendulum on the PARITY pivot (m·l = +{p.pendulum_moment_mg_mm:g} mg·mm) delays the yaw divergence",
+            math.isfinite(ty["PARITY"]) and (not math.isfinite(ty[plus]) or ty[plus] > 1.2 * ty["PARITY"]),
+            computed=f"time to |yaw| > {lim}: without {fmt(ty['PARITY'])}, with {fmt(ty[plus])}",
+            criterion="with > 1.2 × without",
+            thesis="§5.1: ground-referenced mechanisms (future work)",
+            note="its torque grows with the tilt (sin), and a static pivot bias shifts the two strokes' means oppositely, a weak lever on the lift balance",
+        ),
+        Claim.holds(
+            "... and reduces the yaw excursion over the run",
+            s[(plus, "yaw")]["max_yaw"] < 0.5 * s[("PARITY", "yaw")]["max_yaw"],
+            computed=f"max |yaw| over {p.wingbeats} wingbeats: without {s[('PARITY', 'yaw')]['max_yaw']:.0f}°, with {s[(plus, 'yaw')]['max_yaw']:.0f}°",
+            criterion="with < 0.5 × without",
+            thesis="§5.1: ground-referenced mechanisms (future work)",
+        ),
+        Claim.holds(
+            "the hanging pendulum keeps roll regulated; an inverted one (m·l < 0, a negative spring on the pivot) does not",
+            s[(plus, "roll")]["max_roll"] < 0.5 * hmf["max_roll"] and s[(minus, "roll")]["max_roll"] > hmf["max_roll"],
+            computed=f"max |roll|: hanging {s[(plus, 'roll')]['max_roll']:.2f}°, inverted {s[(minus, 'roll')]['max_roll']:.0f}° (HMF {hmf['max_roll']:.2f}°)",
+            criterion="hanging < 0.5 × HMF, inverted > HMF",
+            thesis="(beyond the thesis; cf. docs/findings.md §3: the pivot needs positive stiffness)",
+        ),
+    ]
+    values = {"roll_ratio": ratio, "hmf_max_roll_deg": hmf["max_roll"], "parity_max_roll_deg": par["max_roll"], **{f"t_yaw_{c}": v for c, v in ty.items()}, **{f"t_tilt_{c}": v for c, v in tt.items()}}
+    return claims, values
+
+
+def eq_5_1_claims(df: pl.DataFrame) -> list[Claim]:
+    """Study 4's claims on :func:`eq_5_1`'s table."""
+    rows = {r["q3"]: r for r in df.iter_rows(named=True)}
+    base = rows[1.0]
+    biased = [q for q in rows if q != 1.0]
+    peak = max(max(r["stand_peak_left"], r["stand_peak_right"]) for r in rows.values())
+    claims = [
+        Claim.all_between("the stand sees τL/τR = q3 (peak roll torques, eq. 5.1)", {f"q3 = {q:g}": rows[q]["stand_peak_ratio"] / q for q in biased}, 0.95, 1.05, thesis="τL/τR = q3", fmt=".3f",
+                          note="shown: measured ratio / q3"),
+        Claim.holds(
+            "... and no cycle-mean roll torque (§2.4.2: the imbalance gives a zero-averaged roll oscillation)",
+            all(abs(rows[q]["stand_roll_mean"]) < 1e-2 * peak for q in biased),
+            computed=", ".join(f"q3 = {q:g}: {rows[q]['stand_roll_mean']:+.1e} mN·mm" for q in biased) + f" (peak {peak:.2f})",
+            criterion="|mean| < 1 % of the peak roll torque",
+            thesis="“does not lead to an average roll torque”",
+        ),
+        Claim.holds(
+            "in flight (roll gimbal) q3 ≠ 1 turns the body, q3 = 1 does not",
+            all(abs(rows[q]["roll_final_deg"]) > 30.0 for q in biased) and abs(base["roll_final_deg"]) < 1e-6,
+            computed=", ".join(f"q3 = {q:g}: {rows[q]['roll_final_deg']:+.0f}°" for q in biased) + f"; q3 = 1: {base['roll_final_deg']:+.1e}°",
+            criterion="|roll| > 30° after the run for q3 ≠ 1, < 1e-6° for q3 = 1",
+            thesis="§5.1: control by biasing the set point",
+        ),
+        Claim.holds(
+            "... in the direction of the stand's mean roll torque, mirrored by q3 ↔ 1/q3",
+            all(np.sign(rows[q]["roll_final_deg"]) == np.sign(rows[q]["stand_roll_mean"]) for q in biased)
+            and abs(rows[biased[0]]["roll_final_deg"] + rows[biased[1]]["roll_final_deg"]) < 1e-3 * abs(rows[biased[0]]["roll_final_deg"]),
+            computed=", ".join(f"q3 = {q:g}: stand {rows[q]['stand_roll_mean']:+.1e} mN·mm, roll {rows[q]['roll_final_deg']:+.1f}°" for q in biased),
+            criterion="signs equal; q3 and 1/q3 opposite within 0.1 %",
+            thesis="(beyond the thesis)",
+        ),
+        Claim.holds(
+            "... at a sustained roll rate (eq. 5.1 as a rate command)",
+            all(abs(rows[q]["roll_rate_last_quarter"]) > 0.2 * abs(rows[q]["roll_rate_first_half"]) and np.sign(rows[q]["roll_rate_first_half"]) == np.sign(rows[q]["roll_rate_last_quarter"]) for q in biased),
+            computed=", ".join(f"q3 = {q:g}: {1e3 * rows[q]['roll_rate_first_half']:+.2f} rad/s (first half) → {1e3 * rows[q]['roll_rate_last_quarter']:+.2f} rad/s (last quarter)" for q in biased),
+            criterion="the last quarter's mean rate keeps its sign and > 20 % of the first half's",
+            thesis="(issue 17's expectation)",
+            note="cf. §2.4.2: a constant torque-ratio bias 'does not lead to an average roll torque'. The turn comes with the whippletree's slow drift "
+            "(no balance spring): q2 " + ", ".join(f"{rows[q]['q2_first_wingbeat']:+.3f} → {rows[q]['q2_last_quarter']:+.3f} rad (q3 = {q:g})" for q in biased)
+            + "; a shift of q2 turns both wings' stroke means the same way about x̂ (a likely mechanism, not separately tested)",
+        ),
+    ]
+    return claims
+
+
+# ---------------------------------------------------------------- figures, CLI, report
+
+
+def _per_wingbeat(n: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Means of ``v`` over each whole wingbeat (``n`` in wingbeats), at the wingbeats' middles."""
+    k = np.floor(n[:-1] + 1e-9).astype(int)  # a sample on a wingbeat boundary opens the next one
+    beats = np.unique(k)
+    return beats + 0.5, np.array([v[:-1][k == b].mean() for b in beats])
+
+
+def _fig_cut(df: pl.DataFrame, p: Params):  # type: ignore[no-untyped-def]
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 2, figsize=(12, 7), sharex=True, constrained_layout=True)
+    for col, study in enumerate(("cut", "pendulum")):
+        cases = ["HMF", "PARITY"] if study == "cut" else ["PARITY", "PARITY + pendulum (+)", "PARITY + pendulum (−)"]
+        for i, case in enumerate(cases):
+            for row, (mode, q) in enumerate((("roll", "roll_deg"), ("yaw", "yaw_deg"))):
+                sub = df.filter((pl.col("case") == case) & (pl.col("mode") == mode))
+                n, v = sub["wingbeat"].to_numpy(), sub[q].to_numpy()
+                axes[row][col].plot(n, v, color=f"C{i}", lw=0.4, alpha=0.35)
+                beat, mean = _per_wingbeat(n, v)
+                axes[row][col].plot(beat, mean, color=f"C{i}", lw=1.8, label=f"{case} (wingbeat mean)")
+        axes[0][col].set_title(("1-Cut right wing, open loop" if study == "cut" else f"PARITY with a pivot pendulum (m·l = ±{p.pendulum_moment_mg_mm:g} mg·mm)"))
+        axes[0][col].set_ylabel("body roll, roll gimbal (deg)")
+        if study == "pendulum":
+            axes[0][col].set_yscale("symlog", linthresh=1.0)
+        axes[1][col].set_ylabel("body yaw, yaw gimbal (deg)")
+        axes[1][col].set_xlabel("wingbeats after release")
+        for row in (0, 1):
+            axes[row][col].grid(alpha=0.3)
+            axes[row][col].legend(fontsize=8)
+    fig.suptitle("Beyond the thesis: §3.4 device on single-axis gimbals, drive trimmed for the Uncut wings")
+    return fig
+
+
+def _fig_eq_5_1(traces: pl.DataFrame):  # type: ignore[no-untyped-def]
+    import matplotlib.pyplot as plt
+
+    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 4.2), constrained_layout=True)
+    for i, q3 in enumerate(sorted(set(traces["q3"].to_list()))):
+        tr = traces.filter(pl.col("q3") == q3)
+        n = tr["wingbeat"].to_numpy()
+        a.plot(n, tr["roll_deg"], color=f"C{i}", label=f"q3 = τL/τR = {q3:g}")
+        beat, rate = _per_wingbeat(n, 1e3 * tr["omega_roll"].to_numpy())
+        b.plot(beat, rate, color=f"C{i}", label=f"q3 = {q3:g}")
+    a.set_ylabel("body roll (deg)")
+    b.set_ylabel("roll rate, wingbeat mean (rad/s)")
+    for ax in (a, b):
+        ax.set_xlabel("wingbeats after release")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    a.set_title("eq. 5.1 in flight: symmetric PARITY on a roll gimbal")
+    b.set_title("roll rate (wingbeat means)")
+    return fig
+
+
+def _cli_trim(out: Path) -> list[Path]:
+    import matplotlib.pyplot as plt
+
+    df = hover_trim()
+    tol = _trim("HMF").tol
+    fig, ax = plt.subplots(1, 2, figsize=(11, 3.8), constrained_layout=True)
+    labels = df["trim"].to_list()
+    x = np.arange(len(labels))
+    ax[0].bar(x, df["amplitude_v"].to_numpy(), 0.5, color="C0")
+    ax[0].set_xticks(x, labels)
+    ax[0].set_ylabel("trim amplitude (V)")
+    ax[0].set_title(f"hover trim of the §3.4 device (weight {df['weight_mn'][0]:.3f} mN)")
+    for k, e in enumerate(("lift", "roll", "yaw", "pitch")):
+        ax[1].bar(x + (k - 1.5) * 0.2, np.abs(df[f"scaled_{e}"].to_numpy()) + 1e-16, 0.2, label=e)
+    ax[1].axhline(tol, color="k", ls="--", lw=1, label=f"tolerance {tol:g}")
+    ax[1].set_yscale("log")
+    ax[1].set_xticks(x, labels)
+    ax[1].set_ylabel("|residual| / scale")
+    ax[1].set_title("residuals at the trim (unsolved ones included)")
+    ax[1].legend(fontsize=7, ncol=2)
+    written = write_trial(df, out, "flight_trim", fig)
+    return [*written, write_claims(out, "flight.trim", trim_claims(df, tol), {"tol": tol})]
+
+
+def _cli_cut(out: Path) -> list[Path]:
+    from .. import plots
+    from ..flight import plots as fplots
+
+    p = params()
+    df, free = cut_wing()
+    written = write_trial(df, out, "flight_cut_wing", _fig_cut(df, p))
+    period = free["HMF"].period_ms
+    frames = {c: free[c].trajectory for c in ("HMF", "PARITY")}
+    written.append(plots.save(fplots.attitude(frames, period, title="1-Cut right wing, free flight at the Uncut trim: attitude and position"), out / "flight_free_attitude.png"))
+    written.append(plots.save(fplots.trajectory_3d(frames, title="1-Cut right wing, free flight: centre of mass; arrows: stroke axis"), out / "flight_free_trajectory.png"))
+    # The animation: the first wingbeats of the HMF's free flight, finely sampled.
+    spec = _trimmed(device_3_4("HMF", "1-Cut"), "HMF")
+    per = max(1, p.animation_frames // p.animation_wingbeats)
+    anim = _fly(spec, "free", p.animation_wingbeats, 4 * per)
+    written.append(fplots.animate(anim.trajectory, out / "flight_free_hmf_1cut.gif", frames=p.animation_frames, title="HMF, 1-Cut, free"))
+    claims, values = cut_claims(df, p)
+    return [*written, write_claims(out, "flight.cut_wing", claims, values)]
+
+
+def _cli_eq_5_1(out: Path) -> list[Path]:
+    df, traces = eq_5_1()
+    actuator = _trim("PARITY", symmetric=True).spec.actuator
+    written = write_trial(df, out, "flight_eq5_1", _fig_eq_5_1(traces))
+    return [*written, write_claims(out, "flight.eq5.1", eq_5_1_claims(df), {"amplitude_v": actuator.waveform.amplitude_v})]
+
+
+CLI_TRIALS = {"flight.trim": _cli_trim, "flight.cut_wing": _cli_cut, "flight.eq5.1": _cli_eq_5_1}
+
+
+def report_section(out: Path) -> str:
+    """Markdown: the flight studies (beyond the thesis), from the files the trials wrote."""
+    from ..claims import render
+
+    trim_found, tv = results(out, "flight.trim")
+    cut_found, _ = results(out, "flight.cut_wing")
+    eq_found, ev = results(out, "flight.eq5.1")
+    p = params()
+    return "\n".join(
+        [
+            "## Beyond the thesis: the §3.4 device in flight (issue 17)",
+            "",
+            "**Not in the thesis**: every thesis trial holds the body on a torque stand. Here the §3.4 device flies on the default "
+            "HMF-class airframe of the spec's `body` section (60 mg, box inertia, shoulders 6 mm above the centre of mass; "
+            "`crates/spec/src/body.rs` states sources and assumptions), with coupled body and wing dynamics (`crates/flight`). "
+            "There are no thesis numbers to compare with: each claim is a physical expectation (some sharpened after first runs, "
+            "e.g. the inverted pendulum's instability), and every verdict is computed on this run. Axes as the thesis names them: roll about the stroke axis x̂ (the drag-torque axis Drag PARITY "
+            "regulates), yaw about the wing normal ŷ (lift asymmetry), pitch about the span ẑ.",
+            "",
+            "### Hover trim",
+            "",
+            f"`paritysim.flight.trim`: actuator amplitude and DC offset (acting as a force) solved on the clamped body for "
+            f"cycle-mean lift = weight and zero pitch torque; with the PARITY pivot (arm ratio) as a third knob, zero yaw too. "
+            f"Tolerance on each solved residual: {tv['tol']:g} of its scale.",
+            "",
+            render(trim_found),
+            "",
+            "![trim](flight_trim.png)",
+            "",
+            f"### A cut wing, open loop, and a pendulum on the pivot",
+            "",
+            f"The 1-Cut right wing (Table 3.3) at the drive trimmed for the Uncut wings, {p.wingbeats} wingbeats after release from "
+            "the clamped steady state. Roll and yaw are each shown on a single-axis gimbal about the centre of mass: the free "
+            "body (and the three-axis ball joint) tumbles within a few dozen wingbeats whatever the drivetrain — open-loop "
+            "hover is unstable (third claim) — so 100 wingbeats of free flight would show the tumble, not the roll/yaw response "
+            "to the cut that the thesis' torques predict. The free flights are drawn below too.",
+            "",
+            render(cut_found),
+            "",
+            "![cut wing](flight_cut_wing.png)",
+            "",
+            "![free attitude](flight_free_attitude.png)",
+            "",
+            "![free trajectory](flight_free_trajectory.png)",
+            "",
+            f"Animation of the HMF's first {p.animation_wingbeats} free wingbeats (schematic wings): `flight_free_hmf_1cut.gif`.",
+            "",
+            "### Eq. 5.1 in flight",
+            "",
+            f"The symmetric device (both wings the Table 3.3 left wing), PARITY trimmed ({ev['amplitude_v']:.2f} V), pivot biased to "
+            "τL/τR = q3 by the whippletree arm ratio hL/hR = 1/q3 (§2.4.2), on the stand and on a roll gimbal.",
+            "",
+            render(eq_found),
+            "",
+            "![eq. 5.1](flight_eq5_1.png)",
+            "",
+        ]
+    )
