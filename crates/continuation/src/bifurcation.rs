@@ -3,9 +3,11 @@
 
 use nalgebra::DVector;
 
-use crate::branch::{BifurcationKind, BranchPoint, ContinuationOptions, Method, OrbitSystem};
 use crate::map::PeriodMap;
 use crate::multipliers::{fold_test, neimark_sacker_test, period_doubling_test};
+use crate::options::{ContinuationOptions, Method};
+use crate::orbit_system::OrbitSystem;
+use crate::points::{BifurcationKind, BranchPoint};
 use crate::system::{Corrected, correct, tangent};
 
 /// Test-function values at a point, used to detect sign changes between neighbours.

@@ -42,18 +42,20 @@ mod branch;
 mod map;
 mod multipliers;
 mod ode;
+mod options;
+mod orbit_system;
 pub mod oscillators;
+mod points;
 mod system;
 mod two_parameter;
 
-pub use branch::{
-    Bifurcation, BifurcationKind, Branch, BranchPoint, ContinuationOptions, Method, StopReason,
-    continue_orbits,
-};
+pub use branch::continue_orbits;
 pub use map::PeriodMap;
 pub use multipliers::{
     Stability, fold_test, multipliers, neimark_sacker_test, period_doubling_test, stability,
 };
 pub use ode::{ForcedOde, RungeKuttaMap};
+pub use options::{ContinuationOptions, Method};
 pub use paritysim_error::{Error, Result};
+pub use points::{Bifurcation, BifurcationKind, Branch, BranchPoint, StopReason};
 pub use two_parameter::{Curve, CurveOptions, CurvePoint, continue_fold_curve};

@@ -10,9 +10,9 @@
 use nalgebra::{DMatrix, DVector};
 use paritysim_error::{Error, Result, check_positive};
 
-use crate::branch::{Bifurcation, BifurcationKind, StopReason};
 use crate::map::PeriodMap;
 use crate::multipliers::multipliers;
+use crate::points::{Bifurcation, BifurcationKind, StopReason};
 use crate::system::{Evaluation, System, correct, tangent};
 use nalgebra::Complex;
 
