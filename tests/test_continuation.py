@@ -81,3 +81,22 @@ def test_cli_continue_writes_branch_and_plot(tmp_path: Path, capsys: pytest.Capt
     bad.write_text('spec = "sreetharan2012_3_3_parity_linkage"\npath = "drivetrain.balance_spring"\nstop = 1.0\nstpo = 2\n')
     assert main(["continue", str(bad), "--out", str(tmp_path)]) == 1
     assert "stpo" in capsys.readouterr().err
+
+
+def test_a_cut_wing_turns_the_boundary_into_a_fold_checked_by_brute_force() -> None:
+    """The imperfect pitchfork: with Ω^L/Ω^R = 0.9 the stable orbit ends at a fold (the branch turns
+    back, multiplier +1), not a branch point, and it never jumps onto another branch. Brute-force
+    Floquet analysis brackets the fold: a stable orbit just above it, none (or an unstable one)
+    just below. A corrector that jumps branches near the fold fails this."""
+    from paritysim.trials.continuation_3_3 import FOLD_RATIO, OMEGA_RIGHT, PATH, START
+    from paritysim.trials.section_2_6 import drag_parity_spec
+
+    spec = drag_parity_spec(START, omega_left=OMEGA_RIGHT * FOLD_RATIO)
+    branch = ps.continuation(spec, PATH, start=START, stop=300.0, metrics=False, max_points=40)
+    assert branch.bifurcations["kind"].to_list()[:1] == ["fold"], branch.bifurcations
+    k_fold = branch.bifurcations[PATH][0]
+    assert branch.bifurcations["critical_modulus"][0] == pytest.approx(1.0, abs=1e-4)
+    # past the fold the branch runs back up in K2 (the unstable side), never below the fold
+    assert branch.branch[PATH].min() >= k_fold - 1e-6
+    above = ps.stability.floquet(drag_parity_spec(k_fold + 3.0, omega_left=OMEGA_RIGHT * FOLD_RATIO))
+    assert above.spectral_radius < 1.0

@@ -12,6 +12,10 @@ use crate::orbit_system::OrbitSystem;
 use crate::points::{Bifurcation, Branch, StopReason};
 use crate::system::{correct, tangent};
 
+/// Largest accepted distance between the predicted and the corrected point, as a fraction of
+/// the pseudo-arclength step.
+const MAX_CORRECTION: f64 = 0.5;
+
 /// Continues the periodic orbit through `x0` at `parameters` (the continued one at
 /// `options.parameter`) towards `options.stop`.
 ///
@@ -94,13 +98,13 @@ pub fn continue_orbits<M: PeriodMap>(
             step = (stop_hat - lambda_hat) / toward;
             exact_stop = true;
         }
+        let predicted = &current_u + &t * step;
         let attempt = match options.method {
             Method::PseudoArclength => {
-                let predicted = &current_u + &t * step;
                 if exact_stop {
                     correct(
                         &system,
-                        predicted,
+                        predicted.clone(),
                         &e_lambda,
                         stop_hat,
                         options.tolerance,
@@ -110,7 +114,7 @@ pub fn continue_orbits<M: PeriodMap>(
                     let target = t.dot(&predicted);
                     correct(
                         &system,
-                        predicted,
+                        predicted.clone(),
                         &t,
                         target,
                         options.tolerance,
@@ -134,12 +138,23 @@ pub fn continue_orbits<M: PeriodMap>(
         };
         let accepted = attempt.and_then(|c| {
             let new_t = tangent(&c.evaluation.jacobian, &t)?;
-            // A sharp turn of the tangent means the corrector jumped to another branch.
-            if new_t.dot(&t) < 0.8 && options.method == Method::PseudoArclength {
-                return Err(Error::OutOfDomain {
-                    what: "continuation step".into(),
-                    detail: "the tangent turned sharply".into(),
-                });
+            // A sharp turn of the tangent, or a correction much longer than the step, means the
+            // corrector jumped to another branch (near a fold a step that is too long lands on
+            // a neighbouring branch with a similar tangent).
+            if options.method == Method::PseudoArclength {
+                let detail = if new_t.dot(&t) < 0.8 {
+                    Some("the tangent turned sharply")
+                } else if (&c.u - &predicted).norm() > MAX_CORRECTION * step {
+                    Some("the corrector moved further than the step")
+                } else {
+                    None
+                };
+                if let Some(detail) = detail {
+                    return Err(Error::OutOfDomain {
+                        what: "continuation step".into(),
+                        detail: detail.into(),
+                    });
+                }
             }
             Ok((c, new_t))
         });
