@@ -86,7 +86,7 @@ CONTROL_INPUTS = ("q2_bias", "actuator_offset", "actuator_gain")
 Controller = Callable[[float, dict[str, float]], Mapping[str, float]]
 
 
-def _control_call(controller: Controller) -> Callable[[float, list[tuple[str, float]]], tuple]:
+def _control_call(controller: Controller) -> Callable[[float, list[tuple[str, float]]], tuple[float, float, float]]:
     """The callback the core calls: the body state as a dict in, checked inputs out."""
 
     def call(t_ms: float, values: list[tuple[str, float]]) -> tuple[float, float, float]:
@@ -96,11 +96,11 @@ def _control_call(controller: Controller) -> Callable[[float, list[tuple[str, fl
         for name in out:
             if name not in CONTROL_INPUTS:
                 raise invalid(f"controller[{name!r}]", out[name], f"one of {', '.join(CONTROL_INPUTS)}")
-        inputs = tuple(real(f"controller[{k!r}]", out.get(k, 0.0)) for k in CONTROL_INPUTS)
-        for k, v in zip(CONTROL_INPUTS, inputs):
+        q2_bias, offset, gain = (real(f"controller[{k!r}]", out.get(k, 0.0)) for k in CONTROL_INPUTS)
+        for k, v in zip(CONTROL_INPUTS, (q2_bias, offset, gain)):
             if not math.isfinite(v):
                 raise invalid(f"controller[{k!r}]", v, "a finite number")
-        return inputs
+        return q2_bias, offset, gain
 
     return call
 
