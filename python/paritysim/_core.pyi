@@ -1,7 +1,7 @@
 # Type stubs of the native module paritysim._core.
 # Checked against the built module by `python -m mypy.stubtest paritysim._core` in the tests.
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any, final
 
 import numpy as np
@@ -68,6 +68,9 @@ class SimulationOutput:
     @property
     def multipliers(self) -> list[tuple[float, float]]: ...
 def simulate(json: str) -> SimulationOutput: ...
+def simulate_controlled(
+    json: str, controller: Callable[[float, list[tuple[str, float]]], tuple[float, float, float]], rate_hz: float
+) -> SimulationOutput: ...
 def dynamics_wing_terms(spec: str, wing: int, p: Sequence[float], p_dot: Sequence[float]) -> dict[str, Any]: ...
 
 # --- aero (begin) ---

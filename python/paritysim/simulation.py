@@ -6,6 +6,7 @@ import math
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
@@ -13,7 +14,7 @@ import polars as pl
 from matplotlib.figure import Figure
 
 from . import _core
-from ._errors import invalid
+from ._errors import invalid, real
 from .spec import Simulation
 
 __all__ = ["SimulationResult", "simulate"]
@@ -78,11 +79,53 @@ class SimulationResult:
         return fig
 
 
-def simulate(spec: Simulation | dict[str, Any], **option_overrides: Any) -> SimulationResult:
+#: The inputs a Python controller may set (as in ``[[body.set_points]]``): whippletree bias
+#: torque (mN·mm), added actuator force (mN), relative actuator amplitude change (1).
+CONTROL_INPUTS = ("q2_bias", "actuator_offset", "actuator_gain")
+
+Controller = Callable[[float, dict[str, float]], Mapping[str, float]]
+
+
+def _control_call(controller: Controller) -> Callable[[float, list[tuple[str, float]]], tuple[float, float, float]]:
+    """The callback the core calls: the body state as a dict in, checked inputs out."""
+
+    def call(t_ms: float, values: list[tuple[str, float]]) -> tuple[float, float, float]:
+        out = controller(t_ms, dict(values))
+        if not isinstance(out, Mapping):
+            raise invalid("controller", type(out).__name__, f"a dict of {', '.join(CONTROL_INPUTS)}")
+        for name in out:
+            if name not in CONTROL_INPUTS:
+                raise invalid(f"controller[{name!r}]", out[name], f"one of {', '.join(CONTROL_INPUTS)}")
+        q2_bias, offset, gain = (real(f"controller[{k!r}]", out.get(k, 0.0)) for k in CONTROL_INPUTS)
+        for k, v in zip(CONTROL_INPUTS, (q2_bias, offset, gain)):
+            if not math.isfinite(v):
+                raise invalid(f"controller[{k!r}]", v, "a finite number")
+        return q2_bias, offset, gain
+
+    return call
+
+
+def simulate(
+    spec: Simulation | dict[str, Any],
+    *,
+    controller: Controller | None = None,
+    control_rate_hz: float | None = None,
+    **option_overrides: Any,
+) -> SimulationResult:
     """Run ``spec`` to periodic steady state (or for ``options.duration_ms``) in Rust.
 
     ``spec`` is a `Simulation` or its dict (``Simulation.to_dict()``). ``option_overrides``
     replace fields of ``spec.options`` for this run, e.g. ``simulate(spec, record_cycles=3)``.
+
+    ``controller`` (a flying spec only: ``[body]`` mode other than ``fixed``) is a Python
+    function ``controller(t_ms, body) -> {input: value}`` called every ``1 / control_rate_hz``
+    from the release (zero-order hold in between). ``body`` holds the ``body_*`` trajectory
+    columns at ``t_ms`` (``body_roll``, ``body_omega_roll``, ``body_x``, ...); the returned
+    inputs (any of ``q2_bias``, ``actuator_offset``, ``actuator_gain``; missing ones are 0)
+    add to ``[body].set_points`` and ``[body.control]``. Slow: each call crosses into Python
+    and restarts the integrator, so keep the rate low (100-1000 Hz); the Rust PD controller
+    (``[body.control]``) is the fast path. An exception raised by ``controller`` stops the run
+    and propagates as is.
 
     Raises
     ------
@@ -103,7 +146,17 @@ def simulate(spec: Simulation | dict[str, Any], **option_overrides: Any) -> Simu
         raise invalid("spec", type(spec).__name__, "a paritysim.Simulation or its dict")
     if option_overrides:
         spec = spec.replace(options=spec.options.with_fields("options", **option_overrides))
-    raw = _core.simulate(spec.to_json())
+    if controller is None:
+        if control_rate_hz is not None:
+            raise invalid("control_rate_hz", control_rate_hz, "given only with a controller")
+        raw = _core.simulate(spec.to_json())
+    else:
+        if not callable(controller):
+            raise invalid("controller", type(controller).__name__, "a callable (t_ms, body) -> dict")
+        if control_rate_hz is None:
+            raise invalid("control_rate_hz", None, "a positive control rate (Hz) with a controller")
+        rate = real("control_rate_hz", control_rate_hz)
+        raw = _core.simulate_controlled(spec.to_json(), _control_call(controller), rate)
     return SimulationResult(
         metrics={k: (v if math.isfinite(v) else None) for k, v in raw.metrics},
         cycles_run=raw.cycles_run,

@@ -354,6 +354,20 @@ impl Default for Release {
     }
 }
 
+/// The body's values at one instant, as the [`BODY_COLUMNS`] name them (what an external
+/// controller sees).
+pub fn body_values(sample: &FlightSample) -> Vec<(&'static str, f64)> {
+    BODY_COLUMNS
+        .iter()
+        .map(|(name, _, get)| (*name, get(sample)))
+        .collect()
+}
+
+/// An external controller (e.g. a Python callback): called at `t` (ms) with the flight
+/// sample there, returns the inputs held until its next tick (added to the set points and
+/// the PD controller's output).
+pub type Controller<'a> = dyn FnMut(f64, &FlightSample) -> Result<Inputs> + 'a;
+
 /// Runs a flight: steady state on the clamped body, release, `record_cycles` wingbeats (or
 /// `duration_ms` without a drive) sampled `samples_per_cycle` times per wingbeat.
 ///
@@ -366,6 +380,31 @@ pub fn fly(
     release: &Release,
     schedule: &Schedule,
 ) -> Result<SimulationResult> {
+    fly_controlled(model, options, release, schedule, None)
+}
+
+/// [`fly`] with an external controller ticking every `period_ms` from the release (zero-order
+/// hold between ticks), next to the schedule's own PD controller (each at its own rate).
+///
+/// # Errors
+/// As [`fly`]; [`Error::InvalidParameter`] (`control_rate_hz`) for a non-positive or
+/// non-finite period; whatever the controller returns (the run stops there).
+pub fn fly_controlled(
+    model: &FlightModel,
+    options: &SimulationOptions,
+    release: &Release,
+    schedule: &Schedule,
+    mut external: Option<(f64, &mut Controller<'_>)>,
+) -> Result<SimulationResult> {
+    if let Some((period, _)) = &external {
+        if !(period.is_finite() && *period > 0.0) {
+            return Err(Error::invalid(
+                "control_rate_hz",
+                1000.0 / period,
+                "a positive, finite control rate (Hz)",
+            ));
+        }
+    }
     let columns = select(model, options.columns.as_deref())?;
     // Steady state of the wings on the clamped body (no recording).
     let steady_options = SimulationOptions {
@@ -423,29 +462,45 @@ pub fn fly(
             .map(|c| (c.name(), Vec::with_capacity(times.len())))
             .collect(),
     };
-    // Control legs: the controller output is held between ticks.
-    let leg = schedule
-        .control
-        .as_ref()
-        .map_or(window, |c| c.period_ms().min(window));
+    // Control legs: each controller's output is held between its ticks (tick k at
+    // t0 + k·period, so both rates keep their own grid).
+    let pd_period = schedule.control.as_ref().map(Control::period_ms);
+    let ext_period = external.as_ref().map(|(p, _)| *p);
+    let mut ticks = [0usize; 2];
+    let tick_time =
+        |period: Option<f64>, k: usize| period.map_or(f64::INFINITY, |p| t0 + p * k as f64);
     let mut y = y0;
     let mut t = t0;
     let mut next = 0;
     let t_end = t0 + window;
+    let (mut output, mut extra) = (0.0, Inputs::default());
     while t < t_end {
-        let t_leg = if t + leg >= t_end - 1e-12 * window {
+        let due = |period: Option<f64>, k: usize| tick_time(period, k) <= t + 1e-12 * window;
+        if due(pd_period, ticks[0]) || due(ext_period, ticks[1]) {
+            let f = FlightSample::new(model, t, &y, &Inputs::default())?;
+            if due(pd_period, ticks[0]) {
+                if let Some(c) = &schedule.control {
+                    output = c.output(f.angles[c.axis], f.flight.omega[c.axis]);
+                }
+                ticks[0] += 1;
+            }
+            if due(ext_period, ticks[1]) {
+                if let Some((_, controller)) = external.as_mut() {
+                    extra = controller(t, &f)?;
+                }
+                ticks[1] += 1;
+            }
+        }
+        let next_tick = tick_time(pd_period, ticks[0]).min(tick_time(ext_period, ticks[1]));
+        let t_leg = if next_tick >= t_end - 1e-12 * window {
             t_end
         } else {
-            t + leg
+            next_tick
         };
-        let output = match &schedule.control {
-            Some(c) => {
-                let f = FlightSample::new(model, t, &y, &Inputs::default())?;
-                c.output(f.angles[c.axis], f.flight.omega[c.axis])
-            }
-            None => 0.0,
-        };
-        let inputs = schedule.inputs(t, output);
+        let mut inputs = schedule.inputs(t, output);
+        inputs.q2_bias += extra.q2_bias;
+        inputs.actuator_offset += extra.actuator_offset;
+        inputs.actuator_gain += extra.actuator_gain;
         let end = times.partition_point(|&s| s < t_leg);
         let end = if t_leg == t_end { times.len() } else { end };
         let leg_times = &times[next..end];

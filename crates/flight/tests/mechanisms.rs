@@ -8,7 +8,8 @@ use paritysim_dynamics::{SimulationOptions, State};
 use paritysim_flight::control::{Control, ControlInput, SetPoint};
 use paritysim_flight::model::{Inputs, STATE_LEN, WORK_ACTUATOR};
 use paritysim_flight::{
-    BodyMode, DriveCoordinate, FlightModel, Mechanism, Release, Schedule, fly, integrate_flight,
+    BodyMode, DriveCoordinate, FlightModel, Mechanism, Release, Schedule, fly, fly_controlled,
+    integrate_flight,
 };
 
 #[test]
@@ -161,4 +162,115 @@ fn set_point_schedule_interpolates_and_holds() {
     assert_eq!(s.value(2.0), 1.0);
     assert_eq!(s.value(9.0), 2.0);
     assert!(SetPoint::new(ControlInput::Q2Bias, vec![1.0, 1.0], vec![0.0, 2.0]).is_err());
+}
+
+#[test]
+fn an_external_controller_flies_like_the_pd_with_the_same_law() {
+    // `fly_controlled` with a closure computing the PD law at the PD's rate must reproduce
+    // `[body.control]` (same ticks, same held inputs); together they add, each on its own grid.
+    let device = drag_only_1cut();
+    let opts = SimulationOptions {
+        record_cycles: 6,
+        samples_per_cycle: 20,
+        ..SimulationOptions::default()
+    };
+    let model = FlightModel::new(&device, hmf_body(BodyMode::Roll), Vec::new()).unwrap();
+    let pd = Control {
+        input: ControlInput::Q2Bias,
+        axis: 0,
+        target: 0.0,
+        kp: 50.0,
+        kd: 100.0,
+        rate_hz: 1000.0,
+        limit: 5.0,
+    };
+    let with_pd = Schedule {
+        set_points: Vec::new(),
+        control: Some(pd),
+    };
+    let release = Release::default();
+    let rust = fly(&model, &opts, &release, &with_pd).unwrap();
+    let mut ticks = Vec::new();
+    let mut law = |t: f64, s: &paritysim_flight::FlightSample| {
+        ticks.push(t);
+        Ok(Inputs {
+            q2_bias: pd.output(s.angles.x, s.flight.omega.x),
+            ..Inputs::default()
+        })
+    };
+    let external = fly_controlled(
+        &model,
+        &opts,
+        &release,
+        &Schedule::default(),
+        Some((pd.period_ms(), &mut law)),
+    )
+    .unwrap();
+    let column = |r: &paritysim_dynamics::simulate::SimulationResult, name: &str| {
+        r.trajectory
+            .columns
+            .iter()
+            .find(|(n, _)| n == name)
+            .unwrap()
+            .1
+            .clone()
+    };
+    let (a, b) = (column(&rust, "body_roll"), column(&external, "body_roll"));
+    let open = column(
+        &fly(&model, &opts, &release, &Schedule::default()).unwrap(),
+        "body_roll",
+    );
+    let moved = a
+        .iter()
+        .zip(&open)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    assert!(moved > 1e-4, "the PD acts: {moved}");
+    let diff = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    assert!(diff < 1e-13, "external vs PD: {diff}");
+    let period = device.period().unwrap();
+    assert_eq!(ticks.len(), (6.0 * period / pd.period_ms()).ceil() as usize);
+    // Both at once: twice the law, on the same grid.
+    let mut half = |_: f64, s: &paritysim_flight::FlightSample| {
+        Ok(Inputs {
+            q2_bias: pd.output(s.angles.x, s.flight.omega.x),
+            ..Inputs::default()
+        })
+    };
+    let doubled = Control {
+        kp: 100.0,
+        kd: 200.0,
+        limit: 10.0,
+        ..pd
+    };
+    let both = fly_controlled(
+        &model,
+        &opts,
+        &release,
+        &with_pd,
+        Some((pd.period_ms(), &mut half)),
+    );
+    let twice = fly(
+        &model,
+        &opts,
+        &release,
+        &Schedule {
+            set_points: Vec::new(),
+            control: Some(doubled),
+        },
+    );
+    let (c, d) = (
+        column(&both.unwrap(), "body_roll"),
+        column(&twice.unwrap(), "body_roll"),
+    );
+    let diff = c
+        .iter()
+        .zip(&d)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    assert!(diff < 1e-9, "PD + external vs doubled PD: {diff}");
 }

@@ -34,6 +34,7 @@ type Canonical = (String, Vec<String>);
 bindings! {
     class SimulationOutput;
     extra simulate;
+    extra simulate_controlled;
 
     /// The JSON Schema of a spec (draft 2020-12), as JSON text.
     fn spec_schema() -> String {
@@ -139,6 +140,51 @@ fn simulate(py: Python<'_>, json: &str) -> PyResult<SimulationOutput> {
         // A spec with a moving body flies (paritysim-flight); otherwise the fixed-body engine.
         spec.run(&device, &options).map_err(|e| spec.attribute(e))
     })?;
+    output(py, r)
+}
+
+/// `simulate` of a flying spec with a Python controller called every `1 / rate_hz` with
+/// `(t_ms, [(body column, value)])` and returning `(q2_bias, actuator_offset,
+/// actuator_gain)` (the facade checks names and values). Its exception is raised as is.
+#[pyfunction]
+fn simulate_controlled(
+    py: Python<'_>,
+    json: &str,
+    controller: Py<PyAny>,
+    rate_hz: f64,
+) -> PyResult<SimulationOutput> {
+    let spec = parse(json).py_err()?;
+    let (device, options) = spec.model().py_err()?;
+    let mut raised: Option<PyErr> = None;
+    let mut call = |t: f64, s: &paritysim_flight::FlightSample| {
+        Python::attach(|py| {
+            let values = paritysim_flight::body_values(s);
+            let out = controller.bind(py).call1((t, values))?;
+            out.extract::<(f64, f64, f64)>()
+        })
+        .map(
+            |(q2_bias, actuator_offset, actuator_gain)| paritysim_flight::Inputs {
+                q2_bias,
+                actuator_offset,
+                actuator_gain,
+            },
+        )
+        .map_err(|e| {
+            raised = Some(e);
+            paritysim_error::Error::Cancelled
+        })
+    };
+    let r = py.detach(|| {
+        spec.run_controlled(&device, &options, rate_hz, &mut call)
+            .map_err(|e| spec.attribute(e))
+    });
+    match (raised, r) {
+        (Some(e), _) => Err(e),
+        (None, r) => output(py, r.py_err()?),
+    }
+}
+
+fn output(py: Python<'_>, r: paritysim_dynamics::SimulationResult) -> PyResult<SimulationOutput> {
     let columns = PyDict::new(py);
     for (name, values) in r.trajectory.columns {
         columns.set_item(name, PyArray1::from_vec(py, values))?;

@@ -4,7 +4,7 @@
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use paritysim_dynamics::sweep::PointOutput;
 use paritysim_dynamics::{Device, SimulationOptions, SimulationResult, Trajectory};
-use paritysim_error::Result;
+use paritysim_error::{Error, Result};
 use paritysim_flight::run::{Release, Schedule};
 use paritysim_flight::{
     Body as EngineBody, BodyMode as EngineMode, Control as EngineControl,
@@ -161,6 +161,36 @@ impl Simulation {
             None => paritysim_dynamics::simulate(device, options),
             Some(f) => paritysim_flight::fly(&f.model, options, &f.release, &f.schedule),
         }
+    }
+
+    /// [`Simulation::run`] with an external controller ticking at `rate_hz` (e.g. a Python
+    /// callback: [`paritysim_flight::fly_controlled`]).
+    ///
+    /// # Errors
+    /// As [`Simulation::run`]; [`Error::InvalidParameter`] (`body.mode`) for a fixed body
+    /// (nothing to control) and (`control_rate_hz`) for a non-positive rate; whatever the
+    /// controller returns.
+    pub fn run_controlled(
+        &self,
+        device: &Device,
+        options: &SimulationOptions,
+        rate_hz: f64,
+        controller: &mut paritysim_flight::Controller<'_>,
+    ) -> Result<SimulationResult> {
+        let Some(f) = self.flight(device)? else {
+            return Err(Error::invalid(
+                "body.mode",
+                "\"fixed\"",
+                "a moving or clamped body for a controller (clamped, roll, yaw, pitch, roll_pitch_yaw, free)",
+            ));
+        };
+        paritysim_flight::fly_controlled(
+            &f.model,
+            options,
+            &f.release,
+            &f.schedule,
+            Some((1000.0 / rate_hz, controller)),
+        )
     }
 
     /// Metric names [`Simulation::run`] reports.
