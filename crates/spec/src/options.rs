@@ -30,10 +30,12 @@ impl From<Method> for EngineMethod {
 #[serde(rename_all = "snake_case")]
 pub enum SteadyState {
     /// Cycle-by-cycle simulation until the change per cycle is below `steady_tol`.
-    #[default]
     Transient,
-    /// A few cycles, then Newton shooting on the stroboscopic map with the variational
-    /// equations (falls back to the transient); reports the residual and the multipliers.
+    /// The default: a few cycles, then Newton shooting on the stroboscopic map retraced on a
+    /// frozen step grid, with the variational equations; falls back to the transient
+    /// automatically (Newton failure, unstable orbit). Reports the residual and the
+    /// multipliers.
+    #[default]
     Shooting,
 }
 
