@@ -417,8 +417,11 @@ fn shooting_steady_state(
         // Far from the orbit Newton's model is poor: settle the fast modes first.
         while cycles < options.min_cycles {
             crate::integrate::budget::check(cycles as f64 * period)?;
-            let Ok(next) = transient.advance(device, 0.0, &y, period) else {
-                break;
+            let next = match transient.advance(device, 0.0, &y, period) {
+                Ok(next) => next,
+                // A spent budget ends the run; any other failure is left to the fallback.
+                Err(e) if crate::grid_shooting::out_of_budget(&e) => return Err(e),
+                Err(_) => break,
             };
             let change = state_change(&next, &y);
             y = next.without_work();
