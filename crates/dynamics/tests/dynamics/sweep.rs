@@ -41,6 +41,8 @@ fn study_device(values: &[f64]) -> paritysim_dynamics::Result<Device> {
 
 fn fast_options() -> SimulationOptions {
     SimulationOptions {
+        // Shooting: the points run in continuation chains (what these tests are about).
+        steady_state: paritysim_dynamics::SteadyState::Shooting,
         max_cycles: 6,
         samples_per_cycle: 40,
         ..Default::default()
