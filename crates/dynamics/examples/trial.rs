@@ -57,6 +57,8 @@ fn main() {
             .unwrap_or(4000),
         ..Default::default()
     };
+    // STEADY-LINE: the fixed workload is 20 wingbeats of transient, whatever the default.
+    options.steady_state = paritysim_dynamics::SteadyState::Transient;
     if metrics_only {
         // COLUMNS-LINE (absent in engines without streamed metrics)
         options.columns = Some(Vec::new());

@@ -29,11 +29,14 @@ impl From<Method> for EngineMethod {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum SteadyState {
-    /// Cycle-by-cycle simulation until the change per cycle is below `steady_tol`.
+    /// Cycle-by-cycle simulation until the change per cycle is below `steady_tol` (the
+    /// default).
     #[default]
     Transient,
-    /// A few cycles, then Newton shooting on the stroboscopic map with the variational
-    /// equations (falls back to the transient); reports the residual and the multipliers.
+    /// A few cycles, then Newton shooting on the stroboscopic map retraced on a frozen step
+    /// grid, with the variational equations; falls back to the transient automatically
+    /// (Newton failure, unstable orbit). Reports the residual and the multipliers. The
+    /// accurate and fast choice for sweeps of stroke-only (fixed-wing) devices.
     Shooting,
 }
 

@@ -46,8 +46,20 @@ fn points_equal_direct_simulations_and_bad_points_are_rows() {
         .collect();
     let out = run_plan(plan).unwrap();
     assert_eq!(out.ok, [true, false, true]);
-    assert_eq!(out.metrics[0].to_bits(), direct[0].to_bits());
-    assert_eq!(out.metrics[2].to_bits(), direct[1].to_bits());
+    // Shooting points start from their converged neighbour: the same orbit as a direct run,
+    // to its accuracy (not bit for bit; see paritysim_dynamics::sweep).
+    assert_eq!(
+        out.metrics[0].to_bits(),
+        direct[0].to_bits(),
+        "a chain's first point"
+    );
+    let relative = (out.metrics[2] - direct[1]).abs() / direct[1].abs();
+    assert!(
+        relative <= 1e-7,
+        "{} vs {} ({relative:e})",
+        out.metrics[2],
+        direct[1]
+    );
     let error = out.error[1].as_deref().unwrap();
     assert!(
         error.contains("actuator.waveform.frequency_hz") && error.contains("(0, 10000] Hz"),
