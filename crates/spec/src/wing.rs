@@ -7,11 +7,12 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct Shoulder {
-    /// Angle between the stroke and deviation axes of the five-bar (rad), in (0, pi]; pi/2
+    /// Angle between the stroke and deviation axes of the five-bar (rad), in [1e-6, pi]; pi/2
     /// gives a decoupled shoulder (eq. 2.7).
-    #[schemars(range(max = std::f64::consts::PI), extend("exclusiveMinimum" = 0.0, "x-unit" = "rad"))]
+    #[schemars(range(min = 1e-6, max = std::f64::consts::PI), extend("x-unit" = "rad"))]
     pub alpha2: f64,
-    /// Second link angle (rad), in [0, pi) and below `alpha2`.
+    /// Second link angle (rad), in [0, pi) and at most `alpha2 - 1e-6` (the closure is singular
+    /// as `alpha2 - alpha3 -> 0`).
     #[schemars(range(min = 0.0, max = std::f64::consts::PI), extend("x-unit" = "rad"))]
     pub alpha3: f64,
 }
@@ -201,7 +202,7 @@ pub struct TunableHinge {
 #[serde(deny_unknown_fields)]
 pub struct Wing {
     /// Inertia tensor about the spherical centre in frame 6 (mg·mm², 3×3, symmetric positive
-    /// definite), entries in [-1e5, 1e5].
+    /// definite), entries in [-1e5, 1e5], principal moments at least 1e-6.
     #[schemars(extend("x-unit" = "mg mm^2"))]
     pub inertia: [[f64; 3]; 3],
     /// Shoulder.

@@ -12,11 +12,11 @@ use super::DrivetrainConfig;
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct LinearDifferential {
-    /// Transmission ratio T (rad/mm), in (0, 100].
-    #[schemars(range(max = 100.0), extend("exclusiveMinimum" = 0.0, "x-unit" = "rad/mm"))]
+    /// Transmission ratio T (rad/mm), in [1e-6, 100].
+    #[schemars(range(min = 1e-6, max = 100.0), extend("x-unit" = "rad/mm"))]
     pub transmission_ratio: f64,
-    /// Mean arm length L (mm), in (0, 100].
-    #[schemars(range(max = 100.0), extend("exclusiveMinimum" = 0.0, "x-unit" = "mm"))]
+    /// Mean arm length L (mm), in [1e-6, 100].
+    #[schemars(range(min = 1e-6, max = 100.0), extend("x-unit" = "mm"))]
     pub arm_length_mm: f64,
     /// Arm ratio hL/hR, in (0, 100].
     #[schemars(range(max = 100.0), extend("exclusiveMinimum" = 0.0, "x-unit" = "1"))]

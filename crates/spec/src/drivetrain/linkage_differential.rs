@@ -12,14 +12,14 @@ use super::DrivetrainConfig;
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct LinkageDifferential {
-    /// Crank length (mm), in (0, 10].
-    #[schemars(range(max = 10.0), extend("exclusiveMinimum" = 0.0, "x-unit" = "mm"))]
+    /// Crank length (mm), in [1e-6, 10].
+    #[schemars(range(min = 1e-6, max = 10.0), extend("x-unit" = "mm"))]
     pub crank_mm: f64,
-    /// Rod length (mm), in (0, 100].
-    #[schemars(range(max = 100.0), extend("exclusiveMinimum" = 0.0, "x-unit" = "mm"))]
+    /// Rod length (mm), in [1e-6, 100].
+    #[schemars(range(min = 1e-6, max = 100.0), extend("x-unit" = "mm"))]
     pub rod_mm: f64,
-    /// Whippletree length (mm), in (0, 100].
-    #[schemars(range(max = 100.0), extend("exclusiveMinimum" = 0.0, "x-unit" = "mm"))]
+    /// Whippletree length (mm), in [1e-6, 100].
+    #[schemars(range(min = 1e-6, max = 100.0), extend("x-unit" = "mm"))]
     pub whippletree_length_mm: f64,
     /// Arm ratio hL/hR (§2.4.2), in (0, 100].
     #[schemars(range(max = 100.0), extend("exclusiveMinimum" = 0.0, "x-unit" = "1"))]
