@@ -20,6 +20,7 @@ use paritysim_error::{Error, Result};
 
 use crate::device::Device;
 use crate::integrate::{RungeKutta, State};
+use crate::stability::shooting::{compact_state as compact, expand_state as expand};
 
 /// A periodic orbit found on a frozen grid.
 #[derive(Clone, Debug)]
@@ -35,22 +36,6 @@ pub(crate) struct GridOrbit {
     pub periods: usize,
     /// The step grid (from 0 to the period).
     pub grid: Vec<f64>,
-}
-
-fn compact(n: usize, y: &State) -> DVector<f64> {
-    DVector::from_fn(
-        2 * n,
-        |i, _| if i < n { y.coords[i] } else { y.rates[i - n] },
-    )
-}
-
-fn expand(n: usize, v: &DVector<f64>) -> State {
-    let mut y = State::default();
-    for i in 0..n {
-        y.coords[i] = v[i];
-        y.rates[i] = v[n + i];
-    }
-    y
 }
 
 /// `(P(y) − y, ‖P(y) − y‖∞ / (1 + ‖y‖∞))`.

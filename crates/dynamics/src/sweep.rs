@@ -77,7 +77,7 @@ use paritysim_error::{Error, Result, bail};
 use crate::device::Device;
 use crate::integrate::budget::{Budget, CancelFlag};
 use crate::metrics;
-use crate::simulate::{SimulationOptions, SteadyState, Trajectory, simulate};
+use crate::simulate::{SimulationOptions, SimulationResult, SteadyState, Trajectory, simulate};
 use crate::trajectory::column_table;
 use paritysim_constraints::Vec6;
 
@@ -313,44 +313,66 @@ pub fn run_point(
         };
         simulate(device, &options)?
     };
-    let metrics = metric_names
-        .iter()
-        .map(|name| {
-            result
-                .metrics
-                .iter()
-                .find(|(n, _)| n == name)
-                .map_or(f64::NAN, |(_, v)| *v)
-        })
-        .collect();
-    let cycle = keep_cycle.then(|| {
-        let traj = result.trajectory;
-        let len = traj.time.len();
-        let keep = if result.period_ms.is_finite() {
-            (options.samples_per_cycle + 1).min(len)
-        } else {
-            len
-        };
-        let start = len - keep;
-        Trajectory {
-            time: traj.time[start..].to_vec(),
-            columns: traj
-                .columns
-                .into_iter()
-                .map(|(name, v)| (name, v[start..].to_vec()))
-                .collect(),
+    let steady_state = device.coordinates(&result.steady_state).ok();
+    Ok(PointOutput::keep(
+        result,
+        metric_names,
+        keep_cycle,
+        options.samples_per_cycle,
+        steady_state,
+    ))
+}
+
+impl PointOutput {
+    /// What a sweep keeps of one run: the asked metrics in order (NaN where absent) and, with
+    /// `keep_cycle`, the last recorded cycle (`samples_per_cycle + 1` samples; the whole
+    /// trajectory of an aperiodic run).
+    pub fn keep(
+        result: SimulationResult,
+        metric_names: &[String],
+        keep_cycle: bool,
+        samples_per_cycle: usize,
+        steady_state: Option<(Vec6, Vec6)>,
+    ) -> Self {
+        let metrics = metric_names
+            .iter()
+            .map(|name| {
+                result
+                    .metrics
+                    .iter()
+                    .find(|(n, _)| n == name)
+                    .map_or(f64::NAN, |(_, v)| *v)
+            })
+            .collect();
+        let cycle = keep_cycle.then(|| {
+            let traj = result.trajectory;
+            let len = traj.time.len();
+            let keep = if result.period_ms.is_finite() {
+                (samples_per_cycle + 1).min(len)
+            } else {
+                len
+            };
+            let start = len - keep;
+            Trajectory {
+                time: traj.time[start..].to_vec(),
+                columns: traj
+                    .columns
+                    .into_iter()
+                    .map(|(name, v)| (name, v[start..].to_vec()))
+                    .collect(),
+            }
+        });
+        Self {
+            metrics,
+            converged: result.converged,
+            cycles_run: result.cycles_run,
+            cycle,
+            residual: result.residual,
+            steady_state,
+            monodromy: result.monodromy,
+            step_grid: result.step_grid,
         }
-    });
-    Ok(PointOutput {
-        metrics,
-        converged: result.converged,
-        cycles_run: result.cycles_run,
-        cycle,
-        residual: result.residual,
-        steady_state: device.coordinates(&result.steady_state).ok(),
-        monodromy: result.monodromy,
-        step_grid: result.step_grid,
-    })
+    }
 }
 
 /// A converged point of a continuation chain: its index, `(p, ṗ)`, shooting Jacobian and step

@@ -3,7 +3,7 @@
 
 use nalgebra::{Matrix3, UnitQuaternion, Vector3};
 use paritysim_dynamics::sweep::PointOutput;
-use paritysim_dynamics::{Device, SimulationOptions, SimulationResult, Trajectory};
+use paritysim_dynamics::{Device, SimulationOptions, SimulationResult};
 use paritysim_error::{Error, Result};
 use paritysim_flight::run::{Release, Schedule};
 use paritysim_flight::{
@@ -233,43 +233,13 @@ pub fn run_point(
         ..options.clone()
     };
     let result = spec.run(device, &options)?;
-    let metrics = metric_names
-        .iter()
-        .map(|name| {
-            result
-                .metrics
-                .iter()
-                .find(|(n, _)| n == name)
-                .map_or(f64::NAN, |(_, v)| *v)
-        })
-        .collect();
-    let cycle = keep_cycle.then(|| {
-        let traj = result.trajectory;
-        let len = traj.time.len();
-        let keep = if result.period_ms.is_finite() {
-            (options.samples_per_cycle + 1).min(len)
-        } else {
-            len
-        };
-        let start = len - keep;
-        Trajectory {
-            time: traj.time[start..].to_vec(),
-            columns: traj
-                .columns
-                .into_iter()
-                .map(|(name, v)| (name, v[start..].to_vec()))
-                .collect(),
-        }
-    });
-    Ok(PointOutput {
-        metrics,
-        converged: result.converged,
-        cycles_run: result.cycles_run,
-        cycle,
-        residual: result.residual,
-        steady_state: None,
-        // No neighbour chaining for flying points: each starts from its own clamped orbit.
-        monodromy: None,
-        step_grid: Vec::new(),
-    })
+    // No neighbour chaining for flying points: each starts from its own clamped orbit (the
+    // flight result carries no monodromy or step grid).
+    Ok(PointOutput::keep(
+        result,
+        metric_names,
+        keep_cycle,
+        options.samples_per_cycle,
+        None,
+    ))
 }
