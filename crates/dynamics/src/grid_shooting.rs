@@ -20,7 +20,6 @@ use paritysim_error::{Error, Result};
 
 use crate::device::Device;
 use crate::integrate::{RungeKutta, State};
-use crate::stability::shooting::{compact_state as compact, expand_state as expand};
 
 /// A periodic orbit found on a frozen grid.
 #[derive(Clone, Debug)]
@@ -40,7 +39,7 @@ pub(crate) struct GridOrbit {
 
 /// `(P(y) − y, ‖P(y) − y‖∞ / (1 + ‖y‖∞))`.
 fn residual(n: usize, y: &State, py: &State) -> (DVector<f64>, f64) {
-    let (yv, pv) = (compact(n, y), compact(n, py));
+    let (yv, pv) = (y.compact(n), py.compact(n));
     let f = pv - &yv;
     let r = f.amax() / (1.0 + yv.amax());
     (f, r)
@@ -133,7 +132,7 @@ pub(crate) fn shoot(
         let Some(delta) = newton_step(&jac, &f) else {
             return Ok(None);
         };
-        let scale = 1.0 + compact(n, &y).amax();
+        let scale = 1.0 + y.compact(n).amax();
         let step = delta.amax() / scale;
         // The next iterate's error: the step times the contraction seen so far (Newton's
         // quadratic model after a fresh Jacobian; unknown, so 1, after a neighbour's).
@@ -143,7 +142,7 @@ pub(crate) fn shoot(
             None => 1.0,
         }
         .min(1.0);
-        let y_new = expand(n, &(compact(n, &y) + &delta));
+        let y_new = State::from_compact(n, &(y.compact(n) + &delta));
         let last = contraction * step <= tol || step <= 1e-3 * tol;
         let trial = if last {
             finish(&grid, &y_new)
@@ -165,7 +164,7 @@ pub(crate) fn shoot(
         let neutral = || {
             res_new <= accept_tol
                 && newton_step(&jac, &f_new)
-                    .is_some_and(|d| d.amax() / (1.0 + compact(n, &y_new).amax()) <= tol)
+                    .is_some_and(|d| d.amax() / (1.0 + y_new.compact(n).amax()) <= tol)
         };
         if last && res_new > tol && res_new <= accept_tol && !fresh {
             // Re-linearise at the candidate, then decide with the exact Jacobian.

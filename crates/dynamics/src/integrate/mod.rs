@@ -53,6 +53,27 @@ impl State {
             && self.work_aero.is_finite()
     }
 
+    /// The first `n` coordinates and rates as one vector `[coords, rates]` (shooting).
+    pub fn compact(&self, n: usize) -> nalgebra::DVector<f64> {
+        nalgebra::DVector::from_fn(2 * n, |i, _| {
+            if i < n {
+                self.coords[i]
+            } else {
+                self.rates[i - n]
+            }
+        })
+    }
+
+    /// The state of a [`Self::compact`] vector (work integrals zero).
+    pub fn from_compact(n: usize, v: &nalgebra::DVector<f64>) -> Self {
+        let mut y = Self::default();
+        for i in 0..n {
+            y.coords[i] = v[i];
+            y.rates[i] = v[n + i];
+        }
+        y
+    }
+
     /// The state with both work integrals set to zero.
     pub fn without_work(mut self) -> Self {
         self.work_actuator = 0.0;

@@ -143,19 +143,11 @@ pub fn expand_state(n: usize, v: &DVector<f64>) -> State {
 }
 
 fn compact(n: usize, y: &State) -> DVector<f64> {
-    DVector::from_fn(
-        2 * n,
-        |i, _| if i < n { y.coords[i] } else { y.rates[i - n] },
-    )
+    y.compact(n)
 }
 
 fn expand(n: usize, v: &DVector<f64>) -> State {
-    let mut y = State::default();
-    for i in 0..n {
-        y.coords[i] = v[i];
-        y.rates[i] = v[n + i];
-    }
-    y
+    State::from_compact(n, v)
 }
 
 /// The drive period (ms).
