@@ -173,6 +173,8 @@ pub struct Actuator {
     stiffness: f64,
     waveform: Waveform,
     dc_offset: DcOffset,
+    /// Per side (left, right) of a dual drivetrain: force scale and added force (mN).
+    sides: [(f64, f64); 2],
 }
 
 impl Actuator {
@@ -188,7 +190,40 @@ impl Actuator {
             stiffness: check_non_negative("stiffness", stiffness)?,
             waveform,
             dc_offset,
+            sides: [(1.0, 0.0); 2],
         })
+    }
+
+    /// The same actuator driving each side of a dual drivetrain
+    /// (`paritysim_kinematics::drivetrain::DualFourBar`: one drive per wing, same stiffness)
+    /// with its own force `F_k(t) = gain[k] F(t) + offset_mn[k]` (left, right).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `side_gain[k]` (finite, in [0, 1e3]) or
+    /// `side_offset[k]` (finite).
+    pub fn with_sides(mut self, gain: [f64; 2], offset_mn: [f64; 2]) -> Result<Self> {
+        for k in 0..2 {
+            if !(gain[k].is_finite() && (0.0..=1e3).contains(&gain[k])) {
+                bail!(invalid format!("side_gain[{k}]"), gain[k], "in [0, 1e3]");
+            }
+            if !offset_mn[k].is_finite() {
+                bail!(invalid format!("side_offset[{k}]"), offset_mn[k], "a finite force (mN)");
+            }
+            self.sides[k] = (gain[k], offset_mn[k]);
+        }
+        Ok(self)
+    }
+
+    /// Whether the sides differ from the common drive (`with_sides` other than gain 1, offset 0).
+    pub fn has_sides(&self) -> bool {
+        self.sides != [(1.0, 0.0); 2]
+    }
+
+    /// Force (mN) of side `k` (0 left, 1 right) of a dual drivetrain at time `t` (ms).
+    #[inline]
+    pub fn side_force(&self, t: f64, k: usize) -> f64 {
+        let (gain, offset) = self.sides[k];
+        gain * self.force(t) + offset
     }
 
     /// The §3.3.1 actuator (467 mN/mm, 1.2 mN/V) with the given waveform.
@@ -198,6 +233,7 @@ impl Actuator {
             stiffness: THESIS_STIFFNESS,
             waveform,
             dc_offset: DcOffset::AsForce,
+            sides: [(1.0, 0.0); 2],
         }
     }
 

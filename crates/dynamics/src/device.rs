@@ -352,11 +352,20 @@ impl Device {
 
     /// Actuator force `F(t)`, drivetrain load `Q = (F − K1 q1, −K2 q2)` and its spring energy
     /// `½K1q1² + ½K2q2²`.
+    ///
+    /// A dual drivetrain (one drive per wing) has the actuator on both coordinates instead:
+    /// `Q = (F_L − K1 q1, F_R − K1 q2)` ([`Actuator::side_force`]); the returned force is
+    /// then the left side's.
     #[inline]
     fn drive_load(&self, t: f64, q: &Vector2<f64>) -> (f64, Vector2<f64>, f64) {
         let actuator = self.spec.actuator.as_ref();
-        let force = actuator.map_or(0.0, |a| a.force(t));
         let k1 = actuator.map_or(0.0, |a| a.stiffness());
+        if let (Some(a), true) = (actuator, self.is_dual()) {
+            let (left, right) = (a.side_force(t, 0), a.side_force(t, 1));
+            let load = Vector2::new(left - k1 * q.x, right - k1 * q.y);
+            return (left, load, 0.5 * k1 * q.norm_squared());
+        }
+        let force = actuator.map_or(0.0, |a| a.force(t));
         let k2 = self
             .spec
             .transmission
@@ -364,6 +373,26 @@ impl Device {
             .map_or(0.0, |tr| tr.balance_stiffness);
         let load = Vector2::new(force - k1 * q.x, -k2 * q.y);
         (force, load, 0.5 * k1 * q.x * q.x + 0.5 * k2 * q.y * q.y)
+    }
+
+    /// Whether the drivetrain is a dual one (one actuator per wing, `q2` the right drive).
+    #[inline]
+    pub fn is_dual(&self) -> bool {
+        self.spec
+            .transmission
+            .as_ref()
+            .is_some_and(|tr| matches!(tr.kinematics, Drivetrain::DualFourBar(_)))
+    }
+
+    /// Actuator power `F q̇1` (plus `F_R q̇2` on a dual drivetrain) for a drive at `t` whose
+    /// (left) force is `force` (µJ/ms).
+    #[inline]
+    pub fn actuator_power(&self, t: f64, force: f64, q_dot: &Vector2<f64>) -> f64 {
+        let right = match (&self.spec.actuator, self.is_dual()) {
+            (Some(a), true) => a.side_force(t, 1) * q_dot.y,
+            _ => 0.0,
+        };
+        force * q_dot.x + right
     }
 
     /// An integrator state from `(p, ṗ)` after checking `C p = c0`, `C ṗ = 0`.
@@ -507,7 +536,7 @@ impl Device {
             dydt.coords[i] = if i < self.n_dof { y.rates[i] } else { 0.0 };
             dydt.rates[i] = if i < self.n_dof { x_ddot[i] } else { 0.0 };
         }
-        dydt.work_actuator = e.drive.actuator_force * e.drive.q_dot.x;
+        dydt.work_actuator = self.actuator_power(t, e.drive.actuator_force, &e.drive.q_dot);
         let mut aero_power = 0.0;
         for (w, terms) in e.wings.iter().take(self.n_wings()).enumerate() {
             aero_power += terms.aero.dot(&Vector3::new(
@@ -617,7 +646,7 @@ impl Device {
             dydt.coords[i] = step.q_dot[i];
             dydt.rates[i] = step.q_ddot[i];
         }
-        dydt.work_actuator = step.force * step.q_dot.x;
+        dydt.work_actuator = self.actuator_power(t, step.force, &step.q_dot);
         dydt.work_aero = step.aero_power;
         Ok(())
     }

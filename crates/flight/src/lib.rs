@@ -23,7 +23,7 @@ pub mod model;
 pub mod run;
 
 pub use body::{Body, BodyMode};
-pub use control::{Control, ControlInput, SetPoint};
+pub use control::{Control, ControlInput, Interpolation, SetPoint};
 pub use mechanisms::DriveCoordinate;
 pub use mechanisms::Mechanism;
 pub use model::Inputs;

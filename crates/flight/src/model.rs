@@ -79,6 +79,27 @@ pub struct Inputs {
     pub actuator_offset: f64,
     /// Relative actuator amplitude change.
     pub actuator_gain: f64,
+    /// `ln q3` of eq. 5.1: the whippletree holds `τL/τR = q3` ([`crate::control`]).
+    pub log_q3: f64,
+    /// Dual drivetrain: relative change of each drive's force (left, right).
+    pub side_gain: [f64; 2],
+    /// Dual drivetrain: added force on each drive (left, right; mN).
+    pub side_offset: [f64; 2],
+}
+
+impl Inputs {
+    /// The sum of two sets of inputs (set points, controllers).
+    pub fn plus(&self, other: &Inputs) -> Inputs {
+        let add2 = |a: [f64; 2], b: [f64; 2]| [a[0] + b[0], a[1] + b[1]];
+        Inputs {
+            q2_bias: self.q2_bias + other.q2_bias,
+            actuator_offset: self.actuator_offset + other.actuator_offset,
+            actuator_gain: self.actuator_gain + other.actuator_gain,
+            log_q3: self.log_q3 + other.log_q3,
+            side_gain: add2(self.side_gain, other.side_gain),
+            side_offset: add2(self.side_offset, other.side_offset),
+        }
+    }
 }
 
 /// The flight model: the device (null-space form, body-mounted drivetrain), the wings'
@@ -405,9 +426,11 @@ impl FlightModel {
     }
 
     /// Extra drivetrain load `ΔQ = (ΔF, τ_q2)` from the inputs and mechanisms, mapped to the
-    /// stroke angles: `τ_φ = J⁻ᵀ ΔQ`.
+    /// stroke angles: `τ_φ = J⁻ᵀ ΔQ`; on a dual drivetrain `ΔQ = (ΔF_L, ΔF_R)`. `ln q3` adds
+    /// the whippletree load that makes `τL/τR = q3` ([`crate::control`], eq. 5.1).
     fn extra_stroke_torque(
         &self,
+        t: f64,
         drive: &DriveState,
         inputs: &Inputs,
         r_b: &Matrix3<f64>,
@@ -416,10 +439,22 @@ impl FlightModel {
         let Some(tr) = &self.device.spec().transmission else {
             return Ok((Vector2::zeros(), 0.0));
         };
-        let mut dq = Vector2::new(
-            inputs.actuator_offset + inputs.actuator_gain * drive.actuator_force,
-            inputs.q2_bias,
-        );
+        let actuator = self.device.spec().actuator.as_ref();
+        let dual = self.device.is_dual();
+        let mut dq = if dual {
+            let right = actuator.map_or(0.0, |a| a.side_force(t, 1));
+            let common = |f: f64, k: usize| {
+                inputs.actuator_offset
+                    + inputs.side_offset[k]
+                    + (inputs.actuator_gain + inputs.side_gain[k]) * f
+            };
+            Vector2::new(common(drive.actuator_force, 0), common(right, 1))
+        } else {
+            Vector2::new(
+                inputs.actuator_offset + inputs.actuator_gain * drive.actuator_force,
+                inputs.q2_bias,
+            )
+        };
         let g = &self.body.gravity;
         for m in &self.mechanisms {
             match m.coordinate() {
@@ -427,11 +462,36 @@ impl FlightModel {
                 DriveCoordinate::Q2 => dq.y += m.force(r_b, omega, g, drive.q.y),
             }
         }
-        if dq == Vector2::zeros() {
+        if dq == Vector2::zeros() && inputs.log_q3 == 0.0 {
             return Ok((Vector2::zeros(), 0.0));
         }
         let kin = tr.kinematics();
         let jac = kin.evaluate(drive.q.x, drive.q.y)?.jacobian;
+        let log_q3 = inputs.log_q3;
+        if log_q3 != 0.0 {
+            if kin.dof() != 2 || dual {
+                return Err(Error::invalid(
+                    "log_q3",
+                    log_q3,
+                    format!(
+                        "0: eq. 5.1 needs a whippletree (a 2-DOF differential), the drivetrain is {}",
+                        kin.name()
+                    ),
+                ));
+            }
+            // Eq. 5.1: Q2 = Q1 (J01 q3 + J11) / (J00 q3 + J10) gives τL/τR = q3.
+            let q3 = log_q3.exp();
+            let k1 = actuator.map_or(0.0, |a| a.stiffness());
+            let q1_load = drive.actuator_force - k1 * drive.q.x + dq.x;
+            let den = jac[(0, 0)] * q3 + jac[(1, 0)];
+            if den == 0.0 || !den.is_finite() {
+                return Err(Error::Singular(format!(
+                    "eq. 5.1 torque ratio q3 = {q3} is not reachable at q = {:?}",
+                    drive.q
+                )));
+            }
+            dq.y += q1_load * (jac[(0, 1)] * q3 + jac[(1, 1)]) / den;
+        }
         let tau = if kin.dof() == 1 {
             Vector2::new(dq.x / jac[(0, 0)], 0.0)
         } else {
@@ -472,7 +532,7 @@ impl FlightModel {
         let omega = Vector3::new(y[OMEGA], y[OMEGA + 1], y[OMEGA + 2]);
         let (p, p_dot) = self.device.coordinates(&self.wing_state(y))?;
         let mut drive = self.device.drive(t, &p, &p_dot)?;
-        let (extra, extra_power) = self.extra_stroke_torque(&drive, inputs, &r_b, &omega)?;
+        let (extra, extra_power) = self.extra_stroke_torque(t, &drive, inputs, &r_b, &omega)?;
         drive.stroke_torque += extra;
         let g = self.body.gravity;
 
@@ -673,7 +733,10 @@ impl FlightModel {
             wing_force += f_on_body;
             wing_torque += t_on_body;
         }
-        let actuator_power = drive.actuator_force * drive.q_dot.x + extra_power;
+        let actuator_power = self
+            .device
+            .actuator_power(t, drive.actuator_force, &drive.q_dot)
+            + extra_power;
         Ok(FlightEval {
             p,
             p_dot,

@@ -15,7 +15,7 @@ use paritysim_dynamics::trajectory::{Column, Sample, column_table};
 use paritysim_dynamics::{SimulationOptions, State, Trajectory};
 use paritysim_error::{Error, Result};
 
-use crate::control::{Control, ControlInput, SetPoint};
+use crate::control::{Control, Interpolation, SetPoint};
 use crate::model::{FlightEval, FlightModel, Inputs, STATE_LEN};
 
 /// Slow inputs of a run: set points and at most one PD controller.
@@ -28,20 +28,37 @@ pub struct Schedule {
 }
 
 impl Schedule {
-    fn inputs(&self, t: f64, control_output: f64) -> Inputs {
+    /// The set points at `t` (ms from the release) plus the PD output; piecewise-constant
+    /// set points at `leg_middle` instead (a leg never straddles a node, so this is their
+    /// value over the whole leg, free of rounding at the leg's ends).
+    fn inputs(&self, t: f64, leg_middle: f64, control_output: f64) -> Inputs {
         let mut u = Inputs::default();
-        let mut add = |input: ControlInput, v: f64| match input {
-            ControlInput::Q2Bias => u.q2_bias += v,
-            ControlInput::ActuatorOffset => u.actuator_offset += v,
-            ControlInput::ActuatorGain => u.actuator_gain += v,
-        };
         for s in &self.set_points {
-            add(s.input, s.value(t));
+            let at = match s.interpolation {
+                Interpolation::Linear => t,
+                Interpolation::Previous => leg_middle,
+            };
+            s.input.add_to(&mut u, s.value(at));
         }
         if let Some(c) = &self.control {
-            add(c.input, control_output);
+            let scale = c.shape.as_ref().map_or(1.0, |s| {
+                s.value(match s.interpolation {
+                    Interpolation::Linear => t,
+                    Interpolation::Previous => leg_middle,
+                })
+            });
+            c.input.add_to(&mut u, control_output * scale);
         }
         u
+    }
+
+    /// The first set-point (or control shape) node after `t` (ms from the release; infinite for none).
+    fn next_node(&self, t: f64, tol: f64) -> f64 {
+        self.set_points
+            .iter()
+            .chain(self.control.as_ref().and_then(|c| c.shape.as_ref()))
+            .map(|s| s.next_node(t, tol))
+            .fold(f64::INFINITY, f64::min)
     }
 }
 
@@ -491,25 +508,27 @@ pub fn fly_controlled(
                 ticks[1] += 1;
             }
         }
-        let next_tick = tick_time(pd_period, ticks[0]).min(tick_time(ext_period, ticks[1]));
+        // Legs also end at the set points' nodes (no step straddles a kink or a jump; a
+        // set point is evaluated inside the leg, at its times from the release).
+        let next_tick = tick_time(pd_period, ticks[0])
+            .min(tick_time(ext_period, ticks[1]))
+            .min(t0 + schedule.next_node(t - t0, 1e-12 * window));
         let t_leg = if next_tick >= t_end - 1e-12 * window {
             t_end
         } else {
             next_tick
         };
-        let mut inputs = schedule.inputs(t, output);
-        inputs.q2_bias += extra.q2_bias;
-        inputs.actuator_offset += extra.actuator_offset;
-        inputs.actuator_gain += extra.actuator_gain;
+        let mid = 0.5 * (t + t_leg) - t0;
+        let leg_inputs = |tt: f64| schedule.inputs(tt - t0, mid, output).plus(&extra);
         let end = times.partition_point(|&s| s < t_leg);
         let end = if t_leg == t_end { times.len() } else { end };
         let leg_times = &times[next..end];
         let offset = next;
         let mut f = |tt: f64, yy: &[f64; STATE_LEN], dy: &mut [f64; STATE_LEN]| {
-            model.rhs(tt, yy, &inputs, dy)
+            model.rhs(tt, yy, &leg_inputs(tt), dy)
         };
         let mut sink = |i: usize, tt: f64, yy: &[f64; STATE_LEN]| -> Result<()> {
-            let s = FlightSample::new(model, tt, yy, &inputs)?;
+            let s = FlightSample::new(model, tt, yy, &leg_inputs(tt))?;
             let closing = offset + i == n_samples;
             metrics.add(&s.sample, closing);
             body.add(&s, closing);

@@ -126,8 +126,10 @@ fn roll_controller_on_the_whippletree_has_authority_over_roll() {
                 target: 0.0,
                 kp,
                 kd: 0.0,
+                target_rate: 0.0,
                 rate_hz: 1000.0,
                 limit: 5.0,
+                shape: None,
             }),
         };
         let r = fly(&model, &opts, &Release::default(), &schedule).unwrap();
@@ -181,12 +183,14 @@ fn an_external_controller_flies_like_the_pd_with_the_same_law() {
         target: 0.0,
         kp: 50.0,
         kd: 100.0,
+        target_rate: 0.0,
         rate_hz: 1000.0,
         limit: 5.0,
+        shape: None,
     };
     let with_pd = Schedule {
         set_points: Vec::new(),
-        control: Some(pd),
+        control: Some(pd.clone()),
     };
     let release = Release::default();
     let rust = fly(&model, &opts, &release, &with_pd).unwrap();
@@ -244,8 +248,9 @@ fn an_external_controller_flies_like_the_pd_with_the_same_law() {
     let doubled = Control {
         kp: 100.0,
         kd: 200.0,
+        target_rate: 0.0,
         limit: 10.0,
-        ..pd
+        ..pd.clone()
     };
     let both = fly_controlled(
         &model,

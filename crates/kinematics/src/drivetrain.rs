@@ -191,6 +191,14 @@ pub struct HmfFourBar {
     side: RodCrank,
 }
 
+/// Two independent four-bars, one actuator per wing (beyond the thesis: the dual-actuator
+/// layout of later flapping robots, issue 17): `q1` drives the left rod-crank, `q2` the
+/// right one, `φL = f(q1)`, `φR = f(q2)` with `f` the HMF side (2 DOF, diagonal Jacobian).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DualFourBar {
+    side: RodCrank,
+}
+
 /// Drag PARITY linear map of eq. 2.15 with a (possibly biased) whippletree.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LinearDifferential {
@@ -232,6 +240,18 @@ impl HmfFourBar {
     }
 
     /// Side linkage.
+    pub fn side(&self) -> RodCrank {
+        self.side
+    }
+}
+
+impl DualFourBar {
+    /// One rod-crank per wing, both of the given geometry.
+    pub fn new(side: RodCrank) -> Self {
+        Self { side }
+    }
+
+    /// Side linkage (both sides).
     pub fn side(&self) -> RodCrank {
         self.side
     }
@@ -321,6 +341,8 @@ pub enum Drivetrain {
     LinearDifferential(LinearDifferential),
     /// Drag PARITY, nonlinear linkage.
     LinkageDifferential(LinkageDifferential),
+    /// Two four-bars, one actuator per wing (`q1` left, `q2` right), 2 DOF.
+    DualFourBar(DualFourBar),
 }
 
 impl Drivetrain {
@@ -337,6 +359,7 @@ impl Drivetrain {
         match self {
             Drivetrain::HmfFourBar(d) => Some(d.side),
             Drivetrain::LinkageDifferential(d) => Some(d.side),
+            Drivetrain::DualFourBar(d) => Some(d.side),
             Drivetrain::LinearDifferential(_) => None,
         }
     }
@@ -347,6 +370,7 @@ impl Drivetrain {
             Drivetrain::HmfFourBar(_) => "hmf_four_bar",
             Drivetrain::LinearDifferential(_) => "linear_differential",
             Drivetrain::LinkageDifferential(_) => "linkage_differential",
+            Drivetrain::DualFourBar(_) => "dual_four_bar",
         }
     }
 
@@ -397,6 +421,19 @@ impl Drivetrain {
                     stroke: Vector2::new(pl, pr),
                     jacobian: Matrix2::new(gl[0], gl[1], gr[0], gr[1]),
                     hessian: [hl, hr],
+                })
+            }
+            Drivetrain::DualFourBar(d) => {
+                // Each side is the HMF side on its own actuator coordinate.
+                let (pl, gl, hl) = d.side.side_stroke(q1, 0.0, 0.0, 1.0)?;
+                let (pr, gr, hr) = d.side.side_stroke(q2, 0.0, 0.0, 1.0)?;
+                Ok(DrivetrainEval {
+                    stroke: Vector2::new(pl, pr),
+                    jacobian: Matrix2::new(gl[0], 0.0, 0.0, gr[0]),
+                    hessian: [
+                        Matrix2::new(hl[(0, 0)], 0.0, 0.0, 0.0),
+                        Matrix2::new(0.0, 0.0, 0.0, hr[(0, 0)]),
+                    ],
                 })
             }
             Drivetrain::LinearDifferential(d) => Ok(d.evaluate(q1, q2)),

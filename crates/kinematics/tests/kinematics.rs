@@ -2,7 +2,9 @@
 
 use approx::assert_relative_eq;
 use nalgebra::{Matrix3, Vector2, Vector3};
-use paritysim_kinematics::drivetrain::{HmfFourBar, LinearDifferential, LinkageDifferential};
+use paritysim_kinematics::drivetrain::{
+    DualFourBar, HmfFourBar, LinearDifferential, LinkageDifferential,
+};
 use paritysim_kinematics::rotation::{rot_axis, rot_x, rot_y, rot_z, skew};
 use paritysim_kinematics::{Drivetrain, Error, RodCrank, SphericalShoulder};
 use proptest::prelude::*;
@@ -373,7 +375,29 @@ fn all_drivetrains() -> Vec<Drivetrain> {
         Drivetrain::LinkageDifferential(
             LinkageDifferential::new(RodCrank::new(0.35, 1.0).unwrap(), 5.0, 0.5).unwrap(),
         ),
+        Drivetrain::DualFourBar(DualFourBar::new(RodCrank::THESIS)),
     ]
+}
+
+#[test]
+fn dual_four_bar_is_one_hmf_side_per_actuator() {
+    // Each wing's stroke is the HMF stroke of its own actuator coordinate, untouched by the
+    // other one (diagonal Jacobian).
+    let hmf = Drivetrain::HmfFourBar(HmfFourBar::new(RodCrank::THESIS));
+    let dual = Drivetrain::DualFourBar(DualFourBar::new(RodCrank::THESIS));
+    for &(q1, q2) in &[(0.0, 0.0), (0.12, -0.07), (-0.18, 0.15)] {
+        let d = dual.evaluate(q1, q2).unwrap();
+        let (l, r) = (
+            hmf.evaluate(q1, 0.0).unwrap(),
+            hmf.evaluate(q2, 0.0).unwrap(),
+        );
+        assert_relative_eq!(d.stroke.x, l.stroke.x, epsilon = 1e-15);
+        assert_relative_eq!(d.stroke.y, r.stroke.y, epsilon = 1e-15);
+        assert_relative_eq!(d.jacobian[(0, 0)], l.jacobian[(0, 0)], epsilon = 1e-15);
+        assert_relative_eq!(d.jacobian[(1, 1)], r.jacobian[(1, 0)], epsilon = 1e-15);
+        assert_eq!((d.jacobian[(0, 1)], d.jacobian[(1, 0)]), (0.0, 0.0));
+    }
+    assert_eq!(dual.dof(), 2);
 }
 
 #[test]

@@ -167,6 +167,7 @@ fn simulate_controlled(
                 q2_bias,
                 actuator_offset,
                 actuator_gain,
+                ..paritysim_flight::Inputs::default()
             },
         )
         .map_err(|e| {

@@ -90,6 +90,14 @@ pub struct Actuator {
     pub stiffness: f64,
     /// DC offset law.
     pub dc_offset: DcOffset,
+    /// Per side (left, right) of a `dual_four_bar` drivetrain (one drive per wing): scale of
+    /// the drive force, each in [0, 1e3]; [1, 1] for any other drivetrain.
+    #[schemars(inner(range(min = 0.0, max = 1e3)), extend("x-unit" = "1"))]
+    pub side_gain: [f64; 2],
+    /// Per side of a `dual_four_bar` drivetrain: added DC voltage (V, a static force
+    /// `force_per_volt × side_offset_v`), each in [-1e4, 1e4]; [0, 0] for any other drivetrain.
+    #[schemars(inner(range(min = -1e4, max = 1e4)), extend("x-unit" = "V"))]
+    pub side_offset_v: [f64; 2],
 }
 
 /// §3.3.1 actuator stiffness (mN/mm), defined by the engine.
@@ -104,6 +112,8 @@ impl Default for Actuator {
             force_per_volt: THESIS_FORCE_PER_VOLT,
             stiffness: THESIS_ACTUATOR_STIFFNESS,
             dc_offset: DcOffset::default(),
+            side_gain: [1.0, 1.0],
+            side_offset_v: [0.0, 0.0],
         }
     }
 }

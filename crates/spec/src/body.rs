@@ -119,6 +119,32 @@ pub enum ControlInput {
     ActuatorOffset,
     /// Relative actuator amplitude change (1 = +100 %).
     ActuatorGain,
+    /// `ln q3` of eq. 5.1 (1): the whippletree holds the torque ratio `τL/τR = q3` (a
+    /// "virtual moving pivot"; a 2-DOF differential drivetrain).
+    LogQ3,
+    /// `dual_four_bar`: relative change of the left drive's force (1 = +100 %).
+    SideGainLeft,
+    /// `dual_four_bar`: relative change of the right drive's force.
+    SideGainRight,
+    /// `dual_four_bar`: added force on the left drive (mN).
+    SideOffsetLeft,
+    /// `dual_four_bar`: added force on the right drive (mN).
+    SideOffsetRight,
+    /// `dual_four_bar`: +u on the left drive's relative force, −u on the right's.
+    SideGainDifference,
+    /// `dual_four_bar`: +u mN on the left drive, −u on the right.
+    SideOffsetDifference,
+}
+
+/// How a set point fills the time between its nodes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Interpolation {
+    /// Piecewise linear.
+    #[default]
+    Linear,
+    /// Piecewise constant: the value of the last node at or before t (steps at the nodes).
+    Previous,
 }
 
 /// A piecewise-linear schedule, held outside its times.
@@ -132,6 +158,30 @@ pub struct SetPoint {
     pub times_ms: Vec<f64>,
     /// Values at those times (unit of the input).
     pub values: Vec<f64>,
+    /// Between the nodes: `linear` or `previous` (steps).
+    pub interpolation: Interpolation,
+    /// Repeat the schedule with this period (ms; times then in [0, period_ms)), e.g. the
+    /// drive period for a stroke-synchronous schedule. Absent: held outside its times.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(range(max = 1e7), extend("exclusiveMinimum" = 0.0, "x-unit" = "ms"))]
+    pub period_ms: Option<f64>,
+}
+
+/// A schedule without an input: what a controller's output multiplies.
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(default, deny_unknown_fields)]
+pub struct Shape {
+    /// Times (ms) from the release, increasing.
+    #[schemars(inner(range(min = 0.0, max = 1e7)), extend("x-unit" = "ms"))]
+    pub times_ms: Vec<f64>,
+    /// Values at those times (1).
+    pub values: Vec<f64>,
+    /// Between the nodes: `linear` or `previous` (steps).
+    pub interpolation: Interpolation,
+    /// Repeat period (ms; times then in [0, period_ms)).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[schemars(range(max = 1e7), extend("exclusiveMinimum" = 0.0, "x-unit" = "ms"))]
+    pub period_ms: Option<f64>,
 }
 
 /// Body axis.
@@ -148,7 +198,8 @@ pub enum Axis {
 }
 
 /// A PD controller on one attitude angle, run at `rate_hz` with zero-order hold:
-/// `u = −kp (angle − target_rad) − kd rate`, saturated at `±limit`.
+/// `u = −kp (angle − target_rad) − kd (rate − target_rate_rad_per_ms)`, saturated at `±limit`
+/// (`kp = 0`: a rate controller).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct Control {
@@ -165,12 +216,19 @@ pub struct Control {
     /// Derivative gain (input unit per rad/ms), in [-1e6, 1e6].
     #[schemars(range(min = -1e6, max = 1e6))]
     pub kd: f64,
+    /// Target rate about the axis (rad/ms), in [-100, 100].
+    #[schemars(range(min = -100.0, max = 100.0), extend("x-unit" = "rad/ms"))]
+    pub target_rate_rad_per_ms: f64,
     /// Control rate (Hz), in (0, 1e5].
     #[schemars(range(max = 1e5), extend("exclusiveMinimum" = 0.0, "x-unit" = "Hz"))]
     pub rate_hz: f64,
     /// Output saturation (input unit), in (0, 1e6].
     #[schemars(range(max = 1e6), extend("exclusiveMinimum" = 0.0))]
     pub limit: f64,
+    /// Optional schedule the output multiplies (the controller sets its amplitude), e.g.
+    /// a stroke-synchronous ±1 with `input = "log_q3"`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shape: Option<Shape>,
 }
 
 impl Default for Control {
@@ -181,8 +239,10 @@ impl Default for Control {
             target_rad: 0.0,
             kp: 0.0,
             kd: 0.0,
+            target_rate_rad_per_ms: 0.0,
             rate_hz: 1000.0,
             limit: 1.0,
+            shape: None,
         }
     }
 }

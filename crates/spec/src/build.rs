@@ -59,6 +59,31 @@ impl Simulation {
             .map(actuator)
             .transpose()
             .map_err(|e| e.in_field("actuator"))?;
+        // Per-side drives need one drive per wing.
+        if let (Some(a), Some(t), Some(spec)) = (&actuator, &transmission, &self.actuator) {
+            let dual = matches!(
+                t.kinematics(),
+                paritysim_kinematics::Drivetrain::DualFourBar(_)
+            );
+            if a.has_sides() && !dual {
+                let (field, value) = if spec.side_gain != [1.0, 1.0] {
+                    ("actuator.side_gain", format!("{:?}", spec.side_gain))
+                } else {
+                    (
+                        "actuator.side_offset_v",
+                        format!("{:?}", spec.side_offset_v),
+                    )
+                };
+                return Err(Error::invalid(
+                    field,
+                    value,
+                    format!(
+                        "[1, 1] (gain) and [0, 0] (offset) unless drivetrain.kind = \"dual_four_bar\" (one drive per wing; this drivetrain is {})",
+                        t.kinematics().name()
+                    ),
+                ));
+            }
+        }
         Device::new(DeviceSpec {
             wings,
             constraints,
@@ -203,7 +228,17 @@ fn actuator(a: &Actuator) -> Result<EngineActuator> {
         DcOffset::AsForce => EngineDc::AsForce,
         DcOffset::Ignore => EngineDc::Ignore,
     };
-    EngineActuator::new(a.force_per_volt, a.stiffness, waveform, dc)
+    let engine = EngineActuator::new(a.force_per_volt, a.stiffness, waveform, dc)?;
+    for k in 0..2 {
+        if !(-1e4..=1e4).contains(&a.side_offset_v[k]) {
+            return Err(Error::invalid(
+                format!("side_offset_v[{k}]"),
+                a.side_offset_v[k],
+                "in [-1e4, 1e4] V",
+            ));
+        }
+    }
+    engine.with_sides(a.side_gain, a.side_offset_v.map(|v| v * a.force_per_volt))
 }
 
 fn vec6(field: &str, v: &Option<Vec<f64>>, n_coords: usize) -> Result<Option<Vec6>> {

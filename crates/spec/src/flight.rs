@@ -9,10 +9,10 @@ use paritysim_flight::run::{Release, Schedule};
 use paritysim_flight::{
     Body as EngineBody, BodyMode as EngineMode, Control as EngineControl,
     ControlInput as EngineInput, DriveCoordinate as EngineCoordinate, FlightModel,
-    Mechanism as EngineMechanism, SetPoint as EngineSetPoint,
+    Interpolation as EngineInterpolation, Mechanism as EngineMechanism, SetPoint as EngineSetPoint,
 };
 
-use crate::body::{Axis, Body, BodyMode, ControlInput, DriveCoordinate, Mechanism};
+use crate::body::{Axis, Body, BodyMode, ControlInput, DriveCoordinate, Interpolation, Mechanism};
 use crate::spec::Simulation;
 
 /// A flight run: model, release state and slow inputs.
@@ -35,7 +35,50 @@ fn input(i: ControlInput) -> EngineInput {
         ControlInput::Q2Bias => EngineInput::Q2Bias,
         ControlInput::ActuatorOffset => EngineInput::ActuatorOffset,
         ControlInput::ActuatorGain => EngineInput::ActuatorGain,
+        ControlInput::LogQ3 => EngineInput::LogQ3,
+        ControlInput::SideGainLeft => EngineInput::SideGainLeft,
+        ControlInput::SideGainRight => EngineInput::SideGainRight,
+        ControlInput::SideOffsetLeft => EngineInput::SideOffsetLeft,
+        ControlInput::SideOffsetRight => EngineInput::SideOffsetRight,
+        ControlInput::SideGainDifference => EngineInput::SideGainDifference,
+        ControlInput::SideOffsetDifference => EngineInput::SideOffsetDifference,
     }
+}
+
+/// Whether `input` can act on `device`'s drivetrain (`field` names it in the error).
+fn check_input(device: &Device, i: ControlInput, field: &str) -> Result<()> {
+    let field = field.to_string();
+    let engine = input(i);
+    let kinematics = device.spec().transmission.as_ref().map(|t| t.kinematics());
+    let name = kinematics.map_or("none", |k| k.name());
+    let two = kinematics.is_some_and(|k| k.dof() == 2);
+    let value = serde_json::to_string(&i).unwrap_or_default();
+    if engine.needs_whippletree() && (!two || device.is_dual()) {
+        return Err(Error::invalid(
+            field.clone(),
+            value,
+            format!(
+                "an input of this drivetrain ({name}): q2_bias and log_q3 need a whippletree (linear_differential, linkage_differential)"
+            ),
+        ));
+    }
+    if engine.needs_dual() && !device.is_dual() {
+        return Err(Error::invalid(
+            field.clone(),
+            value,
+            format!(
+                "an input of this drivetrain ({name}): side_* inputs need drivetrain.kind = \"dual_four_bar\" (one drive per wing)"
+            ),
+        ));
+    }
+    if kinematics.is_none() {
+        return Err(Error::invalid(
+            field,
+            value,
+            "an input of a device with a drivetrain",
+        ));
+    }
+    Ok(())
 }
 
 fn coordinate(c: DriveCoordinate) -> EngineCoordinate {
@@ -107,30 +150,76 @@ impl Simulation {
             })
             .collect::<Result<Vec<_>>>()?;
         let model = FlightModel::new(device, engine_body(b), mechanisms)?;
+        let schedule = |input_kind: ControlInput,
+                        times: &[f64],
+                        values: &[f64],
+                        interpolation: Interpolation,
+                        period: Option<f64>| {
+            let point = EngineSetPoint::new(input(input_kind), times.to_vec(), values.to_vec())
+                .map(|p| {
+                    p.with_interpolation(match interpolation {
+                        Interpolation::Linear => EngineInterpolation::Linear,
+                        Interpolation::Previous => EngineInterpolation::Previous,
+                    })
+                });
+            match period {
+                None => point,
+                Some(period) => point.and_then(|p| p.with_period(period)),
+            }
+        };
         let set_points = b
             .set_points
             .iter()
             .enumerate()
             .map(|(i, s)| {
-                EngineSetPoint::new(input(s.input), s.times_ms.clone(), s.values.clone())
-                    .map_err(|e| e.in_field(&format!("body.set_points[{i}]")))
+                let at = format!("body.set_points[{i}]");
+                check_input(device, s.input, &format!("{at}.input"))?;
+                schedule(
+                    s.input,
+                    &s.times_ms,
+                    &s.values,
+                    s.interpolation,
+                    s.period_ms,
+                )
+                .map_err(|e| e.in_field(&at))
             })
             .collect::<Result<Vec<_>>>()?;
-        let control = b.control.as_ref().map(|c| EngineControl {
-            input: input(c.input),
-            axis: match c.axis {
-                Axis::Roll => 0,
-                Axis::Yaw => 1,
-                Axis::Pitch => 2,
-            },
-            target: c.target_rad,
-            kp: c.kp,
-            kd: c.kd,
-            rate_hz: c.rate_hz,
-            limit: c.limit,
-        });
+        let control = match b.control.as_ref() {
+            None => None,
+            Some(c) => Some(EngineControl {
+                input: input(c.input),
+                axis: match c.axis {
+                    Axis::Roll => 0,
+                    Axis::Yaw => 1,
+                    Axis::Pitch => 2,
+                },
+                target: c.target_rad,
+                kp: c.kp,
+                kd: c.kd,
+                target_rate: c.target_rate_rad_per_ms,
+                rate_hz: c.rate_hz,
+                limit: c.limit,
+                shape: c
+                    .shape
+                    .as_ref()
+                    .map(|s| {
+                        schedule(
+                            c.input,
+                            &s.times_ms,
+                            &s.values,
+                            s.interpolation,
+                            s.period_ms,
+                        )
+                        .map_err(|e| e.in_field("body.control.shape"))
+                    })
+                    .transpose()?,
+            }),
+        };
         if let Some(c) = &control {
             c.validate()?;
+        }
+        if let Some(c) = &b.control {
+            check_input(device, c.input, "body.control.input")?;
         }
         let [roll, yaw, pitch] = b.initial_attitude_rad;
         let attitude = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), roll)

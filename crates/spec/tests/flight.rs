@@ -133,3 +133,91 @@ fn sweeps_run_flying_specs() {
         .1;
     assert_eq!(ltw.to_bits(), a.to_bits());
 }
+
+/// The §3.4 PARITY device with its drivetrain section replaced by `drivetrain` (TOML body).
+fn with_drivetrain(drivetrain: &str, body: &str) -> String {
+    let base = device_toml("sreetharan2012_3_4_parity.toml");
+    let start = base.find("[drivetrain]").unwrap();
+    let end = start + base[start..].find("\n[actuator]").unwrap();
+    format!(
+        "{}[drivetrain]\n{drivetrain}\n{}\n[body]\n{body}\n",
+        &base[..start],
+        &base[end..]
+    )
+}
+
+fn invalid_field(text: &str) -> String {
+    let spec = from_toml(text).unwrap().0;
+    match spec.model() {
+        Err(Error::InvalidParameter { field, .. }) => field.to_string(),
+        other => panic!("expected a field error, got {:?}", other.map(|_| ())),
+    }
+}
+
+#[test]
+fn per_side_drive_and_eq_5_1_inputs_are_checked_against_the_drivetrain() {
+    // Per-side fields need a dual drivetrain; side inputs need one; q2_bias / log_q3 need a
+    // whippletree; each error names its field.
+    let linear = device_toml("sreetharan2012_3_4_parity.toml");
+    let sided = linear.replace(
+        "dc_offset = \"ignore\"",
+        "dc_offset = \"ignore\"\nside_gain = [1.0, 1.2]",
+    );
+    assert_eq!(invalid_field(&sided), "actuator.side_gain");
+    let offset = linear.replace(
+        "dc_offset = \"ignore\"",
+        "dc_offset = \"ignore\"\nside_offset_v = [0.0, 5.0]",
+    );
+    assert_eq!(invalid_field(&offset), "actuator.side_offset_v");
+    let bad_gain = with_drivetrain("kind = \"dual_four_bar\"", "mode = \"fixed\"").replace(
+        "dc_offset = \"ignore\"",
+        "dc_offset = \"ignore\"\nside_gain = [1.0, -2.0]",
+    );
+    match from_toml(&bad_gain) {
+        Err(e) => assert!(e.to_string().contains("actuator.side_gain[1]"), "{e}"),
+        Ok(_) => panic!("a negative side gain is accepted"),
+    }
+    let side_on_parity = with_body(
+        "mode = \"roll\"\n[[body.set_points]]\ninput = \"side_gain_left\"\ntimes_ms = [0]\nvalues = [0.1]",
+    );
+    assert_eq!(invalid_field(&side_on_parity), "body.set_points[0].input");
+    let q3_on_dual = with_drivetrain(
+        "kind = \"dual_four_bar\"",
+        "mode = \"roll\"\n[body.control]\ninput = \"log_q3\"\nkp = 1.0",
+    );
+    assert_eq!(invalid_field(&q3_on_dual), "body.control.input");
+    let bad_period = with_body(
+        "mode = \"roll\"\n[[body.set_points]]\ninput = \"log_q3\"\ntimes_ms = [0, 12]\nvalues = [0.1, -0.1]\nperiod_ms = 9.0",
+    );
+    assert_eq!(invalid_field(&bad_period), "body.set_points[0].times_ms");
+}
+
+#[test]
+fn a_dual_drive_spec_runs_with_per_side_gains() {
+    // The dual four-bar from a spec: a larger right gain gives a larger right stroke only
+    // (one drive per wing).
+    let run = |gain: &str| {
+        let text = with_drivetrain("kind = \"dual_four_bar\"", "mode = \"fixed\"")
+            .replace("amplitude_v = 100.0", "amplitude_v = 40.0")
+            .replace(
+                "dc_offset = \"ignore\"",
+                &format!("dc_offset = \"ignore\"\nside_gain = {gain}"),
+            );
+        let spec = from_toml(&text).unwrap().0;
+        let (device, mut options) = spec.model().unwrap();
+        options.record_cycles = 1;
+        let r = spec.run(&device, &options).unwrap();
+        let amp = |c: &str| {
+            r.trajectory
+                .column(c)
+                .unwrap()
+                .iter()
+                .fold(0.0f64, |m, x| m.max(x.abs()))
+        };
+        (amp("left_phi"), amp("right_phi"))
+    };
+    let (l0, r0) = run("[1.0, 1.0]");
+    let (l1, r1) = run("[1.0, 1.25]");
+    assert!((l1 - l0).abs() < 1e-6 * l0, "left unchanged: {l0} -> {l1}");
+    assert!(r1 > 1.1 * r0, "right grows: {r0} -> {r1}");
+}

@@ -8,10 +8,12 @@
 use paritysim_error::Result;
 use paritysim_kinematics::Drivetrain as Kinematics;
 
+mod dual_four_bar;
 mod hmf_four_bar;
 mod linear_differential;
 mod linkage_differential;
 
+pub use dual_four_bar::DualFourBar;
 pub use hmf_four_bar::HmfFourBar;
 pub use linear_differential::LinearDifferential;
 pub use linkage_differential::LinkageDifferential;
@@ -63,6 +65,8 @@ registry! {
     LinearDifferential,
     /// The Drag PARITY linkage differential of §3.3.2, 2 DOF.
     LinkageDifferential,
+    /// Two four-bars, one drive per wing (beyond the thesis), 2 DOF.
+    DualFourBar,
 }
 
 impl Drivetrain {
