@@ -7,6 +7,7 @@ import dataclasses
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import paritysim as ps
 
@@ -54,3 +55,62 @@ def test_sweep_over_a_body_field() -> None:
     assert abs(ratio[0] / ratio[1] - 2.0) < 1e-12
     direct = ps.simulate(spec).metrics["lift_to_weight"]
     assert np.float64(direct).tobytes() == np.float64(ratio[0]).tobytes()
+
+
+def test_sweeps_over_body_modes_and_schedules() -> None:
+    """ps.sweep runs body-mode specs like any other: one row per body mode (a string path),
+    and over a set point's values (eq. 5.1's ln q3 on the stand), each row the same numbers as
+    ps.simulate of that point."""
+    spec = _spec(mode="clamped")
+    df = ps.sweep(spec, {"body.mode": ["clamped", "roll", "yaw", "free"]}, metrics=["body_omega_roll_mean", "lift_to_weight"], progress=False)
+    assert df["status"].to_list() == ["ok"] * 4
+    lift = df["lift_to_weight"].to_list()
+    assert len(set(lift)) > 1 and all(v > 1.0 for v in lift)
+    assert df["body_omega_roll_mean"][0] == 0.0  # clamped: the body cannot turn
+    q3 = ps.flight.with_body(spec, set_points=[{"input": "log_q3", "times_ms": [0.0], "values": [0.0]}])
+    u = float(np.log(2.0))
+    swept = ps.sweep(q3, {"body.set_points[0].values": [[0.0], [u]]}, metrics=["body_torque_roll_mean"], progress=False)
+    assert swept["status"].to_list() == ["ok", "ok"]
+    direct = ps.simulate(q3.with_paths({"body.set_points[0].values": [u]}))
+    assert np.float64(direct.metrics["body_torque_roll_mean"]).tobytes() == np.float64(swept["body_torque_roll_mean"][1]).tobytes()
+
+
+def test_log_q3_holds_the_torque_ratio_on_the_stand() -> None:
+    """Eq. 5.1 from a spec: with ln q3 = u the stand's peak stroke-torque ratio of a symmetric
+    device is e^u (the whippletree load of crates/flight/src/control.rs)."""
+    spec = _spec(mode="clamped")
+    left = spec.wings[0]
+    spec = spec.replace(wings=(left, left))
+    ratios = {}
+    for q3 in (0.5, 2.0):
+        s = ps.flight.with_body(spec, set_points=[{"input": "log_q3", "times_ms": [0.0], "values": [float(np.log(q3))]}])
+        cyc = ps.simulate(s).cycle
+        tau = {side: np.abs((cyc[f"{side}_roll_aero"] + cyc[f"{side}_roll_inertial"]).to_numpy()).max() for side in ("left", "right")}
+        ratios[q3] = tau["left"] / tau["right"] / q3
+    assert all(abs(r - 1.0) < 0.05 for r in ratios.values()), ratios
+
+
+def test_dual_drive_fields_are_validated_by_name() -> None:
+    """Per-side drive fields need the dual four-bar; side inputs need it; eq. 5.1 needs a
+    whippletree: each error names its field."""
+    spec = _spec(mode="roll")
+    with pytest.raises(ps.InvalidParameterError, match=r"actuator\.side_gain"):
+        ps.simulate(spec.with_paths({"actuator.side_gain": [1.0, 1.2]}))
+    with pytest.raises(ps.InvalidParameterError, match=r"body\.set_points\[0\]\.input"):
+        ps.simulate(ps.flight.with_body(spec, set_points=[{"input": "side_gain_left", "times_ms": [0.0], "values": [0.1]}]))
+    dual = spec.replace(drivetrain=ps.spec.Drivetrain.dual_four_bar())
+    with pytest.raises(ps.InvalidParameterError, match=r"body\.control\.input"):
+        ps.simulate(ps.flight.with_body(dual, control={"input": "log_q3", "kp": 1.0}))
+
+
+def test_animation_writes_mp4_with_ffmpeg_and_falls_back_to_gif(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from paritysim.flight import plots as fplots
+
+    run = ps.simulate(_spec(mode="free"), record_cycles=1, samples_per_cycle=12)
+    if fplots.ffmpeg_path() is not None:
+        mp4 = fplots.animate(run.trajectory, tmp_path / "a.mp4", frames=6)
+        assert mp4.suffix == ".mp4" and mp4.read_bytes()[4:8] == b"ftyp"
+    monkeypatch.setattr(fplots, "ffmpeg_path", lambda: None)
+    with pytest.warns(UserWarning, match="no ffmpeg"):
+        gif = fplots.animate(run.trajectory, tmp_path / "b.mp4", frames=6)
+    assert gif.name == "b.gif" and gif.read_bytes()[:6] in (b"GIF87a", b"GIF89a")

@@ -182,8 +182,9 @@ def test_flight_trials_write_claims_figures_and_an_animation(reproduced: Path) -
         found, _ = cl.load(reproduced / f"{trial}.claims.json")
         assert found and all(c.ok is not None for c in found), trial
         assert (reproduced / f"{trial}.png").read_bytes()[:4] == b"\x89PNG"
-    gif = (reproduced / "flight_free_hmf_1cut.gif").read_bytes()
-    assert gif[:6] in (b"GIF87a", b"GIF89a") and len(gif) < 2_000_000
+    # The animation: MP4 when an ffmpeg was found (the `video` extra), else the GIF fallback.
+    movie = next(p for p in (reproduced / "flight_free_hmf_1cut.mp4", reproduced / "flight_free_hmf_1cut.gif") if p.exists()).read_bytes()
+    assert (movie[4:8] == b"ftyp" or movie[:6] in (b"GIF87a", b"GIF89a")) and len(movie) < 2_000_000
     report = (reproduced / "report.md").read_text()
     assert "## Beyond the thesis: the §3.4 device in flight" in report
     assert math.isfinite(float(pl.read_csv(reproduced / "flight_trim.csv")["amplitude_v"][0]))

@@ -288,7 +288,8 @@ class Wing(_Node):
 @_from_core
 class Drivetrain(_Tagged):
     """A planar drivetrain (§2.3-2.4), tagged by ``kind`` (the kinds registered in Rust:
-    ``hmf_four_bar``, ``linear_differential``, ``linkage_differential``), with the balance-beam
+    ``hmf_four_bar``, ``linear_differential``, ``linkage_differential``, ``dual_four_bar``: one
+    four-bar and one drive per wing, beyond the thesis), with the balance-beam
     spring ``balance_spring`` K2 (mN·mm/rad) of the 2-DOF kinds. ``.evaluate`` maps actuator
     coordinates to stroke angles through the Rust kinematics.
     """
@@ -302,6 +303,13 @@ class Drivetrain(_Tagged):
         """HMF four-bar (§2.3.1): 400 µm of actuator stroke gives 60° with the defaults (the Rust
         core's; ``None`` takes them)."""
         return cls(kind="hmf_four_bar", crank_mm=crank_mm, rod_mm=rod_mm)  # type: ignore[call-arg]
+
+    @classmethod
+    def dual_four_bar(cls, crank_mm: float | None = None, rod_mm: float | None = None) -> Drivetrain:
+        """One HMF rod-crank and one drive per wing (``q1`` left, ``q2`` right; beyond the
+        thesis): use with ``configuration = "drag_parity"``; ``actuator.side_gain`` and
+        ``actuator.side_offset_v`` scale each side's drive."""
+        return cls(kind="dual_four_bar", crank_mm=crank_mm, rod_mm=rod_mm)  # type: ignore[call-arg]
 
     @classmethod
     def linear_differential(cls, transmission_ratio: float, arm_length_mm: float, arm_ratio: float | None = None, balance_spring: float | None = None, **deprecated: float) -> Drivetrain:

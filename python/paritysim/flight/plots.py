@@ -1,5 +1,7 @@
 """Pictures of free flight: attitude and position against time, the 3-D trajectory of the
-centre of mass, and an animation of body and wings (GIF through matplotlib's PillowWriter).
+centre of mass, and an animation of body and wings (MP4 through matplotlib's FFMpegWriter when
+an ffmpeg binary is found, from the optional ``video`` extra's ``imageio-ffmpeg`` or the
+system's ``PATH``; GIF through PillowWriter otherwise, or when asked for a ``.gif``).
 
 Every function takes flight trajectories (``SimulationResult.trajectory`` of a spec with a
 ``body`` section, or frames with the same columns) keyed by a label, and returns a matplotlib
@@ -17,7 +19,23 @@ from matplotlib.figure import Figure
 
 from . import tilt_angle, twist_angle
 
-__all__ = ["animate", "attitude", "trajectory_3d"]
+__all__ = ["animate", "attitude", "ffmpeg_path", "trajectory_3d"]
+
+
+def ffmpeg_path() -> str | None:
+    """An ffmpeg binary for MP4: ``imageio_ffmpeg``'s (``pip install paritysim[video]``), else
+    one on ``PATH``; None without either."""
+    import shutil
+
+    try:
+        import imageio_ffmpeg  # type: ignore[import-not-found,unused-ignore]
+
+        exe = imageio_ffmpeg.get_ffmpeg_exe()
+        if exe:
+            return str(exe)
+    except (ImportError, RuntimeError):
+        pass
+    return shutil.which("ffmpeg")
 
 
 def _wingbeats(df: pl.DataFrame, period_ms: float) -> np.ndarray:
@@ -106,15 +124,29 @@ def _body_axis(df: pl.DataFrame, k: int) -> np.ndarray:
 
 
 def animate(df: pl.DataFrame, path: str | Path, *, shoulders_mm: tuple[tuple[float, float, float], ...] = ((6.0, 0.0, -1.5), (6.0, 0.0, 1.5)), span_mm: float = 16.0, body_mm: float = 18.0, frames: int = 60, fps: int = 15, dpi: int = 60, title: str = "") -> Path:
-    """A GIF of the body (black: a stick along x̂ through the centre of mass) and both wings
+    """An animation of the body (black: a stick along x̂ through the centre of mass) and both wings
     (left blue, right red; schematic: the leading edge turned by the stroke φ about x̂ from
     ±ẑ, a chord turned by the rotation ψ), ``frames`` instants evenly over the trajectory, in a
-    box that follows the centre of mass (grey: its path so far; dashed: world up). Written with
-    matplotlib's PillowWriter; returns ``path``."""
+    box that follows the centre of mass (grey: its path so far; dashed: world up).
+
+    The format follows ``path``'s suffix: ``.mp4`` through matplotlib's FFMpegWriter (H.264)
+    when :func:`ffmpeg_path` finds a binary; without one a ``UserWarning`` says so and the GIF
+    is written next to it (``path`` with the suffix ``.gif``); any other suffix is a GIF
+    (PillowWriter). Returns the path written."""
+    import warnings
+
     import matplotlib.pyplot as plt
-    from matplotlib.animation import FuncAnimation, PillowWriter
+    from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
 
     path = Path(path)
+    ffmpeg = ffmpeg_path() if path.suffix.lower() == ".mp4" else None
+    if path.suffix.lower() == ".mp4" and ffmpeg is None:
+        warnings.warn(
+            f"no ffmpeg found for {path.name} (pip install 'paritysim[video]' for imageio-ffmpeg's, or put ffmpeg on PATH): writing a GIF instead",
+            UserWarning,
+            stacklevel=2,
+        )
+        path = path.with_suffix(".gif")
     path.parent.mkdir(parents=True, exist_ok=True)
     idx = np.linspace(0, len(df) - 1, frames).astype(int)
     rot = _rotations(df)
@@ -161,7 +193,16 @@ def animate(df: pl.DataFrame, path: str | Path, *, shoulders_mm: tuple[tuple[flo
         label.set_text(f"{title}\nt = {t[i]:.1f} ms" if title else f"t = {t[i]:.1f} ms")
 
     anim = FuncAnimation(fig, draw, frames=len(idx))
-    anim.save(path, writer=PillowWriter(fps=fps), dpi=dpi)
+    if ffmpeg is not None:
+        import matplotlib as mpl
+
+        with mpl.rc_context({"animation.ffmpeg_path": ffmpeg}):
+            # yuv420p: the pixel format every player decodes (matplotlib crops h264 frames to
+            # even sizes itself).
+            writer = FFMpegWriter(fps=fps, codec="h264", extra_args=["-pix_fmt", "yuv420p"])
+            anim.save(path, writer=writer, dpi=dpi)
+    else:
+        anim.save(path, writer=PillowWriter(fps=fps), dpi=dpi)
     plt.close(fig)
     return path
 

@@ -16,8 +16,9 @@ mass: ``crates/spec/src/body.rs`` gives the sources and assumptions) and release
 3. The same with a **gravity pendulum on the PARITY pivot** (``body.mechanisms``), both signs
    of its moment.
 4. **Eq. 5.1 in flight**: the symmetric device (both wings the Table 3.3 left wing), PARITY
-   trimmed, whippletree pivot biased to ``τL/τR = q3`` (arm ratio ``hL/hR = 1/q3``, §2.4.2),
-   on the torque stand (mean and peak roll torques) and on the roll gimbal (mean roll rate).
+   trimmed: a constant q3 (pivot arm ratio ``hL/hR = 1/q3``, §2.4.2), a stroke-synchronous q3
+   (``log_q3`` set point, q3 and 1/q3 on the two half-strokes) and a rate controller on the
+   synchronous q3's amplitude, on the torque stand and on the roll gimbal.
 
 All numbers are computed here; the thesis has no flight results to compare with, so every claim
 is a physical expectation stated before the run, with its computed verdict.
@@ -50,6 +51,11 @@ class Params:
     samples_per_cycle: int = 20
     pendulum_moment_mg_mm: float = 1000.0  # m·l of the pivot pendulum: deliberately large (10 mg on 100 mm), to give it authority
     q3: tuple[float, ...] = (0.5, 2.0)  # τL/τR set points of eq. 5.1
+    sync_q3: float = 1.2  # the stroke-synchronous q3 (1/q3 on the other half-stroke)
+    spring_k2: float = 100.0  # balance spring (mN·mm/rad) of the open-loop synchronous run: without one the strokes slide freely
+    target_rates: tuple[float, ...] = (2e-3, -2e-3, 5e-3)  # rad/ms held by the rate controller
+    rate_kd: float = 10.0  # ln q3 amplitude per rad/ms of rate error
+    control_rate_hz: float = 1000.0
     tilt_limit_deg: float = 30.0  # "tumbled": the stroke axis tipped this far
     animation_wingbeats: int = 12
     animation_frames: int = 60
@@ -159,6 +165,7 @@ def _attitude_frame(result, study: str, case: str, mode: str) -> pl.DataFrame:  
             "pitch_deg": np.degrees(flight.twist_angle(df, "pitch")),
             "tilt_deg": np.degrees(flight.tilt_angle(df)),
             "omega_roll": df["body_omega_roll"].to_numpy(),
+            "q2": df["q2"].to_numpy() if "q2" in df.columns else np.zeros(len(df)),
             "x_mm": df["body_x"].to_numpy(),
             "y_mm": df["body_y"].to_numpy(),
             "z_mm": df["body_z"].to_numpy(),
@@ -191,46 +198,125 @@ def cut_wing(**overrides: Any) -> tuple[pl.DataFrame, dict[str, Any]]:
     return pl.concat(frames), free
 
 
+def _slide(df: pl.DataFrame, spec) -> tuple[float, float]:  # type: ignore[no-untyped-def]
+    """``(turn, slide)`` (rad) over a roll-gimbal run: the body's roll and ``T L Δq2``, the
+    strokes' differential shift on the linear differential (``φL − φR = 2 T L q2`` with
+    ``L`` the mean arm): equal when the body turns under wings that stay put in the world."""
+    from .. import flight
+
+    roll = flight.twist_angle(df, "roll")
+    q2 = df["q2"].to_numpy()
+    d = spec.drivetrain
+    return float(roll[-1] - roll[0]), float(d.transmission_ratio * d.arm_length_mm * (q2[-1] - q2[0]))
+
+
+def _reversals(stand) -> tuple[float, float]:  # type: ignore[no-untyped-def]
+    """Phases (ms into the drive period, from the release) where the right stroke rate turns
+    positive and negative on the clamped orbit (linear interpolation between samples)."""
+    df = stand.trajectory
+    t, w = df["time_ms"].to_numpy(), df["right_phi_dot"].to_numpy()
+    out = {}
+    for i in np.flatnonzero(np.sign(w[:-1]) != np.sign(w[1:])):
+        s = w[i] / (w[i] - w[i + 1])
+        out[bool(w[i + 1] > 0)] = float((t[i] + s * (t[i + 1] - t[i]) - t[0]) % stand.period_ms)
+    return out[True], out[False]
+
+
+def stroke_synchronous(u: float, phases: tuple[float, float], period_ms: float, input: str = "log_q3") -> dict[str, Any]:
+    """A periodic step schedule: ``+u`` while the right stroke angle grows, ``−u`` on its
+    return (``ln q3 = ±u``: q3 = e^u on one half-stroke, 1/q3 on the other)."""
+    up, down = phases
+    times, values = ([up, down], [u, -u]) if up < down else ([down, up], [-u, u])
+    return {"input": input, "times_ms": times, "values": values, "interpolation": "previous", "period_ms": period_ms}
+
+
+def _quarters(df: pl.DataFrame) -> list[float]:
+    """Mean roll rate (rad/ms) over each quarter of the whole wingbeats."""
+    w = df["body_omega_roll"].to_numpy()[:-1]
+    n = len(w)
+    return [float(w[k * n // 4 : (k + 1) * n // 4].mean()) for k in range(4)]
+
+
 def eq_5_1(**overrides: Any) -> tuple[pl.DataFrame, pl.DataFrame]:
-    """Study 4: per q3 (and 1), the symmetric PARITY at its trim: stand cycle-mean and peak
-    roll torques per wing, the stand's peak ratio τL/τR, and on the roll gimbal the mean roll
-    rate over the first half and the last quarter of the run and the final roll (twist) angle.
-    Returns that table and the roll-gimbal attitude traces."""
+    """Study 4, one row per case of the symmetric PARITY at its trim (``case`` column):
+
+    * ``constant`` (q3 = 1, and each of ``q3``; the pivot's arm ratio hL/hR = 1/q3, §2.4.2):
+      stand cycle-mean and peak roll torques per wing and their peak ratio; on the roll gimbal
+      the mean roll rate per quarter of the run, the turn and the whippletree slide T L Δq2;
+    * ``synchronous`` (ln q3 = ±ln ``sync_q3`` on the two half-strokes, the centred pivot):
+      the stand's cycle-mean roll torque; open loop on the roll gimbal with a balance spring
+      ``spring_k2`` (the free whippletree lets the body spin up while the strokes slide);
+    * ``rate`` (each of ``target_rates``): a PD at ``control_rate_hz`` on the roll rate setting
+      the amplitude of the stroke-synchronous ``ln q3`` (eq. 5.1 as a rate command).
+
+    Returns that table and the roll-gimbal traces (``case``, ``label``)."""
     from .. import flight
     from ..simulation import simulate
 
     p = params(**overrides)
     actuator = _trim("PARITY", symmetric=True).spec.actuator
     rows, traces = [], []
+
+    def trace(r, case: str, label: str) -> None:  # type: ignore[no-untyped-def]
+        traces.append(_attitude_frame(r, "eq5.1", label, "roll").with_columns(pl.lit(case).alias("kind"), pl.lit(label).alias("label")))
+
+    def gimbal(spec, label: str, case: str, **body: Any) -> dict[str, Any]:  # type: ignore[no-untyped-def]
+        r = _fly(spec, "roll", p.wingbeats, p.samples_per_cycle, **body)
+        df = r.trajectory
+        trace(r, case, label)
+        turn, slide = _slide(df, spec)
+        q = _quarters(df)
+        q2 = df["q2"].to_numpy()
+        return dict(rate_q1=q[0], rate_q2=q[1], rate_q3=q[2], rate_q4=q[3], turn_rad=turn, slide_rad=slide, q2_travel=float(q2[-1] - q2[0]), q2_max=float(np.abs(q2).max()), q2_last_quarter=float(q2[:-1][3 * (len(q2) - 1) // 4 :].mean()))
+
     for q3 in (1.0, *p.q3):
         spec = symmetric_device("PARITY", q3).replace(actuator=actuator)
         stand = simulate(flight.with_body(spec, mode="clamped"))
         cyc = stand.cycle[:-1]
         left = (cyc["left_roll_aero"] + cyc["left_roll_inertial"]).to_numpy()
         right = (cyc["right_roll_aero"] + cyc["right_roll_inertial"]).to_numpy()
-        r = _fly(spec, "roll", p.wingbeats, p.samples_per_cycle)
-        df = r.trajectory
-        traces.append(_attitude_frame(r, "eq5.1", f"q3 = {q3:g}", "roll").with_columns(pl.lit(q3).alias("q3")))
-        w = df["body_omega_roll"].to_numpy()[:-1]  # whole wingbeats (the last sample closes one)
-        half, quarter = len(w) // 2, 3 * len(w) // 4
         rows.append(
             dict(
+                case="constant",
+                label=f"q3 = {q3:g}",
                 q3=q3,
-                arm_ratio=1.0 / q3,
                 stand_roll_mean=float(stand.metrics["body_torque_roll_mean"]),
-                stand_yaw_mean=float(stand.metrics["body_torque_yaw_mean"]),
-                stand_peak_left=float(np.abs(left).max()),
-                stand_peak_right=float(np.abs(right).max()),
+                stand_peak=float(np.abs(cyc["body_torque_roll"].to_numpy()).max()),
                 stand_peak_ratio=float(np.abs(left).max() / np.abs(right).max()),
-                roll_rate_first_half=float(w[:half].mean()),
-                roll_rate_last_quarter=float(w[quarter:].mean()),
-                q2_first_wingbeat=float(df["q2"].to_numpy()[: p.samples_per_cycle].mean()),
-                q2_last_quarter=float(df["q2"].to_numpy()[:-1][quarter:].mean()),
-                roll_rate_mean=float(r.metrics["body_omega_roll_mean"]),
-                roll_final_deg=float(np.degrees(flight.twist_angle(df, "roll")[-1])),
+                **gimbal(spec, f"q3 = {q3:g}", "constant"),
             )
         )
-    return pl.DataFrame(rows), pl.concat(traces)
+    centred = symmetric_device("PARITY").replace(actuator=actuator)
+    stand = simulate(flight.with_body(centred, mode="clamped"), samples_per_cycle=200)
+    phases, period = _reversals(stand), stand.period_ms
+    sprung = centred.with_paths({"drivetrain.balance_spring": p.spring_k2})
+    sprung_phases = _reversals(simulate(flight.with_body(sprung, mode="clamped"), samples_per_cycle=200))
+    for q3 in (p.sync_q3, 1.0 / p.sync_q3):
+        u = math.log(q3)
+        s = simulate(flight.with_body(centred, mode="clamped", set_points=[stroke_synchronous(u, phases, period)]), samples_per_cycle=p.samples_per_cycle)
+        rows.append(
+            dict(
+                case="synchronous",
+                label=f"q3 = {q3:.3g} / {1 / q3:.3g}, K2 = {p.spring_k2:g}",
+                q3=q3,
+                stand_roll_mean=float(s.metrics["body_torque_roll_mean"]),
+                stand_peak=float(np.abs(s.cycle["body_torque_roll"].to_numpy()).max()),
+                **gimbal(sprung, f"synchronous q3 = {q3:.3g}, K2 = {p.spring_k2:g}", "synchronous", set_points=[stroke_synchronous(u, sprung_phases, period)]),
+            )
+        )
+    for target in p.target_rates:
+        control = {
+            "input": "log_q3",
+            "axis": "roll",
+            "kp": 0.0,
+            "kd": p.rate_kd,
+            "target_rate_rad_per_ms": target,
+            "rate_hz": p.control_rate_hz,
+            "limit": 0.5,
+            "shape": {k: v for k, v in stroke_synchronous(1.0, phases, period).items() if k != "input"},
+        }
+        rows.append(dict(case="rate", label=f"hold {1e3 * target:+g} rad/s", target_rate=target, **gimbal(centred, f"hold {1e3 * target:+g} rad/s", "rate", control=control)))
+    return pl.from_dicts(rows, infer_schema_length=None), pl.concat(traces, how="diagonal")
 
 
 # ---------------------------------------------------------------- claims
@@ -341,44 +427,80 @@ def cut_claims(df: pl.DataFrame, p: Params) -> tuple[list[Claim], dict[str, floa
 
 def eq_5_1_claims(df: pl.DataFrame) -> list[Claim]:
     """Study 4's claims on :func:`eq_5_1`'s table."""
-    rows = {r["q3"]: r for r in df.iter_rows(named=True)}
-    base = rows[1.0]
-    biased = [q for q in rows if q != 1.0]
-    peak = max(max(r["stand_peak_left"], r["stand_peak_right"]) for r in rows.values())
+    by = {case: {r["label"]: r for r in df.filter(pl.col("case") == case).iter_rows(named=True)} for case in ("constant", "synchronous", "rate")}
+    const = {r["q3"]: r for r in by["constant"].values()}
+    base = const[1.0]
+    biased = [q for q in const if q != 1.0]
+    peak = max(r["stand_peak"] for r in const.values())
+    deg = math.degrees
+    sync = list(by["synchronous"].values())
+    rate = list(by["rate"].values())
+    fmt_q = lambda r: "/".join(f"{1e3 * r[f'rate_q{k}']:+.2f}" for k in range(1, 5))  # noqa: E731
+    slide_ok = lambda r: abs(r["turn_rad"] - r["slide_rad"]) < 0.25 * abs(r["turn_rad"])  # noqa: E731
     claims = [
-        Claim.all_between("the stand sees τL/τR = q3 (peak roll torques, eq. 5.1)", {f"q3 = {q:g}": rows[q]["stand_peak_ratio"] / q for q in biased}, 0.95, 1.05, thesis="τL/τR = q3", fmt=".3f",
+        Claim.all_between("the stand sees τL/τR = q3 (peak roll torques, eq. 5.1)", {f"q3 = {q:g}": const[q]["stand_peak_ratio"] / q for q in biased}, 0.95, 1.05, thesis="τL/τR = q3", fmt=".3f",
                           note="shown: measured ratio / q3"),
         Claim.holds(
             "... and no cycle-mean roll torque (§2.4.2: the imbalance gives a zero-averaged roll oscillation)",
-            all(abs(rows[q]["stand_roll_mean"]) < 1e-2 * peak for q in biased),
-            computed=", ".join(f"q3 = {q:g}: {rows[q]['stand_roll_mean']:+.1e} mN·mm" for q in biased) + f" (peak {peak:.2f})",
+            all(abs(const[q]["stand_roll_mean"]) < 1e-2 * peak for q in biased),
+            computed=", ".join(f"q3 = {q:g}: {const[q]['stand_roll_mean']:+.1e} mN·mm" for q in biased) + f" (peak {peak:.2f})",
             criterion="|mean| < 1 % of the peak roll torque",
             thesis="“does not lead to an average roll torque”",
         ),
         Claim.holds(
-            "in flight (roll gimbal) q3 ≠ 1 turns the body, q3 = 1 does not",
-            all(abs(rows[q]["roll_final_deg"]) > 30.0 for q in biased) and abs(base["roll_final_deg"]) < 1e-6,
-            computed=", ".join(f"q3 = {q:g}: {rows[q]['roll_final_deg']:+.0f}°" for q in biased) + f"; q3 = 1: {base['roll_final_deg']:+.1e}°",
-            criterion="|roll| > 30° after the run for q3 ≠ 1, < 1e-6° for q3 = 1",
+            "in flight (roll gimbal) a constant q3 ≠ 1 turns the body, q3 = 1 does not, q3 ↔ 1/q3 mirrored",
+            all(abs(deg(const[q]["turn_rad"])) > 30.0 for q in biased) and abs(deg(base["turn_rad"])) < 1e-6
+            and abs(const[biased[0]]["turn_rad"] + const[biased[1]]["turn_rad"]) < 1e-3 * abs(const[biased[0]]["turn_rad"]),
+            computed=", ".join(f"q3 = {q:g}: {deg(const[q]['turn_rad']):+.0f}°" for q in biased) + f"; q3 = 1: {deg(base['turn_rad']):+.1e}°",
+            criterion="|turn| > 30° for q3 ≠ 1, < 1e-6° for q3 = 1; q3 and 1/q3 opposite within 0.1 %",
             thesis="§5.1: control by biasing the set point",
         ),
         Claim.holds(
-            "... in the direction of the stand's mean roll torque, mirrored by q3 ↔ 1/q3",
-            all(np.sign(rows[q]["roll_final_deg"]) == np.sign(rows[q]["stand_roll_mean"]) for q in biased)
-            and abs(rows[biased[0]]["roll_final_deg"] + rows[biased[1]]["roll_final_deg"]) < 1e-3 * abs(rows[biased[0]]["roll_final_deg"]),
-            computed=", ".join(f"q3 = {q:g}: stand {rows[q]['stand_roll_mean']:+.1e} mN·mm, roll {rows[q]['roll_final_deg']:+.1f}°" for q in biased),
-            criterion="signs equal; q3 and 1/q3 opposite within 0.1 %",
-            thesis="(beyond the thesis)",
+            "... but no sustained roll rate (the constant q3's average roll torque is zero)",
+            all(abs(const[q]["rate_q4"]) < 0.2 * max(abs(const[q][f"rate_q{k}"]) for k in (1, 2, 3)) for q in biased),
+            computed="mean roll rate per quarter of the run (rad/s): " + "; ".join(f"q3 = {q:g}: {fmt_q(const[q])}" for q in biased),
+            criterion="|last quarter| < 20 % of the largest earlier quarter",
+            thesis="§2.4.2: “a zero-averaged roll oscillation”",
         ),
         Claim.holds(
-            "... at a sustained roll rate (eq. 5.1 as a rate command)",
-            all(abs(rows[q]["roll_rate_last_quarter"]) > 0.2 * abs(rows[q]["roll_rate_first_half"]) and np.sign(rows[q]["roll_rate_first_half"]) == np.sign(rows[q]["roll_rate_last_quarter"]) for q in biased),
-            computed=", ".join(f"q3 = {q:g}: {1e3 * rows[q]['roll_rate_first_half']:+.2f} rad/s (first half) → {1e3 * rows[q]['roll_rate_last_quarter']:+.2f} rad/s (last quarter)" for q in biased),
-            criterion="the last quarter's mean rate keeps its sign and > 20 % of the first half's",
-            thesis="(issue 17's expectation)",
-            note="cf. §2.4.2: a constant torque-ratio bias 'does not lead to an average roll torque'. The turn comes with the whippletree's slow drift "
-            "(no balance spring): q2 " + ", ".join(f"{rows[q]['q2_first_wingbeat']:+.3f} → {rows[q]['q2_last_quarter']:+.3f} rad (q3 = {q:g})" for q in biased)
-            + "; a shift of q2 turns both wings' stroke means the same way about x̂ (a likely mechanism, not separately tested)",
+            "the turn is the whippletree sliding: the body turns under wings that stay put (turn ≈ T L Δq2)",
+            all(slide_ok(const[q]) for q in biased),
+            computed="; ".join(f"q3 = {q:g}: turn {const[q]['turn_rad']:+.2f} rad, T L Δq2 {const[q]['slide_rad']:+.2f} rad (Δq2 {const[q]['q2_travel']:+.3f} rad)" for q in biased),
+            criterion="|turn − T L Δq2| < 25 % of |turn|",
+            thesis="(beyond the thesis: the free whippletree is a zero-stiffness roll mode)",
+            note="the strokes' differential φL − φR = 2 T L q2 is a body roll relative to the wings; no balance spring holds it",
+        ),
+        Claim.holds(
+            "a stroke-synchronous q3 (q3 on one half-stroke, 1/q3 on the other) has a cycle-mean roll torque, mirrored by q3 ↔ 1/q3",
+            all(abs(r["stand_roll_mean"]) > 0.05 * r["stand_peak"] for r in sync) and abs(sync[0]["stand_roll_mean"] + sync[1]["stand_roll_mean"]) < 1e-6 * abs(sync[0]["stand_roll_mean"]),
+            computed=", ".join(f"q3 = {r['q3']:.3g}: mean {r['stand_roll_mean']:+.3f} of peak {r['stand_peak']:.2f} mN·mm" for r in sync),
+            criterion="|mean| > 5 % of the peak; the two means opposite within 1e-6",
+            thesis="§2.4.2: “combination with a split-cycle control strategy”",
+        ),
+        Claim.holds(
+            f"... which with a balance spring turns the body, then settles into a static whippletree deflection (no sustained rate open loop)",
+            all(abs(r["rate_q4"]) < 0.1 * abs(r["rate_q1"]) and abs(r["q2_last_quarter"]) > 0.01 for r in sync),
+            computed="; ".join(f"q3 = {r['q3']:.3g}: rate per quarter {fmt_q(r)} rad/s, q2 late {r['q2_last_quarter']:+.3f} rad" for r in sync),
+            criterion="|last quarter| < 10 % of the first; |late q2| > 0.01 rad",
+            thesis="(beyond the thesis)",
+            note="the mean torque is internal (airframe against wings): the spring takes it",
+        ),
+        Claim.holds(
+            "a rate controller on the stroke-synchronous q3 holds a commanded roll rate (eq. 5.1 as a rate command)",
+            all(all(abs(r[f"rate_q{k}"] - r["target_rate"]) < 0.2 * abs(r["target_rate"]) for k in (2, 3, 4)) for r in rate),
+            computed="; ".join(f"{r['label']}: {fmt_q(r)} rad/s" for r in rate),
+            criterion="each quarter after the first within 20 % of the target",
+            thesis="§5.1: long-timescale control through eq. 5.1",
+            note="a proportional loop on the rate: what remains is its droop",
+        ),
+        Claim.holds(
+            "... mirrored, and by sliding the body under the wings: a sustained turn costs whippletree travel",
+            all(slide_ok(r) for r in rate)
+            and abs(sum(r["rate_q4"] for r in rate if abs(abs(r["target_rate"]) - abs(rate[0]["target_rate"])) < 1e-15)) < 1e-6 * abs(rate[0]["rate_q4"]),
+            computed="; ".join(f"{r['label']}: turn {r['turn_rad']:+.2f} rad, T L Δq2 {r['slide_rad']:+.2f} rad (Δq2 {r['q2_travel']:+.3f} rad)" for r in rate),
+            criterion="|turn − T L Δq2| < 25 % of |turn|; ±target last quarters opposite within 1e-6",
+            thesis="(beyond the thesis)",
+            note="so the linkage's q2 range (|q2| < π/2) and the strokes' range bound how far the body can turn this way",
         ),
     ]
     return claims
@@ -420,24 +542,34 @@ def _fig_cut(df: pl.DataFrame, p: Params):  # type: ignore[no-untyped-def]
     return fig
 
 
-def _fig_eq_5_1(traces: pl.DataFrame):  # type: ignore[no-untyped-def]
+def _fig_eq_5_1(traces: pl.DataFrame, df: pl.DataFrame):  # type: ignore[no-untyped-def]
     import matplotlib.pyplot as plt
 
-    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 4.2), constrained_layout=True)
-    for i, q3 in enumerate(sorted(set(traces["q3"].to_list()))):
-        tr = traces.filter(pl.col("q3") == q3)
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.2), constrained_layout=True)
+    titles = {"constant": "constant q3 (pivot arm ratio 1/q3)", "synchronous": "stroke-synchronous q3, open loop, with a balance spring", "rate": "rate controller on the synchronous q3"}
+    th = {r["label"]: r["slide_rad"] / r["q2_travel"] if r["q2_travel"] else math.nan for r in df.iter_rows(named=True)}
+    for col, kind in enumerate(("constant", "synchronous", "rate")):
+        sub = traces.filter(pl.col("kind") == kind)
+        for i, label in enumerate(dict.fromkeys(sub["label"].to_list())):
+            tr = sub.filter(pl.col("label") == label)
+            n = tr["wingbeat"].to_numpy()
+            beat, rate = _per_wingbeat(n, 1e3 * tr["omega_roll"].to_numpy())
+            ax[col].plot(beat, rate, color=f"C{i}", label=label)
+        ax[col].set_title(titles[kind], fontsize=10)
+        ax[col].set_xlabel("wingbeats after release")
+        ax[col].grid(alpha=0.3)
+        ax[col].legend(fontsize=7)
+    ax[0].set_ylabel("roll rate, wingbeat mean (rad/s)")
+    # The slide: turn against T L Δq2 for the controlled runs (inset-free: dashed on the right axis).
+    twin = ax[2].twinx()
+    sub = traces.filter(pl.col("kind") == "rate")
+    for i, label in enumerate(dict.fromkeys(sub["label"].to_list())):
+        tr = sub.filter(pl.col("label") == label)
         n = tr["wingbeat"].to_numpy()
-        a.plot(n, tr["roll_deg"], color=f"C{i}", label=f"q3 = τL/τR = {q3:g}")
-        beat, rate = _per_wingbeat(n, 1e3 * tr["omega_roll"].to_numpy())
-        b.plot(beat, rate, color=f"C{i}", label=f"q3 = {q3:g}")
-    a.set_ylabel("body roll (deg)")
-    b.set_ylabel("roll rate, wingbeat mean (rad/s)")
-    for ax in (a, b):
-        ax.set_xlabel("wingbeats after release")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-    a.set_title("eq. 5.1 in flight: symmetric PARITY on a roll gimbal")
-    b.set_title("roll rate (wingbeat means)")
+        twin.plot(n, tr["roll_deg"].to_numpy() - tr["roll_deg"][0], color=f"C{i}", lw=0.8, alpha=0.6)
+        twin.plot(n, np.degrees(th[label] * (tr["q2"].to_numpy() - tr["q2"][0])), color=f"C{i}", lw=0.8, ls=":")
+    twin.set_ylabel("thin: turn; dotted: T L Δq2 (deg)")
+    fig.suptitle("eq. 5.1 in flight: the symmetric PARITY on a roll gimbal")
     return fig
 
 
@@ -480,15 +612,18 @@ def _cli_cut(out: Path) -> list[Path]:
     spec = _trimmed(device_3_4("HMF", "1-Cut"), "HMF")
     per = max(1, p.animation_frames // p.animation_wingbeats)
     anim = _fly(spec, "free", p.animation_wingbeats, 4 * per)
-    written.append(fplots.animate(anim.trajectory, out / "flight_free_hmf_1cut.gif", frames=p.animation_frames, title="HMF, 1-Cut, free"))
+    # MP4 through ffmpeg (imageio-ffmpeg's binary or a system one), else the GIF it falls back to.
+    movie = fplots.animate(anim.trajectory, out / "flight_free_hmf_1cut.mp4", frames=p.animation_frames, title="HMF, 1-Cut, free")
+    written.append(movie)
     claims, values = cut_claims(df, p)
+    values["animation"] = movie.name
     return [*written, write_claims(out, "flight.cut_wing", claims, values)]
 
 
 def _cli_eq_5_1(out: Path) -> list[Path]:
     df, traces = eq_5_1()
     actuator = _trim("PARITY", symmetric=True).spec.actuator
-    written = write_trial(df, out, "flight_eq5_1", _fig_eq_5_1(traces))
+    written = write_trial(df, out, "flight_eq5_1", _fig_eq_5_1(traces, df))
     return [*written, write_claims(out, "flight.eq5.1", eq_5_1_claims(df), {"amplitude_v": actuator.waveform.amplitude_v})]
 
 
@@ -500,7 +635,7 @@ def report_section(out: Path) -> str:
     from ..claims import render
 
     trim_found, tv = results(out, "flight.trim")
-    cut_found, _ = results(out, "flight.cut_wing")
+    cut_found, cv = results(out, "flight.cut_wing")
     eq_found, ev = results(out, "flight.eq5.1")
     p = params()
     return "\n".join(
@@ -540,12 +675,21 @@ def report_section(out: Path) -> str:
             "",
             "![free trajectory](flight_free_trajectory.png)",
             "",
-            f"Animation of the HMF's first {p.animation_wingbeats} free wingbeats (schematic wings): `flight_free_hmf_1cut.gif`.",
+            f"Animation of the HMF's first {p.animation_wingbeats} free wingbeats (schematic wings): `{cv.get('animation', 'flight_free_hmf_1cut.gif')}` "
+            "(MP4 through ffmpeg when one is found, from the optional `video` extra's imageio-ffmpeg or the system; a GIF otherwise).",
             "",
             "### Eq. 5.1 in flight",
             "",
-            f"The symmetric device (both wings the Table 3.3 left wing), PARITY trimmed ({ev['amplitude_v']:.2f} V), pivot biased to "
-            "τL/τR = q3 by the whippletree arm ratio hL/hR = 1/q3 (§2.4.2), on the stand and on a roll gimbal.",
+            f"The symmetric device (both wings the Table 3.3 left wing), PARITY trimmed ({ev['amplitude_v']:.2f} V), on the stand and "
+            f"on a roll gimbal for {p.wingbeats} wingbeats. Three ways to command q3: a **constant** q3 by the pivot's arm ratio "
+            "hL/hR = 1/q3 (§2.4.2); a **stroke-synchronous** q3 (q3 while the right stroke angle grows, 1/q3 on its return: a "
+            "periodic step set point of the `log_q3` input, the whippletree load that holds τL/τR = q3 on the centred pivot); and a "
+            f"**rate controller**, a PD at {p.control_rate_hz:g} Hz on the roll rate setting the amplitude of that synchronous "
+            "ln q3 (`[body.control]` with `target_rate_rad_per_ms` and a `shape`). Findings: a constant q3 has no mean roll "
+            "torque (the thesis' own remark) and turns the body only while the free whippletree slides; the synchronous q3 has a "
+            "mean torque, but it is internal (airframe against wings), so open loop it ends in a whippletree deflection (with a "
+            f"balance spring of {p.spring_k2:g} mN·mm/rad) or in sliding strokes (without); closing the loop on the rate holds a "
+            "commanded roll rate, the body turning under the wings at a whippletree travel of 1/(T L) per radian.",
             "",
             render(eq_found),
             "",
