@@ -94,12 +94,13 @@ def test_dual_drive_fields_are_validated_by_name() -> None:
     """Per-side drive fields need the dual four-bar; side inputs need it; eq. 5.1 needs a
     whippletree: each error names its field."""
     spec = _spec(mode="roll")
-    with pytest.raises(ps.InvalidParameterError, match=r"actuator\.side_gain"):
-        ps.simulate(spec.with_paths({"actuator.side_gain": [1.0, 1.2]}))
-    with pytest.raises(ps.InvalidParameterError, match=r"body\.set_points\[0\]\.input"):
+    sided = spec.with_paths({"actuator.side_gain[1]": 1.2})  # a valid path: the check is the drivetrain's
+    with pytest.raises(ps.InvalidParameterError, match=r"invalid `actuator\.side_gain` = \[1\.0, 1\.2\].*dual_four_bar"):
+        ps.simulate(sided)
+    with pytest.raises(ps.InvalidParameterError, match=r"invalid `body\.set_points\[0\]\.input`"):
         ps.simulate(ps.flight.with_body(spec, set_points=[{"input": "side_gain_left", "times_ms": [0.0], "values": [0.1]}]))
     dual = spec.replace(drivetrain=ps.spec.Drivetrain.dual_four_bar())
-    with pytest.raises(ps.InvalidParameterError, match=r"body\.control\.input"):
+    with pytest.raises(ps.InvalidParameterError, match=r"invalid `body\.control\.input`"):
         ps.simulate(ps.flight.with_body(dual, control={"input": "log_q3", "kp": 1.0}))
 
 

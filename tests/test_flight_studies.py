@@ -188,3 +188,25 @@ def test_flight_trials_write_claims_figures_and_an_animation(reproduced: Path) -
     report = (reproduced / "report.md").read_text()
     assert "## Beyond the thesis: the §3.4 device in flight" in report
     assert math.isfinite(float(pl.read_csv(reproduced / "flight_trim.csv")["amplitude_v"][0]))
+
+
+def test_stroke_synchronous_q3_has_a_mean_roll_torque_a_constant_one_has_none() -> None:
+    """§2.4.2 and the split cycle, from specs: on the stand a constant ln q3 leaves no cycle-mean
+    roll torque (well below 1 % of the synchronous one), the stroke-synchronous ±ln q3
+    (paritysim.trials.flight.stroke_synchronous) has one, and −u mirrors it."""
+    from paritysim.trials import flight as studies
+
+    spec = flight.with_body(_device("PARITY"), mode="clamped")
+    orbit = ps.simulate(spec, samples_per_cycle=200)
+    phases = studies._reversals(orbit)
+    u = float(np.log(1.2))
+
+    def mean(points: list[dict[str, object]]) -> float:
+        return float(ps.simulate(flight.with_body(spec, set_points=points)).metrics["body_torque_roll_mean"])
+
+    constant = mean([{"input": "log_q3", "times_ms": [0.0], "values": [u]}])
+    plus = mean([studies.stroke_synchronous(u, phases, orbit.period_ms)])
+    minus = mean([studies.stroke_synchronous(-u, phases, orbit.period_ms)])
+    assert abs(plus) > 0.1, plus
+    assert abs(constant) < 1e-2 * abs(plus), (constant, plus)
+    assert abs(plus + minus) < 1e-6 * abs(plus), (plus, minus)

@@ -28,7 +28,7 @@ def ffmpeg_path() -> str | None:
     import shutil
 
     try:
-        import imageio_ffmpeg  # type: ignore[import-not-found,unused-ignore]
+        import imageio_ffmpeg  # type: ignore[import-untyped,import-not-found,unused-ignore]
 
         exe = imageio_ffmpeg.get_ffmpeg_exe()
         if exe:

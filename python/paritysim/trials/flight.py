@@ -280,7 +280,7 @@ def eq_5_1(**overrides: Any) -> tuple[pl.DataFrame, pl.DataFrame]:
                 case="constant",
                 label=f"q3 = {q3:g}",
                 q3=q3,
-                stand_roll_mean=float(stand.metrics["body_torque_roll_mean"]),
+                stand_roll_mean=stand.metrics["body_torque_roll_mean"],
                 stand_peak=float(np.abs(cyc["body_torque_roll"].to_numpy()).max()),
                 stand_peak_ratio=float(np.abs(left).max() / np.abs(right).max()),
                 **gimbal(spec, f"q3 = {q3:g}", "constant"),
@@ -299,7 +299,7 @@ def eq_5_1(**overrides: Any) -> tuple[pl.DataFrame, pl.DataFrame]:
                 case="synchronous",
                 label=f"q3 = {q3:.3g} / {1 / q3:.3g}, K2 = {p.spring_k2:g}",
                 q3=q3,
-                stand_roll_mean=float(s.metrics["body_torque_roll_mean"]),
+                stand_roll_mean=s.metrics["body_torque_roll_mean"],
                 stand_peak=float(np.abs(s.cycle["body_torque_roll"].to_numpy()).max()),
                 **gimbal(sprung, f"synchronous q3 = {q3:.3g}, K2 = {p.spring_k2:g}", "synchronous", set_points=[stroke_synchronous(u, sprung_phases, period)]),
             )
@@ -615,8 +615,8 @@ def _cli_cut(out: Path) -> list[Path]:
     # MP4 through ffmpeg (imageio-ffmpeg's binary or a system one), else the GIF it falls back to.
     movie = fplots.animate(anim.trajectory, out / "flight_free_hmf_1cut.mp4", frames=p.animation_frames, title="HMF, 1-Cut, free")
     written.append(movie)
-    claims, values = cut_claims(df, p)
-    values["animation"] = movie.name
+    claims, numbers = cut_claims(df, p)
+    values: dict[str, Any] = {**numbers, "animation": movie.name}
     return [*written, write_claims(out, "flight.cut_wing", claims, values)]
 
 
