@@ -73,3 +73,22 @@ def test_bad_controller_output_and_arguments_name_the_field() -> None:
     fixed = with_body(_spec(), mode="fixed")
     with pytest.raises(ps.InvalidParameterError, match="body.mode"):
         ps.simulate(fixed, controller=lambda t, b: {}, control_rate_hz=500.0)
+
+
+def test_python_controller_drives_eq_5_1_like_the_rust_pd() -> None:
+    """The same PD on roll through ln q3 (eq. 5.1's torque ratio) in Python and in
+    ``[body.control]``: the same trajectory; an input the drivetrain has no place for (a side
+    drive without a dual four-bar) raises naming it."""
+    gains = {"kp": 0.5, "kd": 5.0, "rate_hz": 1000.0, "limit": 0.3}
+    rust = ps.simulate(_spec(control={"input": "log_q3", "axis": "roll", **gains}))
+
+    def controller(t_ms: float, body: dict[str, float]) -> dict[str, float]:
+        u = -gains["kp"] * body["body_roll"] - gains["kd"] * body["body_omega_roll"]
+        return {"log_q3": min(max(u, -gains["limit"]), gains["limit"])}
+
+    python = ps.simulate(_spec(), controller=controller, control_rate_hz=gains["rate_hz"])
+    a, b, c = (r.trajectory["body_roll"].to_numpy() for r in (rust, python, ps.simulate(_spec())))
+    assert np.max(np.abs(a - c)) > 1e-4
+    np.testing.assert_allclose(b, a, rtol=0.0, atol=1e-12)
+    with pytest.raises(ps.InvalidParameterError, match="side_"):
+        ps.simulate(_spec(), controller=lambda t, b: {"side_gain_left": 0.1}, control_rate_hz=500.0)

@@ -80,27 +80,41 @@ class SimulationResult:
 
 
 #: The inputs a Python controller may set (as in ``[[body.set_points]]``): whippletree bias
-#: torque (mN·mm), added actuator force (mN), relative actuator amplitude change (1).
-CONTROL_INPUTS = ("q2_bias", "actuator_offset", "actuator_gain")
+#: torque (mN·mm), added actuator force (mN), relative actuator amplitude change (1), eq. 5.1's
+#: ln q3 (1), and the per-side drives of a ``dual_four_bar`` (relative, mN; ``*_difference``:
+#: +u left, −u right).
+CONTROL_INPUTS = (
+    "q2_bias",
+    "actuator_offset",
+    "actuator_gain",
+    "log_q3",
+    "side_gain_left",
+    "side_gain_right",
+    "side_offset_left",
+    "side_offset_right",
+    "side_gain_difference",
+    "side_offset_difference",
+)
 
 Controller = Callable[[float, dict[str, float]], Mapping[str, float]]
 
 
-def _control_call(controller: Controller) -> Callable[[float, list[tuple[str, float]]], tuple[float, float, float]]:
+def _control_call(controller: Controller) -> Callable[[float, list[tuple[str, float]]], list[tuple[str, float]]]:
     """The callback the core calls: the body state as a dict in, checked inputs out."""
 
-    def call(t_ms: float, values: list[tuple[str, float]]) -> tuple[float, float, float]:
+    def call(t_ms: float, values: list[tuple[str, float]]) -> list[tuple[str, float]]:
         out = controller(t_ms, dict(values))
         if not isinstance(out, Mapping):
             raise invalid("controller", type(out).__name__, f"a dict of {', '.join(CONTROL_INPUTS)}")
+        checked = []
         for name in out:
             if name not in CONTROL_INPUTS:
                 raise invalid(f"controller[{name!r}]", out[name], f"one of {', '.join(CONTROL_INPUTS)}")
-        q2_bias, offset, gain = (real(f"controller[{k!r}]", out.get(k, 0.0)) for k in CONTROL_INPUTS)
-        for k, v in zip(CONTROL_INPUTS, (q2_bias, offset, gain)):
+            v = real(f"controller[{name!r}]", out[name])
             if not math.isfinite(v):
-                raise invalid(f"controller[{k!r}]", v, "a finite number")
-        return q2_bias, offset, gain
+                raise invalid(f"controller[{name!r}]", v, "a finite number")
+            checked.append((str(name), v))
+        return checked
 
     return call
 
@@ -121,8 +135,10 @@ def simulate(
     function ``controller(t_ms, body) -> {input: value}`` called every ``1 / control_rate_hz``
     from the release (zero-order hold in between). ``body`` holds the ``body_*`` trajectory
     columns at ``t_ms`` (``body_roll``, ``body_omega_roll``, ``body_x``, ...); the returned
-    inputs (any of ``q2_bias``, ``actuator_offset``, ``actuator_gain``; missing ones are 0)
-    add to ``[body].set_points`` and ``[body.control]``. Slow: each call crosses into Python
+    inputs (any of :data:`CONTROL_INPUTS`: ``q2_bias``, ``actuator_offset``, ``actuator_gain``,
+    ``log_q3``, the ``side_*`` drives of a ``dual_four_bar``; missing ones are 0) add to
+    ``[body].set_points`` and ``[body.control]``; one the drivetrain has no place for (``side_*``
+    without a dual drivetrain, ``q2_bias`` on one) raises ``InvalidParameterError``. Slow: each call crosses into Python
     and restarts the integrator, so keep the rate low (100-1000 Hz); the Rust PD controller
     (``[body.control]``) is the fast path. An exception raised by ``controller`` stops the run
     and propagates as is.

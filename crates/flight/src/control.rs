@@ -41,6 +41,45 @@ pub enum ControlInput {
 }
 
 impl ControlInput {
+    /// Every input with its spec name (`[[body.set_points]] input = "..."`).
+    pub const NAMES: [(&'static str, ControlInput); 10] = [
+        ("q2_bias", ControlInput::Q2Bias),
+        ("actuator_offset", ControlInput::ActuatorOffset),
+        ("actuator_gain", ControlInput::ActuatorGain),
+        ("log_q3", ControlInput::LogQ3),
+        ("side_gain_left", ControlInput::SideGainLeft),
+        ("side_gain_right", ControlInput::SideGainRight),
+        ("side_offset_left", ControlInput::SideOffsetLeft),
+        ("side_offset_right", ControlInput::SideOffsetRight),
+        ("side_gain_difference", ControlInput::SideGainDifference),
+        ("side_offset_difference", ControlInput::SideOffsetDifference),
+    ];
+
+    /// Inputs from `(name, value)` pairs (an external controller's output), summed per name.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `controller[name]` for an unknown name or a
+    /// non-finite value.
+    pub fn inputs_from_named(pairs: &[(String, f64)]) -> Result<crate::model::Inputs> {
+        let mut inputs = crate::model::Inputs::default();
+        for (name, value) in pairs {
+            let field = format!("controller[{name:?}]");
+            let Some((_, input)) = Self::NAMES.iter().find(|(n, _)| n == name) else {
+                let names: Vec<&str> = Self::NAMES.iter().map(|(n, _)| *n).collect();
+                return Err(Error::invalid(
+                    field,
+                    value,
+                    format!("one of {}", names.join(", ")),
+                ));
+            };
+            if !value.is_finite() {
+                return Err(Error::invalid(field, value, "a finite number"));
+            }
+            input.add_to(&mut inputs, *value);
+        }
+        Ok(inputs)
+    }
+
     /// Whether the input acts through the whippletree of a 2-DOF differential (not a dual
     /// drivetrain): [`ControlInput::Q2Bias`] and [`ControlInput::LogQ3`].
     pub fn needs_whippletree(self) -> bool {
@@ -126,11 +165,7 @@ impl SetPoint {
         }
         for w in times.windows(2) {
             if w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater) {
-                return Err(Error::invalid(
-                    "times_ms",
-                    w[1],
-                    "increasing times",
-                ));
+                return Err(Error::invalid("times_ms", w[1], "increasing times"));
             }
         }
         for v in times.iter().chain(&values) {

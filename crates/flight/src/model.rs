@@ -441,6 +441,26 @@ impl FlightModel {
         };
         let actuator = self.device.spec().actuator.as_ref();
         let dual = self.device.is_dual();
+        // Inputs this drivetrain has no place for are errors, not silently dropped (the spec
+        // checks its own set points and controller; an external controller lands here).
+        let sided = inputs.side_gain != [0.0; 2] || inputs.side_offset != [0.0; 2];
+        if sided && !dual {
+            return Err(Error::invalid(
+                "side_gain/side_offset",
+                format!("{:?}/{:?}", inputs.side_gain, inputs.side_offset),
+                format!(
+                    "0: side_* inputs need a dual_four_bar drivetrain, the drivetrain is {}",
+                    tr.kinematics().name()
+                ),
+            ));
+        }
+        if dual && inputs.q2_bias != 0.0 {
+            return Err(Error::invalid(
+                "q2_bias",
+                inputs.q2_bias,
+                "0: a dual_four_bar has no whippletree (q2 is the right drive)",
+            ));
+        }
         let mut dq = if dual {
             let right = actuator.map_or(0.0, |a| a.side_force(t, 1));
             let common = |f: f64, k: usize| {

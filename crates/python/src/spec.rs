@@ -144,8 +144,9 @@ fn simulate(py: Python<'_>, json: &str) -> PyResult<SimulationOutput> {
 }
 
 /// `simulate` of a flying spec with a Python controller called every `1 / rate_hz` with
-/// `(t_ms, [(body column, value)])` and returning `(q2_bias, actuator_offset,
-/// actuator_gain)` (the facade checks names and values). Its exception is raised as is.
+/// `(t_ms, [(body column, value)])` and returning `[(input name, value)]` (names as in
+/// `[[body.set_points]]`; unknown names and non-finite values raise `InvalidParameterError`).
+/// Its exception is raised as is.
 #[pyfunction]
 fn simulate_controlled(
     py: Python<'_>,
@@ -160,16 +161,12 @@ fn simulate_controlled(
         Python::attach(|py| {
             let values = paritysim_flight::body_values(s);
             let out = controller.bind(py).call1((t, values))?;
-            out.extract::<(f64, f64, f64)>()
+            out.extract::<Vec<(String, f64)>>()
         })
-        .map(
-            |(q2_bias, actuator_offset, actuator_gain)| paritysim_flight::Inputs {
-                q2_bias,
-                actuator_offset,
-                actuator_gain,
-                ..paritysim_flight::Inputs::default()
-            },
-        )
+        .and_then(|pairs| {
+            paritysim_flight::ControlInput::inputs_from_named(&pairs)
+                .map_err(crate::errors::to_pyerr)
+        })
         .map_err(|e| {
             raised = Some(e);
             paritysim_error::Error::Cancelled
