@@ -178,7 +178,7 @@ def test_pivot_bias_q3_and_its_inverse_roll_the_body_oppositely() -> None:
 def test_flight_trials_write_claims_figures_and_an_animation(reproduced: Path) -> None:
     from paritysim import claims as cl
 
-    for trial in ("flight_trim", "flight_cut_wing", "flight_eq5_1"):
+    for trial in ("flight_trim", "flight_cut_wing", "flight_eq5_1", "flight_dual_drive"):
         found, _ = cl.load(reproduced / f"{trial}.claims.json")
         assert found and all(c.ok is not None for c in found), trial
         assert (reproduced / f"{trial}.png").read_bytes()[:4] == b"\x89PNG"

@@ -519,7 +519,20 @@ pub fn fly_controlled(
             next_tick
         };
         let mid = 0.5 * (t + t_leg) - t0;
-        let leg_inputs = |tt: f64| schedule.inputs(tt - t0, mid, output).plus(&extra);
+        // Without linear set points (or a linear shape) the inputs are constant over the leg.
+        let varying = schedule
+            .set_points
+            .iter()
+            .chain(schedule.control.as_ref().and_then(|c| c.shape.as_ref()))
+            .any(|s| s.interpolation == Interpolation::Linear);
+        let held = schedule.inputs(mid, mid, output).plus(&extra);
+        let leg_inputs = |tt: f64| {
+            if varying {
+                schedule.inputs(tt - t0, mid, output).plus(&extra)
+            } else {
+                held
+            }
+        };
         let end = times.partition_point(|&s| s < t_leg);
         let end = if t_leg == t_end { times.len() } else { end };
         let leg_times = &times[next..end];

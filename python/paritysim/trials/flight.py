@@ -19,6 +19,8 @@ mass: ``crates/spec/src/body.rs`` gives the sources and assumptions) and release
    trimmed: a constant q3 (pivot arm ratio ``hL/hR = 1/q3``, §2.4.2), a stroke-synchronous q3
    (``log_q3`` set point, q3 and 1/q3 on the two half-strokes) and a rate controller on the
    synchronous q3's amplitude, on the torque stand and on the roll gimbal.
+5. **One drive per wing** (``dual_four_bar``): trims, and a PD on yaw through the side-gain
+   difference against the 1-Cut wing on the yaw gimbal.
 
 All numbers are computed here; the thesis has no flight results to compare with, so every claim
 is a physical expectation stated before the run, with its computed verdict.
@@ -56,6 +58,8 @@ class Params:
     target_rates: tuple[float, ...] = (2e-3, -2e-3, 5e-3)  # rad/ms held by the rate controller
     rate_kd: float = 10.0  # ln q3 amplitude per rad/ms of rate error
     control_rate_hz: float = 1000.0
+    dual_kp: float = 2.0  # side-gain difference per rad of yaw (sign from the stand)
+    dual_kd: float = 20.0  # per rad/ms
     tilt_limit_deg: float = 30.0  # "tumbled": the stroke axis tipped this far
     animation_wingbeats: int = 12
     animation_frames: int = 60
@@ -506,6 +510,122 @@ def eq_5_1_claims(df: pl.DataFrame) -> list[Claim]:
     return claims
 
 
+# ---------------------------------------------------------------- one drive per wing
+
+
+def dual_device(trial: str, mirrored: bool = False):  # type: ignore[no-untyped-def]
+    """The §3.4 wings on a ``dual_four_bar`` (one four-bar and one drive per wing), started at
+    30 V (the §3.4 100 V would toggle a rod-crank that drives one wing alone); ``mirrored``
+    swaps the wings (the trial's wing on the left)."""
+    from ..spec import Drivetrain
+
+    spec = device_3_4("PARITY", trial)
+    if mirrored:
+        spec = spec.replace(wings=(spec.wings[1], spec.wings[0]))
+    return spec.replace(drivetrain=Drivetrain.dual_four_bar(), name=f"§3.4 dual drive {trial}").with_paths({"actuator.waveform.amplitude_v": 30.0})
+
+
+@functools.lru_cache(maxsize=2)
+def _dual_trim():  # type: ignore[no-untyped-def]
+    from .. import flight
+
+    return flight.trim(dual_device("Uncut"))
+
+
+def dual_drive(**overrides: Any) -> tuple[pl.DataFrame, pl.DataFrame, dict[str, Any]]:
+    """Study 5 (one drive per wing): the dual-drive trim (amplitude and DC offset, Uncut
+    wings), and the 1-Cut right wing at that trim on the yaw gimbal, open loop (and mirrored:
+    the cut wing on the left) and with a PD on yaw driving the side-gain difference (its sign
+    from the stand's slope). Returns the trim row, the attitude frame and the numbers the
+    claims use."""
+    from .. import flight
+    from ..simulation import simulate
+
+    p = params(**overrides)
+    tr = _dual_trim()
+    trims = [dict(trim="dual drive", amplitude_v=tr.knobs["actuator.waveform.amplitude_v"], offset_v=tr.knobs["actuator.waveform.offset_v"], converged=tr.converged, **{f"residual_{k}": v for k, v in tr.residuals.items()}, **{f"scaled_{k}": v for k, v in tr.scaled.items()})]
+    actuator = tr.spec.actuator
+    cut = dual_device("1-Cut").replace(actuator=actuator)
+
+    def stand_yaw(u: float) -> float:
+        r = simulate(flight.with_body(cut, mode="clamped", set_points=[{"input": "side_gain_difference", "times_ms": [0.0], "values": [u]}]))
+        v = r.metrics["body_torque_yaw_mean"]
+        return float("nan") if v is None else float(v)
+
+    slope = (stand_yaw(0.05) - stand_yaw(-0.05)) / 0.1
+    sign = math.copysign(1.0, slope)
+    control = {"input": "side_gain_difference", "axis": "yaw", "kp": sign * p.dual_kp, "kd": sign * p.dual_kd, "rate_hz": p.control_rate_hz, "limit": 0.3}
+    frames = []
+    for case, spec, body in (
+        ("open loop", cut, {}),
+        ("open loop, mirrored", dual_device("1-Cut", mirrored=True).replace(actuator=actuator), {}),
+        ("PD on yaw", cut, {"control": control}),
+    ):
+        r = _fly(spec, "yaw", p.wingbeats, p.samples_per_cycle, **body)
+        frames.append(_attitude_frame(r, "dual", case, "yaw"))
+    return pl.DataFrame(trims), pl.concat(frames), {"slope": slope}
+
+
+def dual_claims(trims: pl.DataFrame, df: pl.DataFrame, values: dict[str, Any], p: Params, tol: float) -> list[Claim]:
+    """Study 5's claims."""
+    by = {r["trim"]: r for r in trims.iter_rows(named=True)}
+    yaw = {case: sub.sort("time_ms")["yaw_deg"].to_numpy() for (case,), sub in df.group_by(["case"])}
+    t = df.filter(pl.col("case") == "open loop").sort("time_ms")["time_ms"].to_numpy()
+    lim = p.tilt_limit_deg
+    t_open = _time_to(np.radians(yaw["open loop"]), t, lim)
+    held = float(np.abs(yaw["PD on yaw"]).max())
+    mirror = float(np.abs(yaw["open loop"] + yaw["open loop, mirrored"]).max())
+    d = by["dual drive"]
+    return [
+        Claim.holds(
+            "trim (dual drive): lift = weight and zero pitch torque",
+            bool(d["converged"]),
+            computed=f"amplitude {d['amplitude_v']:.2f} V, DC {d['offset_v']:+.2g} V; lift − weight {d['residual_lift']:+.1e} mN, pitch {d['residual_pitch']:+.1e}, yaw {d['residual_yaw']:+.2g}, roll {d['residual_roll']:+.1e} mN·mm",
+            criterion=f"each solved residual / scale < {tol:g}",
+            thesis="(beyond the thesis)",
+        ),
+        Claim.holds(
+            "a PD on yaw through the side-gain difference holds a 1-Cut airframe that yaws away open loop",
+            math.isfinite(t_open) and held < 10.0,
+            computed=f"open loop |yaw| > {lim:g}° after {t_open:.0f} ms; PD (stand slope {values['slope']:+.2f} mN·mm per unit gain difference): max |yaw| {held:.2f}° over {p.wingbeats} wingbeats",
+            criterion=f"open loop exceeds {lim:g}°; PD max |yaw| < 10°",
+            thesis="(beyond the thesis: per-side drive control, issue 17)",
+        ),
+        Claim.holds(
+            "the mirrored cut (left wing) yaws the mirrored way",
+            mirror < 1e-6 * float(np.abs(yaw["open loop"]).max()),
+            computed=f"max |yaw_right-cut + yaw_left-cut| = {mirror:.1e}° of {np.abs(yaw['open loop']).max():.0f}°",
+            criterion="< 1e-6 of the excursion",
+            thesis="(mirror symmetry)",
+        ),
+    ]
+
+
+def _fig_dual(df: pl.DataFrame):  # type: ignore[no-untyped-def]
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(8, 3.8), constrained_layout=True)
+    for i, case in enumerate(("open loop", "open loop, mirrored", "PD on yaw")):
+        sub = df.filter(pl.col("case") == case).sort("time_ms")
+        ax.plot(sub["wingbeat"].to_numpy(), sub["yaw_deg"].to_numpy(), color=f"C{i}", label=case)
+    ax.set_yscale("symlog", linthresh=5.0)
+    ax.set_xlabel("wingbeats after release")
+    ax.set_ylabel("body yaw, yaw gimbal (deg)")
+    ax.set_title("one drive per wing: 1-Cut right wing at the Uncut trim")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig
+
+
+def _cli_dual(out: Path) -> list[Path]:
+    p = params()
+    trims, df, values = dual_drive()
+    tol = _dual_trim().tol
+    written = write_trial(df, out, "flight_dual_drive", _fig_dual(df))
+    trims.write_csv(out / "flight_dual_drive_trim.csv")
+    return [*written, out / "flight_dual_drive_trim.csv", write_claims(out, "flight.dual_drive", dual_claims(trims, df, values, p, tol), {"tol": tol})]
+
+
 # ---------------------------------------------------------------- figures, CLI, report
 
 
@@ -627,7 +747,7 @@ def _cli_eq_5_1(out: Path) -> list[Path]:
     return [*written, write_claims(out, "flight.eq5.1", eq_5_1_claims(df), {"amplitude_v": actuator.waveform.amplitude_v})]
 
 
-CLI_TRIALS = {"flight.trim": _cli_trim, "flight.cut_wing": _cli_cut, "flight.eq5.1": _cli_eq_5_1}
+CLI_TRIALS = {"flight.trim": _cli_trim, "flight.cut_wing": _cli_cut, "flight.eq5.1": _cli_eq_5_1, "flight.dual_drive": _cli_dual}
 
 
 def report_section(out: Path) -> str:
@@ -637,6 +757,7 @@ def report_section(out: Path) -> str:
     trim_found, tv = results(out, "flight.trim")
     cut_found, cv = results(out, "flight.cut_wing")
     eq_found, ev = results(out, "flight.eq5.1")
+    dual_found, _ = results(out, "flight.dual_drive")
     p = params()
     return "\n".join(
         [
@@ -694,6 +815,17 @@ def report_section(out: Path) -> str:
             render(eq_found),
             "",
             "![eq. 5.1](flight_eq5_1.png)",
+            "",
+            "### One drive per wing",
+            "",
+            "The §3.4 wings on a `dual_four_bar` drivetrain: each wing its own HMF rod-crank and its own drive (the `[actuator]` "
+            "scaled per side by `side_gain`, shifted by `side_offset_v`), the layout of later dual-actuator robots, for comparison "
+            f"with the passive drivetrains. Trimmed like the others (amplitude and DC offset), then the 1-Cut right wing at the Uncut trim on the yaw gimbal for {p.wingbeats} wingbeats: open loop, "
+            f"mirrored, and with a PD on yaw ({p.control_rate_hz:g} Hz) driving the side-gain difference (+u left, −u right).",
+            "",
+            render(dual_found),
+            "",
+            "![dual drive](flight_dual_drive.png)",
             "",
         ]
     )
