@@ -39,7 +39,9 @@ def _numeric_paths(spec: ps.Simulation) -> list[tuple[str, float]]:
     out = []
     for path, _unit, _allowed, value in ps.spec.spec_paths(spec).rows():
         v = json.loads(value)
-        if isinstance(v, float) and not path.startswith("options.") and math.isfinite(v):
+        # actuator.side_*: per-side drives of a dual_four_bar, [1, 1] / [0, 0] on these bases
+        # (any other value is rejected by design, naming the field).
+        if isinstance(v, float) and not path.startswith(("options.", "actuator.side_")) and math.isfinite(v):
             out.append((path, v))
     return out
 
