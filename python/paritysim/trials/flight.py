@@ -226,12 +226,16 @@ def _reversals(stand) -> tuple[float, float]:  # type: ignore[no-untyped-def]
     return out[True], out[False]
 
 
-def stroke_synchronous(u: float, phases: tuple[float, float], period_ms: float, input: str = "log_q3") -> dict[str, Any]:
+def stroke_synchronous(u: float, phases: tuple[float, float], period_ms: float, input: str | None = "log_q3") -> dict[str, Any]:
     """A periodic step schedule: ``+u`` while the right stroke angle grows, ``−u`` on its
-    return (``ln q3 = ±u``: q3 = e^u on one half-stroke, 1/q3 on the other)."""
+    return (``ln q3 = ±u``: q3 = e^u on one half-stroke, 1/q3 on the other); without a
+    target name (``None``) a controller's ``shape``."""
     up, down = phases
     times, values = ([up, down], [u, -u]) if up < down else ([down, up], [-u, u])
-    return {"input": input, "times_ms": times, "values": values, "interpolation": "previous", "period_ms": period_ms}
+    out: dict[str, Any] = dict(times_ms=times, values=values, interpolation="previous", period_ms=period_ms)
+    if input is not None:
+        out.update(input=input)
+    return out
 
 
 def _quarters(df: pl.DataFrame) -> list[float]:
@@ -310,14 +314,14 @@ def eq_5_1(**overrides: Any) -> tuple[pl.DataFrame, pl.DataFrame]:
         )
     for target in p.target_rates:
         control = {
-            "input": "log_q3",
+            **dict(input="log_q3"),
             "axis": "roll",
             "kp": 0.0,
             "kd": p.rate_kd,
             "target_rate_rad_per_ms": target,
             "rate_hz": p.control_rate_hz,
             "limit": 0.5,
-            "shape": {k: v for k, v in stroke_synchronous(1.0, phases, period).items() if k != "input"},
+            "shape": stroke_synchronous(1.0, phases, period, input=None),
         }
         rows.append(dict(case="rate", label=f"hold {1e3 * target:+g} rad/s", target_rate=target, **gimbal(centred, f"hold {1e3 * target:+g} rad/s", "rate", control=control)))
     return pl.from_dicts(rows, infer_schema_length=None), pl.concat(traces, how="diagonal")
@@ -548,13 +552,13 @@ def dual_drive(**overrides: Any) -> tuple[pl.DataFrame, pl.DataFrame, dict[str, 
     cut = dual_device("1-Cut").replace(actuator=actuator)
 
     def stand_yaw(u: float) -> float:
-        r = simulate(flight.with_body(cut, mode="clamped", set_points=[{"input": "side_gain_difference", "times_ms": [0.0], "values": [u]}]))
+        r = simulate(flight.with_body(cut, mode="clamped", set_points=[dict(input="side_gain_difference", times_ms=[0.0], values=[u])]))
         v = r.metrics["body_torque_yaw_mean"]
         return float("nan") if v is None else float(v)
 
     slope = (stand_yaw(0.05) - stand_yaw(-0.05)) / 0.1
     sign = math.copysign(1.0, slope)
-    control = {"input": "side_gain_difference", "axis": "yaw", "kp": sign * p.dual_kp, "kd": sign * p.dual_kd, "rate_hz": p.control_rate_hz, "limit": 0.3}
+    control = {**dict(input="side_gain_difference"), "axis": "yaw", "kp": sign * p.dual_kp, "kd": sign * p.dual_kd, "rate_hz": p.control_rate_hz, "limit": 0.3}
     frames = []
     for case, spec, body in (
         ("open loop", cut, {}),
@@ -804,7 +808,7 @@ def report_section(out: Path) -> str:
             f"The symmetric device (both wings the Table 3.3 left wing), PARITY trimmed ({ev['amplitude_v']:.2f} V), on the stand and "
             f"on a roll gimbal for {p.wingbeats} wingbeats. Three ways to command q3: a **constant** q3 by the pivot's arm ratio "
             "hL/hR = 1/q3 (§2.4.2); a **stroke-synchronous** q3 (q3 while the right stroke angle grows, 1/q3 on its return: a "
-            "periodic step set point of the `log_q3` input, the whippletree load that holds τL/τR = q3 on the centred pivot); and a "
+            "periodic step set point of `log_q3`, the whippletree load that holds τL/τR = q3 on the centred pivot); and a "
             f"**rate controller**, a PD at {p.control_rate_hz:g} Hz on the roll rate setting the amplitude of that synchronous "
             "ln q3 (`[body.control]` with `target_rate_rad_per_ms` and a `shape`). Findings: a constant q3 has no mean roll "
             "torque (the thesis' own remark) and turns the body only while the free whippletree slides; the synchronous q3 has a "
