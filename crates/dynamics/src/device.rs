@@ -67,6 +67,40 @@ pub enum Formulation {
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct StrokeOnly {
     stroke_inertia: [f64; 2],
+    /// The linear map's constants (None for the linkages).
+    linear: Option<ConstantMap>,
+}
+
+/// A drivetrain with a constant Jacobian (the linear map, eq. 2.15): `φ = J q`, `h = 0` and a
+/// constant `M_q = Σ_k I_k J_kᵀ J_k`, precomputed with the operations of the general
+/// drivetrain step (so the lean right-hand side gives its numbers).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ConstantMap {
+    jacobian: Matrix2<f64>,
+    /// `M_q` entries `(m00, m01, m11)` and `det M_q`.
+    mass: (f64, f64, f64),
+    det: f64,
+}
+
+impl ConstantMap {
+    fn of(kinematics: &Drivetrain, stroke_inertia: [f64; 2]) -> Option<Self> {
+        let Drivetrain::LinearDifferential(map) = kinematics else {
+            return None;
+        };
+        let j = map.evaluate(0.0, 0.0).jacobian;
+        let (mut m00, mut m01, mut m11) = (0.0, 0.0, 0.0);
+        for (k, inertia) in stroke_inertia.iter().enumerate() {
+            let (a, b) = (j[(k, 0)], j[(k, 1)]);
+            m00 += inertia * a * a;
+            m01 += inertia * a * b;
+            m11 += inertia * b * b;
+        }
+        Some(Self {
+            jacobian: j,
+            mass: (m00, m01, m11),
+            det: m00 * m11 - m01 * m01,
+        })
+    }
 }
 
 /// Why a device cannot use drivetrain coordinates (None when it can).
@@ -108,7 +142,10 @@ fn stroke_only(spec: &DeviceSpec) -> std::result::Result<StrokeOnly, String> {
         }
         stroke_inertia[k] = wing.inertia()[(0, 0)];
     }
-    Ok(StrokeOnly { stroke_inertia })
+    Ok(StrokeOnly {
+        stroke_inertia,
+        linear: ConstantMap::of(&tr.kinematics, stroke_inertia),
+    })
 }
 
 /// Everything needed to build a [`Device`].
@@ -145,6 +182,22 @@ pub struct Device {
 /// Stroke angles `(φL, φR)`, their rates and the whippletree angle `q2` (see
 /// [`Device::stroke_state`]).
 pub type StrokeState = (Vector2<f64>, Vector2<f64>, f64);
+
+/// Stroke kinematics and actuator force of a drivetrain-coordinate state (see
+/// [`Device::stroke_motion_unchecked`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct StrokeMotion {
+    /// `(φL, φR)` (rad).
+    pub stroke: Vector2<f64>,
+    /// `(φ̇L, φ̇R)` (rad/ms).
+    pub rate: Vector2<f64>,
+    /// `(φ̈L, φ̈R)` (rad/ms²).
+    pub accel: Vector2<f64>,
+    /// Whippletree angle `q2` (rad).
+    pub q2: f64,
+    /// Actuator force F(t) (mN).
+    pub actuator_force: f64,
+}
 
 /// The drivetrain state recovered from the stroke angles.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -348,6 +401,43 @@ impl Device {
         let (q, q_dot) = self.drive_coordinates(y);
         let e = self.drivetrain().evaluate(q.x, q.y)?;
         Ok((e.stroke, e.jacobian * q_dot, q.y))
+    }
+
+    /// Stroke angles, rates and accelerations `(φ, φ̇, φ̈)`, `q2` and the actuator force of a
+    /// drivetrain-coordinate state (`φ̈ = J q̈ + h`, eq. 2.18 generalised to the drivetrain's
+    /// map): what the body torques of stroke-only wings need, without the mass matrices and
+    /// rotations of [`Self::evaluate_state`].
+    ///
+    /// # Errors
+    /// A drivetrain evaluation outside the linkage's domain; a singular drivetrain mass matrix.
+    #[inline]
+    pub(crate) fn stroke_motion_unchecked(&self, t: f64, y: &State) -> Result<StrokeMotion> {
+        let fast = self
+            .stroke_only
+            .as_ref()
+            .expect("only called for drivetrain-coordinate devices");
+        if let Some(map) = &fast.linear {
+            // φ̈ = J q̈: the linear map has no velocity product.
+            let (q_dot, q_ddot, force, _) = self.linear_map_step(map, t, y)?;
+            let (q, _) = self.drive_coordinates(y);
+            let j = &map.jacobian;
+            return Ok(StrokeMotion {
+                stroke: j * q,
+                rate: j * q_dot,
+                accel: j * q_ddot,
+                q2: q.y,
+                actuator_force: force,
+            });
+        }
+        let step = self.drivetrain_step(fast, t, y)?;
+        let e = &step.eval;
+        Ok(StrokeMotion {
+            stroke: e.stroke,
+            rate: e.jacobian * step.q_dot,
+            accel: e.jacobian * step.q_ddot + e.velocity_product(&step.q_dot),
+            q2: step.q.y,
+            actuator_force: step.force,
+        })
     }
 
     /// Actuator force `F(t)`, drivetrain load `Q = (F − K1 q1, −K2 q2)` and its spring energy
@@ -611,15 +701,67 @@ impl Device {
 
     /// Right-hand side in drivetrain coordinates (see [`Formulation::DrivetrainCoordinates`]).
     fn rhs_drivetrain(&self, fast: &StrokeOnly, t: f64, y: &State, dydt: &mut State) -> Result<()> {
-        let step = self.drivetrain_step(fast, t, y)?;
+        let (q_dot, q_ddot, force, aero_power) = match &fast.linear {
+            Some(map) => self.linear_map_step(map, t, y)?,
+            None => {
+                let step = self.drivetrain_step(fast, t, y)?;
+                (step.q_dot, step.q_ddot, step.force, step.aero_power)
+            }
+        };
         *dydt = State::default();
         for i in 0..self.n_dof {
-            dydt.coords[i] = step.q_dot[i];
-            dydt.rates[i] = step.q_ddot[i];
+            dydt.coords[i] = q_dot[i];
+            dydt.rates[i] = q_ddot[i];
         }
-        dydt.work_actuator = step.force * step.q_dot.x;
-        dydt.work_aero = step.aero_power;
+        dydt.work_actuator = force * q_dot.x;
+        dydt.work_aero = aero_power;
         Ok(())
+    }
+
+    /// [`Self::drivetrain_step`] for the linear map (eq. 2.15) in scalars: `φ = J q`,
+    /// `φ̇ = J q̇`, no velocity product, the constant `M_q` solved by Cramer's rule. The same
+    /// operations in the same order as the general step, without its linkage evaluation,
+    /// Hessians and mass assembly: `(q̇, q̈, F, aerodynamic power)`.
+    #[inline(always)]
+    fn linear_map_step(
+        &self,
+        map: &ConstantMap,
+        t: f64,
+        y: &State,
+    ) -> Result<(Vector2<f64>, Vector2<f64>, f64, f64)> {
+        let (q, q_dot) = self.drive_coordinates(y);
+        if !(q.x.abs() <= paritysim_error::plausible::OFFSET_MM
+            && q.y.abs() <= paritysim_error::plausible::ANGLE_RAD)
+        {
+            // The drivetrain names the implausible coordinate.
+            self.drivetrain().evaluate(q.x, q.y)?;
+        }
+        let j = &map.jacobian;
+        let (force, load, _) = self.drive_load(t, &q);
+        let (mut g0, mut g1) = (load.x, load.y);
+        let mut aero_power = 0.0;
+        for k in 0..2 {
+            let wing = &self.spec.wings[k];
+            let (a, b) = (j[(k, 0)], j[(k, 1)]);
+            let phi = a * q.x + b * q.y;
+            let phi_dot = a * q_dot.x + b * q_dot.y;
+            let tau_aero = wing.aero().stroke_torque(phi_dot);
+            let tau = tau_aero - wing.springs()[0].torque(phi);
+            g0 += a * tau;
+            g1 += b * tau;
+            aero_power += tau_aero * phi_dot;
+        }
+        let (m00, m01, m11) = map.mass;
+        let q_ddot = if self.n_dof == 2 {
+            let det = map.det;
+            if det == 0.0 || !det.is_finite() {
+                return Err(singular_drive(&q));
+            }
+            Vector2::new((m11 * g0 - m01 * g1) / det, (m00 * g1 - m01 * g0) / det)
+        } else {
+            Vector2::new(g0 / m00, 0.0)
+        };
+        Ok((q_dot, q_ddot, force, aero_power))
     }
 
     /// Mechanical energy: kinetic + joint springs + drivetrain springs (µJ).
