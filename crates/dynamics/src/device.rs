@@ -177,6 +177,9 @@ pub struct Device {
     /// Wings whose deviation C holds at zero on an α2 = 90° shoulder: their terms are closed form
     /// ([`Wing::stroke_plane_terms`]).
     stroke_plane: [bool; 2],
+    /// `J⁻¹` of a 2-DOF linear-map drivetrain (eq. 2.15), whose inverse kinematics are then
+    /// closed form.
+    linear_inverse: Option<Matrix2<f64>>,
 }
 
 /// Stroke angles `(φL, φR)`, their rates and the whippletree angle `q2` (see
@@ -303,6 +306,12 @@ impl Device {
                 stroke_plane[w] = theta_held && wing.has_closed_form_stroke_plane();
             }
         }
+        let linear_inverse = match spec.transmission.as_ref().map(|tr| &tr.kinematics) {
+            Some(Drivetrain::LinearDifferential(map)) => {
+                map.evaluate(0.0, 0.0).jacobian.try_inverse()
+            }
+            _ => None,
+        };
         Ok(Self {
             spec,
             n_coords,
@@ -312,6 +321,7 @@ impl Device {
             formulation,
             stroke_only,
             stroke_plane,
+            linear_inverse,
         })
     }
 
@@ -503,6 +513,25 @@ impl Device {
             });
         }
         let target = Vector2::new(p[0], p[3]);
+        if let Some(inverse) = &self.linear_inverse {
+            // The linear map (eq. 2.15) inverted in closed form: q = J⁻¹ φ, q̇ = J⁻¹ φ̇,
+            // τ_φ = J⁻ᵀ Q (no Newton iterations, no LU factorisations).
+            let q = inverse * target;
+            if !(q.x.abs() <= paritysim_error::plausible::OFFSET_MM
+                && q.y.abs() <= paritysim_error::plausible::ANGLE_RAD)
+            {
+                // The drivetrain names the implausible coordinate.
+                dt.evaluate(q.x, q.y)?;
+            }
+            let (force, load, potential) = self.drive_load(t, &q);
+            return Ok(DriveState {
+                q,
+                q_dot: inverse * Vector2::new(p_dot[0], p_dot[3]),
+                actuator_force: force,
+                stroke_torque: inverse.transpose() * load,
+                potential,
+            });
+        }
         let (q, jac) = invert_2dof(dt, &target)?;
         let q_dot = jac
             .lu()
@@ -545,28 +574,20 @@ impl Device {
         // The null-space solve also serves the drivetrain-coordinate devices here (recording).
         let p_ddot = match self.formulation {
             Formulation::NullSpace | Formulation::Auto | Formulation::DrivetrainCoordinates => {
-                let n = self.n_dof;
-                let mut reduced_mass = self.basis.transpose() * mass * self.basis;
-                for i in n..6 {
-                    for j in 0..6 {
-                        reduced_mass[(i, j)] = if i == j { 1.0 } else { 0.0 };
-                        reduced_mass[(j, i)] = if i == j { 1.0 } else { 0.0 };
-                    }
-                }
-                let mut reduced_force = self.basis.transpose() * force;
-                for i in n..6 {
-                    reduced_force[i] = 0.0;
-                }
-                let x_ddot = reduced_mass
-                    .cholesky()
-                    .ok_or_else(|| {
-                        Error::Singular(format!(
-                            "reduced mass matrix is not positive definite at p = {:?}",
-                            p.as_slice()
-                        ))
-                    })?
-                    .solve(&reduced_force);
-                self.basis * x_ddot
+                let solved = match self.n_dof {
+                    1 => self.solve_reduced::<1>(&mass, &force),
+                    2 => self.solve_reduced::<2>(&mass, &force),
+                    3 => self.solve_reduced::<3>(&mass, &force),
+                    4 => self.solve_reduced::<4>(&mass, &force),
+                    5 => self.solve_reduced::<5>(&mass, &force),
+                    _ => self.solve_reduced::<6>(&mass, &force),
+                };
+                solved.ok_or_else(|| {
+                    Error::Singular(format!(
+                        "reduced mass matrix is not positive definite at p = {:?}",
+                        p.as_slice()
+                    ))
+                })?
             }
             Formulation::Projection => {
                 let m_inv = mass.try_inverse().ok_or_else(|| {
@@ -582,6 +603,26 @@ impl Device {
             wings,
             drive,
         })
+    }
+
+    /// `p̈ = N (Nᵀ M N)⁻¹ Nᵀ f` (eq. 3.20 in null-space coordinates) on `n = N` integrated
+    /// coordinates, using that `M` is block diagonal (one 3 × 3 block per wing): the reduced
+    /// matrices are `Σ_w N_wᵀ M_w N_w` and `Σ_w N_wᵀ f_w` of fixed size `N` (unrolled, no dense
+    /// 6 × 6 products, an `N × N` Cholesky). `None` when `Nᵀ M N` is not positive definite.
+    #[inline]
+    fn solve_reduced<const N: usize>(&self, mass: &Mat6, force: &Vec6) -> Option<Vec6> {
+        let mut reduced_mass = nalgebra::SMatrix::<f64, N, N>::zeros();
+        let mut reduced_force = nalgebra::SVector::<f64, N>::zeros();
+        for w in 0..self.n_wings() {
+            let k = 3 * w;
+            let basis_w: nalgebra::SMatrix<f64, 3, N> =
+                self.basis.fixed_view::<3, N>(k, 0).into_owned();
+            let mass_w: nalgebra::Matrix3<f64> = mass.fixed_view::<3, 3>(k, k).into_owned();
+            reduced_mass += basis_w.transpose() * (mass_w * basis_w);
+            reduced_force += basis_w.transpose() * force.fixed_rows::<3>(k);
+        }
+        let x_ddot = reduced_mass.cholesky()?.solve(&reduced_force);
+        Some(self.basis.fixed_columns::<N>(0) * x_ddot)
     }
 
     /// The right-hand side `ẏ = f(t, y)`; also integrates the actuator work and the
