@@ -177,6 +177,9 @@ pub struct Device {
     /// Wings whose deviation C holds at zero on an α2 = 90° shoulder: their terms are closed form
     /// ([`Wing::stroke_plane_terms`]).
     stroke_plane: [bool; 2],
+    /// Wings with a free deviation on an α2 = 90°, α3 = 0 shoulder: closed-form terms
+    /// ([`Wing::free_deviation_terms`]).
+    free_deviation: [bool; 2],
     /// `J⁻¹` of a 2-DOF linear-map drivetrain (eq. 2.15), whose inverse kinematics are then
     /// closed form.
     linear_inverse: Option<Matrix2<f64>>,
@@ -306,6 +309,10 @@ impl Device {
                 stroke_plane[w] = theta_held && wing.has_closed_form_stroke_plane();
             }
         }
+        let mut free_deviation = [false; 2];
+        for (w, wing) in spec.wings.iter().enumerate() {
+            free_deviation[w] = !stroke_plane[w] && wing.has_closed_form_free_deviation();
+        }
         let linear_inverse = match spec.transmission.as_ref().map(|tr| &tr.kinematics) {
             Some(Drivetrain::LinearDifferential(map)) => {
                 map.evaluate(0.0, 0.0).jacobian.try_inverse()
@@ -321,6 +328,7 @@ impl Device {
             formulation,
             stroke_only,
             stroke_plane,
+            free_deviation,
             linear_inverse,
         })
     }
@@ -558,6 +566,11 @@ impl Device {
             let vw = Vector3::new(p_dot[k], p_dot[k + 1], p_dot[k + 2]);
             let terms = if self.stroke_plane[w] {
                 wing.stroke_plane_terms(&pw, &vw)
+            } else if let Some(terms) = self.free_deviation[w]
+                .then(|| wing.free_deviation_terms(&pw, &vw))
+                .flatten()
+            {
+                terms
             } else {
                 wing.terms(&pw, &vw)?
             };
