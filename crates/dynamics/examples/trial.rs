@@ -155,4 +155,30 @@ fn main() {
     let ms = start.elapsed().as_secs_f64() * 1e3 / repeat as f64;
     let n_dof = device.n_dof();
     println!("{ms:.3} ms per trial (checksum {check:.12e}; {n_dof} DOF)");
+    if std::env::var("STATS").is_ok() {
+        // The transient's step counters (the 19 cycles before the recorded one).
+        use paritysim_dynamics::integrate::RungeKutta;
+        let rk = RungeKutta::new(
+            options.method,
+            options.rtol,
+            options.atol,
+            options.max_steps,
+        )
+        .unwrap()
+        .with_work(false);
+        let y0 = device
+            .state_from(
+                device.spec().constraints.particular(),
+                &paritysim_constraints::Vec6::zeros(),
+            )
+            .unwrap();
+        let t_end = 19.0 * device.period().unwrap();
+        let (_, stats) = rk
+            .integrate_counted(&device, 0.0, &y0, t_end, &[], &mut |_, _, _| Ok(()))
+            .unwrap();
+        println!(
+            "transient: {} rhs calls, {} accepted, {} rejected steps",
+            stats.rhs_calls, stats.accepted, stats.rejected
+        );
+    }
 }

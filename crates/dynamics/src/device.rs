@@ -460,7 +460,8 @@ impl Device {
 
     /// Actuator force `F(t)`, drivetrain load `Q = (F − K1 q1, −K2 q2)` and its spring energy
     /// `½K1q1² + ½K2q2²`.
-    #[inline]
+    // Always inlined: every right-hand side calls it (a call and its spills cost more than it).
+    #[inline(always)]
     fn drive_load(&self, t: f64, q: &Vector2<f64>) -> (f64, Vector2<f64>, f64) {
         let actuator = self.spec.actuator.as_ref();
         let force = actuator.map_or(0.0, |a| a.force(t));
