@@ -180,9 +180,9 @@ pub struct Device {
     /// Wings with a free deviation on an α2 = 90°, α3 = 0 shoulder: closed-form terms
     /// ([`Wing::free_deviation_terms`]).
     free_deviation: [bool; 2],
-    /// `J⁻¹` of a 2-DOF linear-map drivetrain (eq. 2.15), whose inverse kinematics are then
-    /// closed form.
-    linear_inverse: Option<Matrix2<f64>>,
+    /// The constant Jacobian of a 2-DOF linear-map drivetrain (eq. 2.15): its inverse
+    /// kinematics need no drivetrain evaluations.
+    linear_jacobian: Option<Matrix2<f64>>,
 }
 
 /// Stroke angles `(φL, φR)`, their rates and the whippletree angle `q2` (see
@@ -313,10 +313,8 @@ impl Device {
         for (w, wing) in spec.wings.iter().enumerate() {
             free_deviation[w] = !stroke_plane[w] && wing.has_closed_form_free_deviation();
         }
-        let linear_inverse = match spec.transmission.as_ref().map(|tr| &tr.kinematics) {
-            Some(Drivetrain::LinearDifferential(map)) => {
-                map.evaluate(0.0, 0.0).jacobian.try_inverse()
-            }
+        let linear_jacobian = match spec.transmission.as_ref().map(|tr| &tr.kinematics) {
+            Some(Drivetrain::LinearDifferential(map)) => Some(map.evaluate(0.0, 0.0).jacobian),
             _ => None,
         };
         Ok(Self {
@@ -329,7 +327,7 @@ impl Device {
             stroke_only,
             stroke_plane,
             free_deviation,
-            linear_inverse,
+            linear_jacobian,
         })
     }
 
@@ -522,22 +520,44 @@ impl Device {
             });
         }
         let target = Vector2::new(p[0], p[3]);
-        if let Some(inverse) = &self.linear_inverse {
-            // The linear map (eq. 2.15) inverted in closed form: q = J⁻¹ φ, q̇ = J⁻¹ φ̇,
-            // τ_φ = J⁻ᵀ Q (no Newton iterations, no LU factorisations).
-            let q = inverse * target;
-            if !(q.x.abs() <= paritysim_error::plausible::OFFSET_MM
-                && q.y.abs() <= paritysim_error::plausible::ANGLE_RAD)
-            {
-                // The drivetrain names the implausible coordinate.
-                dt.evaluate(q.x, q.y)?;
+        if let Some(jac) = &self.linear_jacobian {
+            // The linear map (eq. 2.15): the Newton inverse of `invert_2dof` with the constant
+            // Jacobian's one LU factorisation and no drivetrain evaluations (same numbers).
+            let lu = jac.lu();
+            let mut q = lu
+                .solve(&target)
+                .ok_or_else(|| singular_drive(&Vector2::zeros()))?;
+            let mut converged = false;
+            for _ in 0..NEWTON_MAX {
+                check_plausible(dt, &q).map_err(|e| unreachable_stroke(e, target.x))?;
+                let step = lu
+                    .solve(&(jac * q - target))
+                    .ok_or_else(|| singular_drive(&q))?;
+                q -= step;
+                if step.amax() <= NEWTON_TOL * (1.0 + q.amax()) {
+                    converged = true;
+                    break;
+                }
             }
+            if !converged {
+                return Err(Error::OutOfDomain {
+                    what: "drivetrain inverse".into(),
+                    detail: format!(
+                        "no convergence for strokes ({}, {}) rad",
+                        target.x, target.y
+                    ),
+                });
+            }
+            check_plausible(dt, &q)?;
+            let q_dot = lu
+                .solve(&Vector2::new(p_dot[0], p_dot[3]))
+                .ok_or_else(|| singular_drive(&q))?;
             let (force, load, potential) = self.drive_load(t, &q);
             return Ok(DriveState {
                 q,
-                q_dot: inverse * Vector2::new(p_dot[0], p_dot[3]),
+                q_dot,
                 actuator_force: force,
-                stroke_torque: inverse.transpose() * load,
+                stroke_torque: stroke_torque(2, jac, &q, &load)?,
                 potential,
             });
         }
@@ -937,6 +957,17 @@ fn invert_2dof(dt: &Drivetrain, target: &Vector2<f64>) -> Result<(Vector2<f64>, 
             target.x, target.y
         ),
     })
+}
+
+/// The drivetrain's plausibility check of `q` (its error when `q` is implausible).
+#[inline]
+fn check_plausible(dt: &Drivetrain, q: &Vector2<f64>) -> Result<()> {
+    if !(q.x.abs() <= paritysim_error::plausible::OFFSET_MM
+        && q.y.abs() <= paritysim_error::plausible::ANGLE_RAD)
+    {
+        dt.evaluate(q.x, q.y)?;
+    }
+    Ok(())
 }
 
 fn unreachable_stroke(e: Error, target: f64) -> Error {
