@@ -8,12 +8,22 @@ use super::*;
 /// A stroke-only device whose wings have products of inertia with the stroke axis (the yaw
 /// and pitch reaction torques are not zero, so the closed form's rotation is exercised).
 fn full_inertia_parity(drivetrain: Drivetrain, k2: f64, formulation: Formulation) -> Device {
+    full_inertia_parity_with(drivetrain, k2, formulation, drag)
+}
+
+/// [`full_inertia_parity`] with the aerodynamics `aero(Ω1)`.
+fn full_inertia_parity_with(
+    drivetrain: Drivetrain,
+    k2: f64,
+    formulation: Formulation,
+    aero: fn(f64) -> WingAero,
+) -> Device {
     let wing = |omega: f64| {
         Wing::new(
             shoulder(90.0, 0.0),
             full_inertia(),
             [JointSpring::default(); 6],
-            drag(omega),
+            aero(omega),
         )
         .unwrap()
     };
@@ -109,6 +119,16 @@ fn streamed_stroke_samples_give_every_metric_of_full_samples() {
             500.0,
             Formulation::Auto,
         ),
+        // Blade-element aerodynamics on the fixed wings: the frame-6 torque is rotated too.
+        full_inertia_parity_with(linear_map(), 10.0, Formulation::Auto, |omega| {
+            WingAero::BladeElement(
+                paritysim_aero::BladeElementModel::new(
+                    paritysim_aero::Omegas::new(omega, 0.59, 17.5, 0.71).unwrap(),
+                    paritysim_aero::CoefficientSet::default(),
+                )
+                .unwrap(),
+            )
+        }),
     ];
     for (case, device) in cases.iter().enumerate() {
         assert_eq!(device.formulation(), Formulation::DrivetrainCoordinates);
