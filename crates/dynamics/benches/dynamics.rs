@@ -1,5 +1,6 @@
-//! Criterion benches: right-hand side of one wing and of the constrained two-wing system, and a
-//! 20-wingbeat §3.3 `drag_parity_fixed` run at rtol 1e-8.
+//! Criterion benches: right-hand side of one wing and of the constrained two-wing system, a
+//! 20-wingbeat §3.3 `drag_parity_fixed` run at rtol 1e-8, and issue 12's single trials
+//! (`cargo bench -p paritysim-dynamics --bench dynamics -- trial`).
 
 #![allow(missing_docs)] // criterion_group! generates undocumented items
 
@@ -105,27 +106,42 @@ fn run(c: &mut Criterion) {
     group.finish();
 }
 
-/// §3.4: two rotating Table 3.3 wings (blade element, hinge spring), Drag PARITY (#3).
-fn rotating(c: &mut Criterion) {
+/// A Table 3.3 wing (blade element, Ω1..Ω4): with `free_deviation` the §2.5 deviation spring
+/// (10 mN·mm/rad) and tunable hinge, else the §3.4 hinge spring 2.53 mN·mm/rad.
+fn table_3_3_wing(inertia: [f64; 4], omegas: [f64; 4], free_deviation: bool) -> Wing {
     use paritysim_aero::{BladeElementModel, CoefficientSet, Omegas};
+    let [ixx, iyy, izz, ixz] = inertia;
     let sh = SphericalShoulder::new(std::f64::consts::FRAC_PI_2, 0.0).unwrap();
-    let wing = |ixx: f64, iyy: f64, izz: f64, ixz: f64, o: [f64; 4]| {
-        let inertia = Matrix3::new(ixx, 0.0, ixz, 0.0, iyy, 0.0, ixz, 0.0, izz);
-        let mut springs = [JointSpring::default(); 6];
+    let matrix = Matrix3::new(ixx, 0.0, ixz, 0.0, iyy, 0.0, ixz, 0.0, izz);
+    let blade = BladeElementModel::new(
+        Omegas::new(omegas[0], omegas[1], omegas[2], omegas[3]).unwrap(),
+        CoefficientSet::default(),
+    )
+    .unwrap();
+    let mut springs = [JointSpring::default(); 6];
+    if !free_deviation {
         springs[5] = JointSpring::linear(2.53, 0.0).unwrap();
-        let blade = BladeElementModel::new(
-            Omegas::new(o[0], o[1], o[2], o[3]).unwrap(),
-            CoefficientSet::default(),
+        return Wing::new(sh, matrix, springs, WingAero::BladeElement(blade)).unwrap();
+    }
+    springs[3] = JointSpring::linear(10.0, 0.0).unwrap();
+    Wing::new(sh, matrix, springs, WingAero::BladeElement(blade))
+        .unwrap()
+        .with_tunable_hinge(
+            paritysim_dynamics::TunableHinge::new(2.533928021702924, 0.0, 20.0).unwrap(),
         )
-        .unwrap();
-        Wing::new(sh, inertia, springs, WingAero::BladeElement(blade)).unwrap()
-    };
-    let device = Device::new(DeviceSpec {
+}
+
+/// §3.4 (`drag_parity`: rotating wings) or §2.5 (`lift_parity` / `dual_parity`: free
+/// deviation θ) on the Table 3.3 1-Cut wings, eq. 2.15 with ±200 µm → ±35°,
+/// V = 100 + 100 sin(2π 110 Hz t) with the DC part ignored.
+fn table_3_3_device(configuration: &str) -> Device {
+    let free = configuration != "drag_parity";
+    Device::new(DeviceSpec {
         wings: vec![
-            wing(49.0, 50.5, 1.56, 4.2, [46.8, 0.587, 17.5, 0.712]),
-            wing(40.6, 42.0, 1.43, 3.38, [28.7, 0.419, 10.6, 0.787]),
+            table_3_3_wing([49.0, 50.5, 1.56, 4.2], [46.8, 0.587, 17.5, 0.712], free),
+            table_3_3_wing([40.6, 42.0, 1.43, 3.38], [28.7, 0.419, 10.6, 0.787], free),
         ],
-        constraints: Constraints::configuration("drag_parity").unwrap(),
+        constraints: Constraints::configuration(configuration).unwrap(),
         transmission: Some(
             Transmission::new(
                 Drivetrain::LinearDifferential(
@@ -151,7 +167,12 @@ fn rotating(c: &mut Criterion) {
         ),
         formulation: Formulation::Auto,
     })
-    .unwrap();
+    .unwrap()
+}
+
+/// §3.4: two rotating Table 3.3 wings (blade element, hinge spring), Drag PARITY (#3).
+fn rotating(c: &mut Criterion) {
+    let device = table_3_3_device("drag_parity");
     let options = SimulationOptions {
         rtol: 1e-8,
         atol: 1e-10,
@@ -169,5 +190,59 @@ fn rotating(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, rhs, run, rotating);
+/// Issue 12's single trials (`examples/trial.rs`'s workload): 20 wingbeats from rest at rtol
+/// 1e-8, every metric of the last cycle from 4000 samples, no trajectory column. The §3.3
+/// Drag PARITY device on the linear map (T = L = 2.5, K2 = 10, 1-Cut, 120 mN: goal ≤ 0.7 ms),
+/// the §3.4 rotating device (goal ≤ 3 ms) and the §2.5 Lift / Dual PARITY devices (free θ).
+fn trial(c: &mut Criterion) {
+    let drag = Device::new(DeviceSpec {
+        wings: vec![wing(0.6 * 31.3), wing(31.3)],
+        constraints: Constraints::configuration("drag_parity_fixed").unwrap(),
+        transmission: Some(
+            Transmission::new(
+                Drivetrain::LinearDifferential(
+                    paritysim_kinematics::drivetrain::LinearDifferential::new(2.5, 2.5, 1.0)
+                        .unwrap(),
+                ),
+                10.0,
+            )
+            .unwrap(),
+        ),
+        actuator: Some(Actuator::thesis(
+            Waveform::sine(100.0, 110.0, 0.0, 0.0).unwrap(),
+        )),
+        formulation: Formulation::Auto,
+    })
+    .unwrap();
+    let options = SimulationOptions {
+        rtol: 1e-8,
+        atol: 1e-10,
+        min_cycles: 19,
+        max_cycles: 19,
+        steady_tol: 1e-30,
+        samples_per_cycle: 4000,
+        columns: Some(Vec::new()),
+        ..Default::default()
+    };
+    let mut group = c.benchmark_group("trial");
+    group.sample_size(10);
+    let cases = [
+        ("section_3_3_drag_parity_linear_map", drag),
+        ("section_3_4_rotating", table_3_3_device("drag_parity")),
+        (
+            "section_2_5_lift_parity_free_theta",
+            table_3_3_device("lift_parity"),
+        ),
+        (
+            "section_2_5_dual_parity_free_theta",
+            table_3_3_device("dual_parity"),
+        ),
+    ];
+    for (name, device) in &cases {
+        group.bench_function(*name, |b| b.iter(|| simulate(device, &options).unwrap()));
+    }
+    group.finish();
+}
+
+criterion_group!(benches, rhs, run, rotating, trial);
 criterion_main!(benches);

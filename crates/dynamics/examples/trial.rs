@@ -1,8 +1,14 @@
-//! One §3.3 Drag PARITY trial (linear map eq. 2.15, T = L = 2.5, K2 = 10, 1-Cut, 120 mN) (20 wingbeats at rtol 1e-8, 4000 samples in the last cycle),
-//! repeated `N` times (first argument, default 20): a fixed workload for callgrind
+//! One §3.3 Drag PARITY trial (linear map eq. 2.15, T = L = 2.5, K2 = 10, 1-Cut, 120 mN; 20
+//! wingbeats at rtol 1e-8, 4000 samples in the last cycle), repeated `N` times (first
+//! argument, default 20): a fixed workload for callgrind
 //! (`valgrind --tool=callgrind target/release/examples/trial 5`) and wall-clock comparisons
-//! against older engines. Second argument `metrics` builds no trajectory column; `SAMPLES`
-//! (environment) overrides the 4000 samples.
+//! against older engines. Second argument `metrics` builds no trajectory column.
+//!
+//! Environment: `SAMPLES` overrides the 4000 samples, `RTOL` the relative tolerance, and
+//! `DEVICE` picks another device for the same workload: `rotating` (§3.4 Drag PARITY, Table
+//! 3.3 1-Cut wings, blade element, hinge spring), `lift` / `dual` (§2.5 Lift / Dual PARITY on
+//! those wings: free deviation θ with a deviation spring and the tunable hinge, as
+//! `paritysim.devices`' `sreetharan2012_2_5_*_parity_1cut`).
 
 use nalgebra::{Matrix3, Vector3};
 use paritysim_constraints::Constraints;
@@ -24,29 +30,99 @@ fn wing(omega: f64) -> Wing {
     .unwrap()
 }
 
+/// A Table 3.3 wing: blade element (Ω1..Ω4), hinge spring 2.53 mN·mm/rad; with
+/// `free_deviation`, the §2.5 deviation spring (10 mN·mm/rad) and tunable hinge.
+fn rotating_wing(inertia: [f64; 4], omegas: [f64; 4], free_deviation: bool) -> Wing {
+    use paritysim_aero::{BladeElementModel, CoefficientSet, Omegas};
+    let [ixx, iyy, izz, ixz] = inertia;
+    let sh = SphericalShoulder::new(std::f64::consts::FRAC_PI_2, 0.0).unwrap();
+    let mut springs = [JointSpring::default(); 6];
+    let blade = BladeElementModel::new(
+        Omegas::new(omegas[0], omegas[1], omegas[2], omegas[3]).unwrap(),
+        CoefficientSet::default(),
+    )
+    .unwrap();
+    let matrix = Matrix3::new(ixx, 0.0, ixz, 0.0, iyy, 0.0, ixz, 0.0, izz);
+    if !free_deviation {
+        springs[5] = JointSpring::linear(2.53, 0.0).unwrap();
+        return Wing::new(sh, matrix, springs, WingAero::BladeElement(blade)).unwrap();
+    }
+    springs[3] = JointSpring::linear(10.0, 0.0).unwrap();
+    Wing::new(sh, matrix, springs, WingAero::BladeElement(blade))
+        .unwrap()
+        .with_tunable_hinge(
+            paritysim_dynamics::TunableHinge::new(2.533928021702924, 0.0, 20.0).unwrap(),
+        )
+}
+
+/// §3.4 (`configuration` drag_parity) or §2.5 (lift_parity / dual_parity) on the Table 3.3
+/// 1-Cut wings, eq. 2.15 with ±200 µm → ±35°, V = 100 + 100 sin(2π 110 Hz t), DC ignored.
+fn rotating_device(configuration: &str) -> Device {
+    let free = configuration != "drag_parity";
+    Device::new(DeviceSpec {
+        wings: vec![
+            rotating_wing([49.0, 50.5, 1.56, 4.2], [46.8, 0.587, 17.5, 0.712], free),
+            rotating_wing([40.6, 42.0, 1.43, 3.38], [28.7, 0.419, 10.6, 0.787], free),
+        ],
+        constraints: Constraints::configuration(configuration).unwrap(),
+        transmission: Some(
+            Transmission::new(
+                Drivetrain::LinearDifferential(
+                    LinearDifferential::new(35f64.to_radians() / 0.2, 2.5, 1.0).unwrap(),
+                ),
+                0.0,
+            )
+            .unwrap(),
+        ),
+        actuator: Some(
+            Actuator::new(
+                paritysim_dynamics::actuator::THESIS_FORCE_PER_VOLT,
+                paritysim_dynamics::actuator::THESIS_STIFFNESS,
+                Waveform::sine(100.0, 110.0, 100.0, 0.0).unwrap(),
+                paritysim_dynamics::DcOffset::Ignore,
+            )
+            .unwrap(),
+        ),
+        formulation: Formulation::Auto,
+    })
+    .unwrap()
+}
+
 fn main() {
     let mut args = std::env::args().skip(1);
     let repeat: usize = args.next().and_then(|a| a.parse().ok()).unwrap_or(20);
     let metrics_only = args.next().is_some_and(|a| a == "metrics");
-    let device = Device::new(DeviceSpec {
-        wings: vec![wing(0.6 * 31.3), wing(31.3)],
-        constraints: Constraints::configuration("drag_parity_fixed").unwrap(),
-        transmission: Some(
-            Transmission::new(
-                Drivetrain::LinearDifferential(LinearDifferential::new(2.5, 2.5, 1.0).unwrap()),
-                10.0,
-            )
-            .unwrap(),
-        ),
-        actuator: Some(Actuator::thesis(
-            Waveform::sine(100.0, 110.0, 0.0, 0.0).unwrap(),
-        )),
-        formulation: Formulation::Auto,
-    })
-    .unwrap();
+    let which = std::env::var("DEVICE").unwrap_or_default();
+    let device = match which.as_str() {
+        "rotating" => Some(rotating_device("drag_parity")),
+        "lift" => Some(rotating_device("lift_parity")),
+        "dual" => Some(rotating_device("dual_parity")),
+        _ => None,
+    };
+    let device = device.unwrap_or_else(|| {
+        Device::new(DeviceSpec {
+            wings: vec![wing(0.6 * 31.3), wing(31.3)],
+            constraints: Constraints::configuration("drag_parity_fixed").unwrap(),
+            transmission: Some(
+                Transmission::new(
+                    Drivetrain::LinearDifferential(LinearDifferential::new(2.5, 2.5, 1.0).unwrap()),
+                    10.0,
+                )
+                .unwrap(),
+            ),
+            actuator: Some(Actuator::thesis(
+                Waveform::sine(100.0, 110.0, 0.0, 0.0).unwrap(),
+            )),
+            formulation: Formulation::Auto,
+        })
+        .unwrap()
+    });
     #[allow(unused_mut)]
     let mut options = SimulationOptions {
-        rtol: 1e-8,
+        rtol: std::env::var("RTOL")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(1e-8),
         atol: 1e-10,
         min_cycles: 19,
         max_cycles: 19,
@@ -77,5 +153,32 @@ fn main() {
         check += r.metrics[0].1;
     }
     let ms = start.elapsed().as_secs_f64() * 1e3 / repeat as f64;
-    println!("{ms:.3} ms per trial (checksum {check:.12e})");
+    let n_dof = device.n_dof();
+    println!("{ms:.3} ms per trial (checksum {check:.12e}; {n_dof} DOF)");
+    if std::env::var("STATS").is_ok() {
+        // The transient's step counters (the 19 cycles before the recorded one).
+        use paritysim_dynamics::integrate::RungeKutta;
+        let rk = RungeKutta::new(
+            options.method,
+            options.rtol,
+            options.atol,
+            options.max_steps,
+        )
+        .unwrap()
+        .with_work(false);
+        let y0 = device
+            .state_from(
+                device.spec().constraints.particular(),
+                &paritysim_constraints::Vec6::zeros(),
+            )
+            .unwrap();
+        let t_end = 19.0 * device.period().unwrap();
+        let (_, stats) = rk
+            .integrate_counted(&device, 0.0, &y0, t_end, &[], &mut |_, _, _| Ok(()))
+            .unwrap();
+        println!(
+            "transient: {} rhs calls, {} accepted, {} rejected steps",
+            stats.rhs_calls, stats.accepted, stats.rejected
+        );
+    }
 }

@@ -67,6 +67,40 @@ pub enum Formulation {
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct StrokeOnly {
     stroke_inertia: [f64; 2],
+    /// The linear map's constants (None for the linkages).
+    linear: Option<ConstantMap>,
+}
+
+/// A drivetrain with a constant Jacobian (the linear map, eq. 2.15): `φ = J q`, `h = 0` and a
+/// constant `M_q = Σ_k I_k J_kᵀ J_k`, precomputed with the operations of the general
+/// drivetrain step (so the lean right-hand side gives its numbers).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ConstantMap {
+    jacobian: Matrix2<f64>,
+    /// `M_q` entries `(m00, m01, m11)` and `det M_q`.
+    mass: (f64, f64, f64),
+    det: f64,
+}
+
+impl ConstantMap {
+    fn of(kinematics: &Drivetrain, stroke_inertia: [f64; 2]) -> Option<Self> {
+        let Drivetrain::LinearDifferential(map) = kinematics else {
+            return None;
+        };
+        let j = map.evaluate(0.0, 0.0).jacobian;
+        let (mut m00, mut m01, mut m11) = (0.0, 0.0, 0.0);
+        for (k, inertia) in stroke_inertia.iter().enumerate() {
+            let (a, b) = (j[(k, 0)], j[(k, 1)]);
+            m00 += inertia * a * a;
+            m01 += inertia * a * b;
+            m11 += inertia * b * b;
+        }
+        Some(Self {
+            jacobian: j,
+            mass: (m00, m01, m11),
+            det: m00 * m11 - m01 * m01,
+        })
+    }
 }
 
 /// Why a device cannot use drivetrain coordinates (None when it can).
@@ -108,7 +142,10 @@ fn stroke_only(spec: &DeviceSpec) -> std::result::Result<StrokeOnly, String> {
         }
         stroke_inertia[k] = wing.inertia()[(0, 0)];
     }
-    Ok(StrokeOnly { stroke_inertia })
+    Ok(StrokeOnly {
+        stroke_inertia,
+        linear: ConstantMap::of(&tr.kinematics, stroke_inertia),
+    })
 }
 
 /// Everything needed to build a [`Device`].
@@ -140,11 +177,33 @@ pub struct Device {
     /// Wings whose deviation C holds at zero on an α2 = 90° shoulder: their terms are closed form
     /// ([`Wing::stroke_plane_terms`]).
     stroke_plane: [bool; 2],
+    /// Wings with a free deviation on an α2 = 90°, α3 = 0 shoulder: closed-form terms
+    /// ([`Wing::free_deviation_terms`]).
+    free_deviation: [bool; 2],
+    /// The constant Jacobian of a 2-DOF linear-map drivetrain (eq. 2.15): its inverse
+    /// kinematics need no drivetrain evaluations.
+    linear_jacobian: Option<Matrix2<f64>>,
 }
 
 /// Stroke angles `(φL, φR)`, their rates and the whippletree angle `q2` (see
 /// [`Device::stroke_state`]).
 pub type StrokeState = (Vector2<f64>, Vector2<f64>, f64);
+
+/// Stroke kinematics and actuator force of a drivetrain-coordinate state (see
+/// [`Device::stroke_motion_unchecked`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct StrokeMotion {
+    /// `(φL, φR)` (rad).
+    pub stroke: Vector2<f64>,
+    /// `(φ̇L, φ̇R)` (rad/ms).
+    pub rate: Vector2<f64>,
+    /// `(φ̈L, φ̈R)` (rad/ms²).
+    pub accel: Vector2<f64>,
+    /// Whippletree angle `q2` (rad).
+    pub q2: f64,
+    /// Actuator force F(t) (mN).
+    pub actuator_force: f64,
+}
 
 /// The drivetrain state recovered from the stroke angles.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -250,6 +309,14 @@ impl Device {
                 stroke_plane[w] = theta_held && wing.has_closed_form_stroke_plane();
             }
         }
+        let mut free_deviation = [false; 2];
+        for (w, wing) in spec.wings.iter().enumerate() {
+            free_deviation[w] = !stroke_plane[w] && wing.has_closed_form_free_deviation();
+        }
+        let linear_jacobian = match spec.transmission.as_ref().map(|tr| &tr.kinematics) {
+            Some(Drivetrain::LinearDifferential(map)) => Some(map.evaluate(0.0, 0.0).jacobian),
+            _ => None,
+        };
         Ok(Self {
             spec,
             n_coords,
@@ -259,6 +326,8 @@ impl Device {
             formulation,
             stroke_only,
             stroke_plane,
+            free_deviation,
+            linear_jacobian,
         })
     }
 
@@ -350,13 +419,51 @@ impl Device {
         Ok((e.stroke, e.jacobian * q_dot, q.y))
     }
 
+    /// Stroke angles, rates and accelerations `(φ, φ̇, φ̈)`, `q2` and the actuator force of a
+    /// drivetrain-coordinate state (`φ̈ = J q̈ + h`, eq. 2.18 generalised to the drivetrain's
+    /// map): what the body torques of stroke-only wings need, without the mass matrices and
+    /// rotations of [`Self::evaluate_state`].
+    ///
+    /// # Errors
+    /// A drivetrain evaluation outside the linkage's domain; a singular drivetrain mass matrix.
+    #[inline]
+    pub(crate) fn stroke_motion_unchecked(&self, t: f64, y: &State) -> Result<StrokeMotion> {
+        let fast = self
+            .stroke_only
+            .as_ref()
+            .expect("only called for drivetrain-coordinate devices");
+        if let Some(map) = &fast.linear {
+            // φ̈ = J q̈: the linear map has no velocity product.
+            let (q_dot, q_ddot, force, _) = self.linear_map_step(map, t, y)?;
+            let (q, _) = self.drive_coordinates(y);
+            let j = &map.jacobian;
+            return Ok(StrokeMotion {
+                stroke: j * q,
+                rate: j * q_dot,
+                accel: j * q_ddot,
+                q2: q.y,
+                actuator_force: force,
+            });
+        }
+        let step = self.drivetrain_step(fast, t, y)?;
+        let e = &step.eval;
+        Ok(StrokeMotion {
+            stroke: e.stroke,
+            rate: e.jacobian * step.q_dot,
+            accel: e.jacobian * step.q_ddot + e.velocity_product(&step.q_dot),
+            q2: step.q.y,
+            actuator_force: step.force,
+        })
+    }
+
     /// Actuator force `F(t)`, drivetrain load `Q = (F − K1 q1, −K2 q2)` and its spring energy
     /// `½K1q1² + ½K2q2²`.
     ///
     /// A dual drivetrain (one drive per wing) has the actuator on both coordinates instead:
     /// `Q = (F_L − K1 q1, F_R − K1 q2)` ([`Actuator::side_force`]); the returned force is
     /// then the left side's.
-    #[inline]
+    // Always inlined: every right-hand side calls it (a call and its spills cost more than it).
+    #[inline(always)]
     fn drive_load(&self, t: f64, q: &Vector2<f64>) -> (f64, Vector2<f64>, f64) {
         let actuator = self.spec.actuator.as_ref();
         let k1 = actuator.map_or(0.0, |a| a.stiffness());
@@ -442,6 +549,47 @@ impl Device {
             });
         }
         let target = Vector2::new(p[0], p[3]);
+        if let Some(jac) = &self.linear_jacobian {
+            // The linear map (eq. 2.15): the Newton inverse of `invert_2dof` with the constant
+            // Jacobian's one LU factorisation and no drivetrain evaluations (same numbers).
+            let lu = jac.lu();
+            let mut q = lu
+                .solve(&target)
+                .ok_or_else(|| singular_drive(&Vector2::zeros()))?;
+            let mut converged = false;
+            for _ in 0..NEWTON_MAX {
+                check_plausible(dt, &q).map_err(|e| unreachable_stroke(e, target.x))?;
+                let step = lu
+                    .solve(&(jac * q - target))
+                    .ok_or_else(|| singular_drive(&q))?;
+                q -= step;
+                if step.amax() <= NEWTON_TOL * (1.0 + q.amax()) {
+                    converged = true;
+                    break;
+                }
+            }
+            if !converged {
+                return Err(Error::OutOfDomain {
+                    what: "drivetrain inverse".into(),
+                    detail: format!(
+                        "no convergence for strokes ({}, {}) rad",
+                        target.x, target.y
+                    ),
+                });
+            }
+            check_plausible(dt, &q)?;
+            let q_dot = lu
+                .solve(&Vector2::new(p_dot[0], p_dot[3]))
+                .ok_or_else(|| singular_drive(&q))?;
+            let (force, load, potential) = self.drive_load(t, &q);
+            return Ok(DriveState {
+                q,
+                q_dot,
+                actuator_force: force,
+                stroke_torque: stroke_torque(2, jac, &q, &load)?,
+                potential,
+            });
+        }
         let (q, jac) = invert_2dof(dt, &target)?;
         let q_dot = jac
             .lu()
@@ -468,6 +616,11 @@ impl Device {
             let vw = Vector3::new(p_dot[k], p_dot[k + 1], p_dot[k + 2]);
             let terms = if self.stroke_plane[w] {
                 wing.stroke_plane_terms(&pw, &vw)
+            } else if let Some(terms) = self.free_deviation[w]
+                .then(|| wing.free_deviation_terms(&pw, &vw))
+                .flatten()
+            {
+                terms
             } else {
                 wing.terms(&pw, &vw)?
             };
@@ -484,28 +637,20 @@ impl Device {
         // The null-space solve also serves the drivetrain-coordinate devices here (recording).
         let p_ddot = match self.formulation {
             Formulation::NullSpace | Formulation::Auto | Formulation::DrivetrainCoordinates => {
-                let n = self.n_dof;
-                let mut reduced_mass = self.basis.transpose() * mass * self.basis;
-                for i in n..6 {
-                    for j in 0..6 {
-                        reduced_mass[(i, j)] = if i == j { 1.0 } else { 0.0 };
-                        reduced_mass[(j, i)] = if i == j { 1.0 } else { 0.0 };
-                    }
-                }
-                let mut reduced_force = self.basis.transpose() * force;
-                for i in n..6 {
-                    reduced_force[i] = 0.0;
-                }
-                let x_ddot = reduced_mass
-                    .cholesky()
-                    .ok_or_else(|| {
-                        Error::Singular(format!(
-                            "reduced mass matrix is not positive definite at p = {:?}",
-                            p.as_slice()
-                        ))
-                    })?
-                    .solve(&reduced_force);
-                self.basis * x_ddot
+                let solved = match self.n_dof {
+                    1 => self.solve_reduced::<1>(&mass, &force),
+                    2 => self.solve_reduced::<2>(&mass, &force),
+                    3 => self.solve_reduced::<3>(&mass, &force),
+                    4 => self.solve_reduced::<4>(&mass, &force),
+                    5 => self.solve_reduced::<5>(&mass, &force),
+                    _ => self.solve_reduced::<6>(&mass, &force),
+                };
+                solved.ok_or_else(|| {
+                    Error::Singular(format!(
+                        "reduced mass matrix is not positive definite at p = {:?}",
+                        p.as_slice()
+                    ))
+                })?
             }
             Formulation::Projection => {
                 let m_inv = mass.try_inverse().ok_or_else(|| {
@@ -521,6 +666,26 @@ impl Device {
             wings,
             drive,
         })
+    }
+
+    /// `p̈ = N (Nᵀ M N)⁻¹ Nᵀ f` (eq. 3.20 in null-space coordinates) on `n = N` integrated
+    /// coordinates, using that `M` is block diagonal (one 3 × 3 block per wing): the reduced
+    /// matrices are `Σ_w N_wᵀ M_w N_w` and `Σ_w N_wᵀ f_w` of fixed size `N` (unrolled, no dense
+    /// 6 × 6 products, an `N × N` Cholesky). `None` when `Nᵀ M N` is not positive definite.
+    #[inline]
+    fn solve_reduced<const N: usize>(&self, mass: &Mat6, force: &Vec6) -> Option<Vec6> {
+        let mut reduced_mass = nalgebra::SMatrix::<f64, N, N>::zeros();
+        let mut reduced_force = nalgebra::SVector::<f64, N>::zeros();
+        for w in 0..self.n_wings() {
+            let k = 3 * w;
+            let basis_w: nalgebra::SMatrix<f64, 3, N> =
+                self.basis.fixed_view::<3, N>(k, 0).into_owned();
+            let mass_w: nalgebra::Matrix3<f64> = mass.fixed_view::<3, 3>(k, k).into_owned();
+            reduced_mass += basis_w.transpose() * (mass_w * basis_w);
+            reduced_force += basis_w.transpose() * force.fixed_rows::<3>(k);
+        }
+        let x_ddot = reduced_mass.cholesky()?.solve(&reduced_force);
+        Some(self.basis.fixed_columns::<N>(0) * x_ddot)
     }
 
     /// The right-hand side `ẏ = f(t, y)`; also integrates the actuator work and the
@@ -640,15 +805,67 @@ impl Device {
 
     /// Right-hand side in drivetrain coordinates (see [`Formulation::DrivetrainCoordinates`]).
     fn rhs_drivetrain(&self, fast: &StrokeOnly, t: f64, y: &State, dydt: &mut State) -> Result<()> {
-        let step = self.drivetrain_step(fast, t, y)?;
+        let (q_dot, q_ddot, force, aero_power) = match &fast.linear {
+            Some(map) => self.linear_map_step(map, t, y)?,
+            None => {
+                let step = self.drivetrain_step(fast, t, y)?;
+                (step.q_dot, step.q_ddot, step.force, step.aero_power)
+            }
+        };
         *dydt = State::default();
         for i in 0..self.n_dof {
-            dydt.coords[i] = step.q_dot[i];
-            dydt.rates[i] = step.q_ddot[i];
+            dydt.coords[i] = q_dot[i];
+            dydt.rates[i] = q_ddot[i];
         }
-        dydt.work_actuator = self.actuator_power(t, step.force, &step.q_dot);
-        dydt.work_aero = step.aero_power;
+        dydt.work_actuator = self.actuator_power(t, force, &q_dot);
+        dydt.work_aero = aero_power;
         Ok(())
+    }
+
+    /// [`Self::drivetrain_step`] for the linear map (eq. 2.15) in scalars: `φ = J q`,
+    /// `φ̇ = J q̇`, no velocity product, the constant `M_q` solved by Cramer's rule. The same
+    /// operations in the same order as the general step, without its linkage evaluation,
+    /// Hessians and mass assembly: `(q̇, q̈, F, aerodynamic power)`.
+    #[inline(always)]
+    fn linear_map_step(
+        &self,
+        map: &ConstantMap,
+        t: f64,
+        y: &State,
+    ) -> Result<(Vector2<f64>, Vector2<f64>, f64, f64)> {
+        let (q, q_dot) = self.drive_coordinates(y);
+        if !(q.x.abs() <= paritysim_error::plausible::OFFSET_MM
+            && q.y.abs() <= paritysim_error::plausible::ANGLE_RAD)
+        {
+            // The drivetrain names the implausible coordinate.
+            self.drivetrain().evaluate(q.x, q.y)?;
+        }
+        let j = &map.jacobian;
+        let (force, load, _) = self.drive_load(t, &q);
+        let (mut g0, mut g1) = (load.x, load.y);
+        let mut aero_power = 0.0;
+        for k in 0..2 {
+            let wing = &self.spec.wings[k];
+            let (a, b) = (j[(k, 0)], j[(k, 1)]);
+            let phi = a * q.x + b * q.y;
+            let phi_dot = a * q_dot.x + b * q_dot.y;
+            let tau_aero = wing.aero().stroke_torque(phi_dot);
+            let tau = tau_aero - wing.springs()[0].torque(phi);
+            g0 += a * tau;
+            g1 += b * tau;
+            aero_power += tau_aero * phi_dot;
+        }
+        let (m00, m01, m11) = map.mass;
+        let q_ddot = if self.n_dof == 2 {
+            let det = map.det;
+            if det == 0.0 || !det.is_finite() {
+                return Err(singular_drive(&q));
+            }
+            Vector2::new((m11 * g0 - m01 * g1) / det, (m00 * g1 - m01 * g0) / det)
+        } else {
+            Vector2::new(g0 / m00, 0.0)
+        };
+        Ok((q_dot, q_ddot, force, aero_power))
     }
 
     /// Mechanical energy: kinetic + joint springs + drivetrain springs (µJ).
@@ -769,6 +986,17 @@ fn invert_2dof(dt: &Drivetrain, target: &Vector2<f64>) -> Result<(Vector2<f64>, 
             target.x, target.y
         ),
     })
+}
+
+/// The drivetrain's plausibility check of `q` (its error when `q` is implausible).
+#[inline]
+fn check_plausible(dt: &Drivetrain, q: &Vector2<f64>) -> Result<()> {
+    if !(q.x.abs() <= paritysim_error::plausible::OFFSET_MM
+        && q.y.abs() <= paritysim_error::plausible::ANGLE_RAD)
+    {
+        dt.evaluate(q.x, q.y)?;
+    }
+    Ok(())
 }
 
 fn unreachable_stroke(e: Error, target: f64) -> Error {

@@ -113,8 +113,73 @@ pub struct MetricsAccumulator {
     last_time: f64,
     work_actuator: f64,
     work_aero: f64,
-    /// Fed with [`StrokeSample`]s only: the metrics outside [`is_stroke_metric`] are NaN.
-    stroke_only: bool,
+    /// Fed with [`StrokeSample`]s computing this much: the metrics they do not provide are NaN.
+    lean: Option<StrokeNeeds>,
+}
+
+/// Metrics read from the work integrals.
+const WORK_METRICS: [&str; 3] = [
+    "work_actuator_per_cycle",
+    "work_aero_per_cycle",
+    "mean_actuator_power",
+];
+
+/// What a [`StrokeSample`] computes beyond the stroke kinematics, as the asked metrics need.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StrokeNeeds {
+    /// The actuator force (`actuator_force_peak`).
+    pub force: bool,
+    /// The body reaction torques: per-wing and net `{roll,yaw,pitch}_{mean,rms,peak}` (the
+    /// stroke accelerations, so one drivetrain solve per sample; the force comes with them).
+    pub torques: bool,
+    /// The work integrals (`work_*_per_cycle`, `mean_actuator_power`): the recorded window
+    /// integrates them.
+    pub work: bool,
+}
+
+impl StrokeNeeds {
+    /// Everything (every metric).
+    pub const ALL: Self = Self {
+        force: true,
+        torques: true,
+        work: true,
+    };
+
+    /// What the metrics `names` need (`None`: all of them). Unknown names count as torque
+    /// metrics (they are reported NaN by the caller's selection).
+    pub fn of(names: Option<&[String]>) -> Self {
+        let Some(names) = names else {
+            return Self::ALL;
+        };
+        let mut needs = Self {
+            force: false,
+            torques: false,
+            work: false,
+        };
+        for name in names {
+            if name == "actuator_force_peak" {
+                needs.force = true;
+            } else if WORK_METRICS.contains(&name.as_str()) {
+                needs.work = true;
+            } else if !is_stroke_metric(name) {
+                needs.torques = true;
+            }
+        }
+        // The torques solve the drivetrain dynamics, which evaluate the force anyway.
+        needs.force |= needs.torques;
+        needs
+    }
+
+    /// Whether samples computing this much give metric `name`.
+    pub fn provides(&self, name: &str) -> bool {
+        if name == "actuator_force_peak" {
+            self.force
+        } else if WORK_METRICS.contains(&name) {
+            self.work
+        } else {
+            is_stroke_metric(name) || self.torques
+        }
+    }
 }
 
 /// The per-sample values every metric path shares.
@@ -176,7 +241,7 @@ impl MetricsAccumulator {
             last_time: 0.0,
             work_actuator: 0.0,
             work_aero: 0.0,
-            stroke_only: false,
+            lean: None,
         }
     }
 
@@ -239,14 +304,14 @@ impl MetricsAccumulator {
         self.work_aero = s.state.work_aero;
     }
 
-    /// Adds a stroke-only sample (see [`is_stroke_metric`]); an accumulator fed this way reports
-    /// NaN for every other metric. The rotation Fourier sums are skipped: ψ ≡ 0, so the phase
-    /// lag is undefined (NaN) on either path.
+    /// Adds a [`StrokeSample`]; an accumulator fed this way reports NaN for the metrics its
+    /// [`StrokeNeeds`] do not provide. The rotation Fourier sums are skipped: ψ ≡ 0, so the
+    /// phase lag is undefined (NaN) on either path.
     #[inline]
     pub fn add_stroke(&mut self, s: &StrokeSample, closing: bool) {
         let body = !closing;
         if self.first_time.is_none() {
-            self.stroke_only = true;
+            self.lean = Some(s.needs);
             self.first_time = Some(s.time);
             // ψ ≡ 0: one zero gives the rotation metrics their (zero) range and mean.
             for acc in &mut self.wings {
@@ -266,6 +331,17 @@ impl MetricsAccumulator {
         self.delta_tau.add(s.roll_aero[0] + s.roll_aero[1]);
         self.force.add(s.actuator_force);
         self.q2.add(s.q2);
+        if s.needs.torques {
+            for (acc, torque) in self.wings.iter_mut().zip(&s.torque) {
+                for (k, stats) in acc.torque.iter_mut().enumerate() {
+                    stats.add(torque[k], body);
+                }
+            }
+            for (k, stats) in self.total.iter_mut().enumerate() {
+                stats.add(s.total[k], body);
+            }
+        }
+        (self.work_actuator, self.work_aero) = s.work;
     }
 
     /// The metrics, names as documented in the module.
@@ -346,9 +422,9 @@ impl MetricsAccumulator {
             out.push(("imbalance_instantaneous_pct".into(), percent(delta)));
             out.push(("imbalance_peak_pct".into(), percent(tau_r - tau_l)));
         }
-        if self.stroke_only {
+        if let Some(needs) = self.lean {
             for (name, value) in &mut out {
-                if !is_stroke_metric(name) {
+                if !needs.provides(name) {
                     *value = f64::NAN;
                 }
             }

@@ -7,7 +7,7 @@ use paritysim_error::{Error, Result, bail, check_positive};
 use crate::device::Device;
 use crate::integrate::budget::{Budget, CancelFlag};
 use crate::integrate::{Integrator, Method, RungeKutta, State};
-use crate::metrics::MetricsAccumulator;
+use crate::metrics::{MetricsAccumulator, StrokeNeeds};
 use crate::trajectory::{Recorder, Sample, StrokeSample, select_columns};
 pub use crate::trajectory::{Trajectory, record};
 
@@ -84,9 +84,10 @@ pub struct SimulationOptions {
     pub duration_ms: Option<f64>,
     /// Trajectory columns to build (`None`: all of them; `Some(vec![])`: none, metrics only).
     pub columns: Option<Vec<String>>,
-    /// Metrics the caller reads (`None`: all). When no column is built, the device integrates
-    /// drivetrain coordinates and every name passes [`crate::metrics::is_stroke_metric`], the
-    /// samples are [`crate::trajectory::StrokeSample`]s and the other metrics come back NaN.
+    /// Metrics the caller reads (`None`: all). When no column is built and the device
+    /// integrates drivetrain coordinates, the samples are [`crate::trajectory::StrokeSample`]s
+    /// computing only what these need ([`crate::metrics::StrokeNeeds`]) and the metrics they do
+    /// not provide come back NaN.
     pub metrics: Option<Vec<String>>,
     /// How the periodic steady state is found (driven devices).
     pub steady_state: SteadyState,
@@ -283,6 +284,11 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
     // The recorded window when the shooting's last period already was it.
     let mut recorded: Option<(Trajectory, Vec<(String, f64)>)> = None;
     let stroke = stroke_sampling(device, options.metrics.as_deref(), &columns);
+    // Lean samples that read no work integral need no work in the recorded window either.
+    let recording = match stroke {
+        Some(needs) if !needs.work => transient,
+        _ => recording,
+    };
     let period = device.period();
     let (window, n_samples) = match period {
         Some(period) => {
@@ -409,7 +415,7 @@ fn shooting_steady_state(
     period: f64,
     y0: &State,
     columns: &[crate::trajectory::Column],
-    stroke: Option<bool>,
+    stroke: Option<StrokeNeeds>,
 ) -> Result<Option<ShotSteadyState>> {
     let mut y = *y0;
     let mut cycles = 0;
@@ -441,11 +447,10 @@ fn shooting_steady_state(
         if !records {
             return transient.integrate_on_grid(device, grid, y, &[], &mut |_, _, _| Ok(()));
         }
-        // Stroke samples read no work integral: the lighter state suffices.
-        let integrator = if stroke.is_some() {
-            transient
-        } else {
-            recording
+        // Samples that read no work integral: the lighter state suffices.
+        let integrator = match stroke {
+            Some(needs) if !needs.work => transient,
+            _ => recording,
         };
         let (trajectory, metrics, end) = record_window(
             device,
@@ -546,18 +551,16 @@ pub fn orbit_metrics(
     Ok(metrics)
 }
 
-/// How samples are taken when only stroke metrics are read (see
-/// [`SimulationOptions::metrics`]): `Some(with_force)`, else `None` (full samples).
+/// How samples are taken (see [`SimulationOptions::metrics`]): `Some(needs)` for lean
+/// [`StrokeSample`]s (no column asked, drivetrain coordinates), else `None` (full samples).
 fn stroke_sampling(
     device: &Device,
     metrics: Option<&[String]>,
     columns: &[crate::trajectory::Column],
-) -> Option<bool> {
-    let metrics = metrics?;
+) -> Option<StrokeNeeds> {
     let lean = columns.is_empty()
-        && device.formulation() == crate::device::Formulation::DrivetrainCoordinates
-        && metrics.iter().all(|m| crate::metrics::is_stroke_metric(m));
-    lean.then(|| metrics.iter().any(|m| m == "actuator_force_peak"))
+        && device.formulation() == crate::device::Formulation::DrivetrainCoordinates;
+    lean.then(|| StrokeNeeds::of(metrics))
 }
 
 /// A recorded window: its columns, its metrics and the state at its end.
@@ -576,7 +579,7 @@ fn record_window(
     period: Option<f64>,
     perturbation: Option<Perturbation>,
     columns: Vec<crate::trajectory::Column>,
-    stroke: Option<bool>,
+    stroke: Option<StrokeNeeds>,
     grid: Option<&[f64]>,
 ) -> Result<Recorded> {
     // The last sample is exactly the window's end: t_start + window·k/n can round one ulp past
@@ -595,8 +598,8 @@ fn record_window(
     let mut recorder = Recorder::new(columns, times.len());
     let mut sink = |i: usize, t: f64, y: &State| -> Result<()> {
         // `stroke` is only set for drivetrain-coordinate devices (see `stroke_sampling`).
-        if let Some(with_force) = stroke {
-            let sample = StrokeSample::of_stroke_device(device, t, y, with_force)?;
+        if let Some(needs) = stroke {
+            let sample = StrokeSample::of_stroke_device(device, t, y, needs)?;
             metrics.add_stroke(&sample, i == n_samples);
             return Ok(());
         }

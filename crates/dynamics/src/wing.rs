@@ -430,6 +430,159 @@ impl Wing {
         }
     }
 
+    /// Body reaction torques `(aerodynamic, inertial)` of a wing that only strokes (θ = ψ = 0
+    /// held, α2 = 90°: [`Self::stroke_plane_terms`] at ψ = 0), in the shoulder ground frame and
+    /// not mirrored: `τ_react = R6 (τ_aero⁶ − (I ω̇ + ω × I ω))` (Euler's equations, the
+    /// reaction of A.13's wing on the body) with, in closed form, `R6 = R_x(φ)`, `ω = φ̇ x̂`,
+    /// `ω̇ = φ̈ x̂` (`J6 = diag(1, cos φ, 1)`, `J̇6 ṗ = 0`), so
+    /// `I ω̇ + ω × I ω = φ̈ I x̂ + φ̇² (0, −I_zx, I_yx)`; the §3.3 drag torque stays on the
+    /// stroke axis (`R6 R6ᵀ x̂ = x̂`). The operations are those of the general path in the same
+    /// order (tested against it): about 30 flops instead of a mass matrix and two rotations.
+    #[inline]
+    pub fn stroke_reaction_torques(
+        &self,
+        phi: f64,
+        phi_dot: f64,
+        phi_ddot: f64,
+    ) -> (Vector3<f64>, Vector3<f64>) {
+        let inertia_x = Vector3::new(
+            self.inertia[(0, 0)],
+            self.inertia[(1, 0)],
+            self.inertia[(2, 0)],
+        );
+        let on_axis = !matches!(self.aero, WingAero::BladeElement(_));
+        if on_axis && inertia_x.y == 0.0 && inertia_x.z == 0.0 {
+            // No product of inertia with the stroke axis and a drag torque about it: both
+            // torques lie on x̂, which R_x(φ) keeps (the general path's other components are
+            // exact zeros too).
+            let inertial = -(inertia_x.x * phi_ddot);
+            return (
+                Vector3::new(self.aero.stroke_torque(phi_dot), 0.0, 0.0),
+                Vector3::new(inertial, 0.0, 0.0),
+            );
+        }
+        let (s, c) = phi.sin_cos();
+        // R_x(φ) v.
+        let rotate = |v: &Vector3<f64>| Vector3::new(v.x, c * v.y - s * v.z, s * v.y + c * v.z);
+        let aero = match &self.aero {
+            WingAero::None => Vector3::zeros(),
+            WingAero::StrokeDrag { .. } => Vector3::new(self.aero.stroke_torque(phi_dot), 0.0, 0.0),
+            other => {
+                let omega = Vector3::new(phi_dot, 0.0, 0.0);
+                let rotation = Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c);
+                rotate(&other.torque(&omega, &omega, &rotation))
+            }
+        };
+        let i_omega = inertia_x * phi_dot;
+        // ω × Iω with ω = φ̇ x̂.
+        let gyro = Vector3::new(0.0, -(phi_dot * i_omega.z), phi_dot * i_omega.y);
+        let inertial6 = -(inertia_x * phi_ddot + gyro);
+        (aero, rotate(&inertial6))
+    }
+
+    /// [`Self::terms`] with the deviation θ free on an α2 = 90°, α3 = 0 shoulder (the Table 3.3
+    /// wings' and the §2.5 Lift / Dual PARITY devices'), in closed form: the closure
+    /// `R_x(φ) R_y(γ5) ŝ3 = R_y(θ) R_ŝ2(γ2) ŝ3` (eqs. 2.2–2.7 with `ŝ2 = x̂`, `ŝ3 = ẑ`) gives
+    /// `tan γ5 = cos φ tan θ` (eq. 2.12's solution, `γ5 = atan2(cos φ sin θ, cos θ)`), so with
+    /// `D = cos²θ + cos²φ sin²θ` (eq. 2.12's determinant)
+    ///
+    /// ```text
+    /// ∂γ5/∂φ = −sin φ sin θ cos θ / D          ∂γ5/∂θ = cos φ / D
+    /// ∂²γ5/∂φ² = −sin θ cos θ cos φ (D + 2 sin²θ sin²φ) / D²
+    /// ∂²γ5/∂φ∂θ = −sin φ (D − 2 cos²φ sin²θ) / D²      ∂²γ5/∂θ² = 2 cos φ sin θ cos θ sin²φ / D²
+    /// ```
+    ///
+    /// and `J6`, `J̇6 ṗ` (A.9, as [`Self::terms`] assembles them) need no joint-angle solve, no
+    /// closure LU and no second pose. Valid without springs on joints 2, 3, 5
+    /// ([`Self::has_closed_form_free_deviation`]); tested against [`Self::terms`]. `None` (use
+    /// [`Self::terms`], which reports the error) for non-finite input or within 1e-12 of the
+    /// singular poses of eqs. 2.12 / 2.13.
+    pub fn free_deviation_terms(
+        &self,
+        p: &Vector3<f64>,
+        p_dot: &Vector3<f64>,
+    ) -> Option<WingTerms> {
+        let (phi, theta, psi) = (p.x, p.y, p.z);
+        if !(phi.is_finite() && theta.is_finite() && psi.is_finite()) {
+            return None;
+        }
+        let (sp, cp) = phi.sin_cos();
+        let (st, ct) = theta.sin_cos();
+        let d = ct * ct + cp * cp * st * st;
+        // The general solve's singular poses (eq. 2.12's and eq. 2.13's determinants).
+        if d < 1e-12 || cp * cp + ct * ct * sp * sp < 1e-12 {
+            return None;
+        }
+        let root = d.sqrt();
+        let (s5, c5) = (cp * st / root, ct / root);
+        let g5 = (cp * st).atan2(ct);
+        let d_sq = d * d;
+        let g5_phi = -sp * st * ct / d;
+        let g5_theta = cp / d;
+        let h_pp = -st * ct * cp * (d + 2.0 * st * st * sp * sp) / d_sq;
+        let h_pt = -sp * (d - 2.0 * cp * cp * st * st) / d_sq;
+        let h_tt = 2.0 * cp * st * ct * sp * sp / d_sq;
+
+        let (ss, cs) = psi.sin_cos();
+        let r3 = Matrix3::new(1.0, 0.0, 0.0, 0.0, cp, -sp, 0.0, sp, cp);
+        let r4 = r3 * Matrix3::new(c5, 0.0, s5, 0.0, 1.0, 0.0, -s5, 0.0, c5);
+        let r61 = r4 * Matrix3::new(cs, -ss, 0.0, ss, cs, 0.0, 0.0, 0.0, 1.0);
+        // A.9: ŷ4⁶ = R_z(ψ)ᵀ ŷ, x̂3⁶ = R_6^1ᵀ x̂.
+        let y4 = Vector3::new(ss, cs, 0.0);
+        let x3 = r61.row(0).transpose();
+        let j6 = Matrix3::from_columns(&[y4 * g5_phi + x3, y4 * g5_theta, Vector3::z()]);
+        let omega = j6 * p_dot;
+
+        // J̇6 ṗ from link angular velocities, as in `terms`.
+        let rates = Vector2::new(p_dot.x, p_dot.y);
+        let g5_dot = g5_phi * p_dot.x + g5_theta * p_dot.y;
+        let y3 = Vector3::new(0.0, cp, sp);
+        let z4 = Vector3::new(r4[(0, 2)], r4[(1, 2)], r4[(2, 2)]);
+        let omega4 = Vector3::x() * p_dot.x + y3 * g5_dot;
+        let hessian = nalgebra::Matrix2::new(h_pp, h_pt, h_pt, h_tt);
+        let accel_ground = y3 * rates.dot(&(hessian * rates))
+            + Vector3::x().cross(&y3) * (g5_dot * p_dot.x)
+            + omega4.cross(&z4) * p_dot.z;
+        let jdot_pdot = r61.transpose() * accel_ground;
+
+        let i_omega = self.inertia * omega;
+        let mass = j6.transpose() * self.inertia * j6;
+        let coriolis = j6.transpose() * (self.inertia * jdot_pdot + omega.cross(&i_omega));
+
+        // A.6 with springs on joints 1, 4, 6 only.
+        let s = &self.springs;
+        let mut spring = Vector3::new(s[0].torque(phi), s[3].torque(theta), s[5].torque(psi));
+        let mut potential = s[0].energy(phi) + s[3].energy(theta) + s[5].energy(psi);
+        if let Some(h) = &self.tunable_hinge {
+            let k = h.stiffness(theta);
+            spring.z += k * psi;
+            spring.y += 0.5 * (h.k1 + 2.0 * h.k2 * theta) * psi * psi;
+            potential += 0.5 * k * psi * psi;
+        }
+
+        let aero_frame6 = self.aero.torque(p_dot, &omega, &r61);
+        Some(WingTerms {
+            mass,
+            coriolis,
+            spring,
+            aero: j6.transpose() * aero_frame6,
+            aero_frame6,
+            j6,
+            omega,
+            jdot_pdot,
+            rotation: r61,
+            theta_w: g5,
+            potential,
+            kinetic: 0.5 * omega.dot(&i_omega),
+        })
+    }
+
+    /// Whether [`Self::free_deviation_terms`] applies to this wing (α2 = 90°, α3 = 0, no
+    /// springs on joints 2, 3, 5).
+    pub fn has_closed_form_free_deviation(&self) -> bool {
+        self.has_closed_form_stroke_plane() && self.shoulder.alpha3() == 0.0
+    }
+
     /// Whether [`Self::stroke_plane_terms`] applies to this wing (α2 = 90°, no springs on
     /// joints 2, 3, 5).
     pub fn has_closed_form_stroke_plane(&self) -> bool {

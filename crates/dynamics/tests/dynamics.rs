@@ -5,6 +5,8 @@
 mod continuation;
 #[path = "dynamics/floquet.rs"]
 mod floquet;
+#[path = "dynamics/lean.rs"]
+mod lean;
 #[path = "dynamics/metrics.rs"]
 mod metrics;
 #[path = "dynamics/steady_state.rs"]
@@ -937,4 +939,115 @@ fn stroke_plane_terms_equal_general_terms() {
             assert_relative_eq!(fast.kinetic, general.kinetic, epsilon = tol);
         }
     }
+}
+
+/// The closed-form free-deviation terms (α2 = 90°, α3 = 0, any θ) equal the general shoulder
+/// terms (joint-angle solve of eqs. 2.11–2.13, closure partials), every field.
+#[test]
+fn free_deviation_terms_equal_general_terms() {
+    use paritysim_dynamics::TunableHinge;
+    let blade = paritysim_aero::BladeElementModel::new(
+        paritysim_aero::Omegas::new(46.8, 0.59, 17.5, 0.71).unwrap(),
+        paritysim_aero::CoefficientSet::default(),
+    )
+    .unwrap();
+    let wing = Wing::new(
+        shoulder(90.0, 0.0),
+        full_inertia(),
+        springs([3.0, 0.0, 0.0, 2.0, 0.0, 1.5]),
+        WingAero::BladeElement(blade),
+    )
+    .unwrap()
+    .with_tunable_hinge(TunableHinge::new(2.0, 0.5, 3.0).unwrap());
+    assert!(wing.has_closed_form_free_deviation());
+    let drag_wing = Wing::new(
+        shoulder(90.0, 0.0),
+        full_inertia(),
+        springs([3.0, 0.0, 0.0, 2.0, 0.0, 1.5]),
+        drag(31.3),
+    )
+    .unwrap();
+    let mut checked = 0;
+    for wing in [&wing, &drag_wing] {
+        for k in 0..300 {
+            let x = k as f64;
+            // Strokes to ±80°, deviations to ±60°, rotations to ±70°, rates of both signs.
+            let p = Vector3::new(
+                1.4 * (0.37 * x).sin(),
+                1.05 * (0.61 * x).cos(),
+                1.2 * (1.3 * x).sin(),
+            );
+            let v = Vector3::new(
+                0.8 * (0.71 * x).cos(),
+                -0.5 * (0.23 * x).sin(),
+                1.5 * (2.1 * x).cos(),
+            );
+            let fast = wing.free_deviation_terms(&p, &v).unwrap();
+            let general = wing.terms(&p, &v).unwrap();
+            let tol = 1e-12;
+            assert_relative_eq!(fast.mass, general.mass, epsilon = tol, max_relative = tol);
+            assert_relative_eq!(
+                fast.coriolis,
+                general.coriolis,
+                epsilon = tol,
+                max_relative = tol
+            );
+            assert_relative_eq!(
+                fast.spring,
+                general.spring,
+                epsilon = tol,
+                max_relative = tol
+            );
+            assert_relative_eq!(fast.aero, general.aero, epsilon = tol, max_relative = tol);
+            assert_relative_eq!(
+                fast.aero_frame6,
+                general.aero_frame6,
+                epsilon = tol,
+                max_relative = tol
+            );
+            assert_relative_eq!(fast.j6, general.j6, epsilon = tol, max_relative = tol);
+            assert_relative_eq!(fast.omega, general.omega, epsilon = tol, max_relative = tol);
+            assert_relative_eq!(
+                fast.jdot_pdot,
+                general.jdot_pdot,
+                epsilon = tol,
+                max_relative = tol
+            );
+            assert_relative_eq!(
+                fast.rotation,
+                general.rotation,
+                epsilon = tol,
+                max_relative = tol
+            );
+            assert_relative_eq!(
+                fast.theta_w,
+                general.theta_w,
+                epsilon = tol,
+                max_relative = tol
+            );
+            assert_relative_eq!(
+                fast.potential,
+                general.potential,
+                epsilon = tol,
+                max_relative = tol
+            );
+            assert_relative_eq!(
+                fast.kinetic,
+                general.kinetic,
+                epsilon = tol,
+                max_relative = tol
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 600);
+    // Other shoulders keep the general terms.
+    let other = Wing::new(
+        shoulder(90.0, 30.0),
+        full_inertia(),
+        springs([0.0; 6]),
+        drag(31.3),
+    )
+    .unwrap();
+    assert!(!other.has_closed_form_free_deviation());
 }

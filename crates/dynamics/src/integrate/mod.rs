@@ -380,9 +380,9 @@ impl RungeKutta {
         sink: &mut Sink<'_>,
         on_step: &mut dyn FnMut(f64, &State),
     ) -> Result<(State, IntegrationStats)> {
+        debug_assert_eq!(n, Adapter::active::<M>());
         let mut rhs = Adapter {
             system,
-            n,
             template: *y0,
             calls: 0,
         };
@@ -487,11 +487,20 @@ pub(crate) trait Stepper<const M: usize> {
 /// [`OdeSystem`] on the compact layout `[coords (n), rates (n), work (0 or 2)]`.
 struct Adapter<'a> {
     system: &'a dyn OdeSystem,
-    n: usize,
     /// Supplies the entries the compact state does not carry (work integrals when not
     /// integrated).
     template: State,
     calls: usize,
+}
+
+impl Adapter<'_> {
+    /// The active coordinates `n` of an `M`-entry array (`2n` or `2n + 2` entries with
+    /// `n ∈ {2, 4, 6}`, see [`RungeKutta::dispatch`]): a constant, so the copies in and out
+    /// of [`State`] compile to a few moves instead of `memcpy` calls.
+    #[inline(always)]
+    const fn active<const M: usize>() -> usize {
+        2 * (M / 4)
+    }
 }
 
 impl<const M: usize> Rhs<M> for Adapter<'_> {
@@ -503,7 +512,7 @@ impl<const M: usize> Rhs<M> for Adapter<'_> {
         if let Err(e) = self.system.rhs(t, &y, &mut dydt) {
             return Err(integration_error(t, &y, format!("the model failed: {e}")));
         }
-        let n = self.n;
+        let n = Self::active::<M>();
         dcdt[..n].copy_from_slice(&dydt.coords[..n]);
         dcdt[n..2 * n].copy_from_slice(&dydt.rates[..n]);
         if M > 2 * n {
@@ -515,7 +524,7 @@ impl<const M: usize> Rhs<M> for Adapter<'_> {
 
     #[inline]
     fn expand(&self, c: &[f64; M]) -> State {
-        let n = self.n;
+        let n = Self::active::<M>();
         let mut y = State::default();
         y.coords[..n].copy_from_slice(&c[..n]);
         y.rates[..n].copy_from_slice(&c[n..2 * n]);

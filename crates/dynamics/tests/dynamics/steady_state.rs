@@ -178,7 +178,15 @@ fn stroke_samples_give_the_metrics_of_full_samples() {
         ]
         .map(String::from)
         .to_vec();
-        let full = simulate(&device, &shooting()).unwrap();
+        // Any column makes every sample a full one.
+        let full = simulate(
+            &device,
+            &SimulationOptions {
+                columns: Some(vec!["q2".into()]),
+                ..shooting()
+            },
+        )
+        .unwrap();
         let lean = simulate(
             &device,
             &SimulationOptions {
