@@ -20,8 +20,9 @@
 //!   from the variational equations ([`crate::integrate::RungeKutta::flow_with_sensitivity`]),
 //!   cycle-to-cycle simulation as the fallback; [`floquet`] returns the Floquet multipliers of
 //!   that monodromy (checked against central differences of the map over the coordinates and
-//!   rates the device integrates); [`balance_stiffness_sweep`] repeats that over K2 in
-//!   parallel.
+//!   rates the device integrates); [`balance_stiffness_sweep`] repeats that over K2 on the
+//!   sweep engine (`rows.rs`: one row per value, a failing value a row with its error, the
+//!   sweep's own thread pool), as [`disturbance_responses`] does over frequencies.
 //!
 //! Errata (docs/errata.md) relied on here, each verified numerically in
 //! `tests/dynamics/floquet.rs`: item 7 (the drag forces of eqs. 2.17–2.19 carry `T³`, so
@@ -32,7 +33,8 @@
 //!
 //! One file per subject: `hill.rs` (§2.6, eq. 2.25), `brockett.rs` (§2.6.4), `lti.rs` (§2.6.1
 //! and eq. 2.59), `shooting.rs` (periodic orbit and Floquet multipliers of the full model),
-//! `disturbance.rs` (K2 sweeps, linearisation and disturbance response, §2.7). Everything is
+//! `disturbance.rs` (K2 sweeps, linearisation and disturbance response, §2.7), `rows.rs` (the
+//! parameter loops on the sweep engine). Everything is
 //! re-exported here (and as `paritysim_dynamics::floquet`, the former module name).
 
 pub mod brockett;
@@ -40,10 +42,12 @@ pub mod disturbance;
 pub mod hill;
 pub mod lti;
 pub mod records;
+pub mod rows;
 pub mod shooting;
 
 pub use brockett::*;
 pub use disturbance::*;
 pub use hill::*;
 pub use lti::*;
+pub use rows::Rows;
 pub use shooting::*;
