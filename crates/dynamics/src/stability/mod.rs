@@ -7,7 +7,7 @@
 //!   2.45, 2.50 and 2.54 hold to 1e-9 or better in `tests/dynamics/floquet.rs`); its
 //!   half trace `a`, determinant `b` (eq. 2.36), multipliers (eq. 2.37) and region of Fig. 2.13
 //!   ([`Region`], with the corrected Region III bound of docs/errata.md#9) follow. A
-//!   [`stability_chart`] over a (β0, κ) grid is computed in parallel with rayon. [`brockett()`]
+//!   [`stability_chart`] over a (β0, κ) grid is computed on the sweep engine's pool. [`brockett()`]
 //!   is the criterion of eqs. 2.57–2.58 and [`PhysicalParameters::hill`] maps a device to
 //!   (β0, κ1, κ2) with the factors of docs/errata.md#7.
 //! * **Disturbance rejection (§2.7).** [`LtiModel`] is eq. 2.59; [`linearise`] derives its

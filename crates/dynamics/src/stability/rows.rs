@@ -12,12 +12,13 @@ pub type Rows<T> = Vec<Result<T>>;
 /// Runs `point(i)` for `i in 0..n` through [`run_indexed`] (the sweep engine: its own rayon
 /// pool of [`resolve_threads`]`(None)` threads, never the global one; a panic is caught as
 /// that row's error), under the caller's wall budget and cancel flag. A failing point's error
-/// is located as `array[i]` and kept in its row; the other rows are kept.
+/// is located as `array[i]` (with `array` given; else left as `point` located it) and kept in
+/// its row; the other rows are kept.
 ///
 /// # Errors
 /// [`Error::Cancelled`] when the caller's budget is cancelled (no new point starts once a
 /// running one saw it); [`Error::InvalidParameter`] for a bad `PARITYSIM_THREADS`.
-pub(crate) fn run_rows<T, F>(n: usize, array: &str, point: F) -> Result<Rows<T>>
+pub(crate) fn run_rows<T, F>(n: usize, array: Option<&str>, point: F) -> Result<Rows<T>>
 where
     T: Send,
     F: Fn(usize) -> Result<T> + Sync,
@@ -33,7 +34,10 @@ where
                 control.cancel();
                 Err(Error::Cancelled)
             }
-            other => other.map_err(|e| e.at_index(i, Some(array))),
+            other => other.map_err(|e| match array {
+                Some(name) => e.at_index(i, Some(name)),
+                None => e,
+            }),
         }
     })?;
     let rows: Rows<T> = slots
