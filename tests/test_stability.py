@@ -168,11 +168,22 @@ def test_hmf_is_stable() -> None:
 
 def test_k2_sweep_frame() -> None:
     df = st.k2_sweep(drag_parity_spec(1.0), [1.0, 100.0, 500.0, 1000.0])
-    assert df.columns == ["k2", "spectral_radius", "whippletree_radius", "max_exponent_per_ms", "slowest_decay_ms", "stability", "moduli"]
+    assert df.columns == ["k2", "spectral_radius", "whippletree_radius", "max_exponent_per_ms", "slowest_decay_ms", "stability", "moduli", "error"]
+    assert df["error"].null_count() == df.height
     assert df["stability"].to_list()[0] == "unstable" and df["stability"].to_list()[-1] == "asymptotic"
     assert (df["whippletree_radius"].diff().drop_nulls() < 0).all()
     single = st.floquet(drag_parity_spec(100.0))
     assert df["spectral_radius"][1] == single.spectral_radius
+
+
+def test_a_failing_k2_is_a_row_with_its_error() -> None:
+    """The K2 loop runs on the sweep engine: a bad value is its row (error naming ``k2[i]``,
+    nulls elsewhere), the others are computed as on their own (formerly the first error raised)."""
+    df = st.k2_sweep(drag_parity_spec(1.0), [-1.0, 100.0])
+    assert df["error"][0] is not None and "k2[0]" in df["error"][0]
+    assert df["spectral_radius"][0] is None and df["stability"][0] is None and df["moduli"][0].to_list() == []
+    assert df["error"][1] is None
+    assert df["spectral_radius"][1] == st.floquet(drag_parity_spec(100.0)).spectral_radius
 
 
 # ------------------------------------------------------------------ CLI and report

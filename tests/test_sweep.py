@@ -81,10 +81,11 @@ def assert_equivalent(a: pl.DataFrame, b: pl.DataFrame, rel: float = 1e-5) -> No
         assert (np.isnan(x) == np.isnan(y)).all(), name
         finite = ~np.isnan(x)
         scale = max(float(np.abs(x[finite]).max(initial=0.0)), 1e-300)
-        # plus 1e-4 absolute: what vanishes by symmetry (q2, net roll torque, imbalance %) is 0
-        # cold and carries the wings' ~1e-7 relative error chained (net roll peak 1.1e-6 mN·mm,
-        # instantaneous imbalance 1.4e-5 %: above issue 12's 1e-5 points, an open defect)
-        assert (np.abs(x[finite] - y[finite]) <= rel * scale + 1e-4).all(), (name, x, y)
+        # no absolute allowance for what vanishes by symmetry (q2, net roll torque, imbalance
+        # %): examples/drag_parity.toml's symmetric orbit is unstable (whippletree multiplier
+        # 1.4-2.0), so its points fall back to the transient and run cold, exactly symmetric,
+        # in every chain (chained, its round-off grew to an imbalance of 1.2e-5 %: findings §9)
+        assert (np.abs(x[finite] - y[finite]) <= rel * scale + 1e-12).all(), (name, x, y)
 
 
 GRID = {"drivetrain.balance_spring": [1.0, 5.0], "wings[*].aero.omega1": [25.0, 31.3], "actuator.frequency_hz": [100.0, 110.0, 120.0]}

@@ -256,6 +256,11 @@ def _shooting(options: dict[str, Any]) -> str | None:
     return json.dumps(given, default=lambda o: o.item() if isinstance(o, np.generic) else repr(o)) if given else None
 
 
+def _strings(name: str, values: Any) -> pl.Series:
+    """A text column from ``_core``, whose converter hands an all-None column over as NaN."""
+    return pl.Series(name, [v if isinstance(v, str) else None for v in values], dtype=pl.String)
+
+
 def _complex(pairs: Any) -> np.ndarray:
     """``[re, im]`` pairs (last axis) from ``_core`` as a complex array."""
     a = np.asarray(pairs, dtype=float)
@@ -307,21 +312,23 @@ def k2_sweep(spec: Simulation | dict[str, Any], k2: Any, **options: Any) -> pl.D
     """:func:`floquet` over balance-beam stiffnesses ``k2`` (mN·mm/rad), in parallel in Rust.
 
     Columns: ``k2, spectral_radius, whippletree_radius`` (null without a whippletree block),
-    ``max_exponent_per_ms, slowest_decay_ms`` (null when nothing decays), ``stability`` and
-    ``moduli`` (list column: |ρ| of every multiplier, largest first).
+    ``max_exponent_per_ms, slowest_decay_ms`` (null when nothing decays), ``stability``,
+    ``moduli`` (list column: |ρ| of every multiplier, largest first) and ``error``: a K2 that
+    fails (invalid, no orbit) is a row with its error message there and nulls elsewhere, as
+    in :func:`paritysim.sweep`; the others are kept. The points run on the sweep engine's own
+    thread pool (``PARITYSIM_THREADS``).
     """
     raw = _core.stability_k2_sweep(_device(spec), _f64(k2, "k2"), _shooting(options))
+    numeric = ["spectral_radius", "whippletree_radius", "max_exponent_per_ms", "slowest_decay_ms"]
     return pl.DataFrame(
         {
             "k2": raw["k2"],
-            "spectral_radius": raw["spectral_radius"],
-            "whippletree_radius": raw["whippletree_radius"],
-            "max_exponent_per_ms": raw["max_exponent_per_ms"],
-            "slowest_decay_ms": raw["slowest_decay_ms"],
-            "stability": raw["stability"],
-            "moduli": [list(np.abs(row)) for row in _complex(raw["multipliers"])],
+            **{name: pl.Series(name, raw[name], dtype=pl.Float64) for name in numeric},
+            "stability": _strings("stability", raw["stability"]),
+            "moduli": pl.Series("moduli", [list(np.abs(_complex(row))) for row in raw["multipliers"]], dtype=pl.List(pl.Float64)),
+            "error": _strings("error", raw["error"]),
         }
-    ).with_columns(pl.col("whippletree_radius", "slowest_decay_ms").fill_nan(None))
+    ).with_columns(pl.col(numeric).fill_nan(None))
 
 
 #: Orbit samples of `linearise` (its cycle averages), also used by `disturbance_response`.
@@ -362,7 +369,8 @@ def disturbance_response(
     (eq. 2.59 from :func:`linearise`'s ``lti``; null for a 1-DOF drivetrain, which has no
     whippletree mode), ``lti_averaged_gain``, ``drift`` (change
     between two consecutive windows: a settled, stable response has drift << 1) and
-    ``window_ms``.
+    ``window_ms`` and ``error`` (a frequency that fails is a row with its error message and
+    nulls elsewhere; the others are kept).
     """
     freqs = _f64(frequency_hz, "frequency_hz")
     dist = {"settle_cycles": settle_cycles, "max_window_cycles": max_window_cycles, "samples_per_cycle": samples_per_cycle}
@@ -385,8 +393,9 @@ def disturbance_response(
             "lti_averaged_gain": np.abs(avg),
             "drift": raw["drift"],
             "window_ms": raw["window_ms"],
+            "error": _strings("error", raw["error"]),
         }
-    ).with_columns(pl.col("lti_gain", "lti_phase_rad", "lti_averaged_gain").fill_nan(None))
+    ).with_columns(pl.col("gain", "phase_rad", "lti_gain", "lti_phase_rad", "lti_averaged_gain", "drift", "window_ms").fill_nan(None))
 
 
 # ------------------------------------------------------------------ plots

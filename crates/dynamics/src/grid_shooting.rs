@@ -51,6 +51,35 @@ pub(crate) fn out_of_budget(e: &Error) -> bool {
     matches!(e, Error::Cancelled) || crate::integrate::budget::check_current().is_err()
 }
 
+/// Singular values of `DP − I` below this fraction of the largest are a neutral direction
+/// (a multiplier within it of 1: a mode that needs more than a million periods to decay, which
+/// no transient resolves either), left where it is by the Newton step.
+///
+/// Why not round-off (the former cutoff `1e-10`): `DP` comes from variational equations
+/// integrated at the grid tolerance (`rtol / 100`, 1e-10 by default) or from Broyden updates,
+/// so an exact multiplier 1 shows up as a singular value of about that size. Measured on two
+/// identical §3.4 rotating wings (linear differential, K2 = 0: the differential stroke offset
+/// is cyclic): the neutral singular value was 2.2e-10 against a cutoff of 1.5e-10, the step
+/// divided the residual's round-off antisymmetric part (4e-15) by it and moved the orbit
+/// 7e-4 rad along the neutral family: a valid but asymmetric orbit (docs/findings.md §10).
+pub(crate) const NEUTRAL_SINGULAR_TOL: f64 = 1e-6;
+
+/// The least-squares Newton step `Δ` of `(DP − I) Δ = −f` with the neutral directions
+/// ([`NEUTRAL_SINGULAR_TOL`]) left out: the minimum-norm solution, which does not move the
+/// state along a family of orbits (a symmetric start stays symmetric). `None` when the SVD
+/// fails (a non-finite Jacobian).
+pub(crate) fn least_squares_step(
+    jac_minus_eye: DMatrix<f64>,
+    f: &DVector<f64>,
+) -> Option<DVector<f64>> {
+    if jac_minus_eye.iter().chain(f.iter()).any(|v| !v.is_finite()) {
+        return None;
+    }
+    let svd = jac_minus_eye.svd(true, true);
+    let cutoff = NEUTRAL_SINGULAR_TOL * svd.singular_values.max().max(f64::MIN_POSITIVE);
+    svd.solve(&(-f), cutoff).ok()
+}
+
 /// Tolerances of the adaptive period that picks the grid, relative to the run's: the fixed-grid
 /// maps then need no rejected steps and the orbit and its recorded window are accurate to about
 /// the run's `rtol` (on the §3.3 grid at rtol 1e-8, the grid at the run's own tolerance left
@@ -120,13 +149,7 @@ pub(crate) fn shoot(
     let eye = DMatrix::<f64>::identity(m, m);
     let mut last_step: Option<f64> = None;
     let mut iterations = 0;
-    // Least squares: a neutral direction (multiplier 1, e.g. K2 = 0 on the linear map, where
-    // every constant q2 is an orbit) is left where it is.
-    let newton_step = |jac: &DMatrix<f64>, f: &DVector<f64>| {
-        let svd = (jac - &eye).svd(true, true);
-        let cutoff = 1e-10 * svd.singular_values.max().max(f64::MIN_POSITIVE);
-        svd.solve(&(-f), cutoff).ok()
-    };
+    let newton_step = |jac: &DMatrix<f64>, f: &DVector<f64>| least_squares_step(jac - &eye, f);
     while iterations < max_newton {
         iterations += 1;
         let Some(delta) = newton_step(&jac, &f) else {

@@ -35,9 +35,8 @@ pub struct Perturbation {
 /// How the periodic steady state is reached.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum SteadyState {
-    /// Cycle-to-cycle simulation until the change per cycle is below `steady_tol` (the
-    /// default, and the automatic fallback of [`SteadyState::Shooting`]).
-    #[default]
+    /// Cycle-to-cycle simulation until the change per cycle is below `steady_tol` (also the
+    /// automatic fallback of [`SteadyState::Shooting`]).
     Transient,
     /// Newton shooting on the stroboscopic map retraced on a frozen step grid
     /// ([`crate::grid_shooting`]): warm-up of up to `min_cycles` (none with
@@ -47,11 +46,11 @@ pub enum SteadyState {
     /// predicted state error and the residual are `≤ min(steady_tol / 100, rtol / 10)` (or the
     /// residual `≤ steady_tol` along a neutral direction). Falls back to
     /// [`SteadyState::Transient`] when Newton fails. The residual and the Floquet multipliers
-    /// (of the final Jacobian estimate) come with the result. It meets issue 12's accuracy
-    /// goals on the §3.3 stroke-only grid at default tolerances, where the transient's
-    /// `steady_tol` stop leaves a slow mode (multiplier 0.98) ~5e-6 off the orbit; not the
-    /// default yet: on identical §3.4 wings (general formulation) it broke the mirror symmetry
-    /// by 2.5e-4 rad (docs/findings.md §8).
+    /// (of the final Jacobian estimate) come with the result. The default: it meets
+    /// issue 12's accuracy goals (torques 1e-7 relative, percentages 1e-5 points of the
+    /// periodic orbit) at default tolerances, where the transient's `steady_tol` stop leaves a
+    /// slow mode (multiplier 0.98) ~5e-6 off the orbit.
+    #[default]
     Shooting,
 }
 
@@ -126,7 +125,7 @@ impl Default for SimulationOptions {
             duration_ms: None,
             columns: None,
             metrics: None,
-            steady_state: SteadyState::Transient,
+            steady_state: SteadyState::Shooting,
             shooting_jacobian: None,
             shooting_grid: None,
             max_wall_ms: Some(DEFAULT_MAX_WALL_MS),

@@ -29,14 +29,13 @@ impl From<Method> for EngineMethod {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum SteadyState {
-    /// Cycle-by-cycle simulation until the change per cycle is below `steady_tol` (the
-    /// default).
-    #[default]
+    /// Cycle-by-cycle simulation until the change per cycle is below `steady_tol`.
     Transient,
-    /// A few cycles, then Newton shooting on the stroboscopic map retraced on a frozen step
-    /// grid, with the variational equations; falls back to the transient automatically
-    /// (Newton failure, unstable orbit). Reports the residual and the multipliers. The
-    /// accurate and fast choice for sweeps of stroke-only (fixed-wing) devices.
+    /// The default: a few cycles, then Newton shooting on the stroboscopic map retraced on a
+    /// frozen step grid, with the variational equations; falls back to the transient
+    /// automatically (Newton failure, unstable orbit). Reports the residual and the
+    /// multipliers.
+    #[default]
     Shooting,
 }
 

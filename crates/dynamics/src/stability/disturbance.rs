@@ -6,7 +6,6 @@ use std::f64::consts::PI;
 
 use nalgebra::{Complex, Matrix2, Vector2};
 use paritysim_error::{Error, Result, bail, check_finite, check_positive};
-use rayon::prelude::*;
 
 use crate::device::{Device, DeviceSpec, Formulation, Transmission};
 use crate::integrate::{Integrator, Method, OdeSystem, RungeKutta, State, budget};
@@ -26,27 +25,21 @@ pub fn with_balance_stiffness(spec: &DeviceSpec, k2: f64) -> Result<DeviceSpec> 
     Ok(out)
 }
 
-/// [`floquet`] for each balance-beam stiffness K2 in `k2` (mN·mm/rad), in parallel.
+/// [`floquet`] for each balance-beam stiffness K2 in `k2` (mN·mm/rad), one row each, on the
+/// sweep engine's pool ([`super::rows`]).
 ///
 /// # Errors
-/// The first failure, located as `k2[i]`.
+/// A failing stiffness (an invalid K2, no orbit) is its row's error, located as `k2[i]`; the
+/// call itself fails only when cancelled ([`Error::Cancelled`]) or for a bad thread count.
 pub fn balance_stiffness_sweep(
     spec: &DeviceSpec,
     k2: &[f64],
     options: &ShootingOptions,
-) -> Result<Vec<NonlinearFloquet>> {
-    let run_budget = budget::current();
-    k2.par_iter()
-        .enumerate()
-        .map(|(i, &k)| {
-            let _budget = run_budget.clone().map(budget::Budget::enter);
-            let run = || -> Result<NonlinearFloquet> {
-                let device = Device::new(with_balance_stiffness(spec, k)?)?;
-                floquet(&device, options)
-            };
-            run().map_err(|e| e.at_index(i, Some("k2")))
-        })
-        .collect()
+) -> Result<Rows<NonlinearFloquet>> {
+    super::rows::run_rows(k2.len(), Some("k2"), |i| {
+        let device = Device::new(with_balance_stiffness(spec, k2[i])?)?;
+        floquet(&device, options)
+    })
 }
 
 /// What a stroke-only (fixed-wing) device needs for §2.7.
@@ -505,25 +498,20 @@ pub fn disturbance_response(
     })
 }
 
-/// [`disturbance_response`] at each of `frequencies_hz`, in parallel.
+/// [`disturbance_response`] at each of `frequencies_hz`, one row each, on the sweep engine's
+/// pool ([`super::rows`]).
 ///
 /// # Errors
-/// The first failure, located as `frequency_hz[i]`.
+/// A failing frequency is its row's error, located as `frequency_hz[i]`; the call itself
+/// fails only when cancelled ([`Error::Cancelled`]) or for a bad thread count.
 pub fn disturbance_responses(
     device: &Device,
     orbit: &PeriodicOrbit,
     frequencies_hz: &[f64],
     amplitude: f64,
     options: &DisturbanceOptions,
-) -> Result<Vec<DisturbanceResponse>> {
-    let run_budget = budget::current();
-    frequencies_hz
-        .par_iter()
-        .enumerate()
-        .map(|(i, &f)| {
-            let _budget = run_budget.clone().map(budget::Budget::enter);
-            disturbance_response(device, orbit, f, amplitude, options)
-                .map_err(|e| e.at_index(i, Some("frequency_hz")))
-        })
-        .collect()
+) -> Result<Rows<DisturbanceResponse>> {
+    super::rows::run_rows(frequencies_hz.len(), Some("frequency_hz"), |i| {
+        disturbance_response(device, orbit, frequencies_hz[i], amplitude, options)
+    })
 }

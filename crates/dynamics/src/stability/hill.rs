@@ -5,7 +5,6 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use nalgebra::{Complex, Matrix2};
 use paritysim_error::{Error, Result, bail, check_finite};
-use rayon::prelude::*;
 
 use crate::integrate::budget;
 
@@ -339,10 +338,14 @@ impl StabilityChart {
     }
 }
 
+/// Points of one task of [`stability_chart`] on the sweep engine's pool.
+const CHART_CHUNK: usize = 1024;
+
 /// Largest number of points of one [`stability_chart`] call.
 pub const MAX_CHART_POINTS: usize = 4_000_000;
 
-/// Evaluates [`hill_floquet`] on every `(β0, κ)` of the grid `beta0 × kappa`, in parallel.
+/// Evaluates [`hill_floquet`] on every `(β0, κ)` of the grid `beta0 × kappa`, in parallel on
+/// the sweep engine's own pool ([`super::rows`]; `PARITYSIM_THREADS`).
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming the first bad element (`beta0[i]`, `kappa[j]`), an
@@ -362,17 +365,25 @@ pub fn stability_chart(beta0: &[f64], kappa: &[f64]) -> Result<StabilityChart> {
         check_hill(0.0, k).map_err(|e| e.at_index(j, Some("kappa")))?;
     }
     let nk = kappa.len();
-    // A chart of millions of points runs for seconds: each point checks the caller's budget
-    // (its cancel flag) on whichever pool thread computes it.
-    let run_budget = budget::current();
-    let points: Vec<HillFloquet> = (0..n)
-        .into_par_iter()
-        .with_min_len(64)
-        .map(|idx| {
-            budget::carry(&run_budget, || budget::check(0.0))?;
-            hill_floquet(beta0[idx / nk], kappa[idx % nk]).map_err(|e| e.at_index(idx, None))
-        })
-        .collect::<Result<_>>()?;
+    // On the sweep engine's own pool, in chunks (a point takes microseconds). Every point
+    // checks the caller's budget (its cancel flag). A point fails only by overflow once the
+    // axes are validated: the chart then fails with that point's error (a chart has no row
+    // for it).
+    let chunks = n.div_ceil(CHART_CHUNK);
+    let rows = super::rows::run_rows(chunks, None, |c| {
+        (c * CHART_CHUNK..((c + 1) * CHART_CHUNK).min(n))
+            .map(|idx| {
+                budget::check(0.0)?;
+                hill_floquet(beta0[idx / nk], kappa[idx % nk]).map_err(|e| e.at_index(idx, None))
+            })
+            .collect::<Result<Vec<HillFloquet>>>()
+    })?;
+    let points: Vec<HillFloquet> = rows
+        .into_iter()
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .flatten()
+        .collect();
     let mut chart = StabilityChart {
         beta0: Vec::with_capacity(n),
         kappa: Vec::with_capacity(n),

@@ -7,7 +7,7 @@
 //!   2.45, 2.50 and 2.54 hold to 1e-9 or better in `tests/dynamics/floquet.rs`); its
 //!   half trace `a`, determinant `b` (eq. 2.36), multipliers (eq. 2.37) and region of Fig. 2.13
 //!   ([`Region`], with the corrected Region III bound of docs/errata.md#9) follow. A
-//!   [`stability_chart`] over a (β0, κ) grid is computed in parallel with rayon. [`brockett()`]
+//!   [`stability_chart`] over a (β0, κ) grid is computed on the sweep engine's pool. [`brockett()`]
 //!   is the criterion of eqs. 2.57–2.58 and [`PhysicalParameters::hill`] maps a device to
 //!   (β0, κ1, κ2) with the factors of docs/errata.md#7.
 //! * **Disturbance rejection (§2.7).** [`LtiModel`] is eq. 2.59; [`linearise`] derives its
@@ -20,8 +20,9 @@
 //!   from the variational equations ([`crate::integrate::RungeKutta::flow_with_sensitivity`]),
 //!   cycle-to-cycle simulation as the fallback; [`floquet`] returns the Floquet multipliers of
 //!   that monodromy (checked against central differences of the map over the coordinates and
-//!   rates the device integrates); [`balance_stiffness_sweep`] repeats that over K2 in
-//!   parallel.
+//!   rates the device integrates); [`balance_stiffness_sweep`] repeats that over K2 on the
+//!   sweep engine (`rows.rs`: one row per value, a failing value a row with its error, the
+//!   sweep's own thread pool), as [`disturbance_responses`] does over frequencies.
 //!
 //! Errata (docs/errata.md) relied on here, each verified numerically in
 //! `tests/dynamics/floquet.rs`: item 7 (the drag forces of eqs. 2.17–2.19 carry `T³`, so
@@ -32,7 +33,8 @@
 //!
 //! One file per subject: `hill.rs` (§2.6, eq. 2.25), `brockett.rs` (§2.6.4), `lti.rs` (§2.6.1
 //! and eq. 2.59), `shooting.rs` (periodic orbit and Floquet multipliers of the full model),
-//! `disturbance.rs` (K2 sweeps, linearisation and disturbance response, §2.7). Everything is
+//! `disturbance.rs` (K2 sweeps, linearisation and disturbance response, §2.7), `rows.rs` (the
+//! parameter loops on the sweep engine). Everything is
 //! re-exported here (and as `paritysim_dynamics::floquet`, the former module name).
 
 pub mod brockett;
@@ -40,10 +42,12 @@ pub mod disturbance;
 pub mod hill;
 pub mod lti;
 pub mod records;
+pub mod rows;
 pub mod shooting;
 
 pub use brockett::*;
 pub use disturbance::*;
 pub use hill::*;
 pub use lti::*;
+pub use rows::Rows;
 pub use shooting::*;

@@ -197,7 +197,8 @@ impl From<&NonlinearFloquet> for FloquetRecord {
     }
 }
 
-/// [`FloquetRecord`]'s summary over balance-beam stiffnesses, as columns.
+/// [`FloquetRecord`]'s summary over balance-beam stiffnesses, as columns; a failed stiffness
+/// is a row with its `error` (NaN and None elsewhere).
 #[derive(Clone, Debug, Serialize)]
 pub struct BalanceSweepRecord {
     /// Balance-beam stiffness, mN·mm/rad.
@@ -210,34 +211,50 @@ pub struct BalanceSweepRecord {
     pub whippletree_radius: Vec<Option<f64>>,
     /// Slowest decay time, ms (None when nothing decays).
     pub slowest_decay_ms: Vec<Option<f64>>,
-    /// Multipliers `[re, im]` per stiffness.
+    /// Multipliers `[re, im]` per stiffness (none for a failed one).
     pub multipliers: Vec<Vec<[f64; 2]>>,
-    /// Stability name per stiffness.
-    pub stability: Vec<&'static str>,
+    /// Stability name per stiffness (None for a failed one).
+    pub stability: Vec<Option<&'static str>>,
+    /// The error of a failed stiffness (None when it ran).
+    pub error: Vec<Option<String>>,
+}
+
+/// `f` of an `Ok` row, `missing` for a failed one.
+fn column<T, U>(runs: &[Result<T>], missing: U, f: impl Fn(&T) -> U) -> Vec<U>
+where
+    U: Clone,
+{
+    runs.iter()
+        .map(|r| r.as_ref().map_or_else(|_| missing.clone(), &f))
+        .collect()
+}
+
+fn errors<T>(runs: &[Result<T>]) -> Vec<Option<String>> {
+    runs.iter()
+        .map(|r| r.as_ref().err().map(ToString::to_string))
+        .collect()
 }
 
 impl BalanceSweepRecord {
-    /// Columns of the runs at `k2`.
-    pub fn of(k2: &[f64], runs: &[NonlinearFloquet]) -> Self {
+    /// Columns of the rows at `k2`.
+    pub fn of(k2: &[f64], runs: &[Result<NonlinearFloquet>]) -> Self {
         Self {
             k2: k2.to_vec(),
-            spectral_radius: runs.iter().map(NonlinearFloquet::spectral_radius).collect(),
-            max_exponent_per_ms: runs.iter().map(NonlinearFloquet::max_exponent).collect(),
-            whippletree_radius: runs
-                .iter()
-                .map(|f| f.whippletree.map(|w| w[0].norm().max(w[1].norm())))
-                .collect(),
-            slowest_decay_ms: runs
-                .iter()
-                .map(NonlinearFloquet::slowest_decay_ms)
-                .collect(),
-            multipliers: runs.iter().map(|f| pairs(&f.multipliers)).collect(),
-            stability: runs.iter().map(|f| stability_name(f.stability())).collect(),
+            spectral_radius: column(runs, f64::NAN, NonlinearFloquet::spectral_radius),
+            max_exponent_per_ms: column(runs, f64::NAN, NonlinearFloquet::max_exponent),
+            whippletree_radius: column(runs, None, |f| {
+                f.whippletree.map(|w| w[0].norm().max(w[1].norm()))
+            }),
+            slowest_decay_ms: column(runs, None, NonlinearFloquet::slowest_decay_ms),
+            multipliers: column(runs, Vec::new(), |f| pairs(&f.multipliers)),
+            stability: column(runs, None, |f| Some(stability_name(f.stability()))),
+            error: errors(runs),
         }
     }
 }
 
-/// Disturbance responses as columns.
+/// Disturbance responses as columns; a failed frequency is a row with its `error` (NaN
+/// elsewhere).
 #[derive(Clone, Debug, Serialize)]
 pub struct DisturbanceRecord {
     /// Disturbance frequency, Hz.
@@ -252,18 +269,21 @@ pub struct DisturbanceRecord {
     pub commensurability_error: Vec<f64>,
     /// Disturbance amplitude, mN·mm.
     pub amplitude: f64,
+    /// The error of a failed frequency (None when it ran).
+    pub error: Vec<Option<String>>,
 }
 
 impl DisturbanceRecord {
-    /// Columns of `runs` at `frequency_hz`.
-    pub fn of(frequency_hz: &[f64], amplitude: f64, runs: &[DisturbanceResponse]) -> Self {
+    /// Columns of the rows at `frequency_hz`.
+    pub fn of(frequency_hz: &[f64], amplitude: f64, runs: &[Result<DisturbanceResponse>]) -> Self {
         Self {
             frequency_hz: frequency_hz.to_vec(),
-            transfer: runs.iter().map(|r| pair(&r.transfer)).collect(),
-            drift: runs.iter().map(|r| r.drift).collect(),
-            window_ms: runs.iter().map(|r| r.window_ms).collect(),
-            commensurability_error: runs.iter().map(|r| r.commensurability_error).collect(),
+            transfer: column(runs, [f64::NAN; 2], |r| pair(&r.transfer)),
+            drift: column(runs, f64::NAN, |r| r.drift),
+            window_ms: column(runs, f64::NAN, |r| r.window_ms),
+            commensurability_error: column(runs, f64::NAN, |r| r.commensurability_error),
             amplitude,
+            error: errors(runs),
         }
     }
 }

@@ -305,11 +305,10 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
         iterations += 1;
         let a = jac - DMatrix::<f64>::identity(2 * n, 2 * n);
         let f = compact(n, &py) - compact(n, &y);
-        let svd = a.svd(true, true);
-        let smax = svd.singular_values.max();
-        let delta = svd
-            .solve(&(-&f), 1e-10 * smax.max(f64::MIN_POSITIVE))
-            .map_err(|e| Error::Singular(format!("Newton step of the shooting method: {e}")))?;
+        // The same step as the frozen-grid shooting: neutral directions are left alone.
+        let delta = crate::grid_shooting::least_squares_step(a, &f).ok_or_else(|| {
+            Error::Singular("Newton step of the shooting method: non-finite Jacobian".into())
+        })?;
         let mut lambda = 1.0;
         let mut accepted = false;
         for _ in 0..if fresh { 8 } else { 1 } {

@@ -654,14 +654,27 @@ fn k2_sweep_is_parallel_and_equals_single_runs() {
     let spec = section_3_3(31.3, 1.0).spec().clone();
     let k2 = [1.0, 100.0, 500.0];
     let sweep = balance_stiffness_sweep(&spec, &k2, &options()).unwrap();
+    let sweep: Vec<_> = sweep.into_iter().map(Result::unwrap).collect();
     for (k, f) in k2.iter().zip(&sweep) {
         let single = floquet(&section_3_3(31.3, *k), &options()).unwrap();
         assert_eq!(f.multipliers, single.multipliers);
     }
     let rho: Vec<f64> = sweep.iter().map(|f| f.spectral_radius()).collect();
     assert!(rho[0] > rho[1] && rho[1] > rho[2], "{rho:?}");
-    let err = balance_stiffness_sweep(&spec, &[1.0, -1.0], &options()).unwrap_err();
-    assert_eq!(err.field(), Some("k2[1]"), "{err}");
+}
+
+#[test]
+fn a_failing_k2_is_a_row_with_its_error_and_the_others_are_kept() {
+    // Formerly the first error stopped the whole sweep.
+    let spec = section_3_3(31.3, 1.0).spec().clone();
+    let rows = balance_stiffness_sweep(&spec, &[-1.0, 100.0, f64::NAN], &options()).unwrap();
+    assert_eq!(rows.len(), 3);
+    for (i, row) in [(0, &rows[0]), (2, &rows[2])] {
+        let err = row.as_ref().unwrap_err();
+        assert_eq!(err.field(), Some(format!("k2[{i}]").as_str()), "{err}");
+    }
+    let single = floquet(&section_3_3(31.3, 100.0), &options()).unwrap();
+    assert_eq!(rows[1].as_ref().unwrap().multipliers, single.multipliers);
 }
 
 #[test]

@@ -1,0 +1,51 @@
+//! The stability module's parameter loops on the sweep engine: one row per parameter value,
+//! a failing value a row with its error, on the sweep's own thread pool.
+
+use paritysim_error::{Error, Result};
+
+use crate::integrate::budget;
+use crate::sweep::{SweepControl, resolve_threads, run_indexed};
+
+/// One row per parameter value: the value's result or the error that stopped it.
+pub type Rows<T> = Vec<Result<T>>;
+
+/// Runs `point(i)` for `i in 0..n` through [`run_indexed`] (the sweep engine: its own rayon
+/// pool of [`resolve_threads`]`(None)` threads, never the global one; a panic is caught as
+/// that row's error), under the caller's wall budget and cancel flag. A failing point's error
+/// is located as `array[i]` (with `array` given; else left as `point` located it) and kept in
+/// its row; the other rows are kept.
+///
+/// # Errors
+/// [`Error::Cancelled`] when the caller's budget is cancelled (no new point starts once a
+/// running one saw it); [`Error::InvalidParameter`] for a bad `PARITYSIM_THREADS`.
+pub(crate) fn run_rows<T, F>(n: usize, array: Option<&str>, point: F) -> Result<Rows<T>>
+where
+    T: Send,
+    F: Fn(usize) -> Result<T> + Sync,
+{
+    let run_budget = budget::current();
+    let threads = resolve_threads(None)?;
+    let control = SweepControl::new();
+    let slots = run_indexed(n, threads, &control, |i| {
+        let out = budget::carry(&run_budget, || point(i));
+        match out {
+            Err(Error::Cancelled) => {
+                // The caller's cancel: the points not yet started do not start.
+                control.cancel();
+                Err(Error::Cancelled)
+            }
+            other => other.map_err(|e| match array {
+                Some(name) => e.at_index(i, Some(name)),
+                None => e,
+            }),
+        }
+    })?;
+    let rows: Rows<T> = slots
+        .into_iter()
+        .map(|slot| slot.unwrap_or(Err(Error::Cancelled)))
+        .collect();
+    if rows.iter().any(|r| matches!(r, Err(Error::Cancelled))) {
+        return Err(Error::Cancelled);
+    }
+    Ok(rows)
+}
