@@ -166,7 +166,7 @@ pub struct SimulationResult {
     pub step_grid: Vec<f64>,
 }
 
-fn validate(options: &SimulationOptions) -> Result<()> {
+pub(crate) fn validate(options: &SimulationOptions) -> Result<()> {
     check_positive("steady_tol", options.steady_tol)?;
     if let Some(ms) = options.max_wall_ms {
         check_positive("max_wall_ms", ms)?;

@@ -16,6 +16,9 @@ mod dopri5;
 mod tests;
 mod variational;
 
+/// DOP853 on fixed grids for several problems in SIMD lanes.
+pub(crate) use dop853::lanes;
+
 use paritysim_error::{Error, Result, check_positive};
 
 /// Largest number of integrated coordinates.

@@ -1,0 +1,454 @@
+//! DOP853 on fixed step grids for [`LANES`] independent problems at once, one per SIMD lane
+//! (`wide::f64x4`): the ensemble technique of heyoka and MPGOS (several sweep points
+//! integrated together, each lane with its own time, step size and state, refilled when its
+//! problem ends; see `crate::sweep` for the scheduler).
+//!
+//! Why fixed grids only: the shooting of [`crate::SteadyState::Shooting`] spends almost all of
+//! a chained sweep point in fixed-grid periods (docs/findings.md §7), which need no per-lane
+//! step control: a lane only carries its own grid, and no lane waits on another's rejection.
+//!
+//! Every lane performs exactly the scalar path's floating-point operations in the same order
+//! (the stages of [`super::Dop853::attempt`], its error norm and dense output, the
+//! drivetrain-coordinate right-hand side of [`crate::device::Device`] for the linear map):
+//! SIMD addition, multiplication, division and square root are the IEEE operations of the
+//! scalar code and nothing is fused, so a lane's result is bit-identical to the scalar
+//! integration of the same problem (tested in `crate::sweep`).
+
+use std::rc::Rc;
+
+use wide::f64x4;
+
+use super::*;
+
+/// Problems integrated at once.
+pub(crate) const LANES: usize = 4;
+
+type V = f64x4;
+
+/// One lane's value of `v`.
+#[inline]
+fn lane(v: V, l: usize) -> f64 {
+    v.as_array()[l]
+}
+
+/// `v` with lane `l` set to `x`.
+#[inline]
+fn with_lane(v: V, l: usize, x: f64) -> V {
+    let mut a = v.to_array();
+    a[l] = x;
+    V::new(a)
+}
+
+/// The right-hand side of several lanes on the compact layout `[q1, q2, q̇1, q̇2]`.
+pub(crate) trait LaneRhs {
+    /// Writes `f(t, y)` of every lane; returns the bit mask of lanes whose evaluation failed
+    /// (left out of the domain of the model).
+    fn eval(&self, t: [f64; LANES], y: &[V; 4], dydt: &mut [V; 4]) -> u32;
+}
+
+/// Tolerances of one lane's error estimate (see [`super::Tolerances`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct LaneTolerances {
+    pub(crate) rtol: f64,
+    pub(crate) atol: f64,
+}
+
+/// One fixed-grid integration given to a lane.
+pub(crate) struct LaneProblem {
+    /// Step times (at least two, increasing).
+    pub(crate) grid: Rc<[f64]>,
+    /// Initial compact state at `grid[0]`.
+    pub(crate) y0: [f64; 4],
+    /// Sample times (sorted, within the grid's span).
+    pub(crate) times: Rc<[f64]>,
+    /// Tolerances of the error estimate (counted in [`LaneOutcome::over_tolerance`]).
+    pub(crate) tol: LaneTolerances,
+}
+
+/// How a lane's integration ended.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum LaneOutcome {
+    /// The state at the grid's end and the steps whose error estimate exceeded the tolerances.
+    Done {
+        /// Compact end state.
+        y: [f64; 4],
+        /// See [`super::IntegrationStats::over_tolerance`].
+        over_tolerance: usize,
+    },
+    /// The scalar path would have returned an error here (the model left its domain, a
+    /// non-finite state or error estimate, or the sample sink refused).
+    Failed,
+}
+
+/// Receives the samples of a lane: `(lane, index in its times, time, compact state)`; `false`
+/// fails the lane.
+pub(crate) type LaneSink<'a> = dyn FnMut(usize, usize, f64, &[f64; 4]) -> bool + 'a;
+
+/// Per-lane progress.
+#[derive(Clone, Default)]
+struct Progress {
+    grid: Rc<[f64]>,
+    times: Rc<[f64]>,
+    step: usize,
+    next: usize,
+    over_tolerance: usize,
+    active: bool,
+}
+
+/// [`LANES`] lanes of DOP853 on fixed grids.
+pub(crate) struct LaneStepper {
+    y: [V; 4],
+    f0: [V; 4],
+    k: [[V; 4]; 10],
+    y1: [V; 4],
+    cont: [[V; 4]; 8],
+    rtol: V,
+    atol: V,
+    lanes: [Progress; LANES],
+}
+
+/// `y + h Σ aᵢ kᵢ` on vectors (the scalar `stage!` of dop853.rs, same operation order).
+macro_rules! vstage {
+    ($out:expr, $y:expr, $h:expr, $( $a:expr => $k:expr ),+ ) => {
+        for i in 0..4 {
+            $out[i] = $y[i] + $h * (V::splat(0.0) $( + V::splat($a) * $k[i] )+);
+        }
+    };
+}
+
+impl LaneStepper {
+    /// All lanes idle.
+    pub(crate) fn new() -> Self {
+        let z = [V::splat(0.0); 4];
+        Self {
+            y: z,
+            f0: z,
+            k: [z; 10],
+            y1: z,
+            cont: [z; 8],
+            rtol: V::splat(1.0),
+            atol: V::splat(1.0),
+            lanes: std::array::from_fn(|_| Progress::default()),
+        }
+    }
+
+    /// Whether any lane is integrating.
+    pub(crate) fn any_busy(&self) -> bool {
+        self.lanes.iter().any(|p| p.active)
+    }
+
+    /// Gives `problem` to the idle lane `l`: its samples at `grid[0]` go to `sink` at once.
+    /// Its first derivative is evaluated by the next [`Self::run`]. `false` (lane left idle)
+    /// when the sink refuses a sample or the grid is too short.
+    pub(crate) fn start(
+        &mut self,
+        l: usize,
+        problem: LaneProblem,
+        sink: &mut LaneSink<'_>,
+    ) -> bool {
+        if problem.grid.len() < 2 {
+            return false;
+        }
+        let t0 = problem.grid[0];
+        let mut next = 0;
+        while next < problem.times.len() && problem.times[next] <= t0 {
+            if !sink(l, next, problem.times[next], &problem.y0) {
+                return false;
+            }
+            next += 1;
+        }
+        for i in 0..4 {
+            self.y[i] = with_lane(self.y[i], l, problem.y0[i]);
+        }
+        self.rtol = with_lane(self.rtol, l, problem.tol.rtol);
+        self.atol = with_lane(self.atol, l, problem.tol.atol);
+        self.lanes[l] = Progress {
+            grid: problem.grid,
+            times: problem.times,
+            step: 0,
+            next,
+            over_tolerance: 0,
+            active: true,
+        };
+        true
+    }
+
+    /// Steps every busy lane until at least one finishes; returns `(lane, outcome)` of the
+    /// finished ones (those lanes are idle again). `fresh`: mask of lanes started since the
+    /// last call (their `f(t0, y0)` is evaluated first).
+    pub(crate) fn run(
+        &mut self,
+        rhs: &dyn LaneRhs,
+        fresh: u32,
+        sink: &mut LaneSink<'_>,
+    ) -> Vec<(usize, LaneOutcome)> {
+        let mut finished = Vec::new();
+        if fresh != 0 {
+            let t0 = std::array::from_fn(|l| {
+                let p = &self.lanes[l];
+                if p.active { p.grid[0] } else { 0.0 }
+            });
+            let mut f = [V::splat(0.0); 4];
+            let failed = rhs.eval(t0, &self.y, &mut f);
+            for l in 0..LANES {
+                if fresh & (1 << l) == 0 || !self.lanes[l].active {
+                    continue;
+                }
+                if failed & (1 << l) != 0 {
+                    self.lanes[l].active = false;
+                    finished.push((l, LaneOutcome::Failed));
+                    continue;
+                }
+                for i in 0..4 {
+                    self.f0[i] = with_lane(self.f0[i], l, lane(f[i], l));
+                }
+            }
+        }
+        while finished.is_empty() && self.any_busy() {
+            self.step(rhs, sink, &mut finished);
+        }
+        finished
+    }
+
+    /// One fixed step of every busy lane (idle lanes repeat a harmless zero step).
+    fn step(
+        &mut self,
+        rhs: &dyn LaneRhs,
+        sink: &mut LaneSink<'_>,
+        finished: &mut Vec<(usize, LaneOutcome)>,
+    ) {
+        let mut t = [0.0; LANES];
+        let mut t_new = [0.0; LANES];
+        let mut hs = [0.0; LANES];
+        for (l, p) in self.lanes.iter().enumerate() {
+            if p.active {
+                t[l] = p.grid[p.step];
+                t_new[l] = p.grid[p.step + 1];
+                hs[l] = t_new[l] - t[l];
+            }
+        }
+        let h = V::new(hs);
+        let at = |c: f64| -> [f64; LANES] { std::array::from_fn(|l| t[l] + c * hs[l]) };
+        let mut failed = 0u32;
+        let y = self.y;
+        let k1 = self.f0;
+        let [k2, k3, k4, k5, k6, k7, k8, k9, k10, _] = &mut self.k;
+        let mut ys = [V::splat(0.0); 4];
+        vstage!(ys, y, h, A21 => k1);
+        failed |= rhs.eval(at(C2), &ys, k2);
+        vstage!(ys, y, h, A31 => k1, A32 => k2);
+        failed |= rhs.eval(at(C3), &ys, k3);
+        vstage!(ys, y, h, A41 => k1, A43 => k3);
+        failed |= rhs.eval(at(C4), &ys, k4);
+        vstage!(ys, y, h, A51 => k1, A53 => k3, A54 => k4);
+        failed |= rhs.eval(at(C5), &ys, k5);
+        vstage!(ys, y, h, A61 => k1, A64 => k4, A65 => k5);
+        failed |= rhs.eval(at(C6), &ys, k6);
+        vstage!(ys, y, h, A71 => k1, A74 => k4, A75 => k5, A76 => k6);
+        failed |= rhs.eval(at(C7), &ys, k7);
+        vstage!(ys, y, h, A81 => k1, A84 => k4, A85 => k5, A86 => k6, A87 => k7);
+        failed |= rhs.eval(at(C8), &ys, k8);
+        vstage!(ys, y, h, A91 => k1, A94 => k4, A95 => k5, A96 => k6, A97 => k7, A98 => k8);
+        failed |= rhs.eval(at(C9), &ys, k9);
+        vstage!(ys, y, h, A101 => k1, A104 => k4, A105 => k5, A106 => k6, A107 => k7, A108 => k8,
+            A109 => k9);
+        failed |= rhs.eval(at(C10), &ys, k10);
+        vstage!(ys, y, h, A111 => k1, A114 => k4, A115 => k5, A116 => k6, A117 => k7, A118 => k8,
+            A119 => k9, A1110 => k10);
+        failed |= rhs.eval(at(C11), &ys, k2);
+        vstage!(ys, y, h, A121 => k1, A124 => k4, A125 => k5, A126 => k6, A127 => k7, A128 => k8,
+            A129 => k9, A1210 => k10, A1211 => k2);
+        failed |= rhs.eval(at(1.0), &ys, k3);
+        // The scalar attempt's increment, new state and error norm (every entry controlled).
+        let mut err5 = V::splat(0.0);
+        let mut err3 = V::splat(0.0);
+        for i in 0..4 {
+            let inc = V::splat(B1) * k1[i]
+                + V::splat(B6) * k6[i]
+                + V::splat(B7) * k7[i]
+                + V::splat(B8) * k8[i]
+                + V::splat(B9) * k9[i]
+                + V::splat(B10) * k10[i]
+                + V::splat(B11) * k2[i]
+                + V::splat(B12) * k3[i];
+            let y1 = y[i] + h * inc;
+            self.y1[i] = y1;
+            let sk = self.atol + self.rtol * y[i].abs().max(y1.abs());
+            let e3 = inc - V::splat(BHH1) * k1[i] - V::splat(BHH2) * k9[i] - V::splat(BHH3) * k3[i];
+            let e5 = V::splat(ER1) * k1[i]
+                + V::splat(ER6) * k6[i]
+                + V::splat(ER7) * k7[i]
+                + V::splat(ER8) * k8[i]
+                + V::splat(ER9) * k9[i]
+                + V::splat(ER10) * k10[i]
+                + V::splat(ER11) * k2[i]
+                + V::splat(ER12) * k3[i];
+            err3 += (e3 / sk) * (e3 / sk);
+            err5 += (e5 / sk) * (e5 / sk);
+        }
+        let mut deno = (err5 + V::splat(0.01) * err3).to_array();
+        for d in &mut deno {
+            if *d <= 0.0 {
+                *d = 1.0;
+            }
+        }
+        let err = h.abs() * err5 * (V::splat(1.0) / (V::splat(4.0) * V::new(deno))).sqrt();
+        let mut f1 = [V::splat(0.0); 4];
+        failed |= rhs.eval(t_new, &self.y1, &mut f1);
+        let y1_finite = (self.y1[0].is_finite()
+            & self.y1[1].is_finite()
+            & self.y1[2].is_finite()
+            & self.y1[3].is_finite())
+        .to_bitmask();
+        let err_finite = err.is_finite().to_bitmask();
+        let wants_dense = (0..LANES).any(|l| {
+            let p = &self.lanes[l];
+            p.active && p.next < p.times.len() && p.times[p.next] < t_new[l]
+        });
+        if wants_dense {
+            failed |= self.prepare_dense(rhs, &t, h, &f1);
+        }
+        for l in 0..LANES {
+            if !self.lanes[l].active {
+                continue;
+            }
+            let bit = 1 << l;
+            let mut ok = failed & bit == 0 && err_finite & bit != 0 && y1_finite & bit != 0;
+            if ok {
+                ok = self.emit(l, t[l], hs[l], t_new[l], sink);
+            }
+            let p = &mut self.lanes[l];
+            if lane(err, l) > 1.0 {
+                p.over_tolerance += 1;
+            }
+            p.step += 1;
+            if !ok {
+                p.active = false;
+                finished.push((l, LaneOutcome::Failed));
+            } else if p.step + 1 == p.grid.len() {
+                p.active = false;
+                finished.push((
+                    l,
+                    LaneOutcome::Done {
+                        y: std::array::from_fn(|i| lane(self.y1[i], l)),
+                        over_tolerance: p.over_tolerance,
+                    },
+                ));
+            }
+        }
+        self.y = self.y1;
+        self.f0 = f1;
+    }
+
+    /// The samples of lane `l` inside `[t, t_new)` (interpolated) and at `t_new`.
+    fn emit(&mut self, l: usize, t: f64, h: f64, t_new: f64, sink: &mut LaneSink<'_>) -> bool {
+        let p = &mut self.lanes[l];
+        while p.next < p.times.len() && p.times[p.next] < t_new {
+            let s = (p.times[p.next] - t) / h;
+            let s1 = 1.0 - s;
+            let mut out = [0.0; 4];
+            let c = |r: usize, i: usize| lane(self.cont[r][i], l);
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = c(0, i)
+                    + s * (c(1, i)
+                        + s1 * (c(2, i)
+                            + s * (c(3, i)
+                                + s1 * (c(4, i)
+                                    + s * (c(5, i) + s1 * (c(6, i) + s * c(7, i)))))));
+            }
+            if !out.iter().all(|v| v.is_finite()) || !sink(l, p.next, p.times[p.next], &out) {
+                return false;
+            }
+            p.next += 1;
+        }
+        let end: [f64; 4] = std::array::from_fn(|i| lane(self.y1[i], l));
+        while p.next < p.times.len() && p.times[p.next] <= t_new {
+            if !sink(l, p.next, p.times[p.next], &end) {
+                return false;
+            }
+            p.next += 1;
+        }
+        true
+    }
+
+    /// The dense output of the step just taken (the scalar `prepare_dense`, on every lane).
+    fn prepare_dense(&mut self, rhs: &dyn LaneRhs, t: &[f64; LANES], h: V, f1: &[V; 4]) -> u32 {
+        let hs = h.to_array();
+        let at = |c: f64| -> [f64; LANES] { std::array::from_fn(|l| t[l] + c * hs[l]) };
+        let y = self.y;
+        let k1 = self.f0;
+        let k13 = *f1;
+        let [k2, k3, _k4, _k5, k6, k7, k8, k9, k10, kx] = &mut self.k;
+        let [r1, r2, r3, r4, r5, r6, r7, r8] = &mut self.cont;
+        let s = V::splat;
+        for i in 0..4 {
+            let ydiff = self.y1[i] - y[i];
+            let bspl = h * k1[i] - ydiff;
+            r1[i] = y[i];
+            r2[i] = ydiff;
+            r3[i] = bspl;
+            r4[i] = ydiff - h * k13[i] - bspl;
+            r5[i] = s(D41) * k1[i]
+                + s(D46) * k6[i]
+                + s(D47) * k7[i]
+                + s(D48) * k8[i]
+                + s(D49) * k9[i]
+                + s(D410) * k10[i]
+                + s(D411) * k2[i]
+                + s(D412) * k3[i];
+            r6[i] = s(D51) * k1[i]
+                + s(D56) * k6[i]
+                + s(D57) * k7[i]
+                + s(D58) * k8[i]
+                + s(D59) * k9[i]
+                + s(D510) * k10[i]
+                + s(D511) * k2[i]
+                + s(D512) * k3[i];
+            r7[i] = s(D61) * k1[i]
+                + s(D66) * k6[i]
+                + s(D67) * k7[i]
+                + s(D68) * k8[i]
+                + s(D69) * k9[i]
+                + s(D610) * k10[i]
+                + s(D611) * k2[i]
+                + s(D612) * k3[i];
+            r8[i] = s(D71) * k1[i]
+                + s(D76) * k6[i]
+                + s(D77) * k7[i]
+                + s(D78) * k8[i]
+                + s(D79) * k9[i]
+                + s(D710) * k10[i]
+                + s(D711) * k2[i]
+                + s(D712) * k3[i];
+        }
+        let mut failed = 0;
+        let mut ys = [V::splat(0.0); 4];
+        vstage!(ys, y, h, A141 => k1, A147 => k7, A148 => k8, A149 => k9, A1410 => k10,
+            A1411 => k2, A1412 => k3, A1413 => k13);
+        failed |= rhs.eval(at(C14), &ys, kx);
+        let k14 = *kx;
+        vstage!(ys, y, h, A151 => k1, A156 => k6, A157 => k7, A158 => k8, A1511 => k2,
+            A1512 => k3, A1513 => k13, A1514 => k14);
+        failed |= rhs.eval(at(C15), &ys, k10);
+        let k15 = *k10;
+        vstage!(ys, y, h, A161 => k1, A166 => k6, A167 => k7, A168 => k8, A169 => k9,
+            A1613 => k13, A1614 => k14, A1615 => k15);
+        failed |= rhs.eval(at(C16), &ys, k2);
+        let k16 = *k2;
+        for i in 0..4 {
+            r5[i] = h
+                * (r5[i] + s(D413) * k13[i] + s(D414) * k14[i] + s(D415) * k15[i]
+                    + s(D416) * k16[i]);
+            r6[i] = h
+                * (r6[i] + s(D513) * k13[i] + s(D514) * k14[i] + s(D515) * k15[i]
+                    + s(D516) * k16[i]);
+            r7[i] = h
+                * (r7[i] + s(D613) * k13[i] + s(D614) * k14[i] + s(D615) * k15[i]
+                    + s(D616) * k16[i]);
+            r8[i] = h
+                * (r8[i] + s(D713) * k13[i] + s(D714) * k14[i] + s(D715) * k15[i]
+                    + s(D716) * k16[i]);
+        }
+        failed
+    }
+}

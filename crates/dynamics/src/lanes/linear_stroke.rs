@@ -1,0 +1,189 @@
+//! The drivetrain-coordinate right-hand side of [`Formulation::DrivetrainCoordinates`] for the
+//! linear differential map (eq. 2.15) in SIMD lanes, one device per lane.
+//!
+//! With the constant Jacobian `J` of eq. 2.15 the mass matrix `M_q = Σ_k I_k J_kᵀ J_k` is
+//! constant and the velocity products vanish: per lane only the stroke springs, the stroke
+//! drag (eq. 2.16) and the actuator force `F(t)` remain. Every operation is the one of
+//! `Device::drivetrain_step` in the same order, so a lane's derivative is bit-identical to
+//! the scalar one; the force is the scalar [`Actuator::force`] of each lane's time (any
+//! waveform).
+
+use wide::f64x4;
+
+use crate::actuator::Actuator;
+use crate::device::{Device, Formulation};
+use crate::integrate::lanes::{LANES, LaneRhs};
+use crate::wing::WingAero;
+use paritysim_kinematics::Drivetrain;
+
+type V = f64x4;
+
+/// Per-device constants of the lane right-hand side.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LinearStroke<'a> {
+    actuator: &'a Actuator,
+    /// `J` by rows: `(J00, J01, J10, J11)`.
+    jacobian: [f64; 4],
+    /// `M_q` entries `(m00, m01, m11)` and `det M_q`, summed as the scalar path sums them.
+    mass: [f64; 3],
+    det: f64,
+    /// `−Ω1 C` per wing (0 without aerodynamics).
+    drag: [f64; 2],
+    /// Stroke springs per wing: `(stiffness, cubic, rest angle)`.
+    springs: [[f64; 3]; 2],
+    k1: f64,
+    k2: f64,
+}
+
+impl<'a> LinearStroke<'a> {
+    /// The constants of `device`, or `None` unless it integrates drivetrain coordinates of a
+    /// two-DOF linear differential with an actuator and stroke drag (or no aerodynamics) on
+    /// both wings: the devices whose scalar right-hand side this model reproduces exactly.
+    pub(crate) fn of(device: &'a Device) -> Option<Self> {
+        if device.formulation() != Formulation::DrivetrainCoordinates || device.n_dof() != 2 {
+            return None;
+        }
+        let spec = device.spec();
+        let transmission = spec.transmission.as_ref()?;
+        let Drivetrain::LinearDifferential(d) = transmission.kinematics() else {
+            return None;
+        };
+        let actuator = spec.actuator.as_ref()?;
+        let t = d.transmission_ratio();
+        let (hl, hr) = d.arms();
+        // As `LinearDifferential::evaluate` builds it.
+        let jacobian = [-t, t * hl, -t, -t * hr];
+        let (mut m00, mut m01, mut m11) = (0.0, 0.0, 0.0);
+        let mut drag = [0.0; 2];
+        let mut springs = [[0.0; 3]; 2];
+        for k in 0..2 {
+            let wing = spec.wings.get(k)?;
+            let (a, b) = (jacobian[2 * k], jacobian[2 * k + 1]);
+            let inertia = wing.inertia()[(0, 0)];
+            m00 += inertia * a * a;
+            m01 += inertia * a * b;
+            m11 += inertia * b * b;
+            drag[k] = match wing.aero() {
+                WingAero::None => 0.0,
+                WingAero::StrokeDrag {
+                    omega1,
+                    coefficient,
+                } => -omega1 * coefficient,
+                WingAero::BladeElement(_) => return None,
+            };
+            let s = &wing.springs()[0];
+            springs[k] = [s.stiffness(), s.cubic(), s.rest_angle()];
+        }
+        let det = m00 * m11 - m01 * m01;
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        Some(Self {
+            actuator,
+            jacobian,
+            mass: [m00, m01, m11],
+            det,
+            drag,
+            springs,
+            k1: actuator.stiffness(),
+            k2: transmission.balance_stiffness(),
+        })
+    }
+}
+
+/// [`LANES`] devices side by side (vectors of their constants).
+pub(crate) struct LinearStrokeLanes<'a> {
+    actuators: [Option<&'a Actuator>; LANES],
+    j: [V; 4],
+    m00: V,
+    m01: V,
+    m11: V,
+    det: V,
+    drag: [V; 2],
+    stiffness: [V; 2],
+    cubic: [V; 2],
+    rest: [V; 2],
+    k1: V,
+    k2: V,
+}
+
+fn set(v: &mut V, l: usize, x: f64) {
+    let mut a = v.to_array();
+    a[l] = x;
+    *v = V::new(a);
+}
+
+impl<'a> LinearStrokeLanes<'a> {
+    /// No device in any lane (idle lanes evaluate a unit-mass system).
+    pub(crate) fn new() -> Self {
+        let (z, one) = (V::splat(0.0), V::splat(1.0));
+        Self {
+            actuators: [None; LANES],
+            j: [one, z, z, one],
+            m00: one,
+            m01: z,
+            m11: one,
+            det: one,
+            drag: [z; 2],
+            stiffness: [z; 2],
+            cubic: [z; 2],
+            rest: [z; 2],
+            k1: z,
+            k2: z,
+        }
+    }
+
+    /// Puts `model` into lane `l`.
+    pub(crate) fn load(&mut self, l: usize, model: &LinearStroke<'a>) {
+        self.actuators[l] = Some(model.actuator);
+        for i in 0..4 {
+            set(&mut self.j[i], l, model.jacobian[i]);
+        }
+        set(&mut self.m00, l, model.mass[0]);
+        set(&mut self.m01, l, model.mass[1]);
+        set(&mut self.m11, l, model.mass[2]);
+        set(&mut self.det, l, model.det);
+        for k in 0..2 {
+            set(&mut self.drag[k], l, model.drag[k]);
+            set(&mut self.stiffness[k], l, model.springs[k][0]);
+            set(&mut self.cubic[k], l, model.springs[k][1]);
+            set(&mut self.rest[k], l, model.springs[k][2]);
+        }
+        set(&mut self.k1, l, model.k1);
+        set(&mut self.k2, l, model.k2);
+    }
+}
+
+impl LaneRhs for LinearStrokeLanes<'_> {
+    #[inline]
+    fn eval(&self, t: [f64; LANES], y: &[V; 4], dydt: &mut [V; 4]) -> u32 {
+        let [q1, q2, q1_dot, q2_dot] = *y;
+        // `Drivetrain::evaluate`'s plausibility check (the scalar path errs outside it).
+        let inside = q1.abs().simd_le(V::splat(paritysim_error::plausible::OFFSET_MM))
+            & q2.abs().simd_le(V::splat(paritysim_error::plausible::ANGLE_RAD));
+        let failed = !inside.to_bitmask() & ((1 << LANES) - 1);
+        let force = V::new(std::array::from_fn(|l| {
+            self.actuators[l].map_or(0.0, |a| a.force(t[l]))
+        }));
+        let [j00, j01, j10, j11] = self.j;
+        let stroke = [j00 * q1 + j01 * q2, j10 * q1 + j11 * q2];
+        let phi_dot = [j00 * q1_dot + j01 * q2_dot, j10 * q1_dot + j11 * q2_dot];
+        let mut g0 = force - self.k1 * q1;
+        let mut g1 = -self.k2 * q2;
+        let rows = [(j00, j01), (j10, j11)];
+        for k in 0..2 {
+            let (a, b) = rows[k];
+            let tau_aero = self.drag[k] * phi_dot[k].abs() * phi_dot[k];
+            let d = stroke[k] - self.rest[k];
+            let spring = self.stiffness[k] * d + self.cubic[k] * d * d * d;
+            let tau = tau_aero - spring;
+            g0 += a * tau;
+            g1 += b * tau;
+        }
+        dydt[0] = q1_dot;
+        dydt[1] = q2_dot;
+        dydt[2] = (self.m11 * g0 - self.m01 * g1) / self.det;
+        dydt[3] = (self.m00 * g1 - self.m01 * g0) / self.det;
+        failed
+    }
+}

@@ -1,0 +1,618 @@
+//! Sweep chains in SIMD lanes: several continued shooting points integrated at once.
+//!
+//! A chained point of [`SteadyState::Shooting`] spends almost all of its work in fixed-grid
+//! periods (the neighbour's grid checked, one or two Newton trials, the recorded window;
+//! docs/findings.md §7). Here [`LANES`] chains advance side by side, one point per lane: every
+//! lane carries its own grid, time, step and state through the DOP853 stages
+//! ([`crate::integrate::lanes`], `wide::f64x4`), and a lane whose period ends is handed its
+//! point's next period (or the next point of its chain, or the next chain of its group) while
+//! the others keep stepping: the ensemble technique of heyoka and MPGOS. Groups of chains run
+//! in parallel on the sweep's rayon pool.
+//!
+//! * **Which points.** A point qualifies when it continues its chain (a converged neighbour's
+//!   state, Jacobian and grid), reads stroke metrics only, records one plain cycle, uses DOP853,
+//!   and its device integrates drivetrain coordinates of the linear differential map with stroke
+//!   drag ([`linear_stroke::LinearStroke::of`]). Chain starts and every other point run the
+//!   scalar path in place.
+//! * **Same results.** The lanes perform the scalar path's floating-point operations in its
+//!   order, and the Newton logic here is that of `grid_shooting::shoot` on its straight path
+//!   (neighbour's grid accepted, Broyden steps, recorded window accepted). Any other branch
+//!   (grid refused, re-linearisation, a failing or non-converging trial, an unstable orbit)
+//!   reruns the point on the scalar path from the same start, so every point's result is
+//!   bit-identical to the scalar sweep (tested for lane widths 1 to 4 and thread counts).
+//! * **Failures are rows**: a failing point fails on the scalar rerun, with the scalar error.
+
+pub(crate) mod linear_stroke;
+
+use std::rc::Rc;
+
+use nalgebra::{DMatrix, DVector};
+use paritysim_error::{Error, Result, bail};
+
+use crate::device::Device;
+use crate::grid_shooting::GRID_TOLERANCE_FACTOR;
+use crate::integrate::lanes::{
+    LANES, LaneOutcome, LaneProblem, LaneStepper, LaneTolerances,
+};
+use crate::integrate::{Method, RungeKutta, State};
+use crate::metrics::MetricsAccumulator;
+use crate::simulate::{SimulationOptions, SimulationResult, SteadyState, UNSTABLE_MARGIN};
+use crate::sweep::{
+    ChainStart, Converged, PointOutput, SweepControl, chain_point, chain_range, chain_start,
+    continued_options, remember, run_tasks,
+};
+use crate::trajectory::{StrokeSample, Trajectory};
+use linear_stroke::{LinearStroke, LinearStrokeLanes};
+
+/// Environment variable read by [`resolve_lanes`] when no lane width is given: an integer in
+/// `[1, 4]` (`PARITYSIM_LANES=1` runs the scalar path).
+pub const LANES_ENV: &str = "PARITYSIM_LANES";
+
+/// The largest lane width (one `f64x4`).
+pub const MAX_LANES: usize = LANES;
+
+/// The lane width a sweep uses: `requested` if given, else [`LANES_ENV`], else
+/// [`MAX_LANES`]. One lane is the scalar path.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for 0, more than [`MAX_LANES`], or an environment value that is
+/// not such an integer (naming `lanes` or `PARITYSIM_LANES`).
+pub fn resolve_lanes(requested: Option<usize>) -> Result<usize> {
+    let allowed = format!("an integer in [1, {MAX_LANES}]");
+    if let Some(n) = requested {
+        if !(1..=MAX_LANES).contains(&n) {
+            bail!(invalid "lanes", n, allowed);
+        }
+        return Ok(n);
+    }
+    if let Ok(raw) = std::env::var(LANES_ENV) {
+        let raw = raw.trim();
+        if !raw.is_empty() {
+            return match raw.parse::<usize>() {
+                Ok(n) if (1..=MAX_LANES).contains(&n) => Ok(n),
+                _ => Err(Error::invalid(LANES_ENV, format!("{raw:?}"), allowed)),
+            };
+        }
+    }
+    Ok(MAX_LANES)
+}
+
+/// Newton steps of the shooting (as `simulate` gives `grid_shooting::shoot`).
+const MAX_NEWTON: usize = 20;
+
+/// The fixed-grid period a lane point waits for.
+#[derive(Clone, Debug)]
+enum Pending {
+    /// The neighbour's grid from the start state, its error estimates counted.
+    Map,
+    /// A Newton trial from `y_new`; `last`: the recorded window.
+    Trial {
+        y_new: State,
+        delta: DVector<f64>,
+        step: f64,
+        last: bool,
+    },
+}
+
+/// What a lane point does next.
+enum Next {
+    /// Integrate this period in its lane.
+    Integrate(LaneProblem),
+    /// Converged: the point's output.
+    Done(Box<PointOutput>),
+    /// Leave the straight path: rerun the point on the scalar path.
+    Scalar,
+}
+
+/// One continued point on the straight path of `grid_shooting::shoot` (see the module).
+struct LanePoint<'a> {
+    device: &'a Device,
+    model: LinearStroke<'a>,
+    metric_names: &'a [String],
+    samples_per_cycle: usize,
+    period: f64,
+    tol: f64,
+    accept_tol: f64,
+    newton_tol: LaneTolerances,
+    grid_tol: LaneTolerances,
+    /// The shooting's integrator (no work integrals) and the grid chooser (tolerances
+    /// tightened by `GRID_TOLERANCE_FACTOR`), for the periods run in place.
+    rk: RungeKutta,
+    chooser: RungeKutta,
+    grid: Rc<[f64]>,
+    times: Rc<[f64]>,
+    jac: DMatrix<f64>,
+    /// Whether `jac` is an exact Jacobian at `y` (after a re-linearisation).
+    fresh: bool,
+    eye: DMatrix<f64>,
+    y: State,
+    f: DVector<f64>,
+    res: f64,
+    last_step: Option<f64>,
+    iterations: usize,
+    periods: usize,
+    pending: Pending,
+    metrics: MetricsAccumulator,
+    with_force: bool,
+}
+
+/// The compact `[q1, q2, q̇1, q̇2]` of a two-DOF state.
+fn compact4(y: &State) -> [f64; 4] {
+    [y.coords[0], y.coords[1], y.rates[0], y.rates[1]]
+}
+
+/// The state of a compact one (work integrals zero, as the shooting's states).
+fn expand4(c: &[f64; 4]) -> State {
+    let mut y = State::default();
+    y.coords[..2].copy_from_slice(&c[..2]);
+    y.rates[..2].copy_from_slice(&c[2..]);
+    y
+}
+
+/// `(P(y) − y, ‖P(y) − y‖∞ / (1 + ‖y‖∞))` (as `grid_shooting`).
+fn residual(y: &State, py: &State) -> (DVector<f64>, f64) {
+    let (yv, pv) = (y.compact(2), py.compact(2));
+    let f = pv - &yv;
+    let r = f.amax() / (1.0 + yv.amax());
+    (f, r)
+}
+
+/// Least-squares Newton step (as `grid_shooting`).
+fn newton_step(jac: &DMatrix<f64>, eye: &DMatrix<f64>, f: &DVector<f64>) -> Option<DVector<f64>> {
+    let svd = (jac - eye).svd(true, true);
+    let cutoff = 1e-10 * svd.singular_values.max().max(f64::MIN_POSITIVE);
+    svd.solve(&(-f), cutoff).ok()
+}
+
+impl<'a> LanePoint<'a> {
+    /// The point and its first period, or `None` when it does not qualify (see the module).
+    fn new(
+        device: &'a Device,
+        options: &SimulationOptions,
+        metric_names: &'a [String],
+        times_cache: &mut Option<(f64, usize, Rc<[f64]>)>,
+    ) -> Option<(Self, LaneProblem)> {
+        let model = LinearStroke::of(device)?;
+        let period = device.period()?;
+        let stroke_metrics = metric_names
+            .iter()
+            .all(|m| crate::metrics::is_stroke_metric(m));
+        let plain = options.steady_state == SteadyState::Shooting
+            && options.method == Method::Dop853
+            && options.record_cycles == 1
+            && options.perturbation.is_none()
+            && stroke_metrics;
+        if !plain || crate::simulate::validate(options).is_err() {
+            return None;
+        }
+        let (p0, pd0) = options.initial?;
+        let jac = options.shooting_jacobian.clone()?;
+        let grid = options.shooting_grid.as_deref()?;
+        if jac.shape() != (4, 4) || grid.first() != Some(&0.0) || grid.last() != Some(&period) {
+            return None;
+        }
+        crate::integrate::check_grid(grid).ok()?;
+        // What `simulate` checks before running (it would fail on the scalar path).
+        let rk = RungeKutta::new(options.method, options.rtol, options.atol, options.max_steps)
+            .ok()?
+            .with_work(false);
+        if options.samples_per_cycle > crate::simulate::MAX_RECORDED_SAMPLES {
+            return None;
+        }
+        let y = device.state_from(&p0, &pd0).ok()?.without_work();
+        let chooser = GRID_TOLERANCE_FACTOR.clamp(f64::MIN_POSITIVE, 1.0);
+        let n_samples = options.samples_per_cycle;
+        // The recorded window's sample times, as `record_window` makes them.
+        let times = match times_cache {
+            Some((p, n, times)) if *p == period && *n == n_samples => times.clone(),
+            _ => {
+                let (t_start, window) = (grid[0], period);
+                let t_end = t_start + window;
+                let times: Rc<[f64]> = (0..=n_samples)
+                    .map(|k| {
+                        if k == n_samples {
+                            t_end
+                        } else {
+                            t_start + window * k as f64 / n_samples as f64
+                        }
+                    })
+                    .collect();
+                *times_cache = Some((period, n_samples, times.clone()));
+                times
+            }
+        };
+        let point = Self {
+            device,
+            model,
+            metric_names,
+            samples_per_cycle: n_samples,
+            period,
+            tol: (1e-2 * options.steady_tol).min(0.1 * options.rtol),
+            accept_tol: options.steady_tol,
+            newton_tol: LaneTolerances {
+                rtol: options.rtol,
+                atol: options.atol,
+            },
+            grid_tol: LaneTolerances {
+                rtol: options.rtol * chooser,
+                atol: options.atol * chooser,
+            },
+            rk,
+            chooser: rk.tightened(GRID_TOLERANCE_FACTOR),
+            grid: grid.into(),
+            times,
+            jac,
+            fresh: false,
+            eye: DMatrix::identity(4, 4),
+            y,
+            f: DVector::zeros(4),
+            res: f64::NAN,
+            last_step: None,
+            iterations: 0,
+            periods: 0,
+            pending: Pending::Map,
+            metrics: MetricsAccumulator::new(device, Some(period)),
+            with_force: metric_names.iter().any(|m| m == "actuator_force_peak"),
+        };
+        let first = point.problem(&point.y, false);
+        Some((point, first))
+    }
+
+    /// The fixed-grid period from `y` (`record`: with the window's samples).
+    fn problem(&self, y: &State, record: bool) -> LaneProblem {
+        LaneProblem {
+            grid: self.grid.clone(),
+            y0: compact4(y),
+            times: if record { self.times.clone() } else { Rc::from([]) },
+            tol: match self.pending {
+                Pending::Map => self.grid_tol,
+                Pending::Trial { .. } => self.newton_tol,
+            },
+        }
+    }
+
+    /// Feeds one recorded sample to the metrics (`false`: the scalar path would fail here).
+    fn sample(&mut self, index: usize, t: f64, c: &[f64; 4]) -> bool {
+        match StrokeSample::of_stroke_device(self.device, t, &expand4(c), self.with_force) {
+            Ok(s) => {
+                self.metrics
+                    .add_stroke(&s, index == self.samples_per_cycle);
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// The next Newton trial from the current iterate (the head of `shoot`'s loop).
+    fn iterate(&mut self) -> Next {
+        if self.iterations >= MAX_NEWTON {
+            return Next::Scalar;
+        }
+        self.iterations += 1;
+        let Some(delta) = newton_step(&self.jac, &self.eye, &self.f) else {
+            return Next::Scalar;
+        };
+        let scale = 1.0 + self.y.compact(2).amax();
+        let step = delta.amax() / scale;
+        // The next iterate's error: the step times the contraction seen so far (Newton's
+        // quadratic model after a fresh Jacobian; unknown, so 1, after a neighbour's).
+        let contraction = match self.last_step {
+            Some(s) => step / s,
+            None if self.fresh => step,
+            None => 1.0,
+        }
+        .min(1.0);
+        let y_new = State::from_compact(2, &(self.y.compact(2) + &delta));
+        let last = contraction * step <= self.tol || step <= 1e-3 * self.tol;
+        self.pending = Pending::Trial {
+            y_new,
+            delta,
+            step,
+            last,
+        };
+        if last {
+            // A fresh window (a refused earlier window's samples are not kept).
+            self.metrics = MetricsAccumulator::new(self.device, Some(self.period));
+        }
+        Next::Integrate(self.problem(&y_new, last))
+    }
+
+    /// Continues after the lane's period ended with `outcome` (the rest of `shoot`'s loop).
+    fn resume(&mut self, outcome: LaneOutcome) -> Next {
+        match (std::mem::replace(&mut self.pending, Pending::Map), outcome) {
+            (Pending::Map, LaneOutcome::Done { y, over_tolerance: 0 }) => {
+                self.periods = 1;
+                (self.f, self.res) = residual(&self.y, &expand4(&y));
+                self.iterate()
+            }
+            (Pending::Map, _) => {
+                // The neighbour's grid no longer suits: one adaptive period picks another.
+                match self
+                    .chooser
+                    .advance_with_steps(self.device, 0.0, &self.y, self.period)
+                {
+                    Ok((py, grid)) => {
+                        self.grid = grid.into();
+                        self.periods = 1;
+                        (self.f, self.res) = residual(&self.y, &py);
+                        self.iterate()
+                    }
+                    Err(_) => Next::Scalar,
+                }
+            }
+            (Pending::Trial { .. }, LaneOutcome::Failed) => Next::Scalar,
+            (
+                Pending::Trial {
+                    y_new,
+                    delta,
+                    step,
+                    last,
+                },
+                LaneOutcome::Done { y, .. },
+            ) => {
+                self.periods += 1;
+                let (f_new, res_new) = residual(&y_new, &expand4(&y));
+                let tol = self.tol;
+                if last && res_new > tol && res_new <= self.accept_tol && !self.fresh {
+                    // Re-linearise at the candidate, then decide with the exact Jacobian.
+                    if !self.relinearise(&y_new) {
+                        return Next::Scalar;
+                    }
+                    (self.y, self.f, self.res) = (y_new, f_new, res_new);
+                    return self.iterate();
+                }
+                let neutral = || {
+                    res_new <= self.accept_tol
+                        && newton_step(&self.jac, &self.eye, &f_new)
+                            .is_some_and(|d| d.amax() / (1.0 + y_new.compact(2).amax()) <= tol)
+                };
+                if last && (res_new <= tol || neutral()) {
+                    return self.done(y_new, res_new);
+                }
+                if res_new >= self.res || res_new.is_nan() {
+                    // A stale Jacobian that no longer descends: the exact one at the iterate.
+                    if self.fresh || !self.relinearise(&self.y.clone()) {
+                        return Next::Scalar;
+                    }
+                    return self.iterate();
+                }
+                // Good Broyden: the secant condition on the step just taken.
+                let s_dot = delta.dot(&delta);
+                if s_dot > 0.0 {
+                    let mismatch = (&f_new - &self.f) - (&self.jac - &self.eye) * &delta;
+                    self.jac += mismatch * delta.transpose() / s_dot;
+                }
+                self.fresh = false;
+                (self.y, self.f, self.res) = (y_new, f_new, res_new);
+                self.last_step = Some(step);
+                self.iterate()
+            }
+        }
+    }
+
+    /// The exact Jacobian at `at` on the grid (one variational period, scalar); `false` when
+    /// it fails (the scalar path then gives up Newton).
+    fn relinearise(&mut self, at: &State) -> bool {
+        match self
+            .rk
+            .flow_with_sensitivity_on_grid(self.device, &self.grid, at)
+        {
+            Ok((_, j)) => {
+                self.jac = j;
+                self.periods += 1;
+                self.fresh = true;
+                self.last_step = None;
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// The converged point as `simulate` and `run_point` report it.
+    fn done(&mut self, state: State, residual: f64) -> Next {
+        let multipliers = crate::floquet::eigenvalues(&self.jac).unwrap_or_default();
+        if multipliers
+            .first()
+            .is_some_and(|m| m.norm() > 1.0 + UNSTABLE_MARGIN)
+        {
+            return Next::Scalar;
+        }
+        let steady_state = state.without_work();
+        let result = SimulationResult {
+            trajectory: Trajectory::default(),
+            metrics: self.metrics.finish(),
+            cycles_run: self.periods - 1,
+            converged: true,
+            period_ms: self.period,
+            residual,
+            steady_state,
+            multipliers,
+            monodromy: Some(self.jac.clone()),
+            step_grid: self.grid.to_vec(),
+        };
+        let coordinates = self.device.coordinates(&steady_state).ok();
+        Next::Done(Box::new(PointOutput::keep(
+            result,
+            self.metric_names,
+            false,
+            self.samples_per_cycle,
+            coordinates,
+        )))
+    }
+}
+
+/// A chain being worked through by one lane.
+struct Cursor<'a> {
+    chain: usize,
+    /// The next point of the chain to start.
+    next: usize,
+    end: usize,
+    previous: Vec<Converged>,
+    out: Vec<Result<PointOutput>>,
+    /// The point in the lane: its index, start and state.
+    point: Option<(usize, ChainStart, LanePoint<'a>)>,
+}
+
+type ChainResults = Vec<Option<Result<Vec<Result<PointOutput>>>>>;
+
+/// Runs the `n_chains` chains of `points` with `lanes` lanes per group of chains (see the
+/// module); slot `c` is chain `c`'s results as `sweep::run_points` collects them.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a bad thread count.
+pub(crate) fn run_chains(
+    points: &[Result<(Device, SimulationOptions)>],
+    metric_names: &[String],
+    n_chains: usize,
+    threads: usize,
+    lanes: usize,
+    control: &SweepControl,
+) -> Result<ChainResults> {
+    // Groups small enough to keep every thread busy, large enough to refill the lanes.
+    let per_group = n_chains.div_ceil(threads.max(1)).clamp(1, 2 * lanes);
+    let n_groups = n_chains.div_ceil(per_group);
+    let groups = run_tasks(n_groups, threads, control, false, |g| {
+        let chains = g * per_group..((g + 1) * per_group).min(n_chains);
+        Ok(run_group(points, metric_names, chains, lanes, control))
+    })?;
+    let mut out: ChainResults = Vec::with_capacity(n_chains);
+    for (g, group) in groups.into_iter().enumerate() {
+        let len = ((g + 1) * per_group).min(n_chains) - g * per_group;
+        match group {
+            Some(Ok(chains)) => out.extend(chains.into_iter().map(|c| Some(Ok(c)))),
+            Some(Err(e)) => out.extend((0..len).map(|_| Some(Err(e.clone())))),
+            None => out.extend((0..len).map(|_| None)),
+        }
+    }
+    Ok(out)
+}
+
+/// One group of chains on `lanes` lanes; each chain's results in order (cut short by a
+/// cancel).
+fn run_group(
+    points: &[Result<(Device, SimulationOptions)>],
+    metric_names: &[String],
+    chains: std::ops::Range<usize>,
+    lanes: usize,
+    control: &SweepControl,
+) -> Vec<Vec<Result<PointOutput>>> {
+    let first_chain = chains.start;
+    let mut results: Vec<Vec<Result<PointOutput>>> = chains.clone().map(|_| Vec::new()).collect();
+    let mut queue = chains;
+    let mut cursors: Vec<Option<Cursor<'_>>> = (0..lanes).map(|_| None).collect();
+    let mut stepper = LaneStepper::new();
+    let mut models = LinearStrokeLanes::new();
+    let mut fresh = 0u32;
+    let mut times_cache = None;
+    loop {
+        if control.is_cancelled() {
+            break;
+        }
+        // Every lane without a point in flight advances its chain (scalar points in place)
+        // to its next lane point, or takes the next chain.
+        for l in 0..lanes {
+            loop {
+                if cursors[l].as_ref().is_some_and(|c| c.point.is_some()) {
+                    break;
+                }
+                if cursors[l].as_ref().is_none_or(|c| c.next == c.end) {
+                    if let Some(done) = cursors[l].take() {
+                        results[done.chain - first_chain] = done.out;
+                    }
+                    let Some(chain) = queue.next() else {
+                        break;
+                    };
+                    let range = chain_range(chain, points.len());
+                    cursors[l] = Some(Cursor {
+                        chain,
+                        next: range.start,
+                        end: range.end,
+                        previous: Vec::with_capacity(2),
+                        out: Vec::with_capacity(range.len()),
+                        point: None,
+                    });
+                    continue;
+                }
+                if control.is_cancelled() {
+                    break;
+                }
+                let cursor = cursors[l].as_mut().expect("a chain is in this lane");
+                let i = cursor.next;
+                cursor.next += 1;
+                let start = chain_start(points, &mut cursor.previous, i);
+                let lane_point = continued_options(points, i, &start).and_then(|options| {
+                    let (device, _) = points[i].as_ref().ok()?;
+                    LanePoint::new(device, &options, metric_names, &mut times_cache)
+                });
+                match lane_point {
+                    Some((point, problem)) => {
+                        models.load(l, &point.model);
+                        let sink = &mut |_: usize, _: usize, _: f64, _: &[f64; 4]| true;
+                        if stepper.start(l, problem, sink) {
+                            fresh |= 1 << l;
+                            cursor.point = Some((i, start, point));
+                        } else {
+                            finish_point(points, metric_names, cursor, i, &start, None, control);
+                        }
+                    }
+                    None => finish_point(points, metric_names, cursor, i, &start, None, control),
+                }
+            }
+        }
+        if control.is_cancelled() || !stepper.any_busy() {
+            break;
+        }
+        let mut sink = |l: usize, index: usize, t: f64, y: &[f64; 4]| {
+            cursors[l]
+                .as_mut()
+                .and_then(|c| c.point.as_mut())
+                .is_some_and(|(_, _, p)| p.sample(index, t, y))
+        };
+        let finished = stepper.run(&models, fresh, &mut sink);
+        fresh = 0;
+        for (l, outcome) in finished {
+            let cursor = cursors[l].as_mut().expect("a busy lane has a chain");
+            let (i, start, mut point) = cursor.point.take().expect("a busy lane has a point");
+            match point.resume(outcome) {
+                Next::Integrate(problem) => {
+                    let mut sink = |_: usize, index: usize, t: f64, y: &[f64; 4]| {
+                        point.sample(index, t, y)
+                    };
+                    if stepper.start(l, problem, &mut sink) {
+                        fresh |= 1 << l;
+                        cursor.point = Some((i, start, point));
+                    } else {
+                        finish_point(points, metric_names, cursor, i, &start, None, control);
+                    }
+                }
+                Next::Done(output) => {
+                    finish_point(points, metric_names, cursor, i, &start, Some(*output), control)
+                }
+                Next::Scalar => {
+                    finish_point(points, metric_names, cursor, i, &start, None, control)
+                }
+            }
+        }
+    }
+    for cursor in cursors.into_iter().flatten() {
+        results[cursor.chain - first_chain] = cursor.out;
+    }
+    results
+}
+
+/// Completes point `i` of the chain in `cursor`: `done` is its lane result, else it runs on
+/// the scalar path; then the chain's bookkeeping of `sweep::run_points`.
+fn finish_point(
+    points: &[Result<(Device, SimulationOptions)>],
+    metric_names: &[String],
+    cursor: &mut Cursor<'_>,
+    i: usize,
+    start: &ChainStart,
+    done: Option<PointOutput>,
+    control: &SweepControl,
+) {
+    let result = chain_point(points, i, start, metric_names, false, done.map(Ok));
+    remember(&mut cursor.previous, i, &result);
+    control.count_point(&result);
+    cursor.out.push(result);
+}
