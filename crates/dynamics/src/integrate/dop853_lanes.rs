@@ -41,9 +41,34 @@ fn with_lane(v: V, l: usize, x: f64) -> V {
 
 /// The right-hand side of several lanes on the compact layout `[q1, q2, q̇1, q̇2]`.
 pub(crate) trait LaneRhs {
-    /// Writes `f(t, y)` of every lane; returns the bit mask of lanes whose evaluation failed
+    /// Writes `f(t, y)` of every lane; `stage[l]` is lane `l`'s position in the list of
+    /// [`stage_times`] of its grid ([`NO_STAGE`] outside it), for right-hand sides that
+    /// tabulate their time dependence. Returns the bit mask of lanes whose evaluation failed
     /// (left out of the domain of the model).
-    fn eval(&self, t: [f64; LANES], y: &[V; 4], dydt: &mut [V; 4]) -> u32;
+    fn eval(&self, t: [f64; LANES], stage: [usize; LANES], y: &[V; 4], dydt: &mut [V; 4]) -> u32;
+}
+
+/// Right-hand side evaluations per step in [`stage_times`]: the step's start, stages 2–12,
+/// and the three dense-output stages.
+pub(crate) const STAGES_PER_STEP: usize = 15;
+
+/// A stage outside a grid's [`stage_times`].
+pub(crate) const NO_STAGE: usize = usize::MAX;
+
+/// Every time at which a fixed-grid integration on `grid` evaluates the right-hand side, in
+/// the table order the stepper's `stage` indices refer to (`STAGES_PER_STEP` per step, then
+/// the grid's end), computed with the stepper's own arithmetic (`t + c h`).
+pub(crate) fn stage_times(grid: &[f64]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(STAGES_PER_STEP * grid.len());
+    for pair in grid.windows(2) {
+        let (t, h) = (pair[0], pair[1] - pair[0]);
+        out.push(t);
+        for c in [C2, C3, C4, C5, C6, C7, C8, C9, C10, C11, 1.0, C14, C15, C16] {
+            out.push(t + c * h);
+        }
+    }
+    out.extend(grid.last());
+    out
 }
 
 /// Tolerances of one lane's error estimate (see [`super::Tolerances`]).
@@ -80,9 +105,23 @@ pub(crate) enum LaneOutcome {
     Failed,
 }
 
-/// Receives the samples of a lane: `(lane, index in its times, time, compact state)`; `false`
-/// fails the lane.
-pub(crate) type LaneSink<'a> = dyn FnMut(usize, usize, f64, &[f64; 4]) -> bool + 'a;
+/// Up to four consecutive samples of one lane: `count` of them from `first` (index in the
+/// lane's times), their times and compact states (sample `j` in vector lane `j`; the others
+/// are padding).
+pub(crate) struct SampleBlock {
+    /// Index of the first sample in the lane's times.
+    pub(crate) first: usize,
+    /// Samples in the block (1 to 4).
+    pub(crate) count: usize,
+    /// Their times.
+    pub(crate) t: [f64; 4],
+    /// Their compact states `[q1, q2, q̇1, q̇2]`, one sample per vector lane.
+    pub(crate) y: [V; 4],
+}
+
+/// Receives the samples of a lane in blocks, in order: `(lane, block)`; `false` fails the
+/// lane.
+pub(crate) type LaneSink<'a> = dyn FnMut(usize, &SampleBlock) -> bool + 'a;
 
 /// Per-lane progress.
 #[derive(Clone, Default)]
@@ -150,13 +189,12 @@ impl LaneStepper {
             return false;
         }
         let t0 = problem.grid[0];
-        let mut next = 0;
-        while next < problem.times.len() && problem.times[next] <= t0 {
-            if !sink(l, next, problem.times[next], &problem.y0) {
-                return false;
-            }
-            next += 1;
+        let at_start = problem.times.partition_point(|&s| s <= t0);
+        let y0 = problem.y0.map(V::splat);
+        if !emit_constant(l, &problem.times, 0, at_start, &y0, sink) {
+            return false;
         }
+        let next = at_start;
         for i in 0..4 {
             self.y[i] = with_lane(self.y[i], l, problem.y0[i]);
         }
@@ -188,8 +226,9 @@ impl LaneStepper {
                 let p = &self.lanes[l];
                 if p.active { p.grid[0] } else { 0.0 }
             });
+            let stage = std::array::from_fn(|l| if self.lanes[l].active { 0 } else { NO_STAGE });
             let mut f = [V::splat(0.0); 4];
-            let failed = rhs.eval(t0, &self.y, &mut f);
+            let failed = rhs.eval(t0, stage, &self.y, &mut f);
             for l in 0..LANES {
                 if fresh & (1 << l) == 0 || !self.lanes[l].active {
                     continue;
@@ -229,36 +268,45 @@ impl LaneStepper {
         }
         let h = V::new(hs);
         let at = |c: f64| -> [f64; LANES] { std::array::from_fn(|l| t[l] + c * hs[l]) };
+        let base: [usize; LANES] = std::array::from_fn(|l| {
+            let p = &self.lanes[l];
+            if p.active {
+                p.step * STAGES_PER_STEP
+            } else {
+                NO_STAGE
+            }
+        });
+        let idx = |s: usize| -> [usize; LANES] { base.map(|b| b.saturating_add(s)) };
         let mut failed = 0u32;
         let y = self.y;
         let k1 = self.f0;
         let [k2, k3, k4, k5, k6, k7, k8, k9, k10, _] = &mut self.k;
         let mut ys = [V::splat(0.0); 4];
         vstage!(ys, y, h, A21 => k1);
-        failed |= rhs.eval(at(C2), &ys, k2);
+        failed |= rhs.eval(at(C2), idx(1), &ys, k2);
         vstage!(ys, y, h, A31 => k1, A32 => k2);
-        failed |= rhs.eval(at(C3), &ys, k3);
+        failed |= rhs.eval(at(C3), idx(2), &ys, k3);
         vstage!(ys, y, h, A41 => k1, A43 => k3);
-        failed |= rhs.eval(at(C4), &ys, k4);
+        failed |= rhs.eval(at(C4), idx(3), &ys, k4);
         vstage!(ys, y, h, A51 => k1, A53 => k3, A54 => k4);
-        failed |= rhs.eval(at(C5), &ys, k5);
+        failed |= rhs.eval(at(C5), idx(4), &ys, k5);
         vstage!(ys, y, h, A61 => k1, A64 => k4, A65 => k5);
-        failed |= rhs.eval(at(C6), &ys, k6);
+        failed |= rhs.eval(at(C6), idx(5), &ys, k6);
         vstage!(ys, y, h, A71 => k1, A74 => k4, A75 => k5, A76 => k6);
-        failed |= rhs.eval(at(C7), &ys, k7);
+        failed |= rhs.eval(at(C7), idx(6), &ys, k7);
         vstage!(ys, y, h, A81 => k1, A84 => k4, A85 => k5, A86 => k6, A87 => k7);
-        failed |= rhs.eval(at(C8), &ys, k8);
+        failed |= rhs.eval(at(C8), idx(7), &ys, k8);
         vstage!(ys, y, h, A91 => k1, A94 => k4, A95 => k5, A96 => k6, A97 => k7, A98 => k8);
-        failed |= rhs.eval(at(C9), &ys, k9);
+        failed |= rhs.eval(at(C9), idx(8), &ys, k9);
         vstage!(ys, y, h, A101 => k1, A104 => k4, A105 => k5, A106 => k6, A107 => k7, A108 => k8,
             A109 => k9);
-        failed |= rhs.eval(at(C10), &ys, k10);
+        failed |= rhs.eval(at(C10), idx(9), &ys, k10);
         vstage!(ys, y, h, A111 => k1, A114 => k4, A115 => k5, A116 => k6, A117 => k7, A118 => k8,
             A119 => k9, A1110 => k10);
-        failed |= rhs.eval(at(C11), &ys, k2);
+        failed |= rhs.eval(at(C11), idx(10), &ys, k2);
         vstage!(ys, y, h, A121 => k1, A124 => k4, A125 => k5, A126 => k6, A127 => k7, A128 => k8,
             A129 => k9, A1210 => k10, A1211 => k2);
-        failed |= rhs.eval(at(1.0), &ys, k3);
+        failed |= rhs.eval(at(1.0), idx(11), &ys, k3);
         // The scalar attempt's increment, new state and error norm (every entry controlled).
         let mut err5 = V::splat(0.0);
         let mut err3 = V::splat(0.0);
@@ -294,7 +342,7 @@ impl LaneStepper {
         }
         let err = h.abs() * err5 * (V::splat(1.0) / (V::splat(4.0) * V::new(deno))).sqrt();
         let mut f1 = [V::splat(0.0); 4];
-        failed |= rhs.eval(t_new, &self.y1, &mut f1);
+        failed |= rhs.eval(t_new, idx(STAGES_PER_STEP), &self.y1, &mut f1);
         let y1_finite = (self.y1[0].is_finite()
             & self.y1[1].is_finite()
             & self.y1[2].is_finite()
@@ -306,7 +354,7 @@ impl LaneStepper {
             p.active && p.next < p.times.len() && p.times[p.next] < t_new[l]
         });
         if wants_dense {
-            failed |= self.prepare_dense(rhs, &t, h, &f1);
+            failed |= self.prepare_dense(rhs, &t, &base, h, &f1);
         }
         for l in 0..LANES {
             if !self.lanes[l].active {
@@ -340,41 +388,64 @@ impl LaneStepper {
         self.f0 = f1;
     }
 
-    /// The samples of lane `l` inside `[t, t_new)` (interpolated) and at `t_new`.
+    /// The samples of lane `l` inside `[t, t_new)` (interpolated, four at a time) and at
+    /// `t_new`.
     fn emit(&mut self, l: usize, t: f64, h: f64, t_new: f64, sink: &mut LaneSink<'_>) -> bool {
         let p = &mut self.lanes[l];
-        while p.next < p.times.len() && p.times[p.next] < t_new {
-            let s = (p.times[p.next] - t) / h;
-            let s1 = 1.0 - s;
-            let mut out = [0.0; 4];
-            let c = |r: usize, i: usize| lane(self.cont[r][i], l);
-            for (i, o) in out.iter_mut().enumerate() {
-                *o = c(0, i)
-                    + s * (c(1, i)
-                        + s1 * (c(2, i)
-                            + s * (c(3, i)
-                                + s1 * (c(4, i)
-                                    + s * (c(5, i) + s1 * (c(6, i) + s * c(7, i)))))));
+        let inside = p.next + p.times[p.next..].partition_point(|&s| s < t_new);
+        if inside > p.next {
+            // This lane's interpolant, broadcast: the vector lanes now hold samples.
+            let c: [[V; 4]; 8] = std::array::from_fn(|r| {
+                std::array::from_fn(|i| V::splat(lane(self.cont[r][i], l)))
+            });
+            while p.next < inside {
+                let count = (inside - p.next).min(4);
+                let mut ts = [t; 4];
+                ts[..count].copy_from_slice(&p.times[p.next..p.next + count]);
+                let s = (V::new(ts) - V::splat(t)) / V::splat(h);
+                let s1 = V::splat(1.0) - s;
+                let y: [V; 4] = std::array::from_fn(|i| {
+                    c[0][i]
+                        + s * (c[1][i]
+                            + s1 * (c[2][i]
+                                + s * (c[3][i]
+                                    + s1 * (c[4][i]
+                                        + s * (c[5][i] + s1 * (c[6][i] + s * c[7][i]))))))
+                });
+                let finite =
+                    (y[0].is_finite() & y[1].is_finite() & y[2].is_finite() & y[3].is_finite())
+                        .to_bitmask();
+                let block = SampleBlock {
+                    first: p.next,
+                    count,
+                    t: ts,
+                    y,
+                };
+                if finite & ((1 << count) - 1) != (1 << count) - 1 || !sink(l, &block) {
+                    return false;
+                }
+                p.next += count;
             }
-            if !out.iter().all(|v| v.is_finite()) || !sink(l, p.next, p.times[p.next], &out) {
-                return false;
-            }
-            p.next += 1;
         }
-        let end: [f64; 4] = std::array::from_fn(|i| lane(self.y1[i], l));
-        while p.next < p.times.len() && p.times[p.next] <= t_new {
-            if !sink(l, p.next, p.times[p.next], &end) {
-                return false;
-            }
-            p.next += 1;
-        }
-        true
+        let at_end = p.next + p.times[p.next..].partition_point(|&s| s <= t_new);
+        let end: [V; 4] = std::array::from_fn(|i| V::splat(lane(self.y1[i], l)));
+        let ok = emit_constant(l, &p.times, p.next, at_end, &end, sink);
+        p.next = at_end;
+        ok
     }
 
     /// The dense output of the step just taken (the scalar `prepare_dense`, on every lane).
-    fn prepare_dense(&mut self, rhs: &dyn LaneRhs, t: &[f64; LANES], h: V, f1: &[V; 4]) -> u32 {
+    fn prepare_dense(
+        &mut self,
+        rhs: &dyn LaneRhs,
+        t: &[f64; LANES],
+        base: &[usize; LANES],
+        h: V,
+        f1: &[V; 4],
+    ) -> u32 {
         let hs = h.to_array();
         let at = |c: f64| -> [f64; LANES] { std::array::from_fn(|l| t[l] + c * hs[l]) };
+        let idx = |s: usize| -> [usize; LANES] { base.map(|b| b.saturating_add(s)) };
         let y = self.y;
         let k1 = self.f0;
         let k13 = *f1;
@@ -425,30 +496,70 @@ impl LaneStepper {
         let mut ys = [V::splat(0.0); 4];
         vstage!(ys, y, h, A141 => k1, A147 => k7, A148 => k8, A149 => k9, A1410 => k10,
             A1411 => k2, A1412 => k3, A1413 => k13);
-        failed |= rhs.eval(at(C14), &ys, kx);
+        failed |= rhs.eval(at(C14), idx(12), &ys, kx);
         let k14 = *kx;
         vstage!(ys, y, h, A151 => k1, A156 => k6, A157 => k7, A158 => k8, A1511 => k2,
             A1512 => k3, A1513 => k13, A1514 => k14);
-        failed |= rhs.eval(at(C15), &ys, k10);
+        failed |= rhs.eval(at(C15), idx(13), &ys, k10);
         let k15 = *k10;
         vstage!(ys, y, h, A161 => k1, A166 => k6, A167 => k7, A168 => k8, A169 => k9,
             A1613 => k13, A1614 => k14, A1615 => k15);
-        failed |= rhs.eval(at(C16), &ys, k2);
+        failed |= rhs.eval(at(C16), idx(14), &ys, k2);
         let k16 = *k2;
         for i in 0..4 {
             r5[i] = h
-                * (r5[i] + s(D413) * k13[i] + s(D414) * k14[i] + s(D415) * k15[i]
+                * (r5[i]
+                    + s(D413) * k13[i]
+                    + s(D414) * k14[i]
+                    + s(D415) * k15[i]
                     + s(D416) * k16[i]);
             r6[i] = h
-                * (r6[i] + s(D513) * k13[i] + s(D514) * k14[i] + s(D515) * k15[i]
+                * (r6[i]
+                    + s(D513) * k13[i]
+                    + s(D514) * k14[i]
+                    + s(D515) * k15[i]
                     + s(D516) * k16[i]);
             r7[i] = h
-                * (r7[i] + s(D613) * k13[i] + s(D614) * k14[i] + s(D615) * k15[i]
+                * (r7[i]
+                    + s(D613) * k13[i]
+                    + s(D614) * k14[i]
+                    + s(D615) * k15[i]
                     + s(D616) * k16[i]);
             r8[i] = h
-                * (r8[i] + s(D713) * k13[i] + s(D714) * k14[i] + s(D715) * k15[i]
+                * (r8[i]
+                    + s(D713) * k13[i]
+                    + s(D714) * k14[i]
+                    + s(D715) * k15[i]
                     + s(D716) * k16[i]);
         }
         failed
     }
+}
+
+/// The samples `from..to` of lane `l` at one state `y` (broadcast), in blocks.
+fn emit_constant(
+    l: usize,
+    times: &[f64],
+    from: usize,
+    to: usize,
+    y: &[V; 4],
+    sink: &mut LaneSink<'_>,
+) -> bool {
+    let mut first = from;
+    while first < to {
+        let count = (to - first).min(4);
+        let mut t = [times[first]; 4];
+        t[..count].copy_from_slice(&times[first..first + count]);
+        let block = SampleBlock {
+            first,
+            count,
+            t,
+            y: *y,
+        };
+        if !sink(l, &block) {
+            return false;
+        }
+        first += count;
+    }
+    true
 }

@@ -12,7 +12,9 @@ use wide::f64x4;
 
 use crate::actuator::Actuator;
 use crate::device::{Device, Formulation};
-use crate::integrate::lanes::{LANES, LaneRhs};
+use std::rc::Rc;
+
+use crate::integrate::lanes::{LANES, LaneRhs, stage_times};
 use crate::wing::WingAero;
 use paritysim_kinematics::Drivetrain;
 
@@ -29,6 +31,8 @@ pub(crate) struct LinearStroke<'a> {
     det: f64,
     /// `−Ω1 C` per wing (0 without aerodynamics).
     drag: [f64; 2],
+    /// Wings without aerodynamics (their torque is exactly 0).
+    vacuum: [bool; 2],
     /// Stroke springs per wing: `(stiffness, cubic, rest angle)`.
     springs: [[f64; 3]; 2],
     k1: f64,
@@ -55,6 +59,7 @@ impl<'a> LinearStroke<'a> {
         let jacobian = [-t, t * hl, -t, -t * hr];
         let (mut m00, mut m01, mut m11) = (0.0, 0.0, 0.0);
         let mut drag = [0.0; 2];
+        let mut vacuum = [false; 2];
         let mut springs = [[0.0; 3]; 2];
         for k in 0..2 {
             let wing = spec.wings.get(k)?;
@@ -64,7 +69,10 @@ impl<'a> LinearStroke<'a> {
             m01 += inertia * a * b;
             m11 += inertia * b * b;
             drag[k] = match wing.aero() {
-                WingAero::None => 0.0,
+                WingAero::None => {
+                    vacuum[k] = true;
+                    0.0
+                }
                 WingAero::StrokeDrag {
                     omega1,
                     coefficient,
@@ -84,6 +92,7 @@ impl<'a> LinearStroke<'a> {
             mass: [m00, m01, m11],
             det,
             drag,
+            vacuum,
             springs,
             k1: actuator.stiffness(),
             k2: transmission.balance_stiffness(),
@@ -91,9 +100,58 @@ impl<'a> LinearStroke<'a> {
     }
 }
 
+impl LinearStroke<'_> {
+    /// The actuator force at `t` (mN).
+    pub(crate) fn force(&self, t: f64) -> f64 {
+        self.actuator.force(t)
+    }
+
+    /// The actuator.
+    pub(crate) fn actuator(&self) -> &Actuator {
+        self.actuator
+    }
+
+    /// The actuator force at every [`stage_times`] of `grid`: the drive's `sin` once per
+    /// grid instead of once per evaluation (the grid is shared by a point's Newton periods
+    /// and usually by its chain neighbours).
+    pub(crate) fn forcing(&self, grid: &[f64]) -> Rc<[f64]> {
+        stage_times(grid)
+            .into_iter()
+            .map(|t| self.actuator.force(t))
+            .collect()
+    }
+
+    /// What `StrokeSample::of_stroke_device` computes at up to four states of this device
+    /// (one per vector lane, compact `[q1, q2, q̇1, q̇2]`), with its operations: the mask of
+    /// states inside the drivetrain's domain, the strokes `(φL, φR)` and the roll torques
+    /// (left mirrored).
+    pub(crate) fn stroke_samples(&self, y: &[V; 4]) -> (u32, [V; 2], [V; 2]) {
+        let [q1, q2, q1_dot, q2_dot] = *y;
+        let inside = (q1
+            .abs()
+            .simd_le(V::splat(paritysim_error::plausible::OFFSET_MM))
+            & q2.abs()
+                .simd_le(V::splat(paritysim_error::plausible::ANGLE_RAD)))
+        .to_bitmask();
+        let j = self.jacobian.map(V::splat);
+        let stroke = [j[0] * q1 + j[1] * q2, j[2] * q1 + j[3] * q2];
+        let rate = [j[0] * q1_dot + j[1] * q2_dot, j[2] * q1_dot + j[3] * q2_dot];
+        let torque = |k: usize| {
+            if self.vacuum[k] {
+                V::splat(0.0)
+            } else {
+                V::splat(self.drag[k]) * rate[k].abs() * rate[k]
+            }
+        };
+        (inside, stroke, [-torque(0), torque(1)])
+    }
+}
+
 /// [`LANES`] devices side by side (vectors of their constants).
 pub(crate) struct LinearStrokeLanes<'a> {
     actuators: [Option<&'a Actuator>; LANES],
+    /// Each lane's [`LinearStroke::forcing`] of its current grid.
+    forcing: [Option<Rc<[f64]>>; LANES],
     j: [V; 4],
     m00: V,
     m01: V,
@@ -119,6 +177,7 @@ impl<'a> LinearStrokeLanes<'a> {
         let (z, one) = (V::splat(0.0), V::splat(1.0));
         Self {
             actuators: [None; LANES],
+            forcing: std::array::from_fn(|_| None),
             j: [one, z, z, one],
             m00: one,
             m01: z,
@@ -131,6 +190,11 @@ impl<'a> LinearStrokeLanes<'a> {
             k1: z,
             k2: z,
         }
+    }
+
+    /// The forcing table lane `l` reads (`None`: the actuator is evaluated).
+    pub(crate) fn load_forcing(&mut self, l: usize, forcing: Option<Rc<[f64]>>) {
+        self.forcing[l] = forcing;
     }
 
     /// Puts `model` into lane `l`.
@@ -156,14 +220,21 @@ impl<'a> LinearStrokeLanes<'a> {
 
 impl LaneRhs for LinearStrokeLanes<'_> {
     #[inline]
-    fn eval(&self, t: [f64; LANES], y: &[V; 4], dydt: &mut [V; 4]) -> u32 {
+    fn eval(&self, t: [f64; LANES], stage: [usize; LANES], y: &[V; 4], dydt: &mut [V; 4]) -> u32 {
         let [q1, q2, q1_dot, q2_dot] = *y;
         // `Drivetrain::evaluate`'s plausibility check (the scalar path errs outside it).
-        let inside = q1.abs().simd_le(V::splat(paritysim_error::plausible::OFFSET_MM))
-            & q2.abs().simd_le(V::splat(paritysim_error::plausible::ANGLE_RAD));
+        let inside = q1
+            .abs()
+            .simd_le(V::splat(paritysim_error::plausible::OFFSET_MM))
+            & q2.abs()
+                .simd_le(V::splat(paritysim_error::plausible::ANGLE_RAD));
         let failed = !inside.to_bitmask() & ((1 << LANES) - 1);
         let force = V::new(std::array::from_fn(|l| {
-            self.actuators[l].map_or(0.0, |a| a.force(t[l]))
+            match (&self.forcing[l], self.actuators[l]) {
+                (Some(table), _) if stage[l] < table.len() => table[stage[l]],
+                (_, Some(a)) => a.force(t[l]),
+                _ => 0.0,
+            }
         }));
         let [j00, j01, j10, j11] = self.j;
         let stroke = [j00 * q1 + j01 * q2, j10 * q1 + j11 * q2];

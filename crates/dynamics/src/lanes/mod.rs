@@ -26,13 +26,13 @@ pub(crate) mod linear_stroke;
 
 use std::rc::Rc;
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, Vector2};
 use paritysim_error::{Error, Result, bail};
 
 use crate::device::Device;
 use crate::grid_shooting::GRID_TOLERANCE_FACTOR;
 use crate::integrate::lanes::{
-    LANES, LaneOutcome, LaneProblem, LaneStepper, LaneTolerances,
+    LANES, LaneOutcome, LaneProblem, LaneStepper, LaneTolerances, SampleBlock,
 };
 use crate::integrate::{Method, RungeKutta, State};
 use crate::metrics::MetricsAccumulator;
@@ -120,6 +120,9 @@ struct LanePoint<'a> {
     rk: RungeKutta,
     chooser: RungeKutta,
     grid: Rc<[f64]>,
+    /// The actuator force at the grid's stage times (`None` until asked, and after the grid
+    /// changes).
+    forcing: Option<Rc<[f64]>>,
     times: Rc<[f64]>,
     jac: DMatrix<f64>,
     /// Whether `jac` is an exact Jacobian at `y` (after a re-linearisation).
@@ -193,9 +196,14 @@ impl<'a> LanePoint<'a> {
         }
         crate::integrate::check_grid(grid).ok()?;
         // What `simulate` checks before running (it would fail on the scalar path).
-        let rk = RungeKutta::new(options.method, options.rtol, options.atol, options.max_steps)
-            .ok()?
-            .with_work(false);
+        let rk = RungeKutta::new(
+            options.method,
+            options.rtol,
+            options.atol,
+            options.max_steps,
+        )
+        .ok()?
+        .with_work(false);
         if options.samples_per_cycle > crate::simulate::MAX_RECORDED_SAMPLES {
             return None;
         }
@@ -240,6 +248,7 @@ impl<'a> LanePoint<'a> {
             rk,
             chooser: rk.tightened(GRID_TOLERANCE_FACTOR),
             grid: grid.into(),
+            forcing: None,
             times,
             jac,
             fresh: false,
@@ -263,7 +272,11 @@ impl<'a> LanePoint<'a> {
         LaneProblem {
             grid: self.grid.clone(),
             y0: compact4(y),
-            times: if record { self.times.clone() } else { Rc::from([]) },
+            times: if record {
+                self.times.clone()
+            } else {
+                Rc::from([])
+            },
             tol: match self.pending {
                 Pending::Map => self.grid_tol,
                 Pending::Trial { .. } => self.newton_tol,
@@ -271,16 +284,33 @@ impl<'a> LanePoint<'a> {
         }
     }
 
-    /// Feeds one recorded sample to the metrics (`false`: the scalar path would fail here).
-    fn sample(&mut self, index: usize, t: f64, c: &[f64; 4]) -> bool {
-        match StrokeSample::of_stroke_device(self.device, t, &expand4(c), self.with_force) {
-            Ok(s) => {
-                self.metrics
-                    .add_stroke(&s, index == self.samples_per_cycle);
-                true
-            }
-            Err(_) => false,
+    /// Feeds recorded samples to the metrics in order, as the scalar window's sink does
+    /// (`StrokeSample::of_stroke_device`, then the accumulator); `false`: the scalar path
+    /// would fail here.
+    fn sample(&mut self, block: &SampleBlock) -> bool {
+        let (inside, stroke, roll) = self.model.stroke_samples(&block.y);
+        let all = (1u32 << block.count) - 1;
+        if inside & all != all {
+            return false;
         }
+        let at = |v: wide::f64x4, j: usize| v.as_array()[j];
+        for j in 0..block.count {
+            let time = block.t[j];
+            let sample = StrokeSample {
+                time,
+                stroke: Vector2::new(at(stroke[0], j), at(stroke[1], j)),
+                roll_aero: [at(roll[0], j), at(roll[1], j)],
+                actuator_force: if self.with_force {
+                    self.model.force(time)
+                } else {
+                    0.0
+                },
+                q2: at(block.y[1], j),
+            };
+            self.metrics
+                .add_stroke(&sample, block.first + j == self.samples_per_cycle);
+        }
+        true
     }
 
     /// The next Newton trial from the current iterate (the head of `shoot`'s loop).
@@ -320,7 +350,13 @@ impl<'a> LanePoint<'a> {
     /// Continues after the lane's period ended with `outcome` (the rest of `shoot`'s loop).
     fn resume(&mut self, outcome: LaneOutcome) -> Next {
         match (std::mem::replace(&mut self.pending, Pending::Map), outcome) {
-            (Pending::Map, LaneOutcome::Done { y, over_tolerance: 0 }) => {
+            (
+                Pending::Map,
+                LaneOutcome::Done {
+                    y,
+                    over_tolerance: 0,
+                },
+            ) => {
                 self.periods = 1;
                 (self.f, self.res) = residual(&self.y, &expand4(&y));
                 self.iterate()
@@ -333,6 +369,7 @@ impl<'a> LanePoint<'a> {
                 {
                     Ok((py, grid)) => {
                         self.grid = grid.into();
+                        self.forcing = None;
                         self.periods = 1;
                         (self.f, self.res) = residual(&self.y, &py);
                         self.iterate()
@@ -441,6 +478,34 @@ impl<'a> LanePoint<'a> {
     }
 }
 
+/// The last forcing table built in a group: its grid, actuator and forces.
+type ForcingCache = Option<(Rc<[f64]>, crate::actuator::Actuator, Rc<[f64]>)>;
+
+/// `point`'s forcing table, from `cache` when a previous point had the same grid and drive.
+fn forcing(point: &mut LanePoint<'_>, cache: &mut ForcingCache) -> Rc<[f64]> {
+    if let Some(f) = &point.forcing {
+        return f.clone();
+    }
+    let table = match cache {
+        Some((grid, actuator, table))
+            if **grid == *point.grid && actuator == point.model.actuator() =>
+        {
+            table.clone()
+        }
+        _ => {
+            let table = point.model.forcing(&point.grid);
+            *cache = Some((
+                point.grid.clone(),
+                point.model.actuator().clone(),
+                table.clone(),
+            ));
+            table
+        }
+    };
+    point.forcing = Some(table.clone());
+    table
+}
+
 /// A chain being worked through by one lane.
 struct Cursor<'a> {
     chain: usize,
@@ -504,6 +569,7 @@ fn run_group(
     let mut models = LinearStrokeLanes::new();
     let mut fresh = 0u32;
     let mut times_cache = None;
+    let mut forcing_cache: ForcingCache = None;
     loop {
         if control.is_cancelled() {
             break;
@@ -545,9 +611,10 @@ fn run_group(
                     LanePoint::new(device, &options, metric_names, &mut times_cache)
                 });
                 match lane_point {
-                    Some((point, problem)) => {
+                    Some((mut point, problem)) => {
                         models.load(l, &point.model);
-                        let sink = &mut |_: usize, _: usize, _: f64, _: &[f64; 4]| true;
+                        models.load_forcing(l, Some(forcing(&mut point, &mut forcing_cache)));
+                        let sink = &mut |_: usize, _: &SampleBlock| true;
                         if stepper.start(l, problem, sink) {
                             fresh |= 1 << l;
                             cursor.point = Some((i, start, point));
@@ -562,11 +629,11 @@ fn run_group(
         if control.is_cancelled() || !stepper.any_busy() {
             break;
         }
-        let mut sink = |l: usize, index: usize, t: f64, y: &[f64; 4]| {
+        let mut sink = |l: usize, block: &SampleBlock| {
             cursors[l]
                 .as_mut()
                 .and_then(|c| c.point.as_mut())
-                .is_some_and(|(_, _, p)| p.sample(index, t, y))
+                .is_some_and(|(_, _, p)| p.sample(block))
         };
         let finished = stepper.run(&models, fresh, &mut sink);
         fresh = 0;
@@ -575,9 +642,8 @@ fn run_group(
             let (i, start, mut point) = cursor.point.take().expect("a busy lane has a point");
             match point.resume(outcome) {
                 Next::Integrate(problem) => {
-                    let mut sink = |_: usize, index: usize, t: f64, y: &[f64; 4]| {
-                        point.sample(index, t, y)
-                    };
+                    models.load_forcing(l, Some(forcing(&mut point, &mut forcing_cache)));
+                    let mut sink = |_: usize, block: &SampleBlock| point.sample(block);
                     if stepper.start(l, problem, &mut sink) {
                         fresh |= 1 << l;
                         cursor.point = Some((i, start, point));
@@ -585,9 +651,15 @@ fn run_group(
                         finish_point(points, metric_names, cursor, i, &start, None, control);
                     }
                 }
-                Next::Done(output) => {
-                    finish_point(points, metric_names, cursor, i, &start, Some(*output), control)
-                }
+                Next::Done(output) => finish_point(
+                    points,
+                    metric_names,
+                    cursor,
+                    i,
+                    &start,
+                    Some(*output),
+                    control,
+                ),
                 Next::Scalar => {
                     finish_point(points, metric_names, cursor, i, &start, None, control)
                 }
