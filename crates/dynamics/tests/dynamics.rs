@@ -5,6 +5,8 @@
 mod continuation;
 #[path = "dynamics/floquet.rs"]
 mod floquet;
+#[path = "dynamics/lanes.rs"]
+mod lanes;
 #[path = "dynamics/metrics.rs"]
 mod metrics;
 #[path = "dynamics/steady_state.rs"]

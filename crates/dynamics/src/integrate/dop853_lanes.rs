@@ -18,6 +18,7 @@ use std::rc::Rc;
 
 use wide::f64x4;
 
+use super::super::{SAFE, State};
 use super::*;
 
 /// Problems integrated at once.
@@ -78,10 +79,14 @@ pub(crate) struct LaneTolerances {
     pub(crate) atol: f64,
 }
 
-/// One fixed-grid integration given to a lane.
+/// One integration given to a lane: on a fixed grid, or adaptive from `grid[0]` to the
+/// grid's end.
 pub(crate) struct LaneProblem {
-    /// Step times (at least two, increasing).
+    /// Step times (at least two, increasing); adaptive: only the span `[t0, t_end]` is read.
     pub(crate) grid: Rc<[f64]>,
+    /// `Some(max_steps)`: adaptive steps (Hairer's control, as `RungeKutta`), returning the
+    /// accepted step times in [`LaneOutcome::Done`]; no samples.
+    pub(crate) adaptive: Option<usize>,
     /// Initial compact state at `grid[0]`.
     pub(crate) y0: [f64; 4],
     /// Sample times (sorted, within the grid's span).
@@ -91,14 +96,17 @@ pub(crate) struct LaneProblem {
 }
 
 /// How a lane's integration ended.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub(crate) enum LaneOutcome {
     /// The state at the grid's end and the steps whose error estimate exceeded the tolerances.
     Done {
         /// Compact end state.
         y: [f64; 4],
-        /// See [`super::IntegrationStats::over_tolerance`].
+        /// See [`super::IntegrationStats::over_tolerance`] (fixed grids).
         over_tolerance: usize,
+        /// Adaptive: `t0` and the accepted step times (the grid a fixed-grid run retraces, as
+        /// `RungeKutta::advance_with_steps` returns it); empty on fixed grids.
+        steps: Vec<f64>,
     },
     /// The scalar path would have returned an error here (the model left its domain, a
     /// non-finite state or error estimate, or the sample sink refused).
@@ -123,9 +131,25 @@ pub(crate) struct SampleBlock {
 /// lane.
 pub(crate) type LaneSink<'a> = dyn FnMut(usize, &SampleBlock) -> bool + 'a;
 
+/// The step control of an adaptive lane (`drive` in integrate/mod.rs, per lane).
+#[derive(Clone, Debug, Default)]
+struct Adaptive {
+    t: f64,
+    t_end: f64,
+    h: f64,
+    fac_old: f64,
+    rejected_last: bool,
+    attempts: usize,
+    max_steps: usize,
+    /// The current attempt is the last step (ends at `t_end`).
+    last: bool,
+    steps: Vec<f64>,
+}
+
 /// Per-lane progress.
 #[derive(Clone, Default)]
 struct Progress {
+    adaptive: Option<Adaptive>,
     grid: Rc<[f64]>,
     times: Rc<[f64]>,
     step: usize,
@@ -200,7 +224,19 @@ impl LaneStepper {
         }
         self.rtol = with_lane(self.rtol, l, problem.tol.rtol);
         self.atol = with_lane(self.atol, l, problem.tol.atol);
+        let adaptive = problem.adaptive.map(|max_steps| Adaptive {
+            t: t0,
+            t_end: problem.grid[problem.grid.len() - 1],
+            h: 0.0,
+            fac_old: 1e-4,
+            rejected_last: false,
+            attempts: 0,
+            max_steps,
+            last: false,
+            steps: vec![t0],
+        });
         self.lanes[l] = Progress {
+            adaptive,
             grid: problem.grid,
             times: problem.times,
             step: 0,
@@ -241,6 +277,10 @@ impl LaneStepper {
                 for i in 0..4 {
                     self.f0[i] = with_lane(self.f0[i], l, lane(f[i], l));
                 }
+                if self.lanes[l].adaptive.is_some() && !self.initial_step(rhs, l) {
+                    self.lanes[l].active = false;
+                    finished.push((l, LaneOutcome::Failed));
+                }
             }
         }
         while finished.is_empty() && self.any_busy() {
@@ -249,7 +289,29 @@ impl LaneStepper {
         finished
     }
 
-    /// One fixed step of every busy lane (idle lanes repeat a harmless zero step).
+    /// Hairer's initial step of adaptive lane `l` (`initial_step` of integrate/mod.rs on
+    /// this lane alone); `false` when its extra evaluation fails.
+    fn initial_step(&mut self, rhs: &dyn LaneRhs, l: usize) -> bool {
+        let y0: [f64; 4] = std::array::from_fn(|i| lane(self.y[i], l));
+        let f0: [f64; 4] = std::array::from_fn(|i| lane(self.f0[i], l));
+        let tol = Tolerances {
+            rtol: lane(self.rtol, l),
+            atol: lane(self.atol, l),
+            controlled: 4,
+        };
+        let a = self.lanes[l].adaptive.as_mut().expect("an adaptive lane");
+        let mut one = OneLane { rhs, l };
+        match super::super::initial_step(&mut one, 8, &tol, a.t, &y0, &f0, a.t_end - a.t) {
+            Ok(h) => {
+                a.h = h;
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// One step of every busy lane (fixed, or an adaptive attempt; idle lanes repeat a
+    /// harmless zero step).
     fn step(
         &mut self,
         rhs: &dyn LaneRhs,
@@ -259,18 +321,40 @@ impl LaneStepper {
         let mut t = [0.0; LANES];
         let mut t_new = [0.0; LANES];
         let mut hs = [0.0; LANES];
-        for (l, p) in self.lanes.iter().enumerate() {
-            if p.active {
-                t[l] = p.grid[p.step];
-                t_new[l] = p.grid[p.step + 1];
-                hs[l] = t_new[l] - t[l];
+        // Lanes whose adaptive control gives up before attempting (the scalar errors).
+        let mut given_up = 0u32;
+        for (l, p) in self.lanes.iter_mut().enumerate() {
+            if !p.active {
+                continue;
+            }
+            match &mut p.adaptive {
+                None => {
+                    t[l] = p.grid[p.step];
+                    t_new[l] = p.grid[p.step + 1];
+                    hs[l] = t_new[l] - t[l];
+                }
+                Some(a) => {
+                    if a.attempts >= a.max_steps
+                        || 0.1 * a.h.abs() <= a.t.abs() * f64::EPSILON
+                        || !a.h.is_finite()
+                    {
+                        given_up |= 1 << l;
+                    }
+                    a.last = a.t + 1.01 * a.h >= a.t_end;
+                    if a.last {
+                        a.h = a.t_end - a.t;
+                    }
+                    t[l] = a.t;
+                    hs[l] = a.h;
+                    t_new[l] = if a.last { a.t_end } else { a.t + a.h };
+                }
             }
         }
         let h = V::new(hs);
         let at = |c: f64| -> [f64; LANES] { std::array::from_fn(|l| t[l] + c * hs[l]) };
         let base: [usize; LANES] = std::array::from_fn(|l| {
             let p = &self.lanes[l];
-            if p.active {
+            if p.active && p.adaptive.is_none() {
                 p.step * STAGES_PER_STEP
             } else {
                 NO_STAGE
@@ -341,8 +425,10 @@ impl LaneStepper {
             }
         }
         let err = h.abs() * err5 * (V::splat(1.0) / (V::splat(4.0) * V::new(deno))).sqrt();
+        // Failures of the new derivative count only on accepted steps (the scalar evaluates
+        // it after accepting).
         let mut f1 = [V::splat(0.0); 4];
-        failed |= rhs.eval(t_new, idx(STAGES_PER_STEP), &self.y1, &mut f1);
+        let failed_f1 = rhs.eval(t_new, idx(STAGES_PER_STEP), &self.y1, &mut f1);
         let y1_finite = (self.y1[0].is_finite()
             & self.y1[1].is_finite()
             & self.y1[2].is_finite()
@@ -356,12 +442,44 @@ impl LaneStepper {
         if wants_dense {
             failed |= self.prepare_dense(rhs, &t, &base, h, &f1);
         }
+        let mut accepted = [true; LANES];
         for l in 0..LANES {
             if !self.lanes[l].active {
                 continue;
             }
             let bit = 1 << l;
-            let mut ok = failed & bit == 0 && err_finite & bit != 0 && y1_finite & bit != 0;
+            if self.lanes[l].adaptive.is_some() {
+                let err = lane(err, l);
+                let p = &mut self.lanes[l];
+                let a = p.adaptive.as_mut().expect("an adaptive lane");
+                let outcome = a.control(err, given_up & bit != 0, failed & bit != 0, || {
+                    failed_f1 & bit == 0 && y1_finite & bit != 0
+                });
+                accepted[l] = outcome == Control::Accepted || outcome == Control::Finished;
+                match outcome {
+                    Control::Failed => {
+                        p.active = false;
+                        finished.push((l, LaneOutcome::Failed));
+                    }
+                    Control::Finished => {
+                        p.active = false;
+                        finished.push((
+                            l,
+                            LaneOutcome::Done {
+                                y: std::array::from_fn(|i| lane(self.y1[i], l)),
+                                over_tolerance: 0,
+                                steps: std::mem::take(&mut a.steps),
+                            },
+                        ));
+                    }
+                    Control::Accepted | Control::Rejected => {}
+                }
+                continue;
+            }
+            let mut ok = failed & bit == 0
+                && failed_f1 & bit == 0
+                && err_finite & bit != 0
+                && y1_finite & bit != 0;
             if ok {
                 ok = self.emit(l, t[l], hs[l], t_new[l], sink);
             }
@@ -380,12 +498,27 @@ impl LaneStepper {
                     LaneOutcome::Done {
                         y: std::array::from_fn(|i| lane(self.y1[i], l)),
                         over_tolerance: p.over_tolerance,
+                        steps: Vec::new(),
                     },
                 ));
             }
         }
-        self.y = self.y1;
-        self.f0 = f1;
+        if accepted.iter().all(|&a| a) {
+            self.y = self.y1;
+            self.f0 = f1;
+        } else {
+            // Rejected lanes retry from the same state and derivative.
+            for i in 0..4 {
+                let (mut y, mut f0) = (self.y[i].to_array(), self.f0[i].to_array());
+                let (y1, f1) = (self.y1[i].to_array(), f1[i].to_array());
+                for l in (0..LANES).filter(|&l| accepted[l]) {
+                    y[l] = y1[l];
+                    f0[l] = f1[l];
+                }
+                self.y[i] = V::new(y);
+                self.f0[i] = V::new(f0);
+            }
+        }
     }
 
     /// The samples of lane `l` inside `[t, t_new)` (interpolated, four at a time) and at
@@ -562,4 +695,103 @@ fn emit_constant(
         first += count;
     }
     true
+}
+
+/// What an adaptive lane's attempt led to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Control {
+    Accepted,
+    Rejected,
+    /// The last step was accepted.
+    Finished,
+    /// The scalar integration errs here (step limit, step-size underflow, a failing model).
+    Failed,
+}
+
+impl Adaptive {
+    /// `drive`'s step control after an attempt with scaled error `err` (`given_up`: the
+    /// limits were hit before it; `failed`: a stage's evaluation failed; `completes`: the new
+    /// derivative and state of an accepted step are valid).
+    fn control(
+        &mut self,
+        err: f64,
+        given_up: bool,
+        failed: bool,
+        completes: impl FnOnce() -> bool,
+    ) -> Control {
+        if given_up || failed {
+            return Control::Failed;
+        }
+        self.attempts += 1;
+        let fac_lo = 1.0 / <Dop853<4> as Stepper<4>>::FAC_MAX;
+        let fac_hi = 1.0 / <Dop853<4> as Stepper<4>>::FAC_MIN;
+        if !err.is_finite() {
+            self.rejected_last = true;
+            self.h *= <Dop853<4> as Stepper<4>>::FAC_MIN;
+            return Control::Rejected;
+        }
+        let fac11 = err.powf(<Dop853<4> as Stepper<4>>::EXPONENT);
+        if err <= 1.0 {
+            let fac = (fac11 / self.fac_old.powf(<Dop853<4> as Stepper<4>>::BETA) / SAFE)
+                .clamp(fac_lo, fac_hi);
+            let mut h_new = self.h / fac;
+            self.fac_old = err.max(1e-4);
+            if !completes() {
+                return Control::Failed;
+            }
+            let t_new = if self.last {
+                self.t_end
+            } else {
+                self.t + self.h
+            };
+            self.t = t_new;
+            self.steps.push(t_new);
+            if self.last {
+                return Control::Finished;
+            }
+            h_new = h_new.min(self.t_end - self.steps[0]);
+            if self.rejected_last {
+                h_new = h_new.min(self.h);
+            }
+            self.rejected_last = false;
+            self.h = h_new;
+            Control::Accepted
+        } else {
+            self.rejected_last = true;
+            self.h /= fac_hi.min(fac11 / SAFE);
+            Control::Rejected
+        }
+    }
+}
+
+/// One lane of a [`LaneRhs`] as a scalar right-hand side (for `initial_step`).
+struct OneLane<'r> {
+    rhs: &'r dyn LaneRhs,
+    l: usize,
+}
+
+impl Rhs<4> for OneLane<'_> {
+    fn eval(&mut self, t: f64, y: &[f64; 4], dydt: &mut [f64; 4]) -> paritysim_error::Result<()> {
+        let mut out = [V::splat(0.0); 4];
+        let failed = self
+            .rhs
+            .eval([t; LANES], [NO_STAGE; LANES], &y.map(V::splat), &mut out);
+        if failed & (1 << self.l) != 0 {
+            return Err(paritysim_error::Error::OutOfDomain {
+                what: "lane right-hand side".into(),
+                detail: format!("t = {t}"),
+            });
+        }
+        for i in 0..4 {
+            dydt[i] = lane(out[i], self.l);
+        }
+        Ok(())
+    }
+
+    fn expand(&self, c: &[f64; 4]) -> State {
+        let mut y = State::default();
+        y.coords[..2].copy_from_slice(&c[..2]);
+        y.rates[..2].copy_from_slice(&c[2..]);
+        y
+    }
 }

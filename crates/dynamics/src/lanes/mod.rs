@@ -77,6 +77,13 @@ pub fn resolve_lanes(requested: Option<usize>) -> Result<usize> {
     Ok(MAX_LANES)
 }
 
+/// Whether `device` has a SIMD-lane model: its continued shooting points then run in lanes
+/// when the sweep's other conditions hold (see the module). Today: drivetrain coordinates of
+/// the two-DOF linear differential map (eq. 2.15) with stroke drag or no aerodynamics.
+pub fn has_lane_model(device: &Device) -> bool {
+    LinearStroke::of(device).is_some()
+}
+
 /// Newton steps of the shooting (as `simulate` gives `grid_shooting::shoot`).
 const MAX_NEWTON: usize = 20;
 
@@ -85,6 +92,8 @@ const MAX_NEWTON: usize = 20;
 enum Pending {
     /// The neighbour's grid from the start state, its error estimates counted.
     Map,
+    /// The adaptive period that picks a new grid (the neighbour's no longer suits).
+    Pick,
     /// A Newton trial from `y_new`; `last`: the recorded window.
     Trial {
         y_new: State,
@@ -115,10 +124,9 @@ struct LanePoint<'a> {
     accept_tol: f64,
     newton_tol: LaneTolerances,
     grid_tol: LaneTolerances,
-    /// The shooting's integrator (no work integrals) and the grid chooser (tolerances
-    /// tightened by `GRID_TOLERANCE_FACTOR`), for the periods run in place.
+    /// The shooting's integrator (no work integrals), for the re-linearisations run in place.
     rk: RungeKutta,
-    chooser: RungeKutta,
+    max_steps: usize,
     grid: Rc<[f64]>,
     /// The actuator force at the grid's stage times (`None` until asked, and after the grid
     /// changes).
@@ -246,7 +254,7 @@ impl<'a> LanePoint<'a> {
                 atol: options.atol * chooser,
             },
             rk,
-            chooser: rk.tightened(GRID_TOLERANCE_FACTOR),
+            max_steps: options.max_steps,
             grid: grid.into(),
             forcing: None,
             times,
@@ -271,6 +279,7 @@ impl<'a> LanePoint<'a> {
     fn problem(&self, y: &State, record: bool) -> LaneProblem {
         LaneProblem {
             grid: self.grid.clone(),
+            adaptive: None,
             y0: compact4(y),
             times: if record {
                 self.times.clone()
@@ -278,7 +287,7 @@ impl<'a> LanePoint<'a> {
                 Rc::from([])
             },
             tol: match self.pending {
-                Pending::Map => self.grid_tol,
+                Pending::Map | Pending::Pick => self.grid_tol,
                 Pending::Trial { .. } => self.newton_tol,
             },
         }
@@ -355,6 +364,7 @@ impl<'a> LanePoint<'a> {
                 LaneOutcome::Done {
                     y,
                     over_tolerance: 0,
+                    ..
                 },
             ) => {
                 self.periods = 1;
@@ -362,21 +372,25 @@ impl<'a> LanePoint<'a> {
                 self.iterate()
             }
             (Pending::Map, _) => {
-                // The neighbour's grid no longer suits: one adaptive period picks another.
-                match self
-                    .chooser
-                    .advance_with_steps(self.device, 0.0, &self.y, self.period)
-                {
-                    Ok((py, grid)) => {
-                        self.grid = grid.into();
-                        self.forcing = None;
-                        self.periods = 1;
-                        (self.f, self.res) = residual(&self.y, &py);
-                        self.iterate()
-                    }
-                    Err(_) => Next::Scalar,
-                }
+                // The neighbour's grid no longer suits: one adaptive period picks another
+                // (`chooser.advance_with_steps`, in the lane).
+                self.pending = Pending::Pick;
+                Next::Integrate(LaneProblem {
+                    grid: Rc::from([0.0, self.period]),
+                    adaptive: Some(self.max_steps),
+                    y0: compact4(&self.y),
+                    times: Rc::from([]),
+                    tol: self.grid_tol,
+                })
             }
+            (Pending::Pick, LaneOutcome::Done { y, steps, .. }) => {
+                self.grid = steps.into();
+                self.forcing = None;
+                self.periods = 1;
+                (self.f, self.res) = residual(&self.y, &expand4(&y));
+                self.iterate()
+            }
+            (Pending::Pick, LaneOutcome::Failed) => Next::Scalar,
             (Pending::Trial { .. }, LaneOutcome::Failed) => Next::Scalar,
             (
                 Pending::Trial {
