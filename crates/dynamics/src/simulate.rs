@@ -233,7 +233,7 @@ fn options_value(field: &str, samples_per_cycle: usize, record_cycles: usize) ->
     }
 }
 
-fn state_change(a: &State, b: &State) -> f64 {
+pub(crate) fn state_change(a: &State, b: &State) -> f64 {
     let mut num: f64 = 0.0;
     let mut den: f64 = 1e-12;
     for (x, y) in a

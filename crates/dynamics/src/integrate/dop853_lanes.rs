@@ -24,6 +24,10 @@ use super::*;
 /// Problems integrated at once.
 pub(crate) const LANES: usize = 4;
 
+/// Entries in the error norm: the state `[q1, q2, q̇1, q̇2]` (a variational system's
+/// sensitivities ride along uncontrolled, as in integrate/variational.rs).
+pub(crate) const CONTROLLED: usize = 4;
+
 type V = f64x4;
 
 /// One lane's value of `v`.
@@ -41,12 +45,12 @@ fn with_lane(v: V, l: usize, x: f64) -> V {
 }
 
 /// The right-hand side of several lanes on the compact layout `[q1, q2, q̇1, q̇2]`.
-pub(crate) trait LaneRhs {
+pub(crate) trait LaneRhs<const M: usize> {
     /// Writes `f(t, y)` of every lane; `stage[l]` is lane `l`'s position in the list of
     /// [`stage_times`] of its grid ([`NO_STAGE`] outside it), for right-hand sides that
     /// tabulate their time dependence. Returns the bit mask of lanes whose evaluation failed
     /// (left out of the domain of the model).
-    fn eval(&self, t: [f64; LANES], stage: [usize; LANES], y: &[V; 4], dydt: &mut [V; 4]) -> u32;
+    fn eval(&self, t: [f64; LANES], stage: [usize; LANES], y: &[V; M], dydt: &mut [V; M]) -> u32;
 }
 
 /// Right-hand side evaluations per step in [`stage_times`]: the step's start, stages 2–12,
@@ -81,14 +85,14 @@ pub(crate) struct LaneTolerances {
 
 /// One integration given to a lane: on a fixed grid, or adaptive from `grid[0]` to the
 /// grid's end.
-pub(crate) struct LaneProblem {
+pub(crate) struct LaneProblem<const M: usize> {
     /// Step times (at least two, increasing); adaptive: only the span `[t0, t_end]` is read.
     pub(crate) grid: Rc<[f64]>,
     /// `Some(max_steps)`: adaptive steps (Hairer's control, as `RungeKutta`), returning the
     /// accepted step times in [`LaneOutcome::Done`]; no samples.
     pub(crate) adaptive: Option<usize>,
     /// Initial compact state at `grid[0]`.
-    pub(crate) y0: [f64; 4],
+    pub(crate) y0: [f64; M],
     /// Sample times (sorted, within the grid's span).
     pub(crate) times: Rc<[f64]>,
     /// Tolerances of the error estimate (counted in [`LaneOutcome::over_tolerance`]).
@@ -97,11 +101,11 @@ pub(crate) struct LaneProblem {
 
 /// How a lane's integration ended.
 #[derive(Clone, Debug, PartialEq)]
-pub(crate) enum LaneOutcome {
+pub(crate) enum LaneOutcome<const M: usize> {
     /// The state at the grid's end and the steps whose error estimate exceeded the tolerances.
     Done {
         /// Compact end state.
-        y: [f64; 4],
+        y: [f64; M],
         /// See [`super::IntegrationStats::over_tolerance`] (fixed grids).
         over_tolerance: usize,
         /// Adaptive: `t0` and the accepted step times (the grid a fixed-grid run retraces, as
@@ -159,12 +163,12 @@ struct Progress {
 }
 
 /// [`LANES`] lanes of DOP853 on fixed grids.
-pub(crate) struct LaneStepper {
-    y: [V; 4],
-    f0: [V; 4],
-    k: [[V; 4]; 10],
-    y1: [V; 4],
-    cont: [[V; 4]; 8],
+pub(crate) struct LaneStepper<const M: usize> {
+    y: [V; M],
+    f0: [V; M],
+    k: [[V; M]; 10],
+    y1: [V; M],
+    cont: [[V; M]; 8],
     rtol: V,
     atol: V,
     lanes: [Progress; LANES],
@@ -173,16 +177,16 @@ pub(crate) struct LaneStepper {
 /// `y + h Σ aᵢ kᵢ` on vectors (the scalar `stage!` of dop853.rs, same operation order).
 macro_rules! vstage {
     ($out:expr, $y:expr, $h:expr, $( $a:expr => $k:expr ),+ ) => {
-        for i in 0..4 {
+        for i in 0..M {
             $out[i] = $y[i] + $h * (V::splat(0.0) $( + V::splat($a) * $k[i] )+);
         }
     };
 }
 
-impl LaneStepper {
+impl<const M: usize> LaneStepper<M> {
     /// All lanes idle.
     pub(crate) fn new() -> Self {
-        let z = [V::splat(0.0); 4];
+        let z = [V::splat(0.0); M];
         Self {
             y: z,
             f0: z,
@@ -206,7 +210,7 @@ impl LaneStepper {
     pub(crate) fn start(
         &mut self,
         l: usize,
-        problem: LaneProblem,
+        problem: LaneProblem<M>,
         sink: &mut LaneSink<'_>,
     ) -> bool {
         if problem.grid.len() < 2 {
@@ -214,12 +218,12 @@ impl LaneStepper {
         }
         let t0 = problem.grid[0];
         let at_start = problem.times.partition_point(|&s| s <= t0);
-        let y0 = problem.y0.map(V::splat);
+        let y0: [V; 4] = std::array::from_fn(|i| V::splat(problem.y0[i]));
         if !emit_constant(l, &problem.times, 0, at_start, &y0, sink) {
             return false;
         }
         let next = at_start;
-        for i in 0..4 {
+        for i in 0..M {
             self.y[i] = with_lane(self.y[i], l, problem.y0[i]);
         }
         self.rtol = with_lane(self.rtol, l, problem.tol.rtol);
@@ -252,10 +256,10 @@ impl LaneStepper {
     /// last call (their `f(t0, y0)` is evaluated first).
     pub(crate) fn run(
         &mut self,
-        rhs: &dyn LaneRhs,
+        rhs: &dyn LaneRhs<M>,
         fresh: u32,
         sink: &mut LaneSink<'_>,
-    ) -> Vec<(usize, LaneOutcome)> {
+    ) -> Vec<(usize, LaneOutcome<M>)> {
         let mut finished = Vec::new();
         if fresh != 0 {
             let t0 = std::array::from_fn(|l| {
@@ -263,7 +267,7 @@ impl LaneStepper {
                 if p.active { p.grid[0] } else { 0.0 }
             });
             let stage = std::array::from_fn(|l| if self.lanes[l].active { 0 } else { NO_STAGE });
-            let mut f = [V::splat(0.0); 4];
+            let mut f = [V::splat(0.0); M];
             let failed = rhs.eval(t0, stage, &self.y, &mut f);
             for l in 0..LANES {
                 if fresh & (1 << l) == 0 || !self.lanes[l].active {
@@ -274,7 +278,7 @@ impl LaneStepper {
                     finished.push((l, LaneOutcome::Failed));
                     continue;
                 }
-                for i in 0..4 {
+                for i in 0..M {
                     self.f0[i] = with_lane(self.f0[i], l, lane(f[i], l));
                 }
                 if self.lanes[l].adaptive.is_some() && !self.initial_step(rhs, l) {
@@ -291,13 +295,13 @@ impl LaneStepper {
 
     /// Hairer's initial step of adaptive lane `l` (`initial_step` of integrate/mod.rs on
     /// this lane alone); `false` when its extra evaluation fails.
-    fn initial_step(&mut self, rhs: &dyn LaneRhs, l: usize) -> bool {
-        let y0: [f64; 4] = std::array::from_fn(|i| lane(self.y[i], l));
-        let f0: [f64; 4] = std::array::from_fn(|i| lane(self.f0[i], l));
+    fn initial_step(&mut self, rhs: &dyn LaneRhs<M>, l: usize) -> bool {
+        let y0: [f64; M] = std::array::from_fn(|i| lane(self.y[i], l));
+        let f0: [f64; M] = std::array::from_fn(|i| lane(self.f0[i], l));
         let tol = Tolerances {
             rtol: lane(self.rtol, l),
             atol: lane(self.atol, l),
-            controlled: 4,
+            controlled: CONTROLLED,
         };
         let a = self.lanes[l].adaptive.as_mut().expect("an adaptive lane");
         let mut one = OneLane { rhs, l };
@@ -314,9 +318,9 @@ impl LaneStepper {
     /// harmless zero step).
     fn step(
         &mut self,
-        rhs: &dyn LaneRhs,
+        rhs: &dyn LaneRhs<M>,
         sink: &mut LaneSink<'_>,
-        finished: &mut Vec<(usize, LaneOutcome)>,
+        finished: &mut Vec<(usize, LaneOutcome<M>)>,
     ) {
         let mut t = [0.0; LANES];
         let mut t_new = [0.0; LANES];
@@ -365,7 +369,7 @@ impl LaneStepper {
         let y = self.y;
         let k1 = self.f0;
         let [k2, k3, k4, k5, k6, k7, k8, k9, k10, _] = &mut self.k;
-        let mut ys = [V::splat(0.0); 4];
+        let mut ys = [V::splat(0.0); M];
         vstage!(ys, y, h, A21 => k1);
         failed |= rhs.eval(at(C2), idx(1), &ys, k2);
         vstage!(ys, y, h, A31 => k1, A32 => k2);
@@ -394,7 +398,7 @@ impl LaneStepper {
         // The scalar attempt's increment, new state and error norm (every entry controlled).
         let mut err5 = V::splat(0.0);
         let mut err3 = V::splat(0.0);
-        for i in 0..4 {
+        for i in 0..M {
             let inc = V::splat(B1) * k1[i]
                 + V::splat(B6) * k6[i]
                 + V::splat(B7) * k7[i]
@@ -405,6 +409,9 @@ impl LaneStepper {
                 + V::splat(B12) * k3[i];
             let y1 = y[i] + h * inc;
             self.y1[i] = y1;
+            if i >= CONTROLLED {
+                continue;
+            }
             let sk = self.atol + self.rtol * y[i].abs().max(y1.abs());
             let e3 = inc - V::splat(BHH1) * k1[i] - V::splat(BHH2) * k9[i] - V::splat(BHH3) * k3[i];
             let e5 = V::splat(ER1) * k1[i]
@@ -424,10 +431,11 @@ impl LaneStepper {
                 *d = 1.0;
             }
         }
-        let err = h.abs() * err5 * (V::splat(1.0) / (V::splat(4.0) * V::new(deno))).sqrt();
+        let err =
+            h.abs() * err5 * (V::splat(1.0) / (V::splat(CONTROLLED as f64) * V::new(deno))).sqrt();
         // Failures of the new derivative count only on accepted steps (the scalar evaluates
         // it after accepting).
-        let mut f1 = [V::splat(0.0); 4];
+        let mut f1 = [V::splat(0.0); M];
         let failed_f1 = rhs.eval(t_new, idx(STAGES_PER_STEP), &self.y1, &mut f1);
         let y1_finite = (self.y1[0].is_finite()
             & self.y1[1].is_finite()
@@ -508,7 +516,7 @@ impl LaneStepper {
             self.f0 = f1;
         } else {
             // Rejected lanes retry from the same state and derivative.
-            for i in 0..4 {
+            for i in 0..M {
                 let (mut y, mut f0) = (self.y[i].to_array(), self.f0[i].to_array());
                 let (y1, f1) = (self.y1[i].to_array(), f1[i].to_array());
                 for l in (0..LANES).filter(|&l| accepted[l]) {
@@ -570,11 +578,11 @@ impl LaneStepper {
     /// The dense output of the step just taken (the scalar `prepare_dense`, on every lane).
     fn prepare_dense(
         &mut self,
-        rhs: &dyn LaneRhs,
+        rhs: &dyn LaneRhs<M>,
         t: &[f64; LANES],
         base: &[usize; LANES],
         h: V,
-        f1: &[V; 4],
+        f1: &[V; M],
     ) -> u32 {
         let hs = h.to_array();
         let at = |c: f64| -> [f64; LANES] { std::array::from_fn(|l| t[l] + c * hs[l]) };
@@ -585,7 +593,7 @@ impl LaneStepper {
         let [k2, k3, _k4, _k5, k6, k7, k8, k9, k10, kx] = &mut self.k;
         let [r1, r2, r3, r4, r5, r6, r7, r8] = &mut self.cont;
         let s = V::splat;
-        for i in 0..4 {
+        for i in 0..M {
             let ydiff = self.y1[i] - y[i];
             let bspl = h * k1[i] - ydiff;
             r1[i] = y[i];
@@ -626,7 +634,7 @@ impl LaneStepper {
                 + s(D712) * k3[i];
         }
         let mut failed = 0;
-        let mut ys = [V::splat(0.0); 4];
+        let mut ys = [V::splat(0.0); M];
         vstage!(ys, y, h, A141 => k1, A147 => k7, A148 => k8, A149 => k9, A1410 => k10,
             A1411 => k2, A1412 => k3, A1413 => k13);
         failed |= rhs.eval(at(C14), idx(12), &ys, kx);
@@ -639,7 +647,7 @@ impl LaneStepper {
             A1613 => k13, A1614 => k14, A1615 => k15);
         failed |= rhs.eval(at(C16), idx(14), &ys, k2);
         let k16 = *k2;
-        for i in 0..4 {
+        for i in 0..M {
             r5[i] = h
                 * (r5[i]
                     + s(D413) * k13[i]
@@ -765,14 +773,14 @@ impl Adaptive {
 }
 
 /// One lane of a [`LaneRhs`] as a scalar right-hand side (for `initial_step`).
-struct OneLane<'r> {
-    rhs: &'r dyn LaneRhs,
+struct OneLane<'r, const M: usize> {
+    rhs: &'r dyn LaneRhs<M>,
     l: usize,
 }
 
-impl Rhs<4> for OneLane<'_> {
-    fn eval(&mut self, t: f64, y: &[f64; 4], dydt: &mut [f64; 4]) -> paritysim_error::Result<()> {
-        let mut out = [V::splat(0.0); 4];
+impl<const M: usize> Rhs<M> for OneLane<'_, M> {
+    fn eval(&mut self, t: f64, y: &[f64; M], dydt: &mut [f64; M]) -> paritysim_error::Result<()> {
+        let mut out = [V::splat(0.0); M];
         let failed = self
             .rhs
             .eval([t; LANES], [NO_STAGE; LANES], &y.map(V::splat), &mut out);
@@ -782,13 +790,13 @@ impl Rhs<4> for OneLane<'_> {
                 detail: format!("t = {t}"),
             });
         }
-        for i in 0..4 {
+        for i in 0..M {
             dydt[i] = lane(out[i], self.l);
         }
         Ok(())
     }
 
-    fn expand(&self, c: &[f64; 4]) -> State {
+    fn expand(&self, c: &[f64; M]) -> State {
         let mut y = State::default();
         y.coords[..2].copy_from_slice(&c[..2]);
         y.rates[..2].copy_from_slice(&c[2..]);

@@ -14,6 +14,7 @@ use crate::actuator::Actuator;
 use crate::device::{Device, Formulation};
 use std::rc::Rc;
 
+use crate::integrate::DIRECTIONAL_STEP;
 use crate::integrate::lanes::{LANES, LaneRhs, stage_times};
 use crate::wing::WingAero;
 use paritysim_kinematics::Drivetrain;
@@ -218,9 +219,22 @@ impl<'a> LinearStrokeLanes<'a> {
     }
 }
 
-impl LaneRhs for LinearStrokeLanes<'_> {
+impl LinearStrokeLanes<'_> {
+    /// The actuator force of every lane at its time (from its forcing table at `stage`).
     #[inline]
-    fn eval(&self, t: [f64; LANES], stage: [usize; LANES], y: &[V; 4], dydt: &mut [V; 4]) -> u32 {
+    fn force(&self, t: [f64; LANES], stage: [usize; LANES]) -> V {
+        V::new(std::array::from_fn(|l| {
+            match (&self.forcing[l], self.actuators[l]) {
+                (Some(table), _) if stage[l] < table.len() => table[stage[l]],
+                (_, Some(a)) => a.force(t[l]),
+                _ => 0.0,
+            }
+        }))
+    }
+
+    /// The right-hand side at the actuator force `force` (see [`LaneRhs::eval`]).
+    #[inline]
+    fn eval_with(&self, force: V, y: &[V; 4], dydt: &mut [V; 4]) -> u32 {
         let [q1, q2, q1_dot, q2_dot] = *y;
         // `Drivetrain::evaluate`'s plausibility check (the scalar path errs outside it).
         let inside = q1
@@ -229,13 +243,6 @@ impl LaneRhs for LinearStrokeLanes<'_> {
             & q2.abs()
                 .simd_le(V::splat(paritysim_error::plausible::ANGLE_RAD));
         let failed = !inside.to_bitmask() & ((1 << LANES) - 1);
-        let force = V::new(std::array::from_fn(|l| {
-            match (&self.forcing[l], self.actuators[l]) {
-                (Some(table), _) if stage[l] < table.len() => table[stage[l]],
-                (_, Some(a)) => a.force(t[l]),
-                _ => 0.0,
-            }
-        }));
         let [j00, j01, j10, j11] = self.j;
         let stroke = [j00 * q1 + j01 * q2, j10 * q1 + j11 * q2];
         let phi_dot = [j00 * q1_dot + j01 * q2_dot, j10 * q1_dot + j11 * q2_dot];
@@ -255,6 +262,56 @@ impl LaneRhs for LinearStrokeLanes<'_> {
         dydt[1] = q2_dot;
         dydt[2] = (self.m11 * g0 - self.m01 * g1) / self.det;
         dydt[3] = (self.m00 * g1 - self.m01 * g0) / self.det;
+        failed
+    }
+}
+
+impl LaneRhs<4> for LinearStrokeLanes<'_> {
+    #[inline]
+    fn eval(&self, t: [f64; LANES], stage: [usize; LANES], y: &[V; 4], dydt: &mut [V; 4]) -> u32 {
+        self.eval_with(self.force(t, stage), y, dydt)
+    }
+}
+
+/// The variational equations of [`LinearStrokeLanes`] on `[y (4), Φ (4 × 4, by columns)]`,
+/// formed as integrate/variational.rs forms them (`J Φ` column by column by central
+/// differences along each column, the same steps and operations), one device per lane.
+pub(crate) struct VariationalLanes<'m, 'a>(pub(crate) &'m LinearStrokeLanes<'a>);
+
+impl LaneRhs<20> for VariationalLanes<'_, '_> {
+    fn eval(&self, t: [f64; LANES], stage: [usize; LANES], c: &[V; 20], dc: &mut [V; 20]) -> u32 {
+        let rhs = self.0;
+        let force = rhs.force(t, stage);
+        let y: [V; 4] = std::array::from_fn(|i| c[i]);
+        let mut f = [V::splat(0.0); 4];
+        let mut failed = rhs.eval_with(force, &y, &mut f);
+        dc[..4].copy_from_slice(&f);
+        let mut largest = V::splat(0.0);
+        for v in &y {
+            largest = largest.max(v.abs());
+        }
+        let scale = V::splat(1.0) + largest;
+        for j in 0..4 {
+            let col = 4 + 4 * j;
+            let v: [V; 4] = std::array::from_fn(|i| c[col + i]);
+            let mut size = V::splat(0.0);
+            for x in &v {
+                size = size.max(x.abs());
+            }
+            // A zero column stays zero (and its differences are never evaluated).
+            let zero = size.simd_eq(V::splat(0.0));
+            let delta = V::splat(DIRECTIONAL_STEP) * scale / size;
+            let yp: [V; 4] = std::array::from_fn(|i| y[i] + delta * v[i]);
+            let ym: [V; 4] = std::array::from_fn(|i| y[i] - delta * v[i]);
+            let (mut fp, mut fm) = ([V::splat(0.0); 4], [V::splat(0.0); 4]);
+            let mut column_failed = rhs.eval_with(force, &yp, &mut fp);
+            column_failed |= rhs.eval_with(force, &ym, &mut fm);
+            failed |= column_failed & !zero.to_bitmask();
+            for i in 0..4 {
+                let d = (fp[i] - fm[i]) / (V::splat(2.0) * delta);
+                dc[col + i] = zero.bitselect(V::splat(0.0), d);
+            }
+        }
         failed
     }
 }

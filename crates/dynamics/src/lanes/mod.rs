@@ -42,7 +42,7 @@ use crate::sweep::{
     continued_options, remember, run_tasks,
 };
 use crate::trajectory::{StrokeSample, Trajectory};
-use linear_stroke::{LinearStroke, LinearStrokeLanes};
+use linear_stroke::{LinearStroke, LinearStrokeLanes, VariationalLanes};
 
 /// Environment variable read by [`resolve_lanes`] when no lane width is given: an integer in
 /// `[1, 4]` (`PARITYSIM_LANES=1` runs the scalar path).
@@ -94,6 +94,10 @@ enum Pending {
     Map,
     /// The adaptive period that picks a new grid (the neighbour's no longer suits).
     Pick,
+    /// A cold point's transient warm-up period.
+    WarmUp,
+    /// A cold point's variational period.
+    Sensitivity,
     /// A Newton trial from `y_new`; `last`: the recorded window.
     Trial {
         y_new: State,
@@ -106,7 +110,9 @@ enum Pending {
 /// What a lane point does next.
 enum Next {
     /// Integrate this period in its lane.
-    Integrate(LaneProblem),
+    Integrate(LaneProblem<4>),
+    /// Integrate this period with the variational equations in its lane.
+    Sensitivity(LaneProblem<20>),
     /// Converged: the point's output.
     Done(Box<PointOutput>),
     /// Leave the straight path: rerun the point on the scalar path.
@@ -135,6 +141,9 @@ struct LanePoint<'a> {
     jac: DMatrix<f64>,
     /// Whether `jac` is an exact Jacobian at `y` (after a re-linearisation).
     fresh: bool,
+    /// Warm-up periods of a cold point: at most `min_cycles`.
+    min_cycles: usize,
+    warm_cycles: usize,
     eye: DMatrix<f64>,
     y: State,
     f: DVector<f64>,
@@ -182,7 +191,7 @@ impl<'a> LanePoint<'a> {
         options: &SimulationOptions,
         metric_names: &'a [String],
         times_cache: &mut Option<(f64, usize, Rc<[f64]>)>,
-    ) -> Option<(Self, LaneProblem)> {
+    ) -> Option<(Self, Next)> {
         let model = LinearStroke::of(device)?;
         let period = device.period()?;
         let stroke_metrics = metric_names
@@ -196,13 +205,31 @@ impl<'a> LanePoint<'a> {
         if !plain || crate::simulate::validate(options).is_err() {
             return None;
         }
-        let (p0, pd0) = options.initial?;
-        let jac = options.shooting_jacobian.clone()?;
-        let grid = options.shooting_grid.as_deref()?;
-        if jac.shape() != (4, 4) || grid.first() != Some(&0.0) || grid.last() != Some(&period) {
-            return None;
-        }
-        crate::integrate::check_grid(grid).ok()?;
+        // A continued point (a neighbour's state, Jacobian and grid) or a cold one (the spec's
+        // own start: warm-up, then the variational period).
+        let cold = options.initial.is_none();
+        let (p0, pd0, jac, grid) = if cold {
+            if options.shooting_jacobian.is_some() || options.shooting_grid.is_some() {
+                return None;
+            }
+            let p0 = *device.spec().constraints.particular();
+            let identity = DMatrix::identity(4, 4);
+            (
+                p0,
+                paritysim_constraints::Vec6::zeros(),
+                identity,
+                vec![0.0, period],
+            )
+        } else {
+            let (p0, pd0) = options.initial?;
+            let jac = options.shooting_jacobian.clone()?;
+            let grid = options.shooting_grid.clone()?;
+            if jac.shape() != (4, 4) || grid.first() != Some(&0.0) || grid.last() != Some(&period) {
+                return None;
+            }
+            crate::integrate::check_grid(&grid).ok()?;
+            (p0, pd0, jac, grid)
+        };
         // What `simulate` checks before running (it would fail on the scalar path).
         let rk = RungeKutta::new(
             options.method,
@@ -216,6 +243,7 @@ impl<'a> LanePoint<'a> {
             return None;
         }
         let y = device.state_from(&p0, &pd0).ok()?.without_work();
+        let min_cycles = options.min_cycles;
         let chooser = GRID_TOLERANCE_FACTOR.clamp(f64::MIN_POSITIVE, 1.0);
         let n_samples = options.samples_per_cycle;
         // The recorded window's sample times, as `record_window` makes them.
@@ -260,6 +288,8 @@ impl<'a> LanePoint<'a> {
             times,
             jac,
             fresh: false,
+            min_cycles,
+            warm_cycles: 0,
             eye: DMatrix::identity(4, 4),
             y,
             f: DVector::zeros(4),
@@ -271,12 +301,65 @@ impl<'a> LanePoint<'a> {
             metrics: MetricsAccumulator::new(device, Some(period)),
             with_force: metric_names.iter().any(|m| m == "actuator_force_peak"),
         };
-        let first = point.problem(&point.y, false);
+        let mut point = point;
+        let first = if !cold {
+            Next::Integrate(point.problem(&point.y, false))
+        } else if min_cycles > 0 {
+            point.warm_up()
+        } else {
+            point.sensitivity()
+        };
         Some((point, first))
     }
 
+    /// One transient warm-up period from the current state (`transient.advance` over one
+    /// period: far from the orbit Newton's model is poor, so the fast modes settle first).
+    fn warm_up(&mut self) -> Next {
+        self.pending = Pending::WarmUp;
+        Next::Integrate(LaneProblem {
+            grid: Rc::from([0.0, self.period]),
+            adaptive: Some(self.max_steps),
+            y0: compact4(&self.y),
+            times: Rc::from([]),
+            tol: self.newton_tol,
+        })
+    }
+
+    /// The adaptive period with the variational equations that picks the grid and gives the
+    /// exact Jacobian (`chooser.flow_with_sensitivity_and_steps`).
+    fn sensitivity(&mut self) -> Next {
+        self.pending = Pending::Sensitivity;
+        let mut c0 = [0.0; 20];
+        c0[..4].copy_from_slice(&compact4(&self.y));
+        for j in 0..4 {
+            c0[4 + j * 4 + j] = 1.0;
+        }
+        Next::Sensitivity(LaneProblem {
+            grid: Rc::from([0.0, self.period]),
+            adaptive: Some(self.max_steps),
+            y0: c0,
+            times: Rc::from([]),
+            tol: self.grid_tol,
+        })
+    }
+
+    /// Continues after the variational period ended with `outcome`.
+    fn resume_sensitivity(&mut self, outcome: LaneOutcome<20>) -> Next {
+        let LaneOutcome::Done { y: c, steps, .. } = outcome else {
+            return Next::Scalar;
+        };
+        let py = expand4(&[c[0], c[1], c[2], c[3]]);
+        self.jac = DMatrix::from_fn(4, 4, |i, j| c[4 + j * 4 + i]);
+        self.grid = steps.into();
+        self.forcing = None;
+        self.fresh = true;
+        self.periods = 1;
+        (self.f, self.res) = residual(&self.y, &py);
+        self.iterate()
+    }
+
     /// The fixed-grid period from `y` (`record`: with the window's samples).
-    fn problem(&self, y: &State, record: bool) -> LaneProblem {
+    fn problem(&self, y: &State, record: bool) -> LaneProblem<4> {
         LaneProblem {
             grid: self.grid.clone(),
             adaptive: None,
@@ -287,8 +370,8 @@ impl<'a> LanePoint<'a> {
                 Rc::from([])
             },
             tol: match self.pending {
-                Pending::Map | Pending::Pick => self.grid_tol,
-                Pending::Trial { .. } => self.newton_tol,
+                Pending::Map | Pending::Pick | Pending::Sensitivity => self.grid_tol,
+                Pending::Trial { .. } | Pending::WarmUp => self.newton_tol,
             },
         }
     }
@@ -357,8 +440,22 @@ impl<'a> LanePoint<'a> {
     }
 
     /// Continues after the lane's period ended with `outcome` (the rest of `shoot`'s loop).
-    fn resume(&mut self, outcome: LaneOutcome) -> Next {
+    fn resume(&mut self, outcome: LaneOutcome<4>) -> Next {
         match (std::mem::replace(&mut self.pending, Pending::Map), outcome) {
+            (Pending::WarmUp, LaneOutcome::Done { y, .. }) => {
+                let next = expand4(&y);
+                let change = crate::simulate::state_change(&next, &self.y);
+                self.y = next.without_work();
+                self.warm_cycles += 1;
+                if self.warm_cycles < self.min_cycles && change >= 1e-3 {
+                    self.warm_up()
+                } else {
+                    self.sensitivity()
+                }
+            }
+            // A failing warm-up period ends the warm-up (the shooting decides).
+            (Pending::WarmUp, LaneOutcome::Failed) => self.sensitivity(),
+            (Pending::Sensitivity, _) => Next::Scalar,
             (
                 Pending::Map,
                 LaneOutcome::Done {
@@ -472,7 +569,7 @@ impl<'a> LanePoint<'a> {
         let result = SimulationResult {
             trajectory: Trajectory::default(),
             metrics: self.metrics.finish(),
-            cycles_run: self.periods - 1,
+            cycles_run: self.warm_cycles + self.periods - 1,
             converged: true,
             period_ms: self.period,
             residual,
@@ -566,6 +663,53 @@ pub(crate) fn run_chains(
     Ok(out)
 }
 
+/// The group's two lane steppers (the state, and the state with its variational equations).
+struct Steppers {
+    state: LaneStepper<4>,
+    variational: LaneStepper<20>,
+    /// Lanes started since each stepper's last run.
+    fresh: [u32; 2],
+}
+
+/// Starts `next` of `point` in lane `l`: `None` while it is in flight, else the point is
+/// complete (`Some(Some(output))` from the lanes, `Some(None)`: run it on the scalar path).
+fn launch<'a>(
+    l: usize,
+    next: Next,
+    point: &mut LanePoint<'a>,
+    steppers: &mut Steppers,
+    models: &mut LinearStrokeLanes<'a>,
+    forcing_cache: &mut ForcingCache,
+) -> Option<Option<PointOutput>> {
+    match next {
+        Next::Integrate(problem) => {
+            if problem.adaptive.is_none() {
+                models.load_forcing(l, Some(forcing(point, forcing_cache)));
+            }
+            let mut sink = |_: usize, block: &SampleBlock| point.sample(block);
+            if steppers.state.start(l, problem, &mut sink) {
+                steppers.fresh[0] |= 1 << l;
+                None
+            } else {
+                Some(None)
+            }
+        }
+        Next::Sensitivity(problem) => {
+            if steppers
+                .variational
+                .start(l, problem, &mut |_: usize, _: &SampleBlock| true)
+            {
+                steppers.fresh[1] |= 1 << l;
+                None
+            } else {
+                Some(None)
+            }
+        }
+        Next::Done(output) => Some(Some(*output)),
+        Next::Scalar => Some(None),
+    }
+}
+
 /// One group of chains on `lanes` lanes; each chain's results in order (cut short by a
 /// cancel).
 fn run_group(
@@ -579,9 +723,12 @@ fn run_group(
     let mut results: Vec<Vec<Result<PointOutput>>> = chains.clone().map(|_| Vec::new()).collect();
     let mut queue = chains;
     let mut cursors: Vec<Option<Cursor<'_>>> = (0..lanes).map(|_| None).collect();
-    let mut stepper = LaneStepper::new();
+    let mut steppers = Steppers {
+        state: LaneStepper::new(),
+        variational: LaneStepper::new(),
+        fresh: [0; 2],
+    };
     let mut models = LinearStrokeLanes::new();
-    let mut fresh = 0u32;
     let mut times_cache = None;
     let mut forcing_cache: ForcingCache = None;
     loop {
@@ -620,63 +767,85 @@ fn run_group(
                 let i = cursor.next;
                 cursor.next += 1;
                 let start = chain_start(points, &mut cursor.previous, i);
-                let lane_point = continued_options(points, i, &start).and_then(|options| {
-                    let (device, _) = points[i].as_ref().ok()?;
-                    LanePoint::new(device, &options, metric_names, &mut times_cache)
+                // Continued from the neighbours, or (a chain's start) from the spec's own state.
+                let lane_point = points[i].as_ref().ok().and_then(|(device, own)| {
+                    let options = continued_options(points, i, &start);
+                    LanePoint::new(
+                        device,
+                        options.as_ref().unwrap_or(own),
+                        metric_names,
+                        &mut times_cache,
+                    )
                 });
-                match lane_point {
-                    Some((mut point, problem)) => {
-                        models.load(l, &point.model);
-                        models.load_forcing(l, Some(forcing(&mut point, &mut forcing_cache)));
-                        let sink = &mut |_: usize, _: &SampleBlock| true;
-                        if stepper.start(l, problem, sink) {
-                            fresh |= 1 << l;
-                            cursor.point = Some((i, start, point));
-                        } else {
-                            finish_point(points, metric_names, cursor, i, &start, None, control);
-                        }
+                let Some((mut point, next)) = lane_point else {
+                    finish_point(points, metric_names, cursor, i, &start, None, control);
+                    continue;
+                };
+                models.load(l, &point.model);
+                match launch(
+                    l,
+                    next,
+                    &mut point,
+                    &mut steppers,
+                    &mut models,
+                    &mut forcing_cache,
+                ) {
+                    None => cursor.point = Some((i, start, point)),
+                    Some(done) => {
+                        finish_point(points, metric_names, cursor, i, &start, done, control)
                     }
-                    None => finish_point(points, metric_names, cursor, i, &start, None, control),
                 }
             }
         }
-        if control.is_cancelled() || !stepper.any_busy() {
+        if control.is_cancelled() || !(steppers.state.any_busy() || steppers.variational.any_busy())
+        {
             break;
         }
-        let mut sink = |l: usize, block: &SampleBlock| {
-            cursors[l]
-                .as_mut()
-                .and_then(|c| c.point.as_mut())
-                .is_some_and(|(_, _, p)| p.sample(block))
-        };
-        let finished = stepper.run(&models, fresh, &mut sink);
-        fresh = 0;
+        let mut finished: Vec<(usize, Result<LaneOutcome<4>, LaneOutcome<20>>)> = Vec::new();
+        if steppers.state.any_busy() {
+            let mut sink = |l: usize, block: &SampleBlock| {
+                cursors[l]
+                    .as_mut()
+                    .and_then(|c| c.point.as_mut())
+                    .is_some_and(|(_, _, p)| p.sample(block))
+            };
+            let fresh = std::mem::take(&mut steppers.fresh[0]);
+            finished.extend(
+                steppers
+                    .state
+                    .run(&models, fresh, &mut sink)
+                    .into_iter()
+                    .map(|(l, o)| (l, Ok(o))),
+            );
+        }
+        if steppers.variational.any_busy() {
+            let fresh = std::mem::take(&mut steppers.fresh[1]);
+            let rhs = VariationalLanes(&models);
+            finished.extend(
+                steppers
+                    .variational
+                    .run(&rhs, fresh, &mut |_: usize, _: &SampleBlock| true)
+                    .into_iter()
+                    .map(|(l, o)| (l, Err(o))),
+            );
+        }
         for (l, outcome) in finished {
             let cursor = cursors[l].as_mut().expect("a busy lane has a chain");
             let (i, start, mut point) = cursor.point.take().expect("a busy lane has a point");
-            match point.resume(outcome) {
-                Next::Integrate(problem) => {
-                    models.load_forcing(l, Some(forcing(&mut point, &mut forcing_cache)));
-                    let mut sink = |_: usize, block: &SampleBlock| point.sample(block);
-                    if stepper.start(l, problem, &mut sink) {
-                        fresh |= 1 << l;
-                        cursor.point = Some((i, start, point));
-                    } else {
-                        finish_point(points, metric_names, cursor, i, &start, None, control);
-                    }
-                }
-                Next::Done(output) => finish_point(
-                    points,
-                    metric_names,
-                    cursor,
-                    i,
-                    &start,
-                    Some(*output),
-                    control,
-                ),
-                Next::Scalar => {
-                    finish_point(points, metric_names, cursor, i, &start, None, control)
-                }
+            let next = match outcome {
+                Ok(o) => point.resume(o),
+                Err(o) => point.resume_sensitivity(o),
+            };
+            match launch(
+                l,
+                next,
+                &mut point,
+                &mut steppers,
+                &mut models,
+                &mut forcing_cache,
+            ) {
+                None => cursor.point = Some((i, start, point)),
+                Some(done) => finish_point(points, metric_names, cursor, i, &start, done, control),
             }
         }
     }
