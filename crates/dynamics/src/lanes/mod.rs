@@ -98,6 +98,11 @@ enum Pending {
     WarmUp,
     /// A cold point's variational period.
     Sensitivity,
+    /// The variational equations on the grid (an exact Jacobian); then the iterate becomes
+    /// `candidate` `(y, f, residual)` when given.
+    Relinearise {
+        candidate: Option<(State, DVector<f64>, f64)>,
+    },
     /// A Newton trial from `y_new`; `last`: the recorded window.
     Trial {
         y_new: State,
@@ -130,8 +135,6 @@ struct LanePoint<'a> {
     accept_tol: f64,
     newton_tol: LaneTolerances,
     grid_tol: LaneTolerances,
-    /// The shooting's integrator (no work integrals), for the re-linearisations run in place.
-    rk: RungeKutta,
     max_steps: usize,
     grid: Rc<[f64]>,
     /// The actuator force at the grid's stage times (`None` until asked, and after the grid
@@ -231,14 +234,13 @@ impl<'a> LanePoint<'a> {
             (p0, pd0, jac, grid)
         };
         // What `simulate` checks before running (it would fail on the scalar path).
-        let rk = RungeKutta::new(
+        RungeKutta::new(
             options.method,
             options.rtol,
             options.atol,
             options.max_steps,
         )
-        .ok()?
-        .with_work(false);
+        .ok()?;
         if options.samples_per_cycle > crate::simulate::MAX_RECORDED_SAMPLES {
             return None;
         }
@@ -281,7 +283,6 @@ impl<'a> LanePoint<'a> {
                 rtol: options.rtol * chooser,
                 atol: options.atol * chooser,
             },
-            rk,
             max_steps: options.max_steps,
             grid: grid.into(),
             forcing: None,
@@ -348,6 +349,18 @@ impl<'a> LanePoint<'a> {
         let LaneOutcome::Done { y: c, steps, .. } = outcome else {
             return Next::Scalar;
         };
+        if let Pending::Relinearise { candidate } =
+            std::mem::replace(&mut self.pending, Pending::Map)
+        {
+            self.jac = DMatrix::from_fn(4, 4, |i, j| c[4 + j * 4 + i]);
+            self.periods += 1;
+            self.fresh = true;
+            self.last_step = None;
+            if let Some((y, f, res)) = candidate {
+                (self.y, self.f, self.res) = (y, f, res);
+            }
+            return self.iterate();
+        }
         let py = expand4(&[c[0], c[1], c[2], c[3]]);
         self.jac = DMatrix::from_fn(4, 4, |i, j| c[4 + j * 4 + i]);
         self.grid = steps.into();
@@ -371,7 +384,9 @@ impl<'a> LanePoint<'a> {
             },
             tol: match self.pending {
                 Pending::Map | Pending::Pick | Pending::Sensitivity => self.grid_tol,
-                Pending::Trial { .. } | Pending::WarmUp => self.newton_tol,
+                Pending::Trial { .. } | Pending::WarmUp | Pending::Relinearise { .. } => {
+                    self.newton_tol
+                }
             },
         }
     }
@@ -455,7 +470,7 @@ impl<'a> LanePoint<'a> {
             }
             // A failing warm-up period ends the warm-up (the shooting decides).
             (Pending::WarmUp, LaneOutcome::Failed) => self.sensitivity(),
-            (Pending::Sensitivity, _) => Next::Scalar,
+            (Pending::Sensitivity | Pending::Relinearise { .. }, _) => Next::Scalar,
             (
                 Pending::Map,
                 LaneOutcome::Done {
@@ -503,11 +518,7 @@ impl<'a> LanePoint<'a> {
                 let tol = self.tol;
                 if last && res_new > tol && res_new <= self.accept_tol && !self.fresh {
                     // Re-linearise at the candidate, then decide with the exact Jacobian.
-                    if !self.relinearise(&y_new) {
-                        return Next::Scalar;
-                    }
-                    (self.y, self.f, self.res) = (y_new, f_new, res_new);
-                    return self.iterate();
+                    return self.relinearise(&y_new, Some((y_new, f_new, res_new)));
                 }
                 let neutral = || {
                     res_new <= self.accept_tol
@@ -519,10 +530,10 @@ impl<'a> LanePoint<'a> {
                 }
                 if res_new >= self.res || res_new.is_nan() {
                     // A stale Jacobian that no longer descends: the exact one at the iterate.
-                    if self.fresh || !self.relinearise(&self.y.clone()) {
+                    if self.fresh {
                         return Next::Scalar;
                     }
-                    return self.iterate();
+                    return self.relinearise(&self.y.clone(), None);
                 }
                 // Good Broyden: the secant condition on the step just taken.
                 let s_dot = delta.dot(&delta);
@@ -538,22 +549,22 @@ impl<'a> LanePoint<'a> {
         }
     }
 
-    /// The exact Jacobian at `at` on the grid (one variational period, scalar); `false` when
-    /// it fails (the scalar path then gives up Newton).
-    fn relinearise(&mut self, at: &State) -> bool {
-        match self
-            .rk
-            .flow_with_sensitivity_on_grid(self.device, &self.grid, at)
-        {
-            Ok((_, j)) => {
-                self.jac = j;
-                self.periods += 1;
-                self.fresh = true;
-                self.last_step = None;
-                true
-            }
-            Err(_) => false,
+    /// The exact Jacobian at `at` on the grid (`rk.flow_with_sensitivity_on_grid`, in the
+    /// lane), then the iterate `candidate` when given.
+    fn relinearise(&mut self, at: &State, candidate: Option<(State, DVector<f64>, f64)>) -> Next {
+        self.pending = Pending::Relinearise { candidate };
+        let mut c0 = [0.0; 20];
+        c0[..4].copy_from_slice(&compact4(at));
+        for j in 0..4 {
+            c0[4 + j * 4 + j] = 1.0;
         }
+        Next::Sensitivity(LaneProblem {
+            grid: self.grid.clone(),
+            adaptive: None,
+            y0: c0,
+            times: Rc::from([]),
+            tol: self.newton_tol,
+        })
     }
 
     /// The converged point as `simulate` and `run_point` report it.
@@ -695,6 +706,9 @@ fn launch<'a>(
             }
         }
         Next::Sensitivity(problem) => {
+            if problem.adaptive.is_none() {
+                models.load_forcing(l, Some(forcing(point, forcing_cache)));
+            }
             if steppers
                 .variational
                 .start(l, problem, &mut |_: usize, _: &SampleBlock| true)
