@@ -26,7 +26,7 @@ pub(crate) mod linear_stroke;
 
 use std::rc::Rc;
 
-use nalgebra::{DMatrix, DVector, Vector2};
+use nalgebra::{DMatrix, DVector};
 use paritysim_error::{Error, Result, bail};
 
 use crate::device::Device;
@@ -35,13 +35,13 @@ use crate::integrate::lanes::{
     LANES, LaneOutcome, LaneProblem, LaneStepper, LaneTolerances, SampleBlock,
 };
 use crate::integrate::{Method, RungeKutta, State};
-use crate::metrics::MetricsAccumulator;
+use crate::metrics::{MetricsAccumulator, StrokeBlock};
 use crate::simulate::{SimulationOptions, SimulationResult, SteadyState, UNSTABLE_MARGIN};
 use crate::sweep::{
     ChainStart, Converged, PointOutput, SweepControl, chain_point, chain_range, chain_start,
     continued_options, remember, run_tasks,
 };
-use crate::trajectory::{StrokeSample, Trajectory};
+use crate::trajectory::Trajectory;
 use linear_stroke::{LinearStroke, LinearStrokeLanes, VariationalLanes};
 
 /// Environment variable read by [`resolve_lanes`] when no lane width is given: an integer in
@@ -400,23 +400,21 @@ impl<'a> LanePoint<'a> {
         if inside & all != all {
             return false;
         }
-        let at = |v: wide::f64x4, j: usize| v.as_array()[j];
-        for j in 0..block.count {
-            let time = block.t[j];
-            let sample = StrokeSample {
-                time,
-                stroke: Vector2::new(at(stroke[0], j), at(stroke[1], j)),
-                roll_aero: [at(roll[0], j), at(roll[1], j)],
-                actuator_force: if self.with_force {
-                    self.model.force(time)
-                } else {
-                    0.0
-                },
-                q2: at(block.y[1], j),
-            };
-            self.metrics
-                .add_stroke(&sample, block.first + j == self.samples_per_cycle);
+        let mut actuator_force = [0.0; 4];
+        if self.with_force {
+            for (f, &t) in actuator_force.iter_mut().zip(&block.t).take(block.count) {
+                *f = self.model.force(t);
+            }
         }
+        self.metrics.add_stroke_block(&StrokeBlock {
+            count: block.count,
+            closing: block.first + block.count - 1 == self.samples_per_cycle,
+            time: block.t,
+            stroke: [stroke[0].to_array(), stroke[1].to_array()],
+            roll_aero: [roll[0].to_array(), roll[1].to_array()],
+            actuator_force,
+            q2: block.y[1].to_array(),
+        });
         true
     }
 
