@@ -1,18 +1,25 @@
-//! DOP853 on fixed step grids for [`LANES`] independent problems at once, one per SIMD lane
-//! (`wide::f64x4`): the ensemble technique of heyoka and MPGOS (several sweep points
-//! integrated together, each lane with its own time, step size and state, refilled when its
-//! problem ends; see `crate::sweep` for the scheduler).
+//! DOP853 for [`LANES`] independent problems at once, one per SIMD lane (`wide::f64x4`): the
+//! ensemble technique of heyoka and MPGOS (several sweep points integrated together, each lane
+//! with its own time, step size, state and accept/reject decision, refilled when its problem
+//! ends; `crate::lanes` schedules them).
 //!
-//! Why fixed grids only: the shooting of [`crate::SteadyState::Shooting`] spends almost all of
-//! a chained sweep point in fixed-grid periods (docs/findings.md §7), which need no per-lane
-//! step control: a lane only carries its own grid, and no lane waits on another's rejection.
+//! * **Fixed grids** (the frozen-grid periods of [`crate::SteadyState::Shooting`], most of a
+//!   chained sweep point's work; docs/findings.md §7), with the error estimate counted per
+//!   lane (`over_tolerance`) and the dense output four samples at a time per lane.
+//! * **Adaptive** lanes with Hairer's initial step and step control per lane (the loop of
+//!   `drive` in integrate/mod.rs): a rejected lane retries from its own state while the others
+//!   move on. They return the accepted step times (the grid the fixed-grid periods retrace).
+//! * The state is the compact `[q1, q2, q̇1, q̇2]`, optionally followed by uncontrolled entries
+//!   (`M = 20`: the variational equations' `Φ`, as in integrate/variational.rs).
 //!
 //! Every lane performs exactly the scalar path's floating-point operations in the same order
-//! (the stages of [`super::Dop853::attempt`], its error norm and dense output, the
-//! drivetrain-coordinate right-hand side of [`crate::device::Device`] for the linear map):
-//! SIMD addition, multiplication, division and square root are the IEEE operations of the
-//! scalar code and nothing is fused, so a lane's result is bit-identical to the scalar
-//! integration of the same problem (tested in `crate::sweep`).
+//! (the stages of [`super::Dop853::attempt`], its error norm and dense output, the step
+//! control of `drive`): SIMD addition, multiplication, division and square root are the IEEE
+//! operations of the scalar code and nothing is fused, so a lane's result is bit-identical to
+//! the scalar integration of the same problem (tested in tests/dynamics/lanes.rs).
+
+// Index loops on purpose: they mirror dop853.rs line by line (the operation order is the contract).
+#![allow(clippy::needless_range_loop)]
 
 use std::rc::Rc;
 

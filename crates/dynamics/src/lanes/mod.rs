@@ -1,26 +1,29 @@
-//! Sweep chains in SIMD lanes: several continued shooting points integrated at once.
+//! Sweep chains in SIMD lanes: several shooting points integrated at once.
 //!
-//! A chained point of [`SteadyState::Shooting`] spends almost all of its work in fixed-grid
-//! periods (the neighbour's grid checked, one or two Newton trials, the recorded window;
-//! docs/findings.md §7). Here [`LANES`] chains advance side by side, one point per lane: every
-//! lane carries its own grid, time, step and state through the DOP853 stages
-//! ([`crate::integrate::lanes`], `wide::f64x4`), and a lane whose period ends is handed its
-//! point's next period (or the next point of its chain, or the next chain of its group) while
-//! the others keep stepping: the ensemble technique of heyoka and MPGOS. Groups of chains run
-//! in parallel on the sweep's rayon pool.
+//! A shooting point of [`SteadyState::Shooting`] is a sequence of one-period integrations:
+//! the warm-up and the variational period of a chain's start, then (continued points) the
+//! neighbour's grid checked or a new one picked, Newton trials on the frozen grid and the
+//! recorded window (docs/findings.md §6-7). Here [`LANES`] chains advance side by side, one
+//! point per lane: every lane carries its own grid or step control, time, step and state
+//! through the DOP853 stages ([`crate::integrate::lanes`], `wide::f64x4`), and a lane whose
+//! period ends is handed its point's next period (or the next point of its chain, or the next
+//! chain of its group) while the others keep stepping: the ensemble technique of heyoka and
+//! MPGOS. Groups of chains run in parallel on the sweep's rayon pool.
 //!
-//! * **Which points.** A point qualifies when it continues its chain (a converged neighbour's
-//!   state, Jacobian and grid), reads stroke metrics only, records one plain cycle, uses DOP853,
-//!   and its device integrates drivetrain coordinates of the linear differential map with stroke
-//!   drag ([`linear_stroke::LinearStroke::of`]). Chain starts and every other point run the
-//!   scalar path in place.
+//! * **Which points.** A shooting point qualifies when it reads stroke metrics only, records
+//!   one plain cycle, uses DOP853, and its device integrates drivetrain coordinates of the
+//!   linear differential map with stroke drag ([`has_lane_model`]); every other point runs the
+//!   scalar path in place, in its chain's order.
 //! * **Same results.** The lanes perform the scalar path's floating-point operations in its
-//!   order, and the Newton logic here is that of `grid_shooting::shoot` on its straight path
-//!   (neighbour's grid accepted, Broyden steps, recorded window accepted). Any other branch
-//!   (grid refused, re-linearisation, a failing or non-converging trial, an unstable orbit)
-//!   reruns the point on the scalar path from the same start, so every point's result is
-//!   bit-identical to the scalar sweep (tested for lane widths 1 to 4 and thread counts).
+//!   order, and the Newton logic here ([`LanePoint`]) is that of `grid_shooting::shoot` and
+//!   `simulate::shooting_steady_state`. The branches it does not follow (a failing period, a
+//!   singular Newton step, no convergence, an unstable orbit: `shoot`'s `Ok(None)` and errors)
+//!   rerun the point on the scalar path from the same start, so every point's result is
+//!   bit-identical to the scalar sweep (`PARITYSIM_LANES=1`; tested for lane widths 1 to 4 and
+//!   thread counts).
 //! * **Failures are rows**: a failing point fails on the scalar rerun, with the scalar error.
+//! * **Not covered**: the per-run wall budget `max_wall_ms` is not checked inside the lanes
+//!   (a lane period is bounded by `max_steps`; the sweep's cancel is checked between periods).
 
 pub(crate) mod linear_stroke;
 
@@ -84,6 +87,16 @@ pub fn has_lane_model(device: &Device) -> bool {
     LinearStroke::of(device).is_some()
 }
 
+/// Points completed in lanes since the process started (tests and benchmarks read it to see
+/// that the lanes ran).
+static COMPLETED_IN_LANES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// How many sweep points the SIMD lanes have completed in this process (monotonic; points
+/// rerun on the scalar path are not counted).
+pub fn points_completed_in_lanes() -> usize {
+    COMPLETED_IN_LANES.load(std::sync::atomic::Ordering::Relaxed)
+}
+
 /// Newton steps of the shooting (as `simulate` gives `grid_shooting::shoot`).
 const MAX_NEWTON: usize = 20;
 
@@ -124,7 +137,8 @@ enum Next {
     Scalar,
 }
 
-/// One continued point on the straight path of `grid_shooting::shoot` (see the module).
+/// One shooting point in a lane: `simulate::shooting_steady_state` and `grid_shooting::shoot`
+/// as a state machine that hands out one period at a time (see the module).
 struct LanePoint<'a> {
     device: &'a Device,
     model: LinearStroke<'a>,
@@ -588,6 +602,7 @@ impl<'a> LanePoint<'a> {
             step_grid: self.grid.to_vec(),
         };
         let coordinates = self.device.coordinates(&steady_state).ok();
+        COMPLETED_IN_LANES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         Next::Done(Box::new(PointOutput::keep(
             result,
             self.metric_names,
@@ -724,6 +739,8 @@ fn launch<'a>(
 
 /// One group of chains on `lanes` lanes; each chain's results in order (cut short by a
 /// cancel).
+// The lane index addresses the cursors and both steppers: an index loop reads clearest.
+#[allow(clippy::needless_range_loop)]
 fn run_group(
     points: &[Result<(Device, SimulationOptions)>],
     metric_names: &[String],

@@ -1,6 +1,8 @@
 //! SIMD-lane sweeps (issue 12 item 5): the lane path against the scalar path (lane width 1).
 
-use paritysim_dynamics::lanes::{LANES_ENV, MAX_LANES, has_lane_model, resolve_lanes};
+use paritysim_dynamics::lanes::{
+    LANES_ENV, MAX_LANES, has_lane_model, points_completed_in_lanes, resolve_lanes,
+};
 use paritysim_dynamics::sweep::{PointOutput, SweepControl, run_points_with_lanes};
 use paritysim_dynamics::{Error, SteadyState};
 use paritysim_kinematics::drivetrain::LinearDifferential;
@@ -108,7 +110,12 @@ fn lane_widths_and_thread_counts_give_bit_identical_sweeps() {
         assert!(o.residual < 1e-7, "residual {}", o.residual);
     }
     for (threads, lanes) in [(1, 2), (1, 3), (1, 4), (2, 4), (2, 1)] {
+        let before = points_completed_in_lanes();
         let other = run(&points, threads, lanes);
+        if lanes > 1 {
+            // Every point, chain starts included, ran in the lanes (none fell back).
+            assert!(points_completed_in_lanes() - before >= points.len());
+        }
         for (i, (a, b)) in scalar.iter().zip(&other).enumerate() {
             let (a, b) = (a.as_ref().unwrap(), b.as_ref().unwrap());
             assert_eq!(
