@@ -261,9 +261,9 @@ impl<const M: usize> LaneStepper<M> {
     /// Steps every busy lane until at least one finishes; returns `(lane, outcome)` of the
     /// finished ones (those lanes are idle again). `fresh`: mask of lanes started since the
     /// last call (their `f(t0, y0)` is evaluated first).
-    pub(crate) fn run(
+    pub(crate) fn run<R: LaneRhs<M>>(
         &mut self,
-        rhs: &dyn LaneRhs<M>,
+        rhs: &R,
         fresh: u32,
         sink: &mut LaneSink<'_>,
     ) -> Vec<(usize, LaneOutcome<M>)> {
@@ -323,9 +323,9 @@ impl<const M: usize> LaneStepper<M> {
 
     /// One step of every busy lane (fixed, or an adaptive attempt; idle lanes repeat a
     /// harmless zero step).
-    fn step(
+    fn step<R: LaneRhs<M>>(
         &mut self,
-        rhs: &dyn LaneRhs<M>,
+        rhs: &R,
         sink: &mut LaneSink<'_>,
         finished: &mut Vec<(usize, LaneOutcome<M>)>,
     ) {
@@ -583,9 +583,9 @@ impl<const M: usize> LaneStepper<M> {
     }
 
     /// The dense output of the step just taken (the scalar `prepare_dense`, on every lane).
-    fn prepare_dense(
+    fn prepare_dense<R: LaneRhs<M>>(
         &mut self,
-        rhs: &dyn LaneRhs<M>,
+        rhs: &R,
         t: &[f64; LANES],
         base: &[usize; LANES],
         h: V,
