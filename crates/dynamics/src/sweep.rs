@@ -463,26 +463,32 @@ pub fn run_points_with_lanes(
     }
     let n_chains = points.len().div_ceil(CHAIN_LENGTH);
     let lanes = crate::lanes::resolve_lanes(lanes)?;
-    let chains: Vec<Option<Result<Vec<Result<PointOutput>>>>> = if lanes > 1 && !keep_cycle {
-        crate::lanes::run_chains(points, metric_names, n_chains, threads, lanes, control)?
-    } else {
-        run_tasks(n_chains, threads, control, false, |c| {
-            let mut previous: Vec<Converged> = Vec::with_capacity(2);
-            let mut out = Vec::with_capacity(CHAIN_LENGTH);
-            for i in chain_range(c, points.len()) {
-                // Cancelled mid-chain: the rest of the chain does not start (reported as not run).
-                if control.is_cancelled() {
-                    break;
+    // Lane groups only when some device has a lane model: otherwise one task per chain
+    // balances the pool better.
+    let lane_devices = points
+        .iter()
+        .any(|p| matches!(p, Ok((d, _)) if crate::lanes::has_lane_model(d)));
+    let chains: Vec<Option<Result<Vec<Result<PointOutput>>>>> =
+        if lanes > 1 && !keep_cycle && lane_devices {
+            crate::lanes::run_chains(points, metric_names, n_chains, threads, lanes, control)?
+        } else {
+            run_tasks(n_chains, threads, control, false, |c| {
+                let mut previous: Vec<Converged> = Vec::with_capacity(2);
+                let mut out = Vec::with_capacity(CHAIN_LENGTH);
+                for i in chain_range(c, points.len()) {
+                    // Cancelled mid-chain: the rest of the chain does not start (reported as not run).
+                    if control.is_cancelled() {
+                        break;
+                    }
+                    let start = chain_start(points, &mut previous, i);
+                    let result = chain_point(points, i, &start, metric_names, keep_cycle, None);
+                    remember(&mut previous, i, &result);
+                    control.count_point(&result);
+                    out.push(result);
                 }
-                let start = chain_start(points, &mut previous, i);
-                let result = chain_point(points, i, &start, metric_names, keep_cycle, None);
-                remember(&mut previous, i, &result);
-                control.count_point(&result);
-                out.push(result);
-            }
-            Ok(out)
-        })?
-    };
+                Ok(out)
+            })?
+        };
     let mut slots = Vec::with_capacity(points.len());
     for (c, chain) in chains.into_iter().enumerate() {
         let len = ((c + 1) * CHAIN_LENGTH).min(points.len()) - c * CHAIN_LENGTH;

@@ -22,6 +22,8 @@
 //!   bit-identical to the scalar sweep (`PARITYSIM_LANES=1`; tested for lane widths 1 to 4 and
 //!   thread counts).
 //! * **Failures are rows**: a failing point fails on the scalar rerun, with the scalar error.
+//!   A panic (an engine bug) fails the points of its group of chains (up to `2 × LANES`
+//!   chains) rather than of its chain.
 //! * **Not covered**: the per-run wall budget `max_wall_ms` is not checked inside the lanes
 //!   (a lane period is bounded by `max_steps`; the sweep's cancel is checked between periods).
 
