@@ -204,3 +204,39 @@ fn lane_widths_are_validated() {
     }
     assert_eq!(LANES_ENV, "PARITYSIM_LANES");
 }
+
+#[test]
+fn a_cancel_stops_the_lanes_and_keeps_the_finished_points() {
+    // 160 lane points on one thread, cancelled once 6 finished: the finished points are the
+    // scalar sweep's rows (bit for bit) and counted; the rest are not run (`None`).
+    let points: Vec<_> = (0..4).flat_map(|_| design_points()).collect();
+    let scalar = run(&points, 1, 1);
+    let control = std::sync::Arc::new(SweepControl::new());
+    let observer = {
+        let control = std::sync::Arc::clone(&control);
+        std::thread::spawn(move || {
+            while control.finished() < 6 {
+                std::thread::sleep(std::time::Duration::from_micros(50));
+            }
+            control.cancel();
+        })
+    };
+    let slots =
+        run_points_with_lanes(&points, &metric_list(), false, Some(1), Some(4), &control).unwrap();
+    observer.join().unwrap();
+    let done: Vec<usize> = (0..slots.len()).filter(|&i| slots[i].is_some()).collect();
+    assert!(
+        done.len() >= 6 && done.len() < points.len(),
+        "{}",
+        done.len()
+    );
+    assert_eq!(done.len(), control.finished());
+    for i in done {
+        let (a, b) = (scalar[i].as_ref().unwrap(), slots[i].as_ref().unwrap());
+        assert_eq!(
+            fingerprint(a),
+            fingerprint(b.as_ref().unwrap()),
+            "point {i}"
+        );
+    }
+}
