@@ -273,7 +273,15 @@ impl<const M: usize> LaneStepper<M> {
                 let p = &self.lanes[l];
                 if p.active { p.grid[0] } else { 0.0 }
             });
-            let stage = std::array::from_fn(|l| if self.lanes[l].active { 0 } else { NO_STAGE });
+            // Fixed grids read their table at the first stage; adaptive lanes have none.
+            let stage = std::array::from_fn(|l| {
+                let p = &self.lanes[l];
+                if p.active && p.adaptive.is_none() {
+                    0
+                } else {
+                    NO_STAGE
+                }
+            });
             let mut f = [V::splat(0.0); M];
             let failed = rhs.eval(t0, stage, &self.y, &mut f);
             for l in 0..LANES {

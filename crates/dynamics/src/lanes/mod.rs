@@ -709,9 +709,12 @@ fn launch<'a>(
 ) -> Option<Option<PointOutput>> {
     match next {
         Next::Integrate(problem) => {
-            if problem.adaptive.is_none() {
-                models.load_forcing(l, Some(forcing(point, forcing_cache)));
-            }
+            // A lane reads only its own point's table (adaptive periods evaluate the drive).
+            let table = problem
+                .adaptive
+                .is_none()
+                .then(|| forcing(point, forcing_cache));
+            models.load_forcing(l, table);
             let mut sink = |_: usize, block: &SampleBlock| point.sample(block);
             if steppers.state.start(l, problem, &mut sink) {
                 steppers.fresh[0] |= 1 << l;
@@ -721,9 +724,11 @@ fn launch<'a>(
             }
         }
         Next::Sensitivity(problem) => {
-            if problem.adaptive.is_none() {
-                models.load_forcing(l, Some(forcing(point, forcing_cache)));
-            }
+            let table = problem
+                .adaptive
+                .is_none()
+                .then(|| forcing(point, forcing_cache));
+            models.load_forcing(l, table);
             if steppers
                 .variational
                 .start(l, problem, &mut |_: usize, _: &SampleBlock| true)

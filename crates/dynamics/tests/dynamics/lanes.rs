@@ -38,6 +38,27 @@ fn design_points() -> Vec<paritysim_dynamics::Result<(Device, SimulationOptions)
         .collect()
 }
 
+/// A chain along the drive amplitude and phase (every point its own actuator, `F(0) ≠ 0`)
+/// and K2: the lanes must read each point's own forcing.
+fn voltage_points() -> Vec<paritysim_dynamics::Result<(Device, SimulationOptions)>> {
+    // Three chains: with two lanes a chain starts in a lane its predecessor's device left.
+    (0..48)
+        .map(|k| {
+            let volts = 60.0 + 1.25 * k as f64;
+            let wing = |omega: f64| fixed_wing(drag(omega));
+            let device = two_wing_device(
+                [wing(0.6 * 31.3), wing(31.3)],
+                "drag_parity_fixed",
+                Drivetrain::LinearDifferential(LinearDifferential::new(2.5, 2.5, 1.0).unwrap()),
+                2.0 * k as f64,
+                Actuator::thesis(Waveform::sine(volts, 110.0, 0.0, 0.02 * k as f64).unwrap()),
+                Formulation::Auto,
+            );
+            Ok((device, shooting_options()))
+        })
+        .collect()
+}
+
 fn metric_list() -> Vec<String> {
     [
         "delta_tau_peak",
@@ -108,6 +129,22 @@ fn lane_widths_and_thread_counts_give_bit_identical_sweeps() {
         assert!(o.converged, "every design point has a stable orbit");
         // The residual the shooting reports is its own: the orbit closes to the tolerance.
         assert!(o.residual < 1e-7, "residual {}", o.residual);
+    }
+    let voltages = voltage_points();
+    let voltage_scalar = run(&voltages, 1, 1);
+    for lanes in [2, 4] {
+        for (i, (a, b)) in voltage_scalar
+            .iter()
+            .zip(&run(&voltages, 1, lanes))
+            .enumerate()
+        {
+            let (a, b) = (a.as_ref().unwrap(), b.as_ref().unwrap());
+            assert_eq!(
+                fingerprint(a),
+                fingerprint(b),
+                "voltage point {i}, {lanes} lanes"
+            );
+        }
     }
     for (threads, lanes) in [(1, 2), (1, 3), (1, 4), (2, 4), (2, 1)] {
         let before = points_completed_in_lanes();
