@@ -221,7 +221,7 @@ impl<'a> LinearStrokeLanes<'a> {
 
 impl LinearStrokeLanes<'_> {
     /// The actuator force of every lane at its time (from its forcing table at `stage`).
-    #[inline]
+    #[inline(always)]
     fn force(&self, t: [f64; LANES], stage: [usize; LANES]) -> V {
         V::new(std::array::from_fn(|l| {
             match (&self.forcing[l], self.actuators[l]) {
@@ -233,7 +233,7 @@ impl LinearStrokeLanes<'_> {
     }
 
     /// The right-hand side at the actuator force `force` (see [`LaneRhs::eval`]).
-    #[inline]
+    #[inline(always)]
     fn eval_with(&self, force: V, y: &[V; 4], dydt: &mut [V; 4]) -> u32 {
         let [q1, q2, q1_dot, q2_dot] = *y;
         // `Drivetrain::evaluate`'s plausibility check (the scalar path errs outside it).
@@ -267,7 +267,8 @@ impl LinearStrokeLanes<'_> {
 }
 
 impl LaneRhs<4> for LinearStrokeLanes<'_> {
-    #[inline]
+    // Inlined into the stages of the lane stepper (it is generic over the right-hand side).
+    #[inline(always)]
     fn eval(&self, t: [f64; LANES], stage: [usize; LANES], y: &[V; 4], dydt: &mut [V; 4]) -> u32 {
         self.eval_with(self.force(t, stage), y, dydt)
     }
