@@ -9,7 +9,8 @@
 //!
 //! Environment: `GRID` (32), `THREADS` (2), `SAMPLES` (4000), `RTOL` (1e-8; atol = rtol/100),
 //! `STEADY` (`shooting` or `transient`; default: the engine's default), `REPEAT` (1),
-//! `METHOD` (`dop853`/`dopri5`).
+//! `METHOD` (`dop853`/`dopri5`), `RANGE=a..b` (points a..b as one single-thread sweep; with
+//! `DUMP` every metric of every point, exactly), `PARITYSIM_LANES` (SIMD lane width, 1 = scalar).
 
 use std::time::Instant;
 
@@ -177,6 +178,14 @@ fn main() {
             keep_cycle: false,
         };
         let r = sweep(&table, device, &options, &settings, &SweepControl::new()).unwrap();
+        if std::env::var("DUMP").is_ok() {
+            // Every metric of every point, round-trip exact (compare lane widths bit for bit).
+            for row in &r.rows {
+                let o = row.outcome.as_ref().unwrap();
+                println!("{:?} {} {:e}", o.metrics, o.cycles_run, o.residual);
+            }
+            return;
+        }
         for (row, p) in r.rows.iter().zip(a..b) {
             let o = row.outcome.as_ref().unwrap();
             let e = (0..3)

@@ -20,6 +20,7 @@ pub mod continuation;
 pub mod device;
 mod grid_shooting;
 pub mod integrate;
+pub mod lanes;
 pub mod metrics;
 pub mod simulate;
 pub mod stability;

@@ -97,6 +97,26 @@ struct WingAcc {
     psi_f: (f64, f64),
 }
 
+/// Up to four consecutive [`StrokeSample`]s by columns (see
+/// [`MetricsAccumulator::add_stroke_block`]); entries past `count` are ignored.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct StrokeBlock {
+    /// Samples in the block (1 to 4).
+    pub(crate) count: usize,
+    /// Whether the last one closes the window.
+    pub(crate) closing: bool,
+    /// Times (ms).
+    pub(crate) time: [f64; 4],
+    /// `φL`, `φR` (rad).
+    pub(crate) stroke: [[f64; 4]; 2],
+    /// Roll torques, left mirrored (see [`StrokeSample::roll_aero`]).
+    pub(crate) roll_aero: [[f64; 4]; 2],
+    /// Actuator forces (mN).
+    pub(crate) actuator_force: [f64; 4],
+    /// `q2` (rad).
+    pub(crate) q2: [f64; 4],
+}
+
 /// Accumulates the metrics over the samples of a recorded window.
 #[derive(Clone, Debug)]
 pub struct MetricsAccumulator {
@@ -342,6 +362,48 @@ impl MetricsAccumulator {
             }
         }
         (self.work_actuator, self.work_aero) = s.work;
+    }
+
+    /// [`Self::add_stroke`] of up to four consecutive stroke samples given as columns (the
+    /// SIMD-lane sweeps, `crate::lanes`): the same operations in the same order per
+    /// accumulator (extrema keep the first extreme value, sums run in sample order), so the
+    /// same metrics bit for bit; only the per-sample bookkeeping is shared.
+    #[inline]
+    pub(crate) fn add_stroke_block(&mut self, b: &StrokeBlock) {
+        let n = b.count;
+        let body = if b.closing { n - 1 } else { n };
+        if self.first_time.is_none() {
+            self.stroke_only = true;
+            self.first_time = Some(b.time[0]);
+            for acc in &mut self.wings {
+                acc.psi.range.add(0.0);
+            }
+        }
+        self.body_samples += body;
+        self.last_time = b.time[n - 1];
+        let stats = |st: &mut Stats, v: &[f64; 4]| {
+            for &x in &v[..n] {
+                st.range.add(x);
+            }
+            for &x in &v[..body] {
+                st.sum += x;
+                st.sum_sq += x * x;
+            }
+        };
+        let [left, right] = &mut self.wings;
+        stats(&mut left.phi, &b.stroke[0]);
+        stats(&mut right.phi, &b.stroke[1]);
+        stats(&mut left.roll_aero, &b.roll_aero[0]);
+        stats(&mut right.roll_aero, &b.roll_aero[1]);
+        for j in 0..n {
+            self.delta_tau.add(b.roll_aero[0][j] + b.roll_aero[1][j]);
+        }
+        for j in 0..n {
+            self.force.add(b.actuator_force[j]);
+        }
+        for j in 0..n {
+            self.q2.add(b.q2[j]);
+        }
     }
 
     /// The metrics, names as documented in the module.

@@ -166,7 +166,7 @@ pub struct SimulationResult {
     pub step_grid: Vec<f64>,
 }
 
-fn validate(options: &SimulationOptions) -> Result<()> {
+pub(crate) fn validate(options: &SimulationOptions) -> Result<()> {
     check_positive("steady_tol", options.steady_tol)?;
     if let Some(ms) = options.max_wall_ms {
         check_positive("max_wall_ms", ms)?;
@@ -233,7 +233,7 @@ fn options_value(field: &str, samples_per_cycle: usize, record_cycles: usize) ->
     }
 }
 
-fn state_change(a: &State, b: &State) -> f64 {
+pub(crate) fn state_change(a: &State, b: &State) -> f64 {
     let mut num: f64 = 0.0;
     let mut den: f64 = 1e-12;
     for (x, y) in a

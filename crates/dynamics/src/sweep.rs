@@ -134,6 +134,13 @@ impl SweepControl {
         self.finished.load(Ordering::Acquire)
     }
 
+    /// Counts one finished point unless it was stopped by the cancel (then it did not finish).
+    pub(crate) fn count_point<T>(&self, result: &Result<T>) {
+        if !(matches!(result, Err(Error::Cancelled)) && self.is_cancelled()) {
+            self.finished.fetch_add(1, Ordering::AcqRel);
+        }
+    }
+
     /// Stops scheduling new points and stops the running ones at their next budget check
     /// (they are reported as not run).
     pub fn cancel(&self) {
@@ -168,7 +175,7 @@ where
 
 /// [`run_indexed`]; `count`: whether a finished task counts as one finished point (a chain
 /// of points counts its points itself).
-fn run_tasks<T, F>(
+pub(crate) fn run_tasks<T, F>(
     n: usize,
     threads: usize,
     control: &SweepControl,
@@ -378,7 +385,7 @@ impl PointOutput {
 
 /// A converged point of a continuation chain: its index, `(p, ṗ)`, shooting Jacobian and step
 /// grid.
-type Converged = (
+pub(crate) type Converged = (
     usize,
     (Vec6, Vec6),
     Option<nalgebra::DMatrix<f64>>,
@@ -429,99 +436,60 @@ pub fn run_points(
     threads: Option<usize>,
     control: &SweepControl,
 ) -> Result<Vec<Option<Result<PointOutput>>>> {
+    run_points_with_lanes(points, metric_names, keep_cycle, threads, None, control)
+}
+
+/// [`run_points`] with an explicit SIMD lane width (`None`: [`crate::lanes::resolve_lanes`]).
+/// With more than one lane, continued shooting points of qualifying devices
+/// ([`crate::lanes`]) run their fixed-grid periods several at once in SIMD lanes; the results
+/// are bit-identical to one lane (the scalar path) and, as there, for any thread count.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a bad thread count or lane width; point failures are
+/// per-slot.
+pub fn run_points_with_lanes(
+    points: &[Result<(Device, SimulationOptions)>],
+    metric_names: &[String],
+    keep_cycle: bool,
+    threads: Option<usize>,
+    lanes: Option<usize>,
+    control: &SweepControl,
+) -> Result<Vec<Option<Result<PointOutput>>>> {
     let threads = resolve_threads(threads)?;
-    let continued = |i: usize| matches!(&points[i], Ok((_, o)) if o.steady_state == SteadyState::Shooting && o.initial.is_none());
-    if !(0..points.len()).any(continued) {
+    if !(0..points.len()).any(|i| continued(points, i)) {
         return run_indexed(points.len(), threads, control, |i| match &points[i] {
             Ok((device, options)) => run_point(device, options, metric_names, keep_cycle),
             Err(e) => Err(e.clone()),
         });
     }
     let n_chains = points.len().div_ceil(CHAIN_LENGTH);
-    let chains = run_tasks(n_chains, threads, control, false, |c| {
-        let range = c * CHAIN_LENGTH..((c + 1) * CHAIN_LENGTH).min(points.len());
-        // The last two converged points of the chain: (index, (p, ṗ), Jacobian).
-        let mut previous: Vec<Converged> = Vec::with_capacity(2);
-        let mut out = Vec::with_capacity(range.len());
-        for i in range {
-            // Cancelled mid-chain: the rest of the chain does not start (reported as not run).
-            if control.is_cancelled() {
-                break;
-            }
-            // Only neighbours driven at the same period continue into this point: across a
-            // frequency step their state and Jacobian are no model of this point's map
-            // (measured: Newton from them accepted a state 4e-7 off the orbit).
-            let period = |k: usize| points[k].as_ref().ok().and_then(|(d, _)| d.period());
-            if previous.last().is_some_and(|c| period(c.0) != period(i)) {
-                previous.clear();
-            }
-            if previous.len() == 2 && period(previous[0].0) != period(i) {
-                previous.remove(0);
-            }
-            let (guess, jacobian) = predict(&previous, i);
-            let grid = previous
-                .last()
-                .map(|c| c.3.clone())
-                .filter(|g| !g.is_empty());
-            let result = match &points[i] {
-                Ok((device, options)) => {
-                    let started = match guess {
-                        Some(initial) if continued(i) => {
-                            let options = SimulationOptions {
-                                initial: Some(initial),
-                                shooting_jacobian: jacobian,
-                                shooting_grid: grid,
-                                ..options.clone()
-                            };
-                            run_point(device, &options, metric_names, keep_cycle)
-                        }
-                        _ => run_point(device, options, metric_names, keep_cycle),
-                    };
-                    // A continuation start that fails, does not converge or needs the
-                    // transient fallback (no stable orbit near the neighbour's) is retried
-                    // from the spec's own start: the point then is exactly a direct
-                    // `simulate`. Why the fallback too: on an unstable orbit the transient
-                    // from a neighbour's state amplifies its round-off (measured on
-                    // examples/drag_parity.toml, whippletree multiplier 1.43-2.0: the
-                    // antisymmetric part grew 20-40× per chained point, up to an imbalance
-                    // of 1.2e-5 %), where a symmetric cold start stays exactly symmetric.
-                    match started {
-                        Err(Error::Cancelled) => Err(Error::Cancelled),
-                        Err(_) if guess.is_some() => {
-                            run_point(device, options, metric_names, keep_cycle)
-                        }
-                        Ok(o)
-                            if guess.is_some()
-                                && continued(i)
-                                && !(o.converged && o.monodromy.is_some()) =>
-                        {
-                            run_point(device, options, metric_names, keep_cycle)
-                        }
-                        other => other,
+    let lanes = crate::lanes::resolve_lanes(lanes)?;
+    // Lane groups only when some device has a lane model: otherwise one task per chain
+    // balances the pool better.
+    let lane_devices = points
+        .iter()
+        .any(|p| matches!(p, Ok((d, _)) if crate::lanes::has_lane_model(d)));
+    let chains: Vec<Option<Result<Vec<Result<PointOutput>>>>> =
+        if lanes > 1 && !keep_cycle && lane_devices {
+            crate::lanes::run_chains(points, metric_names, n_chains, threads, lanes, control)?
+        } else {
+            run_tasks(n_chains, threads, control, false, |c| {
+                let mut previous: Vec<Converged> = Vec::with_capacity(2);
+                let mut out = Vec::with_capacity(CHAIN_LENGTH);
+                for i in chain_range(c, points.len()) {
+                    // Cancelled mid-chain: the rest of the chain does not start (reported as not run).
+                    if control.is_cancelled() {
+                        break;
                     }
+                    let start = chain_start(points, &mut previous, i);
+                    let result = chain_point(points, i, &start, metric_names, keep_cycle, None);
+                    remember(&mut previous, i, &result);
+                    control.count_point(&result);
+                    out.push(result);
                 }
-                Err(e) => Err(e.clone()),
-            };
-            // Only an orbit found by shooting (a stable one) continues into the next point.
-            if let Ok(o) = &result {
-                if let (true, Some(state), true) =
-                    (o.converged, o.steady_state, o.monodromy.is_some())
-                {
-                    if previous.len() == 2 {
-                        previous.remove(0);
-                    }
-                    previous.push((i, state, o.monodromy.clone(), o.step_grid.clone()));
-                }
-            }
-            // A point stopped by the cancel did not finish (and is reported as not run).
-            let stopped = matches!(result, Err(Error::Cancelled)) && control.is_cancelled();
-            if !stopped {
-                control.finished.fetch_add(1, Ordering::AcqRel);
-            }
-            out.push(result);
-        }
-        Ok(out)
-    })?;
+                Ok(out)
+            })?
+        };
     let mut slots = Vec::with_capacity(points.len());
     for (c, chain) in chains.into_iter().enumerate() {
         let len = ((c + 1) * CHAIN_LENGTH).min(points.len()) - c * CHAIN_LENGTH;
@@ -541,6 +509,128 @@ pub fn run_points(
         }
     }
     Ok(slots)
+}
+
+/// The points of chain `c` (consecutive, [`CHAIN_LENGTH`] of them).
+pub(crate) fn chain_range(c: usize, n_points: usize) -> std::ops::Range<usize> {
+    c * CHAIN_LENGTH..((c + 1) * CHAIN_LENGTH).min(n_points)
+}
+
+/// Whether point `i` continues its chain (shooting, no initial state of its own).
+pub(crate) fn continued(points: &[Result<(Device, SimulationOptions)>], i: usize) -> bool {
+    matches!(&points[i], Ok((_, o)) if o.steady_state == SteadyState::Shooting && o.initial.is_none())
+}
+
+/// Where point `i` of a chain starts: the prediction from its converged predecessors
+/// ([`predict`]) and the last one's step grid.
+pub(crate) struct ChainStart {
+    /// `(p, ṗ)` guess.
+    pub(crate) guess: Option<(Vec6, Vec6)>,
+    /// Jacobian guess of the stroboscopic map.
+    pub(crate) jacobian: Option<nalgebra::DMatrix<f64>>,
+    /// The predecessor's step grid.
+    pub(crate) grid: Option<Vec<f64>>,
+}
+
+/// [`ChainStart`] of point `i`; drops predecessors driven at another period first.
+pub(crate) fn chain_start(
+    points: &[Result<(Device, SimulationOptions)>],
+    previous: &mut Vec<Converged>,
+    i: usize,
+) -> ChainStart {
+    // Only neighbours driven at the same period continue into this point: across a
+    // frequency step their state and Jacobian are no model of this point's map
+    // (measured: Newton from them accepted a state 4e-7 off the orbit).
+    let period = |k: usize| points[k].as_ref().ok().and_then(|(d, _)| d.period());
+    if previous.last().is_some_and(|c| period(c.0) != period(i)) {
+        previous.clear();
+    }
+    if previous.len() == 2 && period(previous[0].0) != period(i) {
+        previous.remove(0);
+    }
+    let (guess, jacobian) = predict(previous, i);
+    let grid = previous
+        .last()
+        .map(|c| c.3.clone())
+        .filter(|g| !g.is_empty());
+    ChainStart {
+        guess,
+        jacobian,
+        grid,
+    }
+}
+
+/// The options of a continued point started at `start` (`None` when it starts on its own).
+pub(crate) fn continued_options(
+    points: &[Result<(Device, SimulationOptions)>],
+    i: usize,
+    start: &ChainStart,
+) -> Option<SimulationOptions> {
+    let (_, options) = points[i].as_ref().ok()?;
+    match start.guess {
+        Some(initial) if continued(points, i) => Some(SimulationOptions {
+            initial: Some(initial),
+            shooting_jacobian: start.jacobian.clone(),
+            shooting_grid: start.grid.clone(),
+            ..options.clone()
+        }),
+        _ => None,
+    }
+}
+
+/// Runs point `i` of a chain from `start`; `started` is its run from the continued options
+/// when it was already computed (the SIMD-lane path), else it is run here.
+pub(crate) fn chain_point(
+    points: &[Result<(Device, SimulationOptions)>],
+    i: usize,
+    start: &ChainStart,
+    metric_names: &[String],
+    keep_cycle: bool,
+    started: Option<Result<PointOutput>>,
+) -> Result<PointOutput> {
+    let (device, options) = match &points[i] {
+        Ok(p) => p,
+        Err(e) => return Err(e.clone()),
+    };
+    let started = match started {
+        Some(s) => s,
+        None => match continued_options(points, i, start) {
+            Some(options) => run_point(device, &options, metric_names, keep_cycle),
+            None => run_point(device, options, metric_names, keep_cycle),
+        },
+    };
+    // A continuation start that fails, does not converge or needs the transient fallback
+    // (no stable orbit near the neighbour's) is retried from the spec's own start: the point
+    // then is exactly a direct `simulate`. Why the fallback too: on an unstable orbit the
+    // transient from a neighbour's state amplifies its round-off (measured on
+    // examples/drag_parity.toml, whippletree multiplier 1.43-2.0: the antisymmetric part grew
+    // 20-40× per chained point, up to an imbalance of 1.2e-5 %), where a symmetric cold start
+    // stays exactly symmetric.
+    match started {
+        Err(Error::Cancelled) => Err(Error::Cancelled),
+        Err(_) if start.guess.is_some() => run_point(device, options, metric_names, keep_cycle),
+        Ok(o)
+            if start.guess.is_some()
+                && continued(points, i)
+                && !(o.converged && o.monodromy.is_some()) =>
+        {
+            run_point(device, options, metric_names, keep_cycle)
+        }
+        other => other,
+    }
+}
+
+/// Keeps a converged result of point `i` as a predecessor (the last two). Only an orbit
+/// found by shooting (a stable one, with its monodromy) continues into the next point.
+pub(crate) fn remember(previous: &mut Vec<Converged>, i: usize, result: &Result<PointOutput>) {
+    if let Ok(o) = result {
+        if let (true, Some(state), true) = (o.converged, o.steady_state, o.monodromy.is_some()) {
+            if previous.len() == 2 {
+                previous.remove(0);
+            }
+            previous.push((i, state, o.monodromy.clone(), o.step_grid.clone()));
+        }
+    }
 }
 
 /// A table of parameter values: named columns, one row per point.

@@ -70,6 +70,16 @@ impl JointSpring {
     pub fn stiffness(&self) -> f64 {
         self.stiffness
     }
+
+    /// Cubic coefficient (mN·mm/rad³).
+    pub fn cubic(&self) -> f64 {
+        self.cubic
+    }
+
+    /// Rest angle (rad).
+    pub fn rest_angle(&self) -> f64 {
+        self.rest_angle
+    }
 }
 
 /// The tunable wing hinge of §2.5.1: a hinge whose stiffness rises with wing deviation,

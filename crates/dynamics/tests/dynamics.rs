@@ -7,6 +7,8 @@ mod continuation;
 mod floquet;
 #[path = "dynamics/lean.rs"]
 mod lean;
+#[path = "dynamics/lanes.rs"]
+mod lanes;
 #[path = "dynamics/metrics.rs"]
 mod metrics;
 #[path = "dynamics/steady_state.rs"]

@@ -13,6 +13,10 @@
 use super::{Rhs, Stepper, Tolerances};
 use paritysim_error::Result;
 
+// The SIMD-lane ensemble version shares this file's coefficients (child modules see them).
+#[path = "dop853_lanes.rs"]
+pub(crate) mod lanes;
+
 const C2: f64 = 0.526001519587677318785587544488E-01;
 const C3: f64 = 0.789002279381515978178381316732E-01;
 const C4: f64 = 0.118350341907227396726757197510E+00;

@@ -16,6 +16,10 @@ mod dopri5;
 mod tests;
 mod variational;
 
+/// DOP853 on fixed grids for several problems in SIMD lanes.
+pub(crate) use dop853::lanes;
+pub(crate) use variational::DIRECTIONAL_STEP;
+
 use paritysim_error::{Error, Result, check_positive};
 
 /// Largest number of integrated coordinates.

@@ -16,7 +16,7 @@ use super::{
 };
 
 /// Relative size of the directional difference step.
-const DIRECTIONAL_STEP: f64 = 1e-6;
+pub(crate) const DIRECTIONAL_STEP: f64 = 1e-6;
 
 struct Variational<'a> {
     system: &'a dyn OdeSystem,

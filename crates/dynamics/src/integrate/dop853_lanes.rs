@@ -1,0 +1,820 @@
+//! DOP853 for [`LANES`] independent problems at once, one per SIMD lane (`wide::f64x4`): the
+//! ensemble technique of heyoka and MPGOS (several sweep points integrated together, each lane
+//! with its own time, step size, state and accept/reject decision, refilled when its problem
+//! ends; `crate::lanes` schedules them).
+//!
+//! * **Fixed grids** (the frozen-grid periods of [`crate::SteadyState::Shooting`], most of a
+//!   chained sweep point's work; docs/findings.md §7), with the error estimate counted per
+//!   lane (`over_tolerance`) and the dense output four samples at a time per lane.
+//! * **Adaptive** lanes with Hairer's initial step and step control per lane (the loop of
+//!   `drive` in integrate/mod.rs): a rejected lane retries from its own state while the others
+//!   move on. They return the accepted step times (the grid the fixed-grid periods retrace).
+//! * The state is the compact `[q1, q2, q̇1, q̇2]`, optionally followed by uncontrolled entries
+//!   (`M = 20`: the variational equations' `Φ`, as in integrate/variational.rs).
+//!
+//! Every lane performs exactly the scalar path's floating-point operations in the same order
+//! (the stages of [`super::Dop853::attempt`], its error norm and dense output, the step
+//! control of `drive`): SIMD addition, multiplication, division and square root are the IEEE
+//! operations of the scalar code and nothing is fused, so a lane's result is bit-identical to
+//! the scalar integration of the same problem (tested in tests/dynamics/lanes.rs).
+
+// Index loops on purpose: they mirror dop853.rs line by line (the operation order is the contract).
+#![allow(clippy::needless_range_loop)]
+
+use std::rc::Rc;
+
+use wide::f64x4;
+
+use super::super::{SAFE, State};
+use super::*;
+
+/// Problems integrated at once.
+pub(crate) const LANES: usize = 4;
+
+/// Entries in the error norm: the state `[q1, q2, q̇1, q̇2]` (a variational system's
+/// sensitivities ride along uncontrolled, as in integrate/variational.rs).
+pub(crate) const CONTROLLED: usize = 4;
+
+type V = f64x4;
+
+/// One lane's value of `v`.
+#[inline]
+fn lane(v: V, l: usize) -> f64 {
+    v.as_array()[l]
+}
+
+/// `v` with lane `l` set to `x`.
+#[inline]
+fn with_lane(v: V, l: usize, x: f64) -> V {
+    let mut a = v.to_array();
+    a[l] = x;
+    V::new(a)
+}
+
+/// The right-hand side of several lanes on the compact layout `[q1, q2, q̇1, q̇2]`.
+pub(crate) trait LaneRhs<const M: usize> {
+    /// Writes `f(t, y)` of every lane; `stage[l]` is lane `l`'s position in the list of
+    /// [`stage_times`] of its grid ([`NO_STAGE`] outside it), for right-hand sides that
+    /// tabulate their time dependence. Returns the bit mask of lanes whose evaluation failed
+    /// (left out of the domain of the model).
+    fn eval(&self, t: [f64; LANES], stage: [usize; LANES], y: &[V; M], dydt: &mut [V; M]) -> u32;
+}
+
+/// Right-hand side evaluations per step in [`stage_times`]: the step's start, stages 2–12,
+/// and the three dense-output stages.
+pub(crate) const STAGES_PER_STEP: usize = 15;
+
+/// A stage outside a grid's [`stage_times`].
+pub(crate) const NO_STAGE: usize = usize::MAX;
+
+/// Every time at which a fixed-grid integration on `grid` evaluates the right-hand side, in
+/// the table order the stepper's `stage` indices refer to (`STAGES_PER_STEP` per step, then
+/// the grid's end), computed with the stepper's own arithmetic (`t + c h`).
+pub(crate) fn stage_times(grid: &[f64]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(STAGES_PER_STEP * grid.len());
+    for pair in grid.windows(2) {
+        let (t, h) = (pair[0], pair[1] - pair[0]);
+        out.push(t);
+        for c in [C2, C3, C4, C5, C6, C7, C8, C9, C10, C11, 1.0, C14, C15, C16] {
+            out.push(t + c * h);
+        }
+    }
+    out.extend(grid.last());
+    out
+}
+
+/// Tolerances of one lane's error estimate (see [`super::Tolerances`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct LaneTolerances {
+    pub(crate) rtol: f64,
+    pub(crate) atol: f64,
+}
+
+/// One integration given to a lane: on a fixed grid, or adaptive from `grid[0]` to the
+/// grid's end.
+pub(crate) struct LaneProblem<const M: usize> {
+    /// Step times (at least two, increasing); adaptive: only the span `[t0, t_end]` is read.
+    pub(crate) grid: Rc<[f64]>,
+    /// `Some(max_steps)`: adaptive steps (Hairer's control, as `RungeKutta`), returning the
+    /// accepted step times in [`LaneOutcome::Done`]; no samples.
+    pub(crate) adaptive: Option<usize>,
+    /// Initial compact state at `grid[0]`.
+    pub(crate) y0: [f64; M],
+    /// Sample times (sorted, within the grid's span).
+    pub(crate) times: Rc<[f64]>,
+    /// Tolerances of the error estimate (counted in [`LaneOutcome::over_tolerance`]).
+    pub(crate) tol: LaneTolerances,
+}
+
+/// How a lane's integration ended.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum LaneOutcome<const M: usize> {
+    /// The state at the grid's end and the steps whose error estimate exceeded the tolerances.
+    Done {
+        /// Compact end state.
+        y: [f64; M],
+        /// See [`super::IntegrationStats::over_tolerance`] (fixed grids).
+        over_tolerance: usize,
+        /// Adaptive: `t0` and the accepted step times (the grid a fixed-grid run retraces, as
+        /// `RungeKutta::advance_with_steps` returns it); empty on fixed grids.
+        steps: Vec<f64>,
+    },
+    /// The scalar path would have returned an error here (the model left its domain, a
+    /// non-finite state or error estimate, or the sample sink refused).
+    Failed,
+}
+
+/// Up to four consecutive samples of one lane: `count` of them from `first` (index in the
+/// lane's times), their times and compact states (sample `j` in vector lane `j`; the others
+/// are padding).
+pub(crate) struct SampleBlock {
+    /// Index of the first sample in the lane's times.
+    pub(crate) first: usize,
+    /// Samples in the block (1 to 4).
+    pub(crate) count: usize,
+    /// Their times.
+    pub(crate) t: [f64; 4],
+    /// Their compact states `[q1, q2, q̇1, q̇2]`, one sample per vector lane.
+    pub(crate) y: [V; 4],
+}
+
+/// Receives the samples of a lane in blocks, in order: `(lane, block)`; `false` fails the
+/// lane.
+pub(crate) type LaneSink<'a> = dyn FnMut(usize, &SampleBlock) -> bool + 'a;
+
+/// The step control of an adaptive lane (`drive` in integrate/mod.rs, per lane).
+#[derive(Clone, Debug, Default)]
+struct Adaptive {
+    t: f64,
+    t_end: f64,
+    h: f64,
+    fac_old: f64,
+    rejected_last: bool,
+    attempts: usize,
+    max_steps: usize,
+    /// The current attempt is the last step (ends at `t_end`).
+    last: bool,
+    steps: Vec<f64>,
+}
+
+/// Per-lane progress.
+#[derive(Clone, Default)]
+struct Progress {
+    adaptive: Option<Adaptive>,
+    grid: Rc<[f64]>,
+    times: Rc<[f64]>,
+    step: usize,
+    next: usize,
+    over_tolerance: usize,
+    active: bool,
+}
+
+/// [`LANES`] lanes of DOP853 on fixed grids.
+pub(crate) struct LaneStepper<const M: usize> {
+    y: [V; M],
+    f0: [V; M],
+    k: [[V; M]; 10],
+    y1: [V; M],
+    cont: [[V; M]; 8],
+    rtol: V,
+    atol: V,
+    lanes: [Progress; LANES],
+}
+
+/// `y + h Σ aᵢ kᵢ` on vectors (the scalar `stage!` of dop853.rs, same operation order).
+macro_rules! vstage {
+    ($out:expr, $y:expr, $h:expr, $( $a:expr => $k:expr ),+ ) => {
+        for i in 0..M {
+            $out[i] = $y[i] + $h * (V::splat(0.0) $( + V::splat($a) * $k[i] )+);
+        }
+    };
+}
+
+impl<const M: usize> LaneStepper<M> {
+    /// All lanes idle.
+    pub(crate) fn new() -> Self {
+        let z = [V::splat(0.0); M];
+        Self {
+            y: z,
+            f0: z,
+            k: [z; 10],
+            y1: z,
+            cont: [z; 8],
+            rtol: V::splat(1.0),
+            atol: V::splat(1.0),
+            lanes: std::array::from_fn(|_| Progress::default()),
+        }
+    }
+
+    /// Whether any lane is integrating.
+    pub(crate) fn any_busy(&self) -> bool {
+        self.lanes.iter().any(|p| p.active)
+    }
+
+    /// Gives `problem` to the idle lane `l`: its samples at `grid[0]` go to `sink` at once.
+    /// Its first derivative is evaluated by the next [`Self::run`]. `false` (lane left idle)
+    /// when the sink refuses a sample or the grid is too short.
+    pub(crate) fn start(
+        &mut self,
+        l: usize,
+        problem: LaneProblem<M>,
+        sink: &mut LaneSink<'_>,
+    ) -> bool {
+        if problem.grid.len() < 2 {
+            return false;
+        }
+        let t0 = problem.grid[0];
+        let at_start = problem.times.partition_point(|&s| s <= t0);
+        let y0: [V; 4] = std::array::from_fn(|i| V::splat(problem.y0[i]));
+        if !emit_constant(l, &problem.times, 0, at_start, &y0, sink) {
+            return false;
+        }
+        let next = at_start;
+        for i in 0..M {
+            self.y[i] = with_lane(self.y[i], l, problem.y0[i]);
+        }
+        self.rtol = with_lane(self.rtol, l, problem.tol.rtol);
+        self.atol = with_lane(self.atol, l, problem.tol.atol);
+        let adaptive = problem.adaptive.map(|max_steps| Adaptive {
+            t: t0,
+            t_end: problem.grid[problem.grid.len() - 1],
+            h: 0.0,
+            fac_old: 1e-4,
+            rejected_last: false,
+            attempts: 0,
+            max_steps,
+            last: false,
+            steps: vec![t0],
+        });
+        self.lanes[l] = Progress {
+            adaptive,
+            grid: problem.grid,
+            times: problem.times,
+            step: 0,
+            next,
+            over_tolerance: 0,
+            active: true,
+        };
+        true
+    }
+
+    /// Steps every busy lane until at least one finishes; returns `(lane, outcome)` of the
+    /// finished ones (those lanes are idle again). `fresh`: mask of lanes started since the
+    /// last call (their `f(t0, y0)` is evaluated first).
+    pub(crate) fn run<R: LaneRhs<M>>(
+        &mut self,
+        rhs: &R,
+        fresh: u32,
+        sink: &mut LaneSink<'_>,
+    ) -> Vec<(usize, LaneOutcome<M>)> {
+        let mut finished = Vec::new();
+        if fresh != 0 {
+            let t0 = std::array::from_fn(|l| {
+                let p = &self.lanes[l];
+                if p.active { p.grid[0] } else { 0.0 }
+            });
+            // Fixed grids read their table at the first stage; adaptive lanes have none.
+            let stage = std::array::from_fn(|l| {
+                let p = &self.lanes[l];
+                if p.active && p.adaptive.is_none() {
+                    0
+                } else {
+                    NO_STAGE
+                }
+            });
+            let mut f = [V::splat(0.0); M];
+            let failed = rhs.eval(t0, stage, &self.y, &mut f);
+            for l in 0..LANES {
+                if fresh & (1 << l) == 0 || !self.lanes[l].active {
+                    continue;
+                }
+                if failed & (1 << l) != 0 {
+                    self.lanes[l].active = false;
+                    finished.push((l, LaneOutcome::Failed));
+                    continue;
+                }
+                for i in 0..M {
+                    self.f0[i] = with_lane(self.f0[i], l, lane(f[i], l));
+                }
+                if self.lanes[l].adaptive.is_some() && !self.initial_step(rhs, l) {
+                    self.lanes[l].active = false;
+                    finished.push((l, LaneOutcome::Failed));
+                }
+            }
+        }
+        while finished.is_empty() && self.any_busy() {
+            self.step(rhs, sink, &mut finished);
+        }
+        finished
+    }
+
+    /// Hairer's initial step of adaptive lane `l` (`initial_step` of integrate/mod.rs on
+    /// this lane alone); `false` when its extra evaluation fails.
+    fn initial_step(&mut self, rhs: &dyn LaneRhs<M>, l: usize) -> bool {
+        let y0: [f64; M] = std::array::from_fn(|i| lane(self.y[i], l));
+        let f0: [f64; M] = std::array::from_fn(|i| lane(self.f0[i], l));
+        let tol = Tolerances {
+            rtol: lane(self.rtol, l),
+            atol: lane(self.atol, l),
+            controlled: CONTROLLED,
+        };
+        let a = self.lanes[l].adaptive.as_mut().expect("an adaptive lane");
+        let mut one = OneLane { rhs, l };
+        match super::super::initial_step(&mut one, 8, &tol, a.t, &y0, &f0, a.t_end - a.t) {
+            Ok(h) => {
+                a.h = h;
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// One step of every busy lane (fixed, or an adaptive attempt; idle lanes repeat a
+    /// harmless zero step).
+    fn step<R: LaneRhs<M>>(
+        &mut self,
+        rhs: &R,
+        sink: &mut LaneSink<'_>,
+        finished: &mut Vec<(usize, LaneOutcome<M>)>,
+    ) {
+        let mut t = [0.0; LANES];
+        let mut t_new = [0.0; LANES];
+        let mut hs = [0.0; LANES];
+        // Lanes whose adaptive control gives up before attempting (the scalar errors).
+        let mut given_up = 0u32;
+        for (l, p) in self.lanes.iter_mut().enumerate() {
+            if !p.active {
+                continue;
+            }
+            match &mut p.adaptive {
+                None => {
+                    t[l] = p.grid[p.step];
+                    t_new[l] = p.grid[p.step + 1];
+                    hs[l] = t_new[l] - t[l];
+                }
+                Some(a) => {
+                    if a.attempts >= a.max_steps
+                        || 0.1 * a.h.abs() <= a.t.abs() * f64::EPSILON
+                        || !a.h.is_finite()
+                    {
+                        given_up |= 1 << l;
+                    }
+                    a.last = a.t + 1.01 * a.h >= a.t_end;
+                    if a.last {
+                        a.h = a.t_end - a.t;
+                    }
+                    t[l] = a.t;
+                    hs[l] = a.h;
+                    t_new[l] = if a.last { a.t_end } else { a.t + a.h };
+                }
+            }
+        }
+        let h = V::new(hs);
+        let at = |c: f64| -> [f64; LANES] { std::array::from_fn(|l| t[l] + c * hs[l]) };
+        let base: [usize; LANES] = std::array::from_fn(|l| {
+            let p = &self.lanes[l];
+            if p.active && p.adaptive.is_none() {
+                p.step * STAGES_PER_STEP
+            } else {
+                NO_STAGE
+            }
+        });
+        let idx = |s: usize| -> [usize; LANES] { base.map(|b| b.saturating_add(s)) };
+        let mut failed = 0u32;
+        let y = self.y;
+        let k1 = self.f0;
+        let [k2, k3, k4, k5, k6, k7, k8, k9, k10, _] = &mut self.k;
+        let mut ys = [V::splat(0.0); M];
+        vstage!(ys, y, h, A21 => k1);
+        failed |= rhs.eval(at(C2), idx(1), &ys, k2);
+        vstage!(ys, y, h, A31 => k1, A32 => k2);
+        failed |= rhs.eval(at(C3), idx(2), &ys, k3);
+        vstage!(ys, y, h, A41 => k1, A43 => k3);
+        failed |= rhs.eval(at(C4), idx(3), &ys, k4);
+        vstage!(ys, y, h, A51 => k1, A53 => k3, A54 => k4);
+        failed |= rhs.eval(at(C5), idx(4), &ys, k5);
+        vstage!(ys, y, h, A61 => k1, A64 => k4, A65 => k5);
+        failed |= rhs.eval(at(C6), idx(5), &ys, k6);
+        vstage!(ys, y, h, A71 => k1, A74 => k4, A75 => k5, A76 => k6);
+        failed |= rhs.eval(at(C7), idx(6), &ys, k7);
+        vstage!(ys, y, h, A81 => k1, A84 => k4, A85 => k5, A86 => k6, A87 => k7);
+        failed |= rhs.eval(at(C8), idx(7), &ys, k8);
+        vstage!(ys, y, h, A91 => k1, A94 => k4, A95 => k5, A96 => k6, A97 => k7, A98 => k8);
+        failed |= rhs.eval(at(C9), idx(8), &ys, k9);
+        vstage!(ys, y, h, A101 => k1, A104 => k4, A105 => k5, A106 => k6, A107 => k7, A108 => k8,
+            A109 => k9);
+        failed |= rhs.eval(at(C10), idx(9), &ys, k10);
+        vstage!(ys, y, h, A111 => k1, A114 => k4, A115 => k5, A116 => k6, A117 => k7, A118 => k8,
+            A119 => k9, A1110 => k10);
+        failed |= rhs.eval(at(C11), idx(10), &ys, k2);
+        vstage!(ys, y, h, A121 => k1, A124 => k4, A125 => k5, A126 => k6, A127 => k7, A128 => k8,
+            A129 => k9, A1210 => k10, A1211 => k2);
+        failed |= rhs.eval(at(1.0), idx(11), &ys, k3);
+        // The scalar attempt's increment, new state and error norm (every entry controlled).
+        let mut err5 = V::splat(0.0);
+        let mut err3 = V::splat(0.0);
+        for i in 0..M {
+            let inc = V::splat(B1) * k1[i]
+                + V::splat(B6) * k6[i]
+                + V::splat(B7) * k7[i]
+                + V::splat(B8) * k8[i]
+                + V::splat(B9) * k9[i]
+                + V::splat(B10) * k10[i]
+                + V::splat(B11) * k2[i]
+                + V::splat(B12) * k3[i];
+            let y1 = y[i] + h * inc;
+            self.y1[i] = y1;
+            if i >= CONTROLLED {
+                continue;
+            }
+            let sk = self.atol + self.rtol * y[i].abs().max(y1.abs());
+            let e3 = inc - V::splat(BHH1) * k1[i] - V::splat(BHH2) * k9[i] - V::splat(BHH3) * k3[i];
+            let e5 = V::splat(ER1) * k1[i]
+                + V::splat(ER6) * k6[i]
+                + V::splat(ER7) * k7[i]
+                + V::splat(ER8) * k8[i]
+                + V::splat(ER9) * k9[i]
+                + V::splat(ER10) * k10[i]
+                + V::splat(ER11) * k2[i]
+                + V::splat(ER12) * k3[i];
+            err3 += (e3 / sk) * (e3 / sk);
+            err5 += (e5 / sk) * (e5 / sk);
+        }
+        let mut deno = (err5 + V::splat(0.01) * err3).to_array();
+        for d in &mut deno {
+            if *d <= 0.0 {
+                *d = 1.0;
+            }
+        }
+        let err =
+            h.abs() * err5 * (V::splat(1.0) / (V::splat(CONTROLLED as f64) * V::new(deno))).sqrt();
+        // Failures of the new derivative count only on accepted steps (the scalar evaluates
+        // it after accepting).
+        let mut f1 = [V::splat(0.0); M];
+        let failed_f1 = rhs.eval(t_new, idx(STAGES_PER_STEP), &self.y1, &mut f1);
+        let y1_finite = (self.y1[0].is_finite()
+            & self.y1[1].is_finite()
+            & self.y1[2].is_finite()
+            & self.y1[3].is_finite())
+        .to_bitmask();
+        let err_finite = err.is_finite().to_bitmask();
+        let wants_dense = (0..LANES).any(|l| {
+            let p = &self.lanes[l];
+            p.active && p.next < p.times.len() && p.times[p.next] < t_new[l]
+        });
+        if wants_dense {
+            failed |= self.prepare_dense(rhs, &t, &base, h, &f1);
+        }
+        let mut accepted = [true; LANES];
+        for l in 0..LANES {
+            if !self.lanes[l].active {
+                continue;
+            }
+            let bit = 1 << l;
+            if self.lanes[l].adaptive.is_some() {
+                let err = lane(err, l);
+                let p = &mut self.lanes[l];
+                let a = p.adaptive.as_mut().expect("an adaptive lane");
+                let outcome = a.control(err, given_up & bit != 0, failed & bit != 0, || {
+                    failed_f1 & bit == 0 && y1_finite & bit != 0
+                });
+                accepted[l] = outcome == Control::Accepted || outcome == Control::Finished;
+                match outcome {
+                    Control::Failed => {
+                        p.active = false;
+                        finished.push((l, LaneOutcome::Failed));
+                    }
+                    Control::Finished => {
+                        p.active = false;
+                        finished.push((
+                            l,
+                            LaneOutcome::Done {
+                                y: std::array::from_fn(|i| lane(self.y1[i], l)),
+                                over_tolerance: 0,
+                                steps: std::mem::take(&mut a.steps),
+                            },
+                        ));
+                    }
+                    Control::Accepted | Control::Rejected => {}
+                }
+                continue;
+            }
+            let mut ok = failed & bit == 0
+                && failed_f1 & bit == 0
+                && err_finite & bit != 0
+                && y1_finite & bit != 0;
+            if ok {
+                ok = self.emit(l, t[l], hs[l], t_new[l], sink);
+            }
+            let p = &mut self.lanes[l];
+            if lane(err, l) > 1.0 {
+                p.over_tolerance += 1;
+            }
+            p.step += 1;
+            if !ok {
+                p.active = false;
+                finished.push((l, LaneOutcome::Failed));
+            } else if p.step + 1 == p.grid.len() {
+                p.active = false;
+                finished.push((
+                    l,
+                    LaneOutcome::Done {
+                        y: std::array::from_fn(|i| lane(self.y1[i], l)),
+                        over_tolerance: p.over_tolerance,
+                        steps: Vec::new(),
+                    },
+                ));
+            }
+        }
+        if accepted.iter().all(|&a| a) {
+            self.y = self.y1;
+            self.f0 = f1;
+        } else {
+            // Rejected lanes retry from the same state and derivative.
+            for i in 0..M {
+                let (mut y, mut f0) = (self.y[i].to_array(), self.f0[i].to_array());
+                let (y1, f1) = (self.y1[i].to_array(), f1[i].to_array());
+                for l in (0..LANES).filter(|&l| accepted[l]) {
+                    y[l] = y1[l];
+                    f0[l] = f1[l];
+                }
+                self.y[i] = V::new(y);
+                self.f0[i] = V::new(f0);
+            }
+        }
+    }
+
+    /// The samples of lane `l` inside `[t, t_new)` (interpolated, four at a time) and at
+    /// `t_new`.
+    fn emit(&mut self, l: usize, t: f64, h: f64, t_new: f64, sink: &mut LaneSink<'_>) -> bool {
+        let p = &mut self.lanes[l];
+        let inside = p.next + p.times[p.next..].partition_point(|&s| s < t_new);
+        if inside > p.next {
+            // This lane's interpolant, broadcast: the vector lanes now hold samples.
+            let c: [[V; 4]; 8] = std::array::from_fn(|r| {
+                std::array::from_fn(|i| V::splat(lane(self.cont[r][i], l)))
+            });
+            while p.next < inside {
+                let count = (inside - p.next).min(4);
+                let mut ts = [t; 4];
+                ts[..count].copy_from_slice(&p.times[p.next..p.next + count]);
+                let s = (V::new(ts) - V::splat(t)) / V::splat(h);
+                let s1 = V::splat(1.0) - s;
+                let y: [V; 4] = std::array::from_fn(|i| {
+                    c[0][i]
+                        + s * (c[1][i]
+                            + s1 * (c[2][i]
+                                + s * (c[3][i]
+                                    + s1 * (c[4][i]
+                                        + s * (c[5][i] + s1 * (c[6][i] + s * c[7][i]))))))
+                });
+                let finite =
+                    (y[0].is_finite() & y[1].is_finite() & y[2].is_finite() & y[3].is_finite())
+                        .to_bitmask();
+                let block = SampleBlock {
+                    first: p.next,
+                    count,
+                    t: ts,
+                    y,
+                };
+                if finite & ((1 << count) - 1) != (1 << count) - 1 || !sink(l, &block) {
+                    return false;
+                }
+                p.next += count;
+            }
+        }
+        let at_end = p.next + p.times[p.next..].partition_point(|&s| s <= t_new);
+        let end: [V; 4] = std::array::from_fn(|i| V::splat(lane(self.y1[i], l)));
+        let ok = emit_constant(l, &p.times, p.next, at_end, &end, sink);
+        p.next = at_end;
+        ok
+    }
+
+    /// The dense output of the step just taken (the scalar `prepare_dense`, on every lane).
+    fn prepare_dense<R: LaneRhs<M>>(
+        &mut self,
+        rhs: &R,
+        t: &[f64; LANES],
+        base: &[usize; LANES],
+        h: V,
+        f1: &[V; M],
+    ) -> u32 {
+        let hs = h.to_array();
+        let at = |c: f64| -> [f64; LANES] { std::array::from_fn(|l| t[l] + c * hs[l]) };
+        let idx = |s: usize| -> [usize; LANES] { base.map(|b| b.saturating_add(s)) };
+        let y = self.y;
+        let k1 = self.f0;
+        let k13 = *f1;
+        let [k2, k3, _k4, _k5, k6, k7, k8, k9, k10, kx] = &mut self.k;
+        let [r1, r2, r3, r4, r5, r6, r7, r8] = &mut self.cont;
+        let s = V::splat;
+        for i in 0..M {
+            let ydiff = self.y1[i] - y[i];
+            let bspl = h * k1[i] - ydiff;
+            r1[i] = y[i];
+            r2[i] = ydiff;
+            r3[i] = bspl;
+            r4[i] = ydiff - h * k13[i] - bspl;
+            r5[i] = s(D41) * k1[i]
+                + s(D46) * k6[i]
+                + s(D47) * k7[i]
+                + s(D48) * k8[i]
+                + s(D49) * k9[i]
+                + s(D410) * k10[i]
+                + s(D411) * k2[i]
+                + s(D412) * k3[i];
+            r6[i] = s(D51) * k1[i]
+                + s(D56) * k6[i]
+                + s(D57) * k7[i]
+                + s(D58) * k8[i]
+                + s(D59) * k9[i]
+                + s(D510) * k10[i]
+                + s(D511) * k2[i]
+                + s(D512) * k3[i];
+            r7[i] = s(D61) * k1[i]
+                + s(D66) * k6[i]
+                + s(D67) * k7[i]
+                + s(D68) * k8[i]
+                + s(D69) * k9[i]
+                + s(D610) * k10[i]
+                + s(D611) * k2[i]
+                + s(D612) * k3[i];
+            r8[i] = s(D71) * k1[i]
+                + s(D76) * k6[i]
+                + s(D77) * k7[i]
+                + s(D78) * k8[i]
+                + s(D79) * k9[i]
+                + s(D710) * k10[i]
+                + s(D711) * k2[i]
+                + s(D712) * k3[i];
+        }
+        let mut failed = 0;
+        let mut ys = [V::splat(0.0); M];
+        vstage!(ys, y, h, A141 => k1, A147 => k7, A148 => k8, A149 => k9, A1410 => k10,
+            A1411 => k2, A1412 => k3, A1413 => k13);
+        failed |= rhs.eval(at(C14), idx(12), &ys, kx);
+        let k14 = *kx;
+        vstage!(ys, y, h, A151 => k1, A156 => k6, A157 => k7, A158 => k8, A1511 => k2,
+            A1512 => k3, A1513 => k13, A1514 => k14);
+        failed |= rhs.eval(at(C15), idx(13), &ys, k10);
+        let k15 = *k10;
+        vstage!(ys, y, h, A161 => k1, A166 => k6, A167 => k7, A168 => k8, A169 => k9,
+            A1613 => k13, A1614 => k14, A1615 => k15);
+        failed |= rhs.eval(at(C16), idx(14), &ys, k2);
+        let k16 = *k2;
+        for i in 0..M {
+            r5[i] = h
+                * (r5[i]
+                    + s(D413) * k13[i]
+                    + s(D414) * k14[i]
+                    + s(D415) * k15[i]
+                    + s(D416) * k16[i]);
+            r6[i] = h
+                * (r6[i]
+                    + s(D513) * k13[i]
+                    + s(D514) * k14[i]
+                    + s(D515) * k15[i]
+                    + s(D516) * k16[i]);
+            r7[i] = h
+                * (r7[i]
+                    + s(D613) * k13[i]
+                    + s(D614) * k14[i]
+                    + s(D615) * k15[i]
+                    + s(D616) * k16[i]);
+            r8[i] = h
+                * (r8[i]
+                    + s(D713) * k13[i]
+                    + s(D714) * k14[i]
+                    + s(D715) * k15[i]
+                    + s(D716) * k16[i]);
+        }
+        failed
+    }
+}
+
+/// The samples `from..to` of lane `l` at one state `y` (broadcast), in blocks.
+fn emit_constant(
+    l: usize,
+    times: &[f64],
+    from: usize,
+    to: usize,
+    y: &[V; 4],
+    sink: &mut LaneSink<'_>,
+) -> bool {
+    let mut first = from;
+    while first < to {
+        let count = (to - first).min(4);
+        let mut t = [times[first]; 4];
+        t[..count].copy_from_slice(&times[first..first + count]);
+        let block = SampleBlock {
+            first,
+            count,
+            t,
+            y: *y,
+        };
+        if !sink(l, &block) {
+            return false;
+        }
+        first += count;
+    }
+    true
+}
+
+/// What an adaptive lane's attempt led to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Control {
+    Accepted,
+    Rejected,
+    /// The last step was accepted.
+    Finished,
+    /// The scalar integration errs here (step limit, step-size underflow, a failing model).
+    Failed,
+}
+
+impl Adaptive {
+    /// `drive`'s step control after an attempt with scaled error `err` (`given_up`: the
+    /// limits were hit before it; `failed`: a stage's evaluation failed; `completes`: the new
+    /// derivative and state of an accepted step are valid).
+    fn control(
+        &mut self,
+        err: f64,
+        given_up: bool,
+        failed: bool,
+        completes: impl FnOnce() -> bool,
+    ) -> Control {
+        if given_up || failed {
+            return Control::Failed;
+        }
+        self.attempts += 1;
+        let fac_lo = 1.0 / <Dop853<4> as Stepper<4>>::FAC_MAX;
+        let fac_hi = 1.0 / <Dop853<4> as Stepper<4>>::FAC_MIN;
+        if !err.is_finite() {
+            self.rejected_last = true;
+            self.h *= <Dop853<4> as Stepper<4>>::FAC_MIN;
+            return Control::Rejected;
+        }
+        let fac11 = err.powf(<Dop853<4> as Stepper<4>>::EXPONENT);
+        if err <= 1.0 {
+            let fac = (fac11 / self.fac_old.powf(<Dop853<4> as Stepper<4>>::BETA) / SAFE)
+                .clamp(fac_lo, fac_hi);
+            let mut h_new = self.h / fac;
+            self.fac_old = err.max(1e-4);
+            if !completes() {
+                return Control::Failed;
+            }
+            let t_new = if self.last {
+                self.t_end
+            } else {
+                self.t + self.h
+            };
+            self.t = t_new;
+            self.steps.push(t_new);
+            if self.last {
+                return Control::Finished;
+            }
+            h_new = h_new.min(self.t_end - self.steps[0]);
+            if self.rejected_last {
+                h_new = h_new.min(self.h);
+            }
+            self.rejected_last = false;
+            self.h = h_new;
+            Control::Accepted
+        } else {
+            self.rejected_last = true;
+            self.h /= fac_hi.min(fac11 / SAFE);
+            Control::Rejected
+        }
+    }
+}
+
+/// One lane of a [`LaneRhs`] as a scalar right-hand side (for `initial_step`).
+struct OneLane<'r, const M: usize> {
+    rhs: &'r dyn LaneRhs<M>,
+    l: usize,
+}
+
+impl<const M: usize> Rhs<M> for OneLane<'_, M> {
+    fn eval(&mut self, t: f64, y: &[f64; M], dydt: &mut [f64; M]) -> paritysim_error::Result<()> {
+        let mut out = [V::splat(0.0); M];
+        let failed = self
+            .rhs
+            .eval([t; LANES], [NO_STAGE; LANES], &y.map(V::splat), &mut out);
+        if failed & (1 << self.l) != 0 {
+            return Err(paritysim_error::Error::OutOfDomain {
+                what: "lane right-hand side".into(),
+                detail: format!("t = {t}"),
+            });
+        }
+        for i in 0..M {
+            dydt[i] = lane(out[i], self.l);
+        }
+        Ok(())
+    }
+
+    fn expand(&self, c: &[f64; M]) -> State {
+        let mut y = State::default();
+        y.coords[..2].copy_from_slice(&c[..2]);
+        y.rates[..2].copy_from_slice(&c[2..]);
+        y
+    }
+}

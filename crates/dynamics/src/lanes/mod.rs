@@ -1,0 +1,90 @@
+//! Sweep chains in SIMD lanes: several shooting points integrated at once.
+//!
+//! A shooting point of [`SteadyState::Shooting`] is a sequence of one-period integrations:
+//! the warm-up and the variational period of a chain's start, then (continued points) the
+//! neighbour's grid checked or a new one picked, Newton trials on the frozen grid and the
+//! recorded window (docs/findings.md §6-7). Here [`LANES`] chains advance side by side, one
+//! point per lane: every lane carries its own grid or step control, time, step and state
+//! through the DOP853 stages ([`crate::integrate::lanes`], `wide::f64x4`), and a lane whose
+//! period ends is handed its point's next period (or the next point of its chain, or the next
+//! chain of its group) while the others keep stepping: the ensemble technique of heyoka and
+//! MPGOS. Groups of chains run in parallel on the sweep's rayon pool.
+//!
+//! * **Which points.** A shooting point qualifies when it reads stroke metrics only, records
+//!   one plain cycle, uses DOP853, and its device integrates drivetrain coordinates of the
+//!   linear differential map with stroke drag ([`has_lane_model`]); every other point runs the
+//!   scalar path in place, in its chain's order.
+//! * **Same results.** The lanes perform the scalar path's floating-point operations in its
+//!   order, and the Newton logic here ([`LanePoint`]) is that of `grid_shooting::shoot` and
+//!   `simulate::shooting_steady_state`. The branches it does not follow (a failing period, a
+//!   singular Newton step, no convergence, an unstable orbit: `shoot`'s `Ok(None)` and errors)
+//!   rerun the point on the scalar path from the same start, so every point's result is
+//!   bit-identical to the scalar sweep (`PARITYSIM_LANES=1`; tested for lane widths 1 to 4 and
+//!   thread counts).
+//! * **Failures are rows**: a failing point fails on the scalar rerun, with the scalar error.
+//!   A panic (an engine bug) fails the points of its group of chains (up to `2 × LANES`
+//!   chains) rather than of its chain.
+//! * **Not covered**: the per-run wall budget `max_wall_ms` is not checked inside the lanes
+//!   (a lane period is bounded by `max_steps`; the sweep's cancel is checked between periods).
+
+pub(crate) mod linear_stroke;
+mod point;
+mod schedule;
+
+use paritysim_error::{Error, Result, bail};
+
+use crate::device::Device;
+use crate::integrate::lanes::LANES;
+use linear_stroke::LinearStroke;
+pub(crate) use schedule::run_chains;
+
+/// Environment variable read by [`resolve_lanes`] when no lane width is given: an integer in
+/// `[1, 4]` (`PARITYSIM_LANES=1` runs the scalar path).
+pub const LANES_ENV: &str = "PARITYSIM_LANES";
+
+/// The largest lane width (one `f64x4`).
+pub const MAX_LANES: usize = LANES;
+
+/// The lane width a sweep uses: `requested` if given, else [`LANES_ENV`], else
+/// [`MAX_LANES`]. One lane is the scalar path.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for 0, more than [`MAX_LANES`], or an environment value that is
+/// not such an integer (naming `lanes` or `PARITYSIM_LANES`).
+pub fn resolve_lanes(requested: Option<usize>) -> Result<usize> {
+    let allowed = format!("an integer in [1, {MAX_LANES}]");
+    if let Some(n) = requested {
+        if !(1..=MAX_LANES).contains(&n) {
+            bail!(invalid "lanes", n, allowed);
+        }
+        return Ok(n);
+    }
+    if let Ok(raw) = std::env::var(LANES_ENV) {
+        let raw = raw.trim();
+        if !raw.is_empty() {
+            return match raw.parse::<usize>() {
+                Ok(n) if (1..=MAX_LANES).contains(&n) => Ok(n),
+                _ => Err(Error::invalid(LANES_ENV, format!("{raw:?}"), allowed)),
+            };
+        }
+    }
+    Ok(MAX_LANES)
+}
+
+/// Whether `device` has a SIMD-lane model: its continued shooting points then run in lanes
+/// when the sweep's other conditions hold (see the module). Today: drivetrain coordinates of
+/// the two-DOF linear differential map (eq. 2.15) with stroke drag or no aerodynamics.
+pub fn has_lane_model(device: &Device) -> bool {
+    LinearStroke::of(device).is_some()
+}
+
+/// Points completed in lanes since the process started (tests and benchmarks read it to see
+/// that the lanes ran).
+pub(crate) static COMPLETED_IN_LANES: std::sync::atomic::AtomicUsize =
+    std::sync::atomic::AtomicUsize::new(0);
+
+/// How many sweep points the SIMD lanes have completed in this process (monotonic; points
+/// rerun on the scalar path are not counted).
+pub fn points_completed_in_lanes() -> usize {
+    COMPLETED_IN_LANES.load(std::sync::atomic::Ordering::Relaxed)
+}
