@@ -373,7 +373,12 @@ impl MetricsAccumulator {
         let n = b.count;
         let body = if b.closing { n - 1 } else { n };
         if self.first_time.is_none() {
-            self.stroke_only = true;
+            // The lanes compute the stroke state and the actuator force (no torques, no work).
+            self.lean = Some(StrokeNeeds {
+                force: true,
+                torques: false,
+                work: false,
+            });
             self.first_time = Some(b.time[0]);
             for acc in &mut self.wings {
                 acc.psi.range.add(0.0);

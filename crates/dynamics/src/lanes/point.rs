@@ -115,9 +115,7 @@ fn residual(y: &State, py: &State) -> (DVector<f64>, f64) {
 
 /// Least-squares Newton step (as `grid_shooting`).
 fn newton_step(jac: &DMatrix<f64>, eye: &DMatrix<f64>, f: &DVector<f64>) -> Option<DVector<f64>> {
-    let svd = (jac - eye).svd(true, true);
-    let cutoff = 1e-10 * svd.singular_values.max().max(f64::MIN_POSITIVE);
-    svd.solve(&(-f), cutoff).ok()
+    crate::grid_shooting::least_squares_step(jac - eye, f)
 }
 
 impl<'a> LanePoint<'a> {
