@@ -5,10 +5,10 @@
 mod continuation;
 #[path = "dynamics/floquet.rs"]
 mod floquet;
-#[path = "dynamics/lean.rs"]
-mod lean;
 #[path = "dynamics/lanes.rs"]
 mod lanes;
+#[path = "dynamics/lean.rs"]
+mod lean;
 #[path = "dynamics/metrics.rs"]
 mod metrics;
 #[path = "dynamics/steady_state.rs"]
