@@ -89,7 +89,10 @@ fn branches_are_smooth_where_the_model_jumps() {
         assert!(jump_branch < 1e3 * e, "{at:?}: branch jump {jump_branch}");
         if dir != Vector3::z() {
             // The model itself jumps (C_N(0) ≠ 0; C_L(90°) ≠ 0 mirrored).
-            assert!(jump_model > 10.0 * jump_branch, "{at:?}: model jump {jump_model}");
+            assert!(
+                jump_model > 10.0 * jump_branch,
+                "{at:?}: model jump {jump_model}"
+            );
         }
     }
     let w = Vector3::new(0.1, 0.2, 0.3);

@@ -41,9 +41,11 @@ use paritysim_dynamics::wing::WingTerms;
 use paritysim_dynamics::{Device, State, Wing, WingAero};
 use paritysim_error::{Error, Result};
 
-use crate::aero::{Wrench, wrench};
+use crate::aero::{Wrench, switching, wrench};
 use crate::body::{Body, BodyMode};
 use crate::mechanisms::{DriveCoordinate, Mechanism};
+use paritysim_aero::Branch;
+use paritysim_dynamics::integrate::{MAX_SWITCHES, Sides};
 
 /// Length of the flight state array:
 /// `[quaternion (w, x, y, z), position (3), x (6), V (3), Ω (3), ẋ (6), work_actuator, work_aero]`.
@@ -380,7 +382,78 @@ impl FlightModel {
         inputs: &Inputs,
         dydt: &mut [f64; STATE_LEN],
     ) -> Result<()> {
-        let e = self.evaluate_with(t, y, inputs, false)?;
+        self.rhs_on(t, y, inputs, None, dydt)
+    }
+
+    /// Number of switching functions of the wings' aerodynamics ([`Self::switches`]): three
+    /// per wing, none when no wing has aerodynamics.
+    pub fn n_switches(&self) -> usize {
+        if self.aero[..self.n_wings]
+            .iter()
+            .all(|a| matches!(a, WingAero::None))
+        {
+            0
+        } else {
+            3 * self.n_wings
+        }
+    }
+
+    /// The wings' switching functions ([`crate::aero::switching`] of wing `k` in
+    /// `g[3k..3k + 3]`): where the right-hand side jumps or kinks (stroke reversal).
+    ///
+    /// # Errors
+    /// As [`Self::rhs`].
+    pub fn switches(&self, y: &[f64; STATE_LEN], g: &mut [f64; MAX_SWITCHES]) -> Result<()> {
+        let attitude =
+            UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(y[0], y[1], y[2], y[3]));
+        let r_b = *attitude.to_rotation_matrix().matrix();
+        let velocity = Vector3::new(y[VEL], y[VEL + 1], y[VEL + 2]);
+        let omega = Vector3::new(y[OMEGA], y[OMEGA + 1], y[OMEGA + 2]);
+        let (p, p_dot) = self.device.coordinates(&self.wing_state(y))?;
+        let v_body = r_b.transpose() * velocity;
+        for k in 0..self.n_wings {
+            let o = 3 * k;
+            let pw = Vector3::new(p[o], p[o + 1], p[o + 2]);
+            let vw = Vector3::new(p_dot[o], p_dot[o + 1], p_dot[o + 2]);
+            let wing = &self.device.spec().wings[k];
+            let terms = if self.stroke_plane[k] {
+                wing.stroke_plane_terms(&pw, &vw)
+            } else {
+                wing.terms(&pw, &vw)?
+            };
+            let r = terms.rotation;
+            let om6 = r.transpose() * (self.axial[k] * omega) + terms.omega;
+            let v6 = r.transpose() * (self.polar[k] * (v_body + omega.cross(&self.shoulder[k])));
+            let gk = switching(&self.aero[k], &om6, &v6, &r, self.body.force_radius);
+            g[o..o + 3].copy_from_slice(&gk);
+        }
+        Ok(())
+    }
+
+    /// The wings' aerodynamic branches named by the sides of [`Self::switches`].
+    pub fn branches(&self, sides: Sides) -> [Branch; 2] {
+        std::array::from_fn(|k| Branch {
+            chordwise_positive: sides.positive(3 * k),
+            normal_positive: sides.positive(3 * k + 1),
+            spanwise_positive: sides.positive(3 * k + 2),
+        })
+    }
+
+    /// [`Self::rhs`] with the wings' aerodynamics on `branches` (event location: the smooth
+    /// branch held between the roots of [`Self::switches`]), or on the state's own sides.
+    ///
+    /// # Errors
+    /// As [`Self::rhs`].
+    #[inline]
+    pub fn rhs_on(
+        &self,
+        t: f64,
+        y: &[f64; STATE_LEN],
+        inputs: &Inputs,
+        branches: Option<&[Branch; 2]>,
+        dydt: &mut [f64; STATE_LEN],
+    ) -> Result<()> {
+        let e = self.evaluate_with(t, y, inputs, false, branches)?;
         *dydt = [0.0; STATE_LEN];
         // q̇ = ½ q ⊗ (0, Ω) on the stored (unnormalised) quaternion.
         let (w, a, b, c) = (y[0], y[1], y[2], y[3]);
@@ -451,7 +524,7 @@ impl FlightModel {
     /// # Errors
     /// As [`Self::rhs`].
     pub fn evaluate(&self, t: f64, y: &[f64; STATE_LEN], inputs: &Inputs) -> Result<FlightEval> {
-        self.evaluate_with(t, y, inputs, true)
+        self.evaluate_with(t, y, inputs, true, None)
     }
 
     /// [`Self::evaluate`]; the reactions on the airframe and the per-wing shoulder torques
@@ -463,6 +536,7 @@ impl FlightModel {
         y: &[f64; STATE_LEN],
         inputs: &Inputs,
         reactions: bool,
+        branches: Option<&[Branch; 2]>,
     ) -> Result<FlightEval> {
         let attitude =
             UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(y[0], y[1], y[2], y[3]));
@@ -589,7 +663,14 @@ impl FlightModel {
             // Aerodynamics: wrench at the shoulder.
             let v_sh_body = r_b.transpose() * velocity + omega.cross(&s);
             let v6 = r.transpose() * (pk * v_sh_body);
-            let wr = wrench(&self.aero[k], &om6, &v6, &r, self.body.force_radius)?;
+            let wr = wrench(
+                &self.aero[k],
+                &om6,
+                &v6,
+                &r,
+                self.body.force_radius,
+                branches.map(|b| b[k]),
+            )?;
             wrenches[k] = wr;
             let f_body = pk * wr.force;
             let tau_body = ak * wr.torque;
