@@ -610,6 +610,52 @@ impl<C: CoefficientModel> BladeElementModel<C> {
         })
     }
 
+    /// The resultant force (mN) and torque about the shoulder (mN·mm) of [`Self::loads_omega_branch`]
+    /// in the **wing frame** (`rot` = identity; `lift + drag` and [`AeroLoads::torque`]), lean:
+    /// one `atan2` and the fit's two trigonometric calls (`sin α = σ ω_x / W`,
+    /// `cos α = ω_y / W` on the branch).
+    ///
+    /// # Errors
+    /// As [`Self::loads`].
+    #[inline]
+    pub fn wing_frame_wrench_branch(
+        &self,
+        omega: &Vector3<f64>,
+        branch: Branch,
+    ) -> Result<(Vector3<f64>, Vector3<f64>)> {
+        let Some(force) = self.omegas.force else {
+            bail!(invalid "omegas.force", "None",
+                "set: build Omegas from a Planform or call Omegas::with_force");
+        };
+        let o = &self.omegas;
+        let (wx, wy, wz) = (omega.x, omega.y, omega.z);
+        let sz = unit_sign(branch.spanwise_positive);
+        let damping = -o.omega2 * self.rotational_damping * sz * wz * wz; // eq. 3.10
+        let w2 = wx * wx + wy * wy;
+        if w2 == 0.0 {
+            return Ok((Vector3::zeros(), Vector3::new(0.0, 0.0, damping)));
+        }
+        let w = w2.sqrt();
+        let sigma = unit_sign(branch.chordwise_positive);
+        let alpha = branch_alpha(sigma * wx, wy);
+        let (cl, cd) = match self.law {
+            NormalForceLaw::Coefficient => self
+                .coefficients
+                .lift_drag_branch(alpha, branch.normal_positive),
+            // C_N ≡ 1, C_T ≡ 0: C_L = cos α, C_D = sin α.
+            NormalForceLaw::Unit => (wy / w, sigma * wx / w),
+        };
+        let lift_dir = Vector3::new(sigma * wx / w, sigma * wy / w, 0.0); // ℓ̂
+        let vel_dir = Vector3::new(wy / w, -wx / w, 0.0); // û
+        let d_cp = 0.82 / PI * alpha + 0.05; // eq. 3.7 on the branch
+        let r_eff = Vector3::new(o.omega4 - d_cp * o.omega3, 0.0, o.omega1);
+        // C_L ℓ̂ − C_D û, the strip force direction times its coefficient.
+        let c = lift_dir * cl - vel_dir * cd;
+        let mut torque = r_eff.cross(&c) * w2;
+        torque.z += damping;
+        Ok((c * (force * w2), torque))
+    }
+
     /// The moments at a wing state (eqs. 3.8–3.11). Infallible; finite input gives finite output.
     #[inline]
     pub fn moments(&self, state: &WingState) -> AeroMoments {

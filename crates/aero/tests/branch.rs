@@ -3,7 +3,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 use paritysim_aero::{
-    AeroLoads, BladeElementModel, Branch, CoefficientSet, Omegas, WhitneyWood2010,
+    AeroLoads, BladeElementModel, Branch, CoefficientSet, NormalForceLaw, Omegas, WhitneyWood2010,
 };
 
 fn model(coefficients: CoefficientSet) -> BladeElementModel {
@@ -27,11 +27,15 @@ fn rot() -> Matrix3<f64> {
 
 #[test]
 fn a_branch_on_its_own_side_is_the_model() {
-    for set in [
-        CoefficientSet::default(),
-        CoefficientSet::WhitneyWood2010(WhitneyWood2010::default()),
+    for (set, law) in [
+        (CoefficientSet::default(), NormalForceLaw::Coefficient),
+        (CoefficientSet::default(), NormalForceLaw::Unit),
+        (
+            CoefficientSet::WhitneyWood2010(WhitneyWood2010::default()),
+            NormalForceLaw::Coefficient,
+        ),
     ] {
-        let m = model(set);
+        let m = model(set).with_normal_force_law(law);
         for w in [
             Vector3::new(0.3, 0.2, -0.1),
             Vector3::new(-0.3, 0.05, 0.4),
@@ -50,6 +54,13 @@ fn a_branch_on_its_own_side_is_the_model() {
                 m.moments_omega(&w),
                 m.moments_omega_branch(&w, Branch::of(&w))
             );
+            // The lean wing-frame wrench: the same loads rotated back.
+            let loads = m.loads_omega(&w, &rot()).unwrap();
+            let (f6, t6) = m.wing_frame_wrench_branch(&w, Branch::of(&w)).unwrap();
+            let (f, t) = (rot() * f6, rot() * t6);
+            let (f_ref, t_ref) = (loads.lift + loads.drag, loads.torque());
+            assert!((f - f_ref).amax() <= 1e-13 * f_ref.amax(), "{f} vs {f_ref}");
+            assert!((t - t_ref).amax() <= 1e-13 * t_ref.amax(), "{t} vs {t_ref}");
         }
     }
 }

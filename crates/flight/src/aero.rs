@@ -102,3 +102,37 @@ pub fn wrench(
         }
     })
 }
+
+/// [`wrench`] together with its torque in the wing frame 6 (`R_6^1ᵀ τ`); on a branch of the
+/// blade-element model through the lean
+/// [`paritysim_aero::BladeElementModel::wing_frame_wrench_branch`] (the right-hand side's path).
+///
+/// # Errors
+/// As [`wrench`].
+#[inline]
+pub fn wrench_and_wing_torque(
+    aero: &WingAero,
+    omega6: &Vector3<f64>,
+    v6: &Vector3<f64>,
+    r61: &Matrix3<f64>,
+    r_f: f64,
+    branch: Option<Branch>,
+) -> Result<(Wrench, Vector3<f64>)> {
+    match (aero, branch) {
+        (WingAero::None, _) => Ok((Wrench::default(), Vector3::zeros())),
+        (WingAero::BladeElement(model), Some(b)) => {
+            let (f6, t6) = model.wing_frame_wrench_branch(&effective(omega6, v6, r_f), b)?;
+            Ok((
+                Wrench {
+                    force: r61 * f6,
+                    torque: r61 * t6,
+                },
+                t6,
+            ))
+        }
+        _ => {
+            let w = wrench(aero, omega6, v6, r61, r_f, branch)?;
+            Ok((w, r61.transpose() * w.torque))
+        }
+    }
+}
