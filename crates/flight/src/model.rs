@@ -862,20 +862,16 @@ impl SolvePlan {
             return true;
         }
         if let Some(off) = self.consecutive {
-            // In place: the symmetric matrix reads the same in either storage order.
-            let a: &mut [f64; NU * NU] = mass
-                .as_mut_slice()
-                .try_into()
-                .expect("the mass matrix is NU x NU");
-            let mut b = [0.0; NU];
-            b.copy_from_slice(force.as_slice());
-            if !solve_spd(a, &mut b, off, nc) {
-                return false;
+            // A fixed-size block: nalgebra's unrolled Cholesky.
+            macro_rules! fixed {
+                ($($k:literal)+) => {
+                    match nc {
+                        $($k => return solve_block::<$k>(mass, force, off, u_dot),)+
+                        _ => {}
+                    }
+                };
             }
-            for i in off..off + nc {
-                u_dot[i] = b[i];
-            }
-            return true;
+            fixed!(1 2 3 4 5 6 7 8 9 10 11 12);
         }
         let mut m_a = [0.0; NU * NU];
         let mut f_a = [0.0; NU];
@@ -893,6 +889,58 @@ impl SolvePlan {
         }
         true
     }
+}
+
+/// Solves the `N × N` block of `mass u̇ = force` at `(off, off)` into `u_dot` by the
+/// Cholesky factorisation of [`solve_spd`] on fixed-size arrays (unrolled, no bounds checks);
+/// false when it is not positive definite.
+#[inline]
+#[allow(clippy::needless_range_loop)] // the index form mirrors the factorisation
+fn solve_block<const N: usize>(mass: &MatU, force: &VecU, off: usize, u_dot: &mut VecU) -> bool {
+    let mut a = [[0.0; N]; N];
+    let mut b = [0.0; N];
+    for i in 0..N {
+        b[i] = force[off + i];
+        for j in 0..=i {
+            a[i][j] = mass[(off + i, off + j)];
+        }
+    }
+    for j in 0..N {
+        let mut d = a[j][j];
+        for k in 0..j {
+            d -= a[j][k] * a[j][k];
+        }
+        if d.is_nan() || d <= 0.0 {
+            return false;
+        }
+        let d = d.sqrt();
+        a[j][j] = d;
+        for i in j + 1..N {
+            let mut v = a[i][j];
+            for k in 0..j {
+                v -= a[i][k] * a[j][k];
+            }
+            a[i][j] = v / d;
+        }
+    }
+    for i in 0..N {
+        let mut v = b[i];
+        for k in 0..i {
+            v -= a[i][k] * b[k];
+        }
+        b[i] = v / a[i][i];
+    }
+    for i in (0..N).rev() {
+        let mut v = b[i];
+        for k in i + 1..N {
+            v -= a[k][i] * b[k];
+        }
+        b[i] = v / a[i][i];
+    }
+    for i in 0..N {
+        u_dot[off + i] = b[i];
+    }
+    true
 }
 
 /// [`Wing::stroke_plane_terms`] without the mass matrix, Coriolis and aerodynamic terms (the
