@@ -1,6 +1,9 @@
 //! One second of free flight (the bench's §3.4 device, 110 wingbeats), integrated once at
 //! `method:rtol:atol[:off]` (as `flight_accuracy`; default the options' defaults with event
-//! location): for instruction counts, e.g.
+//! location), or with `fixed` the fixed-body engine on the same window and options, or with
+//! `clamped` the flight model on a clamped body (the torque stand's physics through the
+//! flight equations: what event location does for a fixed-body trial): for instruction
+//! counts, e.g.
 //!
 //! `valgrind --tool=callgrind target/release/examples/flight_once 8:1e-8:1e-10`
 #![allow(missing_docs)]
@@ -22,7 +25,12 @@ fn main() {
     );
     let options = SimulationOptions::default();
     let steady = simulate(&device, &options).unwrap();
-    let model = FlightModel::new(&device, common::hmf_body(BodyMode::Free), Vec::new()).unwrap();
+    let mode = if std::env::args().nth(2).as_deref() == Some("clamped") {
+        BodyMode::Clamped
+    } else {
+        BodyMode::Free
+    };
+    let model = FlightModel::new(&device, common::hmf_body(mode), Vec::new()).unwrap();
     let y0 = released(&model, &model.convert_state(&steady.steady_state).unwrap());
     let period = device.period().unwrap();
     let t0 = steady.cycles_run as f64 * period;
@@ -41,6 +49,22 @@ fn main() {
     } else {
         system
     };
+    if std::env::args().nth(2).as_deref() == Some("fixed") {
+        use paritysim_dynamics::integrate::{RungeKutta, Sink};
+        let rk = RungeKutta::new(method, rtol, atol, options.max_steps)
+            .unwrap()
+            .with_work(false);
+        let start = std::time::Instant::now();
+        let sink: &mut Sink<'_> = &mut |_, _, _| Ok(());
+        let (_, stats) = rk
+            .integrate_counted(&device, t0, &steady.steady_state, t1, &[], sink)
+            .unwrap();
+        println!(
+            "fixed body, {method:?} rtol {rtol:e}: {:.1} ms, {stats:?}",
+            start.elapsed().as_secs_f64() * 1e3
+        );
+        return;
+    }
     let start = std::time::Instant::now();
     let (_, stats) = system
         .integrate(
