@@ -90,3 +90,46 @@ fn event_location_agrees_with_straddling_steps_and_is_cheaper() {
         "{on_stats:?} vs {off_stats:?}"
     );
 }
+
+#[test]
+fn mirror_symmetric_wings_switch_together() {
+    // The symmetric §3.4 device released in free flight: by mirror symmetry the body only
+    // pitches. Both wings cross their switching surfaces at the same instants up to
+    // round-off; switched one after the other they would roll and yaw the body.
+    let device = symmetric_3_4();
+    let options = SimulationOptions::default();
+    let steady = simulate(&device, &options).unwrap();
+    let model = FlightModel::new(&device, hmf_body(BodyMode::Free), Vec::new()).unwrap();
+    let y0 = released(&model, &model.convert_state(&steady.steady_state).unwrap());
+    let period = device.period().unwrap();
+    let t0 = steady.cycles_run as f64 * period;
+    let t1 = t0 + 10.0 * period;
+    let times: Vec<f64> = (0..=160)
+        .map(|k| t0 + (t1 - t0) * k as f64 / 160.0)
+        .collect();
+    let (mut asymmetric, mut pitch) = (0.0f64, 0.0f64);
+    let (_, stats) = FlightSystem::new(&model, Inputs::default())
+        .integrate(
+            (
+                options.method,
+                options.rtol,
+                options.atol,
+                options.max_steps,
+            ),
+            t0,
+            &y0,
+            t1,
+            &times,
+            &mut |_, t, y: &[f64; STATE_LEN]| {
+                let e = model.evaluate(t, y, &Inputs::default()).unwrap();
+                asymmetric = asymmetric.max(e.omega.x.abs()).max(e.omega.y.abs());
+                pitch = pitch.max(e.omega.z.abs());
+                Ok(())
+            },
+        )
+        .unwrap();
+    println!("{stats:?}: |roll|, |yaw| rates <= {asymmetric:.1e}, pitch up to {pitch:.1e} rad/ms");
+    assert!(stats.events >= 40, "{stats:?}");
+    assert!(pitch > 1e-4, "the body pitches ({pitch})");
+    assert!(asymmetric < 1e-12, "{asymmetric}");
+}

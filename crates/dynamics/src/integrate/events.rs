@@ -7,8 +7,9 @@
 //! evaluates the *smooth continuation* of the branch those sides name, also slightly past the
 //! switching surface. So no step straddles a jump: an accepted step on which some `g_i` ends on
 //! the other side is cut at the first root (found on the step's dense output, Illinois
-//! regula falsi to `1e-10 h`), the sides there are taken over, and the integration restarts
-//! from the root with the step size the controller proposed. Without that, an embedded
+//! regula falsi to `1e-10 h`; roots within `1e-8 h` after it count as the same event), the
+//! sides there are taken over, and the integration restarts from the root with the step size
+//! the controller proposed. Without that, an embedded
 //! pair's error estimate is `O(h)` across a jump whatever its order, and the controller
 //! rejects step after step there.
 //!
@@ -86,6 +87,11 @@ pub(crate) struct Event<const M: usize> {
 /// Relative bracket width of the root search (of the step size).
 const ROOT_TOLERANCE: f64 = 1e-10;
 
+/// Roots this close after the first (relative to the step size) are one event: the step ends
+/// there with all of them switched. Mirror-symmetric wings cross together up to round-off;
+/// switching them one after the other would break the symmetry by `jump × (t₂ − t₁)`.
+const CLUSTER: f64 = 1e-8;
+
 /// Locates the first root inside the accepted step `[t, t + h]` (dense output prepared) among
 /// the switching functions whose end value `g1` lies across `sides` (`g0` their values at `t`).
 ///
@@ -156,6 +162,9 @@ pub(crate) fn locate<const M: usize, S: Stepper<M>>(
         first = b;
     }
     let at_start = first - t <= 2.0 * tol;
+    if !at_start && first < t1 {
+        first = (first + CLUSTER * h.abs()).min(t1);
+    }
     if first >= t1 {
         y = *stepper.y1();
         g = *g1;
