@@ -320,6 +320,47 @@ fn alpha_from_omega(omega: &Vector3<f64>) -> f64 {
     }
 }
 
+/// The smooth branch of the blade-element model on one side of each of its three switching
+/// surfaces, in the wing-frame angular velocity `ω`: the stroke reversal `ω_x = 0` (where
+/// `σ = sgn ω_x` flips: `M_N` jumps by `2 Ω1 W² C_N(0)`, α has a kink), `ω_y = 0` (α = π/2,
+/// where a fit extended by symmetry jumps, [`CoefficientModel::jumps_at_right_angle`]) and
+/// `ω_z = 0` (the rotational damping `ω_z |ω_z|`). On its own side a branch gives the model's
+/// values; past a surface it continues them analytically (σ held, α continued through 0 and π,
+/// `ω_z |ω_z| → ±ω_z²`), which is what an integrator with event location evaluates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Branch {
+    /// `ω_x >= 0`: σ = +1.
+    pub chordwise_positive: bool,
+    /// `ω_y >= 0`: the α <= π/2 branch of the coefficients.
+    pub normal_positive: bool,
+    /// `ω_z >= 0`.
+    pub spanwise_positive: bool,
+}
+
+impl Branch {
+    /// The branch `ω` lies on.
+    #[inline]
+    pub fn of(omega: &Vector3<f64>) -> Self {
+        Self {
+            chordwise_positive: omega.x >= 0.0,
+            normal_positive: omega.y >= 0.0,
+            spanwise_positive: omega.z >= 0.0,
+        }
+    }
+}
+
+/// α on a branch of σ: `atan2(σ ω_x, ω_y)` continued through 0 (negative) and π (past π).
+#[inline]
+fn branch_alpha(sigma_wx: f64, wy: f64) -> f64 {
+    let a = sigma_wx.atan2(wy);
+    if a < -FRAC_PI_2 { a + 2.0 * PI } else { a }
+}
+
+#[inline]
+fn unit_sign(positive: bool) -> f64 {
+    if positive { 1.0 } else { -1.0 }
+}
+
 /// The four moments of eqs. 3.8–3.11 (mN·mm) at one state.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct AeroMoments {
@@ -463,6 +504,156 @@ impl<C: CoefficientModel> BladeElementModel<C> {
             }
             NormalForceLaw::Unit => (1.0, 0.0),
         }
+    }
+
+    /// `(C_N, C_T)` on one side of α = π/2 (see [`Branch`]).
+    #[inline]
+    fn normal_tangential_branch(&self, alpha: f64, below: bool) -> (f64, f64) {
+        match self.law {
+            NormalForceLaw::Coefficient => {
+                let (cl, cd) = self.coefficients.lift_drag_branch(alpha, below);
+                crate::coefficients::to_normal_tangential(alpha, cl, cd)
+            }
+            NormalForceLaw::Unit => (1.0, 0.0),
+        }
+    }
+
+    /// The model's three switching functions at `ω` (see [`Branch`]): `(ω_x, ω_y, ω_z)`, with
+    /// `1` in place of a surface where this model is smooth (`ω_y` unless the coefficients
+    /// jump at 90°, `ω_z` without rotational damping).
+    #[inline]
+    pub fn switching_functions(&self, omega: &Vector3<f64>) -> [f64; 3] {
+        let right_angle =
+            self.law == NormalForceLaw::Coefficient && self.coefficients.jumps_at_right_angle();
+        let damped = self.omegas.omega2 * self.rotational_damping != 0.0;
+        [
+            omega.x,
+            if right_angle { omega.y } else { 1.0 },
+            if damped { omega.z } else { 1.0 },
+        ]
+    }
+
+    /// [`Self::moments_omega`] on a [`Branch`] (its values on the branch's own side).
+    #[inline]
+    pub fn moments_omega_branch(&self, omega: &Vector3<f64>, branch: Branch) -> AeroMoments {
+        let o = &self.omegas;
+        let (wx, wy, wz) = (omega.x, omega.y, omega.z);
+        let w2 = wx * wx + wy * wy;
+        let sz = unit_sign(branch.spanwise_positive);
+        let rotational_damping = -o.omega2 * self.rotational_damping * sz * wz * wz; // eq. 3.10
+        if w2 == 0.0 {
+            return AeroMoments {
+                rotational_damping,
+                alpha: FRAC_PI_2,
+                ..AeroMoments::default()
+            };
+        }
+        let sigma = unit_sign(branch.chordwise_positive);
+        let alpha = branch_alpha(sigma * wx, wy);
+        let (cn, ct) = self.normal_tangential_branch(alpha, branch.normal_positive);
+        let d_cp = 0.82 / PI * alpha + 0.05; // eq. 3.7, |α| = α on the branch's own side
+        AeroMoments {
+            normal: -o.omega1 * sigma * w2 * cn, // eq. 3.8
+            tangential: -o.omega1 * w2 * ct,     // eq. 3.9
+            rotational: -(o.omega3 * d_cp - o.omega4) * sigma * w2 * cn, // eq. 3.11
+            rotational_damping,
+            alpha,
+        }
+    }
+
+    /// [`Self::loads_omega`] on a [`Branch`] (its values on the branch's own side).
+    ///
+    /// # Errors
+    /// As [`Self::loads`].
+    #[inline]
+    pub fn loads_omega_branch(
+        &self,
+        omega: &Vector3<f64>,
+        rot: &Matrix3<f64>,
+        branch: Branch,
+    ) -> Result<AeroLoads> {
+        let Some(force) = self.omegas.force else {
+            bail!(invalid "omegas.force", "None",
+                "set: build Omegas from a Planform or call Omegas::with_force");
+        };
+        let moments = self.moments_omega_branch(omega, branch);
+        let damping_torque = rot * Vector3::new(0.0, 0.0, moments.rotational_damping);
+        let (wx, wy) = (omega.x, omega.y);
+        let w2 = wx * wx + wy * wy;
+        if w2 == 0.0 {
+            return Ok(AeroLoads {
+                lift: Vector3::zeros(),
+                drag: Vector3::zeros(),
+                lift_torque: Vector3::zeros(),
+                drag_torque: Vector3::zeros(),
+                damping_torque,
+                moments,
+            });
+        }
+        let w = w2.sqrt();
+        let alpha = moments.alpha;
+        let (cn, ct) = self.normal_tangential_branch(alpha, branch.normal_positive);
+        let (cl, cd) = from_normal_tangential(alpha, cn, ct);
+        let sigma = unit_sign(branch.chordwise_positive);
+        let lift_dir = Vector3::new(sigma * wx / w, sigma * wy / w, 0.0); // ℓ̂
+        let vel_dir = Vector3::new(wy / w, -wx / w, 0.0); // û
+        let o = &self.omegas;
+        let d_cp = 0.82 / PI * alpha + 0.05; // eq. 3.7 on the branch
+        let r_eff = Vector3::new(o.omega4 - d_cp * o.omega3, 0.0, o.omega1);
+        Ok(AeroLoads {
+            lift: rot * (lift_dir * (force * w2 * cl)),
+            drag: rot * (vel_dir * (-force * w2 * cd)),
+            lift_torque: rot * r_eff.cross(&lift_dir) * (w2 * cl),
+            drag_torque: rot * r_eff.cross(&vel_dir) * (-w2 * cd),
+            damping_torque,
+            moments,
+        })
+    }
+
+    /// The resultant force (mN) and torque about the shoulder (mN·mm) of [`Self::loads_omega_branch`]
+    /// in the **wing frame** (`rot` = identity; `lift + drag` and [`AeroLoads::torque`]), lean:
+    /// one `atan2` and the fit's two trigonometric calls (`sin α = σ ω_x / W`,
+    /// `cos α = ω_y / W` on the branch).
+    ///
+    /// # Errors
+    /// As [`Self::loads`].
+    #[inline]
+    pub fn wing_frame_wrench_branch(
+        &self,
+        omega: &Vector3<f64>,
+        branch: Branch,
+    ) -> Result<(Vector3<f64>, Vector3<f64>)> {
+        let Some(force) = self.omegas.force else {
+            bail!(invalid "omegas.force", "None",
+                "set: build Omegas from a Planform or call Omegas::with_force");
+        };
+        let o = &self.omegas;
+        let (wx, wy, wz) = (omega.x, omega.y, omega.z);
+        let sz = unit_sign(branch.spanwise_positive);
+        let damping = -o.omega2 * self.rotational_damping * sz * wz * wz; // eq. 3.10
+        let w2 = wx * wx + wy * wy;
+        if w2 == 0.0 {
+            return Ok((Vector3::zeros(), Vector3::new(0.0, 0.0, damping)));
+        }
+        let w = w2.sqrt();
+        let sigma = unit_sign(branch.chordwise_positive);
+        let alpha = branch_alpha(sigma * wx, wy);
+        let (cl, cd) = match self.law {
+            NormalForceLaw::Coefficient => self
+                .coefficients
+                .lift_drag_branch(alpha, branch.normal_positive),
+            // C_N ≡ 1, C_T ≡ 0: C_L = cos α, C_D = sin α.
+            NormalForceLaw::Unit => (wy / w, sigma * wx / w),
+        };
+        let lift_dir = Vector3::new(sigma * wx / w, sigma * wy / w, 0.0); // ℓ̂
+        let vel_dir = Vector3::new(wy / w, -wx / w, 0.0); // û
+        let d_cp = 0.82 / PI * alpha + 0.05; // eq. 3.7 on the branch
+        let r_eff = Vector3::new(o.omega4 - d_cp * o.omega3, 0.0, o.omega1);
+        // C_L ℓ̂ − C_D û, the strip force direction times its coefficient.
+        let c = lift_dir * cl - vel_dir * cd;
+        let mut torque = r_eff.cross(&c) * w2;
+        torque.z += damping;
+        Ok((c * (force * w2), torque))
     }
 
     /// The moments at a wing state (eqs. 3.8–3.11). Infallible; finite input gives finite output.

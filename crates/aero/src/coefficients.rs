@@ -87,6 +87,20 @@ pub trait CoefficientModel: Send + Sync + fmt::Debug {
     /// Short stable identifier (`"dickinson1999"`, `"whitney_wood2010"`).
     fn name(&self) -> &'static str;
 
+    /// Whether `(C_L, C_D)` jump at `α = π/2` (a fit extended past 90° by symmetry whose
+    /// `C_L(90°) ≠ 0`): a switching surface of the blade-element model.
+    fn jumps_at_right_angle(&self) -> bool {
+        false
+    }
+
+    /// The smooth branch of [`Self::lift_drag`] on one side of `α = π/2` (`below` for
+    /// `α <= π/2`), continued analytically past it (event location integrates each branch a
+    /// little beyond its switching surface). Equals [`Self::lift_drag`] on its own side.
+    #[inline]
+    fn lift_drag_branch(&self, alpha: f64, _below: bool) -> (f64, f64) {
+        self.lift_drag(alpha)
+    }
+
     /// All four coefficients at `alpha` (rad).
     #[inline]
     fn coefficients(&self, alpha: f64) -> Coefficients {
@@ -152,6 +166,20 @@ impl CoefficientModel for Dickinson1999 {
 
     fn name(&self) -> &'static str {
         "dickinson1999"
+    }
+
+    fn jumps_at_right_angle(&self) -> bool {
+        true
+    }
+
+    #[inline]
+    fn lift_drag_branch(&self, alpha: f64, below: bool) -> (f64, f64) {
+        if below {
+            Self::fit(alpha)
+        } else {
+            let (cl, cd) = Self::fit(PI - alpha);
+            (-cl, cd)
+        }
     }
 }
 
@@ -263,6 +291,21 @@ impl CoefficientModel for CoefficientSet {
         match self {
             CoefficientSet::Dickinson1999(m) => m.name(),
             CoefficientSet::WhitneyWood2010(m) => m.name(),
+        }
+    }
+
+    fn jumps_at_right_angle(&self) -> bool {
+        match self {
+            CoefficientSet::Dickinson1999(m) => m.jumps_at_right_angle(),
+            CoefficientSet::WhitneyWood2010(m) => m.jumps_at_right_angle(),
+        }
+    }
+
+    #[inline]
+    fn lift_drag_branch(&self, alpha: f64, below: bool) -> (f64, f64) {
+        match self {
+            CoefficientSet::Dickinson1999(m) => m.lift_drag_branch(alpha, below),
+            CoefficientSet::WhitneyWood2010(m) => m.lift_drag_branch(alpha, below),
         }
     }
 }

@@ -41,9 +41,11 @@ use paritysim_dynamics::wing::WingTerms;
 use paritysim_dynamics::{Device, State, Wing, WingAero};
 use paritysim_error::{Error, Result};
 
-use crate::aero::{Wrench, wrench};
+use crate::aero::{Wrench, switching, wrench_and_wing_torque};
 use crate::body::{Body, BodyMode};
 use crate::mechanisms::{DriveCoordinate, Mechanism};
+use paritysim_aero::Branch;
+use paritysim_dynamics::integrate::{MAX_SWITCHES, Sides};
 
 /// Length of the flight state array:
 /// `[quaternion (w, x, y, z), position (3), x (6), V (3), Ω (3), ẋ (6), work_actuator, work_aero]`.
@@ -120,7 +122,12 @@ pub struct FlightModel {
     polar: [Matrix3<f64>; 2],
     axial: [Matrix3<f64>; 2],
     shoulder: [Vector3<f64>; 2],
+    /// Diagonals of `polar` and `axial` (both are `±1` diagonal matrices).
+    polar_sign: [Vector3<f64>; 2],
+    axial_sign: [Vector3<f64>; 2],
     active: Vec<usize>,
+    /// How the active speeds are solved for.
+    plan: SolvePlan,
     /// Wings whose deviation the constraints hold at zero on an α2 = 90° shoulder: closed-form
     /// terms ([`Wing::stroke_plane_terms`], as the device uses them).
     stroke_plane: [bool; 2],
@@ -279,7 +286,7 @@ impl FlightModel {
                 stroke_plane[k] = held && wing.has_closed_form_stroke_plane();
             }
         }
-        let active = body
+        let active: Vec<usize> = body
             .mode
             .active()
             .iter()
@@ -288,7 +295,14 @@ impl FlightModel {
             .map(|(i, _)| i)
             .chain(6..6 + device.n_dof())
             .collect();
+        let massless = body.wing_mass[..n_wings].iter().all(|m| *m == 0.0);
+        let plan = SolvePlan::new(&active, massless);
+        let polar_sign = polar.map(|m| m.diagonal());
+        let axial_sign = axial.map(|m| m.diagonal());
         Ok(Self {
+            polar_sign,
+            axial_sign,
+            plan,
             source: source.clone(),
             n: device.n_dof(),
             basis: *device.spec().constraints.null_basis(),
@@ -342,6 +356,10 @@ impl FlightModel {
             .map(|(i, _)| i)
             .chain(6..6 + self.n)
             .collect();
+        let massless = self.body.wing_mass[..self.n_wings]
+            .iter()
+            .all(|m| *m == 0.0);
+        out.plan = SolvePlan::new(&out.active, massless);
         out
     }
 
@@ -401,7 +419,81 @@ impl FlightModel {
         inputs: &Inputs,
         dydt: &mut [f64; STATE_LEN],
     ) -> Result<()> {
-        let e = self.evaluate_with(t, y, inputs, false)?;
+        self.rhs_on(t, y, inputs, None, dydt)
+    }
+
+    /// Number of switching functions of the wings' aerodynamics ([`Self::switches`]): three
+    /// per wing, none when no wing has aerodynamics.
+    pub fn n_switches(&self) -> usize {
+        if self.aero[..self.n_wings]
+            .iter()
+            .all(|a| matches!(a, WingAero::None))
+        {
+            0
+        } else {
+            3 * self.n_wings
+        }
+    }
+
+    /// The wings' switching functions ([`crate::aero::switching`] of wing `k` in
+    /// `g[3k..3k + 3]`): where the right-hand side jumps or kinks (stroke reversal).
+    ///
+    /// # Errors
+    /// As [`Self::rhs`].
+    pub fn switches(&self, y: &[f64; STATE_LEN], g: &mut [f64; MAX_SWITCHES]) -> Result<()> {
+        let attitude =
+            UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(y[0], y[1], y[2], y[3]));
+        let r_b = *attitude.to_rotation_matrix().matrix();
+        let velocity = Vector3::new(y[VEL], y[VEL + 1], y[VEL + 2]);
+        let omega = Vector3::new(y[OMEGA], y[OMEGA + 1], y[OMEGA + 2]);
+        let (p, p_dot) = self.device.coordinates(&self.wing_state(y))?;
+        let v_body = r_b.transpose() * velocity;
+        for k in 0..self.n_wings {
+            let o = 3 * k;
+            let pw = Vector3::new(p[o], p[o + 1], p[o + 2]);
+            let vw = Vector3::new(p_dot[o], p_dot[o + 1], p_dot[o + 2]);
+            let wing = &self.device.spec().wings[k];
+            let terms = if self.stroke_plane[k] && wing.tunable_hinge().is_none() {
+                stroke_plane_kinematics(wing, &pw, &vw)
+            } else if self.stroke_plane[k] {
+                wing.stroke_plane_terms(&pw, &vw)
+            } else {
+                wing.terms(&pw, &vw)?
+            };
+            let r = terms.rotation;
+            let om6 = r.transpose() * omega.component_mul(&self.axial_sign[k]) + terms.omega;
+            let v6 = r.transpose()
+                * (v_body + omega.cross(&self.shoulder[k])).component_mul(&self.polar_sign[k]);
+            let gk = switching(&self.aero[k], &om6, &v6, &r, self.body.force_radius);
+            g[o..o + 3].copy_from_slice(&gk);
+        }
+        Ok(())
+    }
+
+    /// The wings' aerodynamic branches named by the sides of [`Self::switches`].
+    pub fn branches(&self, sides: Sides) -> [Branch; 2] {
+        std::array::from_fn(|k| Branch {
+            chordwise_positive: sides.positive(3 * k),
+            normal_positive: sides.positive(3 * k + 1),
+            spanwise_positive: sides.positive(3 * k + 2),
+        })
+    }
+
+    /// [`Self::rhs`] with the wings' aerodynamics on `branches` (event location: the smooth
+    /// branch held between the roots of [`Self::switches`]), or on the state's own sides.
+    ///
+    /// # Errors
+    /// As [`Self::rhs`].
+    #[inline]
+    pub fn rhs_on(
+        &self,
+        t: f64,
+        y: &[f64; STATE_LEN],
+        inputs: &Inputs,
+        branches: Option<&[Branch; 2]>,
+        dydt: &mut [f64; STATE_LEN],
+    ) -> Result<()> {
+        let e = self.evaluate_with(t, y, inputs, false, branches)?;
         *dydt = [0.0; STATE_LEN];
         // q̇ = ½ q ⊗ (0, Ω) on the stored (unnormalised) quaternion.
         let (w, a, b, c) = (y[0], y[1], y[2], y[3]);
@@ -531,7 +623,7 @@ impl FlightModel {
     /// # Errors
     /// As [`Self::rhs`].
     pub fn evaluate(&self, t: f64, y: &[f64; STATE_LEN], inputs: &Inputs) -> Result<FlightEval> {
-        self.evaluate_with(t, y, inputs, true)
+        self.evaluate_with(t, y, inputs, true, None)
     }
 
     /// [`Self::evaluate`]; the reactions on the airframe and the per-wing shoulder torques
@@ -543,6 +635,7 @@ impl FlightModel {
         y: &[f64; STATE_LEN],
         inputs: &Inputs,
         reactions: bool,
+        branches: Option<&[Branch; 2]>,
     ) -> Result<FlightEval> {
         let attitude =
             UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(y[0], y[1], y[2], y[3]));
@@ -569,10 +662,20 @@ impl FlightModel {
         let gyro = omega.cross(&h_b);
         force.fixed_rows_mut::<3>(0).add_assign(&(g * mb));
         force.fixed_rows_mut::<3>(3).add_assign(&(-gyro));
-        let mut kinetic = 0.5 * mb * velocity.norm_squared() + 0.5 * omega.dot(&h_b);
-        let mut momentum = velocity * mb;
-        let mut angular_momentum = position.cross(&(velocity * mb)) + r_b * h_b;
-        let mut gravity_potential = -mb * g.dot(&position);
+        // Energies and momenta: samples only (`reactions`), not the right-hand side.
+        let (mut kinetic, mut momentum, mut angular_momentum, mut gravity_potential) = if reactions
+        {
+            (
+                0.5 * mb * velocity.norm_squared() + 0.5 * omega.dot(&h_b),
+                velocity * mb,
+                position.cross(&(velocity * mb)) + r_b * h_b,
+                -mb * g.dot(&position),
+            )
+        } else {
+            (0.0, Vector3::zeros(), Vector3::zeros(), 0.0)
+        };
+        let v_body = r_b.transpose() * velocity;
+        let n = self.n;
 
         // Joint springs and the drivetrain on p, reduced by Nᵀ.
         let mut generalized_p = Vec6::zeros();
@@ -595,7 +698,10 @@ impl FlightModel {
             let pw = Vector3::new(p[o], p[o + 1], p[o + 2]);
             let vw = Vector3::new(p_dot[o], p_dot[o + 1], p_dot[o + 2]);
             let wing = &self.device.spec().wings[k];
-            let mut terms = if self.stroke_plane[k] {
+            let mut terms = if self.stroke_plane[k] && !reactions && wing.tunable_hinge().is_none()
+            {
+                stroke_plane_kinematics(wing, &pw, &vw)
+            } else if self.stroke_plane[k] {
                 wing.stroke_plane_terms(&pw, &vw)
             } else {
                 wing.terms(&pw, &vw)?
@@ -606,10 +712,26 @@ impl FlightModel {
             }
             let r = terms.rotation;
             let w = terms.omega;
-            let (pk, ak) = (&self.polar[k], &self.axial[k]);
-            let nk = self.basis.fixed_view::<3, 6>(o, 0);
-            let gk: SMatrix<f64, 3, 6> = terms.j6 * nk;
-            let rt_a = r.transpose() * ak;
+            let pk = &self.polar[k];
+            let (ps, sa) = (&self.polar_sign[k], &self.axial_sign[k]);
+            // G = J6 N_k on the n free columns (N's other columns are zero).
+            let mut gk = SMatrix::<f64, 3, 6>::zeros();
+            for j in 0..n {
+                let nj = Vector3::new(
+                    self.basis[(o, j)],
+                    self.basis[(o + 1, j)],
+                    self.basis[(o + 2, j)],
+                );
+                gk.set_column(j, &(terms.j6 * nj));
+            }
+            // Rᵀ A with A = diag(sa): Rᵀ's columns scaled.
+            let mut rt_a = r.transpose();
+            for j in 0..3 {
+                for i in 0..3 {
+                    rt_a[(i, j)] *= sa[j];
+                }
+            }
+            let a_r = rt_a.transpose();
             let om_local = rt_a * omega;
             let om6 = om_local + w;
             omega6[k] = om6;
@@ -618,24 +740,31 @@ impl FlightModel {
             bias_w[k] = -w.cross(&om_local) + terms.jdot_pdot;
             let ic = self.inertia_cm[k];
             let h6 = ic * om6;
-            let ic_g = ic * gk;
-            let cross: SMatrix<f64, 3, 6> = rt_a.transpose() * ic_g;
             mass.fixed_view_mut::<3, 3>(3, 3)
-                .add_assign(&(rt_a.transpose() * ic * rt_a));
-            mass.fixed_view_mut::<3, 6>(3, 6).add_assign(&cross);
-            mass.fixed_view_mut::<6, 3>(6, 3)
-                .add_assign(&cross.transpose());
-            mass.fixed_view_mut::<6, 6>(6, 6)
-                .add_assign(&(gk.transpose() * ic_g));
+                .add_assign(&(a_r * ic * rt_a));
             let euler = ic * bias_w[k] + om6.cross(&h6);
-            force
-                .fixed_rows_mut::<3>(3)
-                .add_assign(&(-(rt_a.transpose() * euler)));
-            force
-                .fixed_rows_mut::<6>(6)
-                .add_assign(&(-(gk.transpose() * euler)));
-            kinetic += 0.5 * om6.dot(&h6);
-            angular_momentum += r_b * (ak * (r * h6));
+            force.fixed_rows_mut::<3>(3).add_assign(&(-(a_r * euler)));
+            let mut ic_g = [Vector3::zeros(); 6];
+            for j in 0..n {
+                let gj = gk.column(j).into_owned();
+                ic_g[j] = ic * gj;
+                let c = a_r * ic_g[j];
+                for i in 0..3 {
+                    mass[(3 + i, 6 + j)] += c[i];
+                    mass[(6 + j, 3 + i)] += c[i];
+                }
+                for i in 0..j {
+                    let v = gk.column(i).dot(&ic_g[j]);
+                    mass[(6 + i, 6 + j)] += v;
+                    mass[(6 + j, 6 + i)] += v;
+                }
+                mass[(6 + j, 6 + j)] += gj.dot(&ic_g[j]);
+                force[6 + j] -= gj.dot(&euler);
+            }
+            if reactions {
+                kinetic += 0.5 * om6.dot(&h6);
+                angular_momentum += r_b * (r * h6).component_mul(sa);
+            }
             // Linear Jacobian of the wing's centre of mass (world).
             let m = self.body.wing_mass[k];
             let c = self.body.wing_center_of_mass[k];
@@ -667,21 +796,28 @@ impl FlightModel {
                 gravity_potential -= m * g.dot(&r_c);
             }
             // Aerodynamics: wrench at the shoulder.
-            let v_sh_body = r_b.transpose() * velocity + omega.cross(&s);
-            let v6 = r.transpose() * (pk * v_sh_body);
-            let wr = wrench(&self.aero[k], &om6, &v6, &r, self.body.force_radius)?;
+            let v_sh_body = v_body + omega.cross(&s);
+            let v6 = r.transpose() * v_sh_body.component_mul(ps);
+            let (wr, tau6) = wrench_and_wing_torque(
+                &self.aero[k],
+                &om6,
+                &v6,
+                &r,
+                self.body.force_radius,
+                branches.map(|b| b[k]),
+            )?;
             wrenches[k] = wr;
-            let f_body = pk * wr.force;
-            let tau_body = ak * wr.torque;
+            let f_body = wr.force.component_mul(ps);
+            let tau_body = wr.torque.component_mul(sa);
             aero_force += f_body;
             force.fixed_rows_mut::<3>(0).add_assign(&(r_b * f_body));
             force
                 .fixed_rows_mut::<3>(3)
                 .add_assign(&(s.cross(&f_body) + tau_body));
-            let tau6 = r.transpose() * wr.torque;
-            let gx: SVector<f64, 6> = gk.transpose() * tau6;
-            force.fixed_rows_mut::<6>(6).add_assign(&gx);
-            aero_power += f_body.dot(&v_sh_body) + tau_body.dot(&(ak * (r * om6)));
+            for j in 0..n {
+                force[6 + j] += gk.column(j).dot(&tau6);
+            }
+            aero_power += f_body.dot(&v_sh_body) + tau_body.dot(&(r * om6).component_mul(sa));
             terms.aero = terms.j6.transpose() * tau6;
             terms.aero_frame6 = tau6;
             wings[k] = terms;
@@ -689,27 +825,13 @@ impl FlightModel {
         let reduced: SVector<f64, 6> = self.basis.transpose() * generalized_p;
         force.fixed_rows_mut::<6>(6).add_assign(&reduced);
 
-        // Solve on the active speeds (Cholesky on the active block only).
-        let na = self.active.len();
+        // Solve on the active speeds (Cholesky on the coupled active block only).
         let mut u_dot = VecU::zeros();
-        if na > 0 {
-            let mut m_a = [0.0; NU * NU];
-            let mut f_a = [0.0; NU];
-            for (i, &ii) in self.active.iter().enumerate() {
-                f_a[i] = force[ii];
-                for (j, &jj) in self.active.iter().enumerate() {
-                    m_a[i * NU + j] = mass[(ii, jj)];
-                }
-            }
-            if !solve_spd(&mut m_a, &mut f_a, na) {
-                return Err(Error::Singular(format!(
-                    "flight mass matrix is not positive definite at p = {:?}",
-                    p.as_slice()
-                )));
-            }
-            for (i, &ii) in self.active.iter().enumerate() {
-                u_dot[ii] = f_a[i];
-            }
+        if !self.plan.solve(&mut mass, &force, &mut u_dot) {
+            return Err(Error::Singular(format!(
+                "flight mass matrix is not positive definite at p = {:?}",
+                p.as_slice()
+            )));
         }
         let mut x_ddot = Vec6::zeros();
         for i in 0..self.n {
@@ -784,11 +906,167 @@ impl FlightModel {
     }
 }
 
-/// Solves `A x = b` for a symmetric positive definite `A` (the leading `n × n` block of a
-/// row-major `NU × NU` array) by an in-place Cholesky factorisation; `b` becomes `x`. False
-/// when `A` is not positive definite.
+/// How the active generalized speeds are solved for.
+#[derive(Clone, Debug, PartialEq)]
+struct SolvePlan {
+    /// Translational speeds of a body with massless wings: their block is `m_b 1` with no
+    /// coupling to the others (`V̇ = F / m_b`).
+    direct: Vec<usize>,
+    /// The rest, by Cholesky.
+    coupled: Vec<usize>,
+    /// The first coupled index when they are consecutive (solved in place).
+    consecutive: Option<usize>,
+}
+
+impl SolvePlan {
+    fn new(active: &[usize], massless_wings: bool) -> Self {
+        let (direct, coupled): (Vec<usize>, Vec<usize>) =
+            active.iter().partition(|&&i| massless_wings && i < 3);
+        let consecutive = coupled
+            .windows(2)
+            .all(|w| w[1] == w[0] + 1)
+            .then(|| coupled.first().copied().unwrap_or(0));
+        Self {
+            direct,
+            coupled,
+            consecutive,
+        }
+    }
+
+    /// `u̇` on the active speeds of `mass u̇ = force` (`mass` is overwritten). False when the
+    /// coupled block is not positive definite.
+    #[inline]
+    fn solve(&self, mass: &mut MatU, force: &VecU, u_dot: &mut VecU) -> bool {
+        for &i in &self.direct {
+            u_dot[i] = force[i] / mass[(i, i)];
+        }
+        let nc = self.coupled.len();
+        if nc == 0 {
+            return true;
+        }
+        if let Some(off) = self.consecutive {
+            // A fixed-size block: nalgebra's unrolled Cholesky.
+            macro_rules! fixed {
+                ($($k:literal)+) => {
+                    match nc {
+                        $($k => return solve_block::<$k>(mass, force, off, u_dot),)+
+                        _ => {}
+                    }
+                };
+            }
+            fixed!(1 2 3 4 5 6 7 8 9 10 11 12);
+        }
+        let mut m_a = [0.0; NU * NU];
+        let mut f_a = [0.0; NU];
+        for (i, &ii) in self.coupled.iter().enumerate() {
+            f_a[i] = force[ii];
+            for (j, &jj) in self.coupled.iter().enumerate() {
+                m_a[i * NU + j] = mass[(ii, jj)];
+            }
+        }
+        if !solve_spd(&mut m_a, &mut f_a, 0, nc) {
+            return false;
+        }
+        for (i, &ii) in self.coupled.iter().enumerate() {
+            u_dot[ii] = f_a[i];
+        }
+        true
+    }
+}
+
+/// Solves the `N × N` block of `mass u̇ = force` at `(off, off)` into `u_dot` by the
+/// Cholesky factorisation of [`solve_spd`] on fixed-size arrays (unrolled, no bounds checks);
+/// false when it is not positive definite.
 #[inline]
-fn solve_spd(a: &mut [f64; NU * NU], b: &mut [f64; NU], n: usize) -> bool {
+#[allow(clippy::needless_range_loop)] // the index form mirrors the factorisation
+fn solve_block<const N: usize>(mass: &MatU, force: &VecU, off: usize, u_dot: &mut VecU) -> bool {
+    let mut a = [[0.0; N]; N];
+    let mut b = [0.0; N];
+    for i in 0..N {
+        b[i] = force[off + i];
+        for j in 0..=i {
+            a[i][j] = mass[(off + i, off + j)];
+        }
+    }
+    for j in 0..N {
+        let mut d = a[j][j];
+        for k in 0..j {
+            d -= a[j][k] * a[j][k];
+        }
+        if d.is_nan() || d <= 0.0 {
+            return false;
+        }
+        let d = d.sqrt();
+        a[j][j] = d;
+        for i in j + 1..N {
+            let mut v = a[i][j];
+            for k in 0..j {
+                v -= a[i][k] * a[j][k];
+            }
+            a[i][j] = v / d;
+        }
+    }
+    for i in 0..N {
+        let mut v = b[i];
+        for k in 0..i {
+            v -= a[i][k] * b[k];
+        }
+        b[i] = v / a[i][i];
+    }
+    for i in (0..N).rev() {
+        let mut v = b[i];
+        for k in i + 1..N {
+            v -= a[k][i] * b[k];
+        }
+        b[i] = v / a[i][i];
+    }
+    for i in 0..N {
+        u_dot[off + i] = b[i];
+    }
+    true
+}
+
+/// [`Wing::stroke_plane_terms`] without the mass matrix, Coriolis and aerodynamic terms (the
+/// flight model assembles its own; a wing without a tunable hinge): the same closed forms.
+#[inline]
+fn stroke_plane_kinematics(wing: &Wing, p: &Vector3<f64>, p_dot: &Vector3<f64>) -> WingTerms {
+    let (phi, psi) = (p.x, p.z);
+    let (sp, cp) = phi.sin_cos();
+    let (ss, cs) = if psi == 0.0 {
+        (0.0, 1.0)
+    } else {
+        psi.sin_cos()
+    };
+    let roll = Matrix3::new(1.0, 0.0, 0.0, 0.0, cp, -sp, 0.0, sp, cp);
+    let rotation = if psi == 0.0 {
+        roll
+    } else {
+        roll * Matrix3::new(cs, -ss, 0.0, ss, cs, 0.0, 0.0, 0.0, 1.0)
+    };
+    let j6 = Matrix3::new(cs, cp * ss, 0.0, -ss, cp * cs, 0.0, 0.0, 0.0, 1.0);
+    let omega = j6 * p_dot;
+    let jdot_pdot = Vector3::new(-ss, -cs, 0.0) * (p_dot.x * p_dot.z);
+    let sp_ = wing.springs();
+    let spring = Vector3::new(sp_[0].torque(phi), sp_[3].torque(0.0), sp_[5].torque(psi));
+    let potential = sp_[0].energy(phi) + sp_[3].energy(0.0) + sp_[5].energy(psi);
+    WingTerms {
+        j6,
+        omega,
+        jdot_pdot,
+        rotation,
+        spring,
+        potential,
+        ..empty_terms()
+    }
+}
+
+/// Solves `A x = b` for a symmetric positive definite `A` (the `n × n` block at `(off, off)`
+/// of a row-major `NU × NU` array, `b`'s entries `off..off + n`) by an in-place Cholesky
+/// factorisation; `b` becomes `x`. False when `A` is not positive definite.
+#[inline]
+fn solve_spd(a: &mut [f64; NU * NU], b: &mut [f64; NU], off: usize, n: usize) -> bool {
+    let a = &mut a[off * NU + off..];
+    let b = &mut b[off..];
     for j in 0..n {
         let mut d = a[j * NU + j];
         for k in 0..j {
@@ -846,6 +1124,34 @@ mod tests {
     use super::*;
 
     #[test]
+    fn lean_stroke_plane_kinematics_match_the_wing() {
+        let mut springs = [paritysim_dynamics::JointSpring::default(); 6];
+        springs[0] = paritysim_dynamics::JointSpring::nonlinear(3.0, 0.4, 0.1).unwrap();
+        springs[5] = paritysim_dynamics::JointSpring::linear(2.5, 0.2).unwrap();
+        let wing = Wing::new(
+            paritysim_kinematics::SphericalShoulder::new(std::f64::consts::FRAC_PI_2, 0.0).unwrap(),
+            Matrix3::new(49.0, 0.0, 4.2, 0.0, 50.5, 0.0, 4.2, 0.0, 1.56),
+            springs,
+            WingAero::None,
+        )
+        .unwrap();
+        assert!(wing.has_closed_form_stroke_plane());
+        for (p, v) in [
+            (Vector3::new(0.7, 0.0, -1.1), Vector3::new(0.2, 0.0, 0.5)),
+            (Vector3::new(-0.4, 0.0, 0.0), Vector3::new(-0.3, 0.0, 0.1)),
+        ] {
+            let a = stroke_plane_kinematics(&wing, &p, &v);
+            let b = wing.stroke_plane_terms(&p, &v);
+            assert_eq!(a.rotation, b.rotation);
+            assert_eq!(a.j6, b.j6);
+            assert_eq!(a.omega, b.omega);
+            assert_eq!(a.jdot_pdot, b.jdot_pdot);
+            assert_eq!(a.spring, b.spring);
+            assert_eq!(a.potential, b.potential);
+        }
+    }
+
+    #[test]
     fn cholesky_solve_matches_nalgebra() {
         let n = 7;
         let b = SMatrix::<f64, 7, 7>::from_fn(|i, j| ((i * 7 + j) as f64 * 0.37).sin());
@@ -860,7 +1166,7 @@ mod tests {
                 a[i * NU + j] = spd[(i, j)];
             }
         }
-        assert!(solve_spd(&mut a, &mut x, n));
+        assert!(solve_spd(&mut a, &mut x, 0, n));
         for i in 0..n {
             assert!(
                 (x[i] - expected[i]).abs() < 1e-12,
@@ -871,6 +1177,20 @@ mod tests {
         }
         let mut bad = [0.0; NU * NU];
         bad[0] = -1.0;
-        assert!(!solve_spd(&mut bad, &mut [1.0; NU], 1));
+        assert!(!solve_spd(&mut bad, &mut [1.0; NU], 0, 1));
+        // The same system at an offset (the block at (off, off) of a larger array).
+        let off = 3;
+        let mut a = [f64::NAN; NU * NU];
+        let mut x = [f64::NAN; NU];
+        for i in 0..n {
+            x[off + i] = rhs[i];
+            for j in 0..n {
+                a[(off + i) * NU + off + j] = spd[(i, j)];
+            }
+        }
+        assert!(solve_spd(&mut a, &mut x, off, n));
+        for i in 0..n {
+            assert!((x[off + i] - expected[i]).abs() < 1e-12);
+        }
     }
 }

@@ -8,7 +8,9 @@
 
 use nalgebra::{UnitQuaternion, Vector3};
 use paritysim_dynamics::device::Evaluation;
-use paritysim_dynamics::integrate::integrate_array;
+use paritysim_dynamics::integrate::{
+    ArraySink, ArraySystem, IntegrationStats, MAX_SWITCHES, Method, Sides, integrate_system,
+};
 use paritysim_dynamics::metrics::MetricsAccumulator;
 use paritysim_dynamics::simulate::SimulationResult;
 use paritysim_dynamics::trajectory::{Column, Sample, column_table};
@@ -385,6 +387,98 @@ pub fn body_values(sample: &FlightSample) -> Vec<(&'static str, f64)> {
 /// the PD controller's output).
 pub type Controller<'a> = dyn FnMut(f64, &FlightSample) -> Result<Inputs> + 'a;
 
+/// The flight equations with constant (or, [`Self::with_inputs_at`], timed) inputs as an
+/// [`ArraySystem`]: the wings' switching
+/// functions ([`FlightModel::switches`]) make the integrator stop each step at a stroke
+/// reversal (and the other surfaces where the blade-element model jumps or kinks) and hold
+/// the smooth branch in between (event location, docs/flight.md#cost).
+#[derive(Clone, Copy)]
+pub struct FlightSystem<'a> {
+    model: &'a FlightModel,
+    inputs: Inputs,
+    /// Inputs varying within the integration (linear set points), else `inputs` throughout.
+    inputs_at: Option<&'a dyn Fn(f64) -> Inputs>,
+    events: bool,
+}
+
+impl<'a> FlightSystem<'a> {
+    /// The system of `model` at `inputs`, with event location.
+    pub fn new(model: &'a FlightModel, inputs: Inputs) -> Self {
+        Self {
+            model,
+            inputs,
+            inputs_at: None,
+            events: true,
+        }
+    }
+
+    /// The same system with inputs that vary with time (`inputs_at(t)` at every evaluation).
+    pub fn with_inputs_at(mut self, inputs_at: &'a dyn Fn(f64) -> Inputs) -> Self {
+        self.inputs_at = Some(inputs_at);
+        self
+    }
+
+    /// The same system without event location (the right-hand side on the state's own sides,
+    /// steps straddling the jumps: comparisons).
+    pub fn without_events(mut self) -> Self {
+        self.events = false;
+        self
+    }
+
+    /// Integrates from `(t0, y0)` to `t_end` with `method`, `rtol`, `atol`, at most
+    /// `max_steps` steps, sampling `times` into `sink`; returns the end state and the step
+    /// counters.
+    ///
+    /// # Errors
+    /// As [`integrate_system`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn integrate(
+        mut self,
+        (method, rtol, atol, max_steps): (Method, f64, f64, usize),
+        t0: f64,
+        y0: &[f64; STATE_LEN],
+        t_end: f64,
+        times: &[f64],
+        sink: &mut ArraySink<'_, STATE_LEN>,
+    ) -> Result<([f64; STATE_LEN], IntegrationStats)> {
+        integrate_system(
+            method, rtol, atol, max_steps, &mut self, t0, y0, t_end, times, sink,
+        )
+    }
+}
+
+impl ArraySystem<STATE_LEN> for FlightSystem<'_> {
+    #[inline]
+    fn rhs(
+        &mut self,
+        t: f64,
+        y: &[f64; STATE_LEN],
+        sides: Sides,
+        dydt: &mut [f64; STATE_LEN],
+    ) -> Result<()> {
+        let branches = self.events.then(|| self.model.branches(sides));
+        let inputs = self.inputs_at.map_or(self.inputs, |at| at(t));
+        self.model.rhs_on(t, y, &inputs, branches.as_ref(), dydt)
+    }
+
+    fn n_switches(&self) -> usize {
+        if self.events {
+            self.model.n_switches()
+        } else {
+            0
+        }
+    }
+
+    fn switches(
+        &mut self,
+        _t: f64,
+        y: &[f64; STATE_LEN],
+        g: &mut [f64; MAX_SWITCHES],
+    ) -> Result<()> {
+        self.model.switches(y, g)
+    }
+}
+
 /// Runs a flight: steady state on the clamped body, release, `record_cycles` wingbeats (or
 /// `duration_ms` without a drive) sampled `samples_per_cycle` times per wingbeat.
 ///
@@ -537,9 +631,6 @@ pub fn fly_controlled(
         let end = if t_leg == t_end { times.len() } else { end };
         let leg_times = &times[next..end];
         let offset = next;
-        let mut f = |tt: f64, yy: &[f64; STATE_LEN], dy: &mut [f64; STATE_LEN]| {
-            model.rhs(tt, yy, &leg_inputs(tt), dy)
-        };
         let mut sink = |i: usize, tt: f64, yy: &[f64; STATE_LEN]| -> Result<()> {
             let s = FlightSample::new(model, tt, yy, &leg_inputs(tt))?;
             let closing = offset + i == n_samples;
@@ -553,12 +644,19 @@ pub fn fly_controlled(
             }
             Ok(())
         };
-        let (y1, _) = integrate_array(
-            options.method,
-            options.rtol,
-            options.atol,
-            options.max_steps,
-            &mut f,
+        let system = FlightSystem::new(model, held);
+        let system = if varying {
+            system.with_inputs_at(&leg_inputs)
+        } else {
+            system
+        };
+        let (y1, _) = system.integrate(
+            (
+                options.method,
+                options.rtol,
+                options.atol,
+                options.max_steps,
+            ),
             t,
             &y,
             t_leg,
@@ -601,23 +699,23 @@ pub fn integrate_flight(
     y0: &[f64; STATE_LEN],
     t_end: f64,
     times: &[f64],
-    sink: &mut paritysim_dynamics::integrate::ArraySink<'_, STATE_LEN>,
+    sink: &mut ArraySink<'_, STATE_LEN>,
 ) -> Result<[f64; STATE_LEN]> {
-    let mut f =
-        |tt: f64, yy: &[f64; STATE_LEN], dy: &mut [f64; STATE_LEN]| model.rhs(tt, yy, inputs, dy);
-    integrate_array(
-        options.method,
-        options.rtol,
-        options.atol,
-        options.max_steps,
-        &mut f,
-        t0,
-        y0,
-        t_end,
-        times,
-        sink,
-    )
-    .map(|(y, _)| y)
+    FlightSystem::new(model, *inputs)
+        .integrate(
+            (
+                options.method,
+                options.rtol,
+                options.atol,
+                options.max_steps,
+            ),
+            t0,
+            y0,
+            t_end,
+            times,
+            sink,
+        )
+        .map(|(y, _)| y)
 }
 
 /// A state of the flight model from a device state (zero body velocity, identity attitude).

@@ -12,6 +12,7 @@
 pub mod budget;
 mod dop853;
 mod dopri5;
+mod events;
 #[cfg(test)]
 mod tests;
 mod variational;
@@ -21,6 +22,8 @@ pub(crate) use dop853::lanes;
 pub(crate) use variational::DIRECTIONAL_STEP;
 
 use paritysim_error::{Error, Result, check_positive};
+
+pub use events::{MAX_SWITCHES, Sides};
 
 /// Largest number of integrated coordinates.
 pub const MAX_DOF: usize = 6;
@@ -125,6 +128,8 @@ pub struct IntegrationStats {
     /// Fixed-grid steps whose local error estimate exceeded the tolerances (always 0 for
     /// adaptive runs, which reject such steps): 0 means the grid still suits the solution.
     pub over_tolerance: usize,
+    /// Accepted steps cut short at a root of a switching function (see [`ArraySystem`]).
+    pub events: usize,
 }
 
 /// Receives the samples of an integration: `(index in times, time, state)`.
@@ -443,6 +448,16 @@ pub(crate) trait Rhs<const M: usize> {
     fn eval(&mut self, t: f64, y: &[f64; M], dydt: &mut [f64; M]) -> Result<()>;
     /// The full state of a compact one.
     fn expand(&self, c: &[f64; M]) -> State;
+    /// Number of switching functions (0: a smooth right-hand side, no event location).
+    fn n_switches(&self) -> usize {
+        0
+    }
+    /// Writes the switching functions `g(t, y)` into `g[..n_switches]`.
+    fn switches(&mut self, _t: f64, _y: &[f64; M], _g: &mut [f64; MAX_SWITCHES]) -> Result<()> {
+        Ok(())
+    }
+    /// The branch the following evaluations take.
+    fn set_sides(&mut self, _sides: Sides) {}
 }
 
 /// An explicit embedded pair with dense output.
@@ -697,8 +712,9 @@ pub(crate) fn drive_method_on_grid<const M: usize>(
     }
 }
 
-/// Emits the samples that fall inside the accepted step `[t, t_new)` from its interpolant
-/// (prepared only when one does), then those at `t_new` from the step's end value.
+/// Emits the samples that fall inside the accepted step `[t, t_stop)` (`t_stop <= t + h`) from
+/// its interpolant (prepared here, unless `dense_ready`, only when one does), then those at
+/// `t_stop` from `y_stop`, the step's value there.
 #[allow(clippy::too_many_arguments)]
 fn sample_step<const M: usize, S: Stepper<M>>(
     stepper: &mut S,
@@ -708,17 +724,20 @@ fn sample_step<const M: usize, S: Stepper<M>>(
     f0: &[f64; M],
     f1: &[f64; M],
     h: f64,
-    t_new: f64,
+    (t_stop, y_stop): (f64, &[f64; M]),
+    dense_ready: bool,
     times: &[f64],
     next: &mut usize,
     sink: &mut Sink<'_>,
     stats: &mut IntegrationStats,
 ) -> Result<State> {
-    if *next < times.len() && times[*next] < t_new {
-        stepper.prepare_dense(rhs, t, y, f0, f1, h)?;
-        stats.dense_steps += 1;
+    if *next < times.len() && times[*next] < t_stop {
+        if !dense_ready {
+            stepper.prepare_dense(rhs, t, y, f0, f1, h)?;
+            stats.dense_steps += 1;
+        }
         let mut sample = [0.0; M];
-        while *next < times.len() && times[*next] < t_new {
+        while *next < times.len() && times[*next] < t_stop {
             stepper.dense((times[*next] - t) / h, &mut sample);
             let state = rhs.expand(&sample);
             if !state.is_finite() {
@@ -728,11 +747,11 @@ fn sample_step<const M: usize, S: Stepper<M>>(
             *next += 1;
         }
     }
-    let state = rhs.expand(stepper.y1());
+    let state = rhs.expand(y_stop);
     if !state.is_finite() {
-        return Err(integration_error(t_new, &state, "non-finite state"));
+        return Err(integration_error(t_stop, &state, "non-finite state"));
     }
-    while *next < times.len() && times[*next] <= t_new {
+    while *next < times.len() && times[*next] <= t_stop {
         sink(*next, times[*next], &state)?;
         *next += 1;
     }
@@ -784,10 +803,23 @@ fn drive_on_grid<const M: usize, S: Stepper<M>>(
         }
         stats.accepted += 1;
         stepper.new_derivative(rhs, t_new, &mut f1)?;
+        let y1 = *stepper.y1();
         sample_step(
-            stepper, rhs, t, &y, &f0, &f1, h, t_new, times, &mut next, sink, &mut stats,
+            stepper,
+            rhs,
+            t,
+            &y,
+            &f0,
+            &f1,
+            h,
+            (t_new, &y1),
+            false,
+            times,
+            &mut next,
+            sink,
+            &mut stats,
         )?;
-        y = *stepper.y1();
+        y = y1;
         f0 = f1;
     }
     Ok((y, stats))
@@ -817,6 +849,17 @@ fn drive<const M: usize, S: Stepper<M>>(
             sink(next, times[next], &state)?;
             next += 1;
         }
+    }
+    // Switching functions: their sides at the start name the branch.
+    let n_switches = rhs.n_switches().min(MAX_SWITCHES);
+    let mut g0 = [0.0; MAX_SWITCHES];
+    let mut g1 = [0.0; MAX_SWITCHES];
+    let mut sides = Sides::default();
+    let mut redone_at = None;
+    if n_switches > 0 {
+        rhs.switches(t, &y, &mut g0)?;
+        sides = Sides::of(&g0[..n_switches]);
+        rhs.set_sides(sides);
     }
     let mut f0 = [0.0; M];
     rhs.eval(t, &y, &mut f0)?;
@@ -865,18 +908,89 @@ fn drive<const M: usize, S: Stepper<M>>(
             let fac = (fac11 / fac_old.powf(S::BETA) / SAFE).clamp(fac_lo, fac_hi);
             let mut h_new = h / fac;
             fac_old = err.max(1e-4);
-            stats.accepted += 1;
             let t_new = if last { t_end } else { t + h };
             stepper.new_derivative(rhs, t_new, &mut f1)?;
-            let state = sample_step(
-                stepper, rhs, t, &y, &f0, &f1, h, t_new, times, &mut next, sink, &mut stats,
-            )?;
-            y = *stepper.y1();
-            f0 = f1;
-            t = t_new;
-            on_step(t, &state);
-            if last {
-                return Ok((y, stats));
+            let y1 = *stepper.y1();
+            let mut event = None;
+            if n_switches > 0 {
+                rhs.switches(t_new, &y1, &mut g1)?;
+                if (0..n_switches).any(|i| events::crossed(sides, i, g1[i])) {
+                    stepper.prepare_dense(rhs, t, &y, &f0, &f1, h)?;
+                    stats.dense_steps += 1;
+                    let found = events::locate(stepper, rhs, n_switches, sides, t, h, &g0, &g1)?;
+                    if found.at_start && redone_at != Some(t) {
+                        // The step began on the wrong branch (a switch sitting at zero there):
+                        // take the far side and redo it.
+                        redone_at = Some(t);
+                        sides = found.sides;
+                        rhs.set_sides(sides);
+                        rhs.eval(t, &y, &mut f0)?;
+                        stats.rejected += 1;
+                        continue;
+                    }
+                    event = Some(found);
+                }
+            }
+            stats.accepted += 1;
+            match event {
+                Some(ev) if !ev.at_start && ev.t < t_new => {
+                    // Cut the step at the first switch and restart there on the new branch.
+                    let state = sample_step(
+                        stepper,
+                        rhs,
+                        t,
+                        &y,
+                        &f0,
+                        &f1,
+                        h,
+                        (ev.t, &ev.y),
+                        true,
+                        times,
+                        &mut next,
+                        sink,
+                        &mut stats,
+                    )?;
+                    stats.events += 1;
+                    y = ev.y;
+                    t = ev.t;
+                    g0 = ev.g;
+                    sides = ev.sides;
+                    rhs.set_sides(sides);
+                    rhs.eval(t, &y, &mut f0)?;
+                    on_step(t, &state);
+                }
+                other => {
+                    let dense_ready = other.is_some();
+                    let state = sample_step(
+                        stepper,
+                        rhs,
+                        t,
+                        &y,
+                        &f0,
+                        &f1,
+                        h,
+                        (t_new, &y1),
+                        dense_ready,
+                        times,
+                        &mut next,
+                        sink,
+                        &mut stats,
+                    )?;
+                    if let Some(ev) = other {
+                        // A switch that could not be bracketed (grazing): continue on its end side.
+                        sides = ev.sides;
+                        rhs.set_sides(sides);
+                        rhs.eval(t_new, &y1, &mut f1)?;
+                    }
+                    y = y1;
+                    f0 = f1;
+                    g0 = g1;
+                    t = t_new;
+                    on_step(t, &state);
+                    if last {
+                        return Ok((y, stats));
+                    }
+                }
             }
             h_new = h_new.min(h_max);
             if rejected_last {
@@ -897,6 +1011,42 @@ pub type ArraySink<'a, const M: usize> = dyn FnMut(usize, f64, &[f64; M]) -> Res
 
 /// The right-hand side of [`integrate_array`]: writes `f(t, y)`.
 pub type ArrayRhs<'a, const M: usize> = dyn FnMut(f64, &[f64; M], &mut [f64; M]) -> Result<()> + 'a;
+
+/// A plain array system `ẏ = f(t, y)` of `M` entries for [`integrate_system`], optionally
+/// piecewise smooth: [`Self::n_switches`] switching functions `g_i(t, y)` whose sign changes
+/// mark where the right-hand side jumps or kinks, and [`Self::rhs`] evaluating the smooth
+/// branch named by [`Sides`] (also slightly past the switching surface: the integrator cuts
+/// each step at the first sign change, see the module `events`).
+pub trait ArraySystem<const M: usize> {
+    /// Writes `f(t, y)` on the branch `sides` (ignored without switching functions).
+    ///
+    /// # Errors
+    /// Any model error; the integrator reports it with the time and state.
+    fn rhs(&mut self, t: f64, y: &[f64; M], sides: Sides, dydt: &mut [f64; M]) -> Result<()>;
+
+    /// Number of switching functions, at most [`MAX_SWITCHES`] (0: smooth, the default).
+    fn n_switches(&self) -> usize {
+        0
+    }
+
+    /// Writes `g(t, y)` into `g[..n_switches]`.
+    ///
+    /// # Errors
+    /// Any model error.
+    fn switches(&mut self, _t: f64, _y: &[f64; M], _g: &mut [f64; MAX_SWITCHES]) -> Result<()> {
+        Ok(())
+    }
+}
+
+/// A closure as a smooth [`ArraySystem`].
+struct Smooth<'a, 'f, const M: usize>(&'a mut ArrayRhs<'f, M>);
+
+impl<const M: usize> ArraySystem<M> for Smooth<'_, '_, M> {
+    #[inline]
+    fn rhs(&mut self, t: f64, y: &[f64; M], _: Sides, dydt: &mut [f64; M]) -> Result<()> {
+        (self.0)(t, y, dydt)
+    }
+}
 
 /// Integrates a plain array system `ẏ = f(t, y)` of `M` entries with the same Dormand–Prince
 /// pairs, step control, dense output and budget checks as [`RungeKutta`] (for models whose
@@ -922,6 +1072,40 @@ pub fn integrate_array<const M: usize>(
     times: &[f64],
     sink: &mut ArraySink<'_, M>,
 ) -> Result<([f64; M], IntegrationStats)> {
+    integrate_system(
+        method,
+        rtol,
+        atol,
+        max_steps,
+        &mut Smooth(f),
+        t0,
+        y0,
+        t_end,
+        times,
+        sink,
+    )
+}
+
+/// [`integrate_array`] on an [`ArraySystem`]: with switching functions, every step ends at
+/// the first sign change inside it (located on the dense output) and the integration
+/// restarts there on the new branch with the step size kept; `IntegrationStats::events`
+/// counts those steps.
+///
+/// # Errors
+/// As [`integrate_array`]; a failing switching function as a failing right-hand side.
+#[allow(clippy::too_many_arguments)]
+pub fn integrate_system<const M: usize>(
+    method: Method,
+    rtol: f64,
+    atol: f64,
+    max_steps: usize,
+    system: &mut dyn ArraySystem<M>,
+    t0: f64,
+    y0: &[f64; M],
+    t_end: f64,
+    times: &[f64],
+    sink: &mut ArraySink<'_, M>,
+) -> Result<([f64; M], IntegrationStats)> {
     RungeKutta::new(method, rtol, atol, max_steps)?;
     if t_end.is_nan() || t_end <= t0 || !t0.is_finite() || !t_end.is_finite() {
         return Err(Error::invalid("t_end", t_end, format!("> t0 = {t0}")));
@@ -935,12 +1119,21 @@ pub fn integrate_array<const M: usize>(
             format!("sorted and within [{t0}, {t_end}]"),
         ));
     }
+    let n_switches = system.n_switches();
+    if n_switches > MAX_SWITCHES {
+        return Err(Error::invalid(
+            "n_switches",
+            n_switches,
+            format!("at most {MAX_SWITCHES}"),
+        ));
+    }
     // The stepper hands samples over as `State`s: the array rides alongside in `last`.
     let last = std::cell::RefCell::new([0.0; M]);
     let mut rhs = ArrayAdapter {
-        f,
+        system,
         last: &last,
         calls: 0,
+        sides: Sides::default(),
     };
     let tol = Tolerances {
         rtol,
@@ -975,24 +1168,31 @@ pub fn integrate_array<const M: usize>(
 }
 
 /// [`Rhs`] of a plain array system; `expand` keeps the array in `last` for the sink.
-struct ArrayAdapter<'a, 'f, const M: usize> {
-    f: &'a mut ArrayRhs<'f, M>,
+struct ArrayAdapter<'a, const M: usize> {
+    system: &'a mut dyn ArraySystem<M>,
     last: &'a std::cell::RefCell<[f64; M]>,
     calls: usize,
+    sides: Sides,
 }
 
-impl<const M: usize> Rhs<M> for ArrayAdapter<'_, '_, M> {
+fn model_error(t: f64, y: &[f64], e: Error) -> Error {
+    match e {
+        e @ (Error::Integration { .. } | Error::Cancelled) => e,
+        e => Error::Integration {
+            time: t,
+            state: y.to_vec(),
+            reason: format!("the model failed: {e}"),
+        },
+    }
+}
+
+impl<const M: usize> Rhs<M> for ArrayAdapter<'_, M> {
     #[inline]
     fn eval(&mut self, t: f64, y: &[f64; M], dydt: &mut [f64; M]) -> Result<()> {
         self.calls += 1;
-        (self.f)(t, y, dydt).map_err(|e| match e {
-            e @ (Error::Integration { .. } | Error::Cancelled) => e,
-            e => Error::Integration {
-                time: t,
-                state: y.to_vec(),
-                reason: format!("the model failed: {e}"),
-            },
-        })
+        self.system
+            .rhs(t, y, self.sides, dydt)
+            .map_err(|e| model_error(t, y, e))
     }
 
     fn expand(&self, c: &[f64; M]) -> State {
@@ -1000,8 +1200,24 @@ impl<const M: usize> Rhs<M> for ArrayAdapter<'_, '_, M> {
         let mut y = State::default();
         let k = M.min(MAX_DOF);
         y.coords[..k].copy_from_slice(&c[..k]);
-        let r = M.saturating_sub(MAX_DOF).min(MAX_DOF);
-        y.rates[..r].copy_from_slice(&c[MAX_DOF..MAX_DOF + r]);
+        if M > MAX_DOF {
+            let r = (M - MAX_DOF).min(MAX_DOF);
+            y.rates[..r].copy_from_slice(&c[MAX_DOF..MAX_DOF + r]);
+        }
         y
+    }
+
+    fn n_switches(&self) -> usize {
+        self.system.n_switches()
+    }
+
+    fn switches(&mut self, t: f64, y: &[f64; M], g: &mut [f64; MAX_SWITCHES]) -> Result<()> {
+        self.system
+            .switches(t, y, g)
+            .map_err(|e| model_error(t, y, e))
+    }
+
+    fn set_sides(&mut self, sides: Sides) {
+        self.sides = sides;
     }
 }
