@@ -572,11 +572,32 @@ impl<C: CoefficientModel> BladeElementModel<C> {
         rot: &Matrix3<f64>,
         branch: Branch,
     ) -> Result<AeroLoads> {
+        let moments = self.moments_omega_branch(omega, branch);
+        let sigma = unit_sign(branch.chordwise_positive);
+        self.loads_from_moments(omega, rot, moments, sigma, |alpha| {
+            let (cn, ct) = self.normal_tangential_branch(alpha, branch.normal_positive);
+            // eq. 3.7 on the branch (α keeps its sign there).
+            (cn, ct, 0.82 / PI * alpha + 0.05)
+        })
+    }
+
+    /// The loads of [`Self::loads_omega`] / [`Self::loads_omega_branch`] from their moments:
+    /// lift along `ℓ̂ = σ (ω_x, ω_y)/W`, drag along `û`, torques about the shoulder from the
+    /// z-weighted strip forces; `coefficients(α) = (C_N, C_T, d_cp)`.
+    #[inline(always)]
+    fn loads_from_moments(
+        &self,
+        omega: &Vector3<f64>,
+        rot: &Matrix3<f64>,
+        moments: AeroMoments,
+        sigma: f64,
+        coefficients: impl Fn(f64) -> (f64, f64, f64),
+    ) -> Result<AeroLoads> {
         let Some(force) = self.omegas.force else {
             bail!(invalid "omegas.force", "None",
                 "set: build Omegas from a Planform or call Omegas::with_force");
         };
-        let moments = self.moments_omega_branch(omega, branch);
+        let rot = *rot;
         let damping_torque = rot * Vector3::new(0.0, 0.0, moments.rotational_damping);
         let (wx, wy) = (omega.x, omega.y);
         let w2 = wx * wx + wy * wy;
@@ -592,13 +613,12 @@ impl<C: CoefficientModel> BladeElementModel<C> {
         }
         let w = w2.sqrt();
         let alpha = moments.alpha;
-        let (cn, ct) = self.normal_tangential_branch(alpha, branch.normal_positive);
+        let (cn, ct, d_cp) = coefficients(alpha);
         let (cl, cd) = from_normal_tangential(alpha, cn, ct);
-        let sigma = unit_sign(branch.chordwise_positive);
         let lift_dir = Vector3::new(sigma * wx / w, sigma * wy / w, 0.0); // ℓ̂
         let vel_dir = Vector3::new(wy / w, -wx / w, 0.0); // û
         let o = &self.omegas;
-        let d_cp = 0.82 / PI * alpha + 0.05; // eq. 3.7 on the branch
+        // Resultant of z-weighted strip forces acting at (x_cp, 0, z): Σ r × dF = W² r_eff × (C ê).
         let r_eff = Vector3::new(o.omega4 - d_cp * o.omega3, 0.0, o.omega1);
         Ok(AeroLoads {
             lift: rot * (lift_dir * (force * w2 * cl)),
@@ -707,47 +727,10 @@ impl<C: CoefficientModel> BladeElementModel<C> {
     /// As [`Self::loads`].
     #[inline]
     pub fn loads_omega(&self, omega: &Vector3<f64>, rot: &Matrix3<f64>) -> Result<AeroLoads> {
-        let Some(force) = self.omegas.force else {
-            bail!(invalid "omegas.force", "None",
-                "set: build Omegas from a Planform or call Omegas::with_force");
-        };
-        let omega = *omega;
-        let rot = *rot;
-        let moments = self.moments_omega(&omega);
-        let damping_torque = rot * Vector3::new(0.0, 0.0, moments.rotational_damping);
-        let (wx, wy) = (omega.x, omega.y);
-        let w2 = wx * wx + wy * wy;
-        if w2 == 0.0 {
-            return Ok(AeroLoads {
-                lift: Vector3::zeros(),
-                drag: Vector3::zeros(),
-                lift_torque: Vector3::zeros(),
-                drag_torque: Vector3::zeros(),
-                damping_torque,
-                moments,
-            });
-        }
-        let w = w2.sqrt();
-        let alpha = moments.alpha;
-        let (cn, ct) = self.normal_tangential(alpha);
-        let (cl, cd) = from_normal_tangential(alpha, cn, ct);
-        let sigma = sign(wx);
-        let lift_dir = Vector3::new(sigma * wx / w, sigma * wy / w, 0.0); // ℓ̂
-        let vel_dir = Vector3::new(wy / w, -wx / w, 0.0); // û
-        let o = &self.omegas;
-        // Resultant of z-weighted strip forces acting at (x_cp, 0, z): Σ r × dF = W² r_eff × (C ê).
-        let r_eff = Vector3::new(
-            o.omega4 - center_of_pressure(alpha) * o.omega3,
-            0.0,
-            o.omega1,
-        );
-        Ok(AeroLoads {
-            lift: rot * (lift_dir * (force * w2 * cl)),
-            drag: rot * (vel_dir * (-force * w2 * cd)),
-            lift_torque: rot * r_eff.cross(&lift_dir) * (w2 * cl),
-            drag_torque: rot * r_eff.cross(&vel_dir) * (-w2 * cd),
-            damping_torque,
-            moments,
+        let moments = self.moments_omega(omega);
+        self.loads_from_moments(omega, rot, moments, sign(omega.x), |alpha| {
+            let (cn, ct) = self.normal_tangential(alpha);
+            (cn, ct, center_of_pressure(alpha))
         })
     }
 }

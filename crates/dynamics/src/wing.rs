@@ -417,12 +417,7 @@ impl Wing {
         let sp_ = &self.springs;
         let mut spring = Vector3::new(sp_[0].torque(phi), sp_[3].torque(0.0), sp_[5].torque(psi));
         let mut potential = sp_[0].energy(phi) + sp_[3].energy(0.0) + sp_[5].energy(psi);
-        if let Some(h) = &self.tunable_hinge {
-            let k = h.stiffness(0.0);
-            spring.z += k * psi;
-            spring.y += 0.5 * h.k1 * psi * psi;
-            potential += 0.5 * k * psi * psi;
-        }
+        self.add_tunable_hinge(0.0, psi, &mut spring, &mut potential);
         let aero_frame6 = self.aero.torque(p_dot, &omega, &rotation);
         WingTerms {
             mass: j6.transpose() * self.inertia * j6,
@@ -563,12 +558,7 @@ impl Wing {
         let s = &self.springs;
         let mut spring = Vector3::new(s[0].torque(phi), s[3].torque(theta), s[5].torque(psi));
         let mut potential = s[0].energy(phi) + s[3].energy(theta) + s[5].energy(psi);
-        if let Some(h) = &self.tunable_hinge {
-            let k = h.stiffness(theta);
-            spring.z += k * psi;
-            spring.y += 0.5 * (h.k1 + 2.0 * h.k2 * theta) * psi * psi;
-            potential += 0.5 * k * psi * psi;
-        }
+        self.add_tunable_hinge(theta, psi, &mut spring, &mut potential);
 
         let aero_frame6 = self.aero.torque(p_dot, &omega, &r61);
         Some(WingTerms {
@@ -585,6 +575,25 @@ impl Wing {
             potential,
             kinetic: 0.5 * omega.dot(&i_omega),
         })
+    }
+
+    /// Adds the tunable hinge's load (§3.4: stiffness `k(θ)` on ψ, and its `∂/∂θ` on θ) and
+    /// energy to the joint springs' (one place for the general, free-deviation and
+    /// stroke-plane terms).
+    #[inline(always)]
+    fn add_tunable_hinge(
+        &self,
+        theta: f64,
+        psi: f64,
+        spring: &mut Vector3<f64>,
+        potential: &mut f64,
+    ) {
+        if let Some(h) = &self.tunable_hinge {
+            let k = h.stiffness(theta);
+            spring.z += k * psi;
+            spring.y += 0.5 * (h.k1 + 2.0 * h.k2 * theta) * psi * psi;
+            *potential += 0.5 * k * psi * psi;
+        }
     }
 
     /// Whether [`Self::free_deviation_terms`] applies to this wing (α2 = 90°, α3 = 0, no
@@ -649,12 +658,7 @@ impl Wing {
             potential += s[j].energy(gammas[j]);
         }
 
-        if let Some(h) = &self.tunable_hinge {
-            let k = h.stiffness(theta);
-            spring.z += k * psi;
-            spring.y += 0.5 * (h.k1 + 2.0 * h.k2 * theta) * psi * psi;
-            potential += 0.5 * k * psi * psi;
-        }
+        self.add_tunable_hinge(theta, psi, &mut spring, &mut potential);
 
         let aero_frame6 = self.aero.torque(p_dot, &omega, &r61);
         Ok(WingTerms {
