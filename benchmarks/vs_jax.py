@@ -266,6 +266,15 @@ def main() -> None:
         [list(scipy_point(omega_l[i], k2[i], args.cycles, args.samples, args.rtol, atol).values()) for i in pick]
     )
     sizes[f"scipy solve_ivp DOP853 loop ({args.scipy_points} points)"] = len(pick)
+    # One cold trial (issue 12: <= 0.7 ms, >= 300x scipy): ps.simulate per point at the
+    # default steady state from the spec's own start, one thread, specs built beforehand,
+    # the Table 3.2 metrics only (no trajectory column).
+    base = spec(args.rtol, atol, args.samples)
+    trial_specs = [base.with_paths({"wings.left.omega_ratio": omega_l[i] / OMEGA_R, "drivetrain.balance_spring": k2[i]}) for i in pick]
+    peers["paritysim simulate, one cold trial per point"] = lambda: np.array(
+        [list(ps.simulate(s, columns=[], metrics=METRICS).metrics.values()) for s in trial_specs]
+    )
+    sizes["paritysim simulate, one cold trial per point"] = len(pick)
 
     times: dict[str, list[float]] = {name: [] for name in peers}
     results: dict[str, np.ndarray] = {}
@@ -279,7 +288,7 @@ def main() -> None:
     jax_best = min((v for k, v in ms.items() if k.startswith("JAX")), default=float("nan"))
     print(f"\n{'implementation':48s} {'ms/point':>10s} {'vs paritysim':>13s} {'torque err':>11s} {'pct err':>9s}")
     for name in peers:
-        ref = reference[pick] if name.startswith("scipy") else reference
+        ref = reference[pick] if name.startswith(("scipy", "paritysim simulate")) else reference
         rel, pct = errors(results[name], ref)
         print(f"{name:48s} {ms[name]:10.3f} {ms[name] / ours:12.1f}x {rel:11.1e} {pct:9.1e}")
     ours_on_scipy_points = errors(results["paritysim sweep, shooting (metrics only)"][pick], reference[pick])

@@ -164,3 +164,25 @@ def test_last_sample_lands_on_the_window_end(frequency_hz: float, amplitude_v: f
     spec = spec.replace(actuator=dataclasses.replace(spec.actuator, waveform=ps.Waveform(amplitude_v=amplitude_v, frequency_hz=frequency_hz)))
     r = ps.simulate(spec, max_cycles=40)
     assert r.trajectory.height == 2 * 200 + 1
+
+
+@pytest.mark.parametrize("name", ["drag_parity", "hmf"])
+def test_asked_columns_and_metrics_are_the_full_runs_values(name: str) -> None:
+    """`columns=` / `metrics=` build only what is asked: the same numbers as the full run
+    (to round-off: the lean samples do the full samples' arithmetic), only those names, in the
+    asked order; unknown names are errors naming the selection."""
+    spec = ps.load_spec(EXAMPLES / f"{name}.toml")
+    full = ps.simulate(spec)
+    asked = ["imbalance_peak_pct", "right_roll_aero_peak", "left_stroke_amplitude"]
+    lean = ps.simulate(spec, columns=["left_phi"], metrics=asked)
+    assert list(lean.metrics) == asked
+    for m in asked:
+        assert lean.metrics[m] == pytest.approx(full.metrics[m], rel=1e-12, abs=1e-12)
+    assert lean.trajectory.columns == ["time_ms", "left_phi"]
+    np.testing.assert_allclose(lean.trajectory["left_phi"], full.trajectory["left_phi"], rtol=0, atol=1e-12)
+    metrics_only = ps.simulate(spec, columns=[], metrics=asked[:1])
+    assert metrics_only.trajectory.height == 0 and list(metrics_only.metrics) == asked[:1]
+    with pytest.raises(ps.InvalidParameterError, match=r"metrics.*imbalance_peak_pct"):
+        ps.simulate(spec, metrics=["imbalance_peak_pc"])
+    with pytest.raises(ps.InvalidParameterError, match=r"columns.*left_phi"):
+        ps.simulate(spec, columns=["left_ph"])

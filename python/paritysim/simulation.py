@@ -6,7 +6,7 @@ import math
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -119,17 +119,33 @@ def _control_call(controller: Controller) -> Callable[[float, list[tuple[str, fl
     return call
 
 
+def _names(names: Sequence[str] | None) -> list[str] | None:
+    """A column or metric selection as the core reads it (a lone string is one name)."""
+    if names is None:
+        return None
+    return [names] if isinstance(names, str) else [str(n) for n in names]
+
+
 def simulate(
     spec: Simulation | dict[str, Any],
     *,
     controller: Controller | None = None,
     control_rate_hz: float | None = None,
+    columns: Sequence[str] | None = None,
+    metrics: Sequence[str] | None = None,
     **option_overrides: Any,
 ) -> SimulationResult:
     """Run ``spec`` to periodic steady state (or for ``options.duration_ms``) in Rust.
 
     ``spec`` is a `Simulation` or its dict (``Simulation.to_dict()``). ``option_overrides``
     replace fields of ``spec.options`` for this run, e.g. ``simulate(spec, record_cycles=3)``.
+
+    ``columns`` and ``metrics`` choose what is built: ``None`` (default) all trajectory
+    columns and metrics, a list only those (``[]``: none, e.g. ``columns=[]`` for metrics
+    only). Asking for less is faster: unasked columns are never recorded, and on fixed-wing
+    drivetrain devices the samples compute only what the asked metrics need. Unknown names
+    raise ``InvalidParameterError`` naming ``columns`` / ``metrics`` and the nearest valid
+    name.
 
     ``controller`` (a flying spec only: ``[body]`` mode other than ``fixed``) is a Python
     function ``controller(t_ms, body) -> {input: value}`` called every ``1 / control_rate_hz``
@@ -165,14 +181,14 @@ def simulate(
     if controller is None:
         if control_rate_hz is not None:
             raise invalid("control_rate_hz", control_rate_hz, "given only with a controller")
-        raw = _core.simulate(spec.to_json())
+        raw = _core.simulate(spec.to_json(), _names(columns), _names(metrics))
     else:
         if not callable(controller):
             raise invalid("controller", type(controller).__name__, "a callable (t_ms, body) -> dict")
         if control_rate_hz is None:
             raise invalid("control_rate_hz", None, "a positive control rate (Hz) with a controller")
         rate = real("control_rate_hz", control_rate_hz)
-        raw = _core.simulate_controlled(spec.to_json(), _control_call(controller), rate)
+        raw = _core.simulate_controlled(spec.to_json(), _control_call(controller), rate, _names(columns), _names(metrics))
     return SimulationResult(
         metrics={k: (v if math.isfinite(v) else None) for k, v in raw.metrics},
         cycles_run=raw.cycles_run,

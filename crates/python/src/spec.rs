@@ -130,17 +130,27 @@ pub(crate) fn cancellable<T: Send>(
 
 /// Simulates a JSON spec on a worker thread (GIL released); Ctrl-C stops it within a few
 /// tens of milliseconds and raises `KeyboardInterrupt`.
+/// `columns` / `metrics` select what is built (`None`: everything).
 #[pyfunction]
-fn simulate(py: Python<'_>, json: &str) -> PyResult<SimulationOutput> {
+#[pyo3(signature = (json, columns=None, metrics=None))]
+fn simulate(
+    py: Python<'_>,
+    json: &str,
+    columns: Option<Vec<String>>,
+    metrics: Option<Vec<String>>,
+) -> PyResult<SimulationOutput> {
     let spec = parse(json).py_err()?;
-    let (device, mut options) = spec.model().py_err()?;
+    let (device, options) = spec.model().py_err()?;
+    let mut options = spec
+        .with_outputs(&device, &options, columns.as_deref(), metrics.as_deref())
+        .py_err()?;
     let cancel = CancelFlag::new();
     options.cancel = Some(cancel.clone());
     let r = interruptible(py, &cancel, || {
         // A spec with a moving body flies (paritysim-flight); otherwise the fixed-body engine.
         spec.run(&device, &options).map_err(|e| spec.attribute(e))
     })?;
-    output(py, r)
+    output(py, Simulation::asked_metrics(&options, r))
 }
 
 /// `simulate` of a flying spec with a Python controller called every `1 / rate_hz` with
@@ -148,14 +158,20 @@ fn simulate(py: Python<'_>, json: &str) -> PyResult<SimulationOutput> {
 /// `[[body.set_points]]`; unknown names and non-finite values raise `InvalidParameterError`).
 /// Its exception is raised as is.
 #[pyfunction]
+#[pyo3(signature = (json, controller, rate_hz, columns=None, metrics=None))]
 fn simulate_controlled(
     py: Python<'_>,
     json: &str,
     controller: Py<PyAny>,
     rate_hz: f64,
+    columns: Option<Vec<String>>,
+    metrics: Option<Vec<String>>,
 ) -> PyResult<SimulationOutput> {
     let spec = parse(json).py_err()?;
     let (device, options) = spec.model().py_err()?;
+    let options = spec
+        .with_outputs(&device, &options, columns.as_deref(), metrics.as_deref())
+        .py_err()?;
     let mut raised: Option<PyErr> = None;
     let mut call = |t: f64, s: &paritysim_flight::FlightSample| {
         Python::attach(|py| {
@@ -178,7 +194,7 @@ fn simulate_controlled(
     });
     match (raised, r) {
         (Some(e), _) => Err(e),
-        (None, r) => output(py, r.py_err()?),
+        (None, r) => output(py, Simulation::asked_metrics(&options, r.py_err()?)),
     }
 }
 

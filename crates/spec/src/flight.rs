@@ -239,6 +239,57 @@ impl Simulation {
         }))
     }
 
+    /// `options` building only the asked trajectory columns and metrics (`None`: all of
+    /// them; an empty list: none). Fewer columns and metrics cost less: no column is recorded
+    /// that is not asked for, and a drivetrain-coordinate device's samples compute only what
+    /// the asked metrics need.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] (`columns` or `metrics`, naming the nearest valid name) for
+    /// an unknown name; as [`Simulation::flight`].
+    pub fn with_outputs(
+        &self,
+        device: &Device,
+        options: &SimulationOptions,
+        columns: Option<&[String]>,
+        metrics: Option<&[String]>,
+    ) -> Result<SimulationOptions> {
+        let mut options = options.clone();
+        if let Some(c) = columns {
+            let valid = self.column_names(device)?;
+            options.columns = Some(paritysim_dynamics::sweep::select(
+                "columns",
+                Some(c),
+                &valid,
+            )?);
+        }
+        if let Some(m) = metrics {
+            let valid = self.metric_names(device)?;
+            options.metrics = Some(paritysim_dynamics::sweep::select(
+                "metrics",
+                Some(m),
+                &valid,
+            )?);
+        }
+        Ok(options)
+    }
+
+    /// The metrics of `result` reduced to `options.metrics` (in that order) when they were
+    /// asked for ([`Simulation::with_outputs`]); all of them otherwise.
+    pub fn asked_metrics(
+        options: &SimulationOptions,
+        mut result: SimulationResult,
+    ) -> SimulationResult {
+        if let Some(names) = &options.metrics {
+            let all = std::mem::take(&mut result.metrics);
+            result.metrics = names
+                .iter()
+                .filter_map(|n| all.iter().find(|(k, _)| k == n).cloned())
+                .collect();
+        }
+        result
+    }
+
     /// Runs the spec: the engine's [`paritysim_dynamics::simulate`] for a fixed body, free
     /// flight ([`paritysim_flight::fly`]) otherwise. `device` and `options` are those of
     /// [`Simulation::model`] (the caller may set a cancel flag on the options).
