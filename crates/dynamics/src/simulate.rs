@@ -39,7 +39,7 @@ pub enum SteadyState {
     /// automatic fallback of [`SteadyState::Shooting`]).
     Transient,
     /// Newton shooting on the stroboscopic map retraced on a frozen step grid
-    /// ([`crate::grid_shooting`]): warm-up of up to `min_cycles` (none with
+    /// (`grid_shooting`): warm-up of up to `min_cycles` (none with
     /// [`SimulationOptions::shooting_jacobian`]), one adaptive period at `rtol / 100` that picks
     /// the grid (with the variational equations when no Jacobian is given), Newton steps with
     /// Broyden updates; the last Newton period is the recorded window. Converged when the

@@ -13,7 +13,7 @@ use paritysim_error::{Error, Result};
 
 use crate::device::{Device, Evaluation};
 use crate::integrate::State;
-use crate::metrics::StrokeNeeds;
+use crate::metrics::needs::StrokeNeeds;
 
 /// Everything derived from one sample `(t, y)`: the model evaluation and the body torques.
 #[derive(Clone, Copy, Debug)]

@@ -1,11 +1,11 @@
 //! Sweep chains in SIMD lanes: several shooting points integrated at once.
 //!
-//! A shooting point of [`SteadyState::Shooting`] is a sequence of one-period integrations:
+//! A shooting point of [`crate::SteadyState::Shooting`] is a sequence of one-period integrations:
 //! the warm-up and the variational period of a chain's start, then (continued points) the
 //! neighbour's grid checked or a new one picked, Newton trials on the frozen grid and the
-//! recorded window (docs/findings.md §6-7). Here [`LANES`] chains advance side by side, one
+//! recorded window (docs/findings.md §6-7). Here `LANES` chains advance side by side, one
 //! point per lane: every lane carries its own grid or step control, time, step and state
-//! through the DOP853 stages ([`crate::integrate::lanes`], `wide::f64x4`), and a lane whose
+//! through the DOP853 stages (`integrate::dop853_lanes`, `wide::f64x4`), and a lane whose
 //! period ends is handed its point's next period (or the next point of its chain, or the next
 //! chain of its group) while the others keep stepping: the ensemble technique of heyoka and
 //! MPGOS. Groups of chains run in parallel on the sweep's rayon pool.
@@ -15,7 +15,7 @@
 //!   linear differential map with stroke drag ([`has_lane_model`]); every other point runs the
 //!   scalar path in place, in its chain's order.
 //! * **Same results.** The lanes perform the scalar path's floating-point operations in its
-//!   order, and the Newton logic here ([`LanePoint`]) is that of `grid_shooting::shoot` and
+//!   order, and the Newton logic here (`LanePoint`) is that of `grid_shooting::shoot` and
 //!   `simulate::shooting_steady_state`. The branches it does not follow (a failing period, a
 //!   singular Newton step, no convergence, an unstable orbit: `shoot`'s `Ok(None)` and errors)
 //!   rerun the point on the scalar path from the same start, so every point's result is

@@ -19,6 +19,8 @@
 //! Undefined metrics are NaN (Python turns them into `None` / null): the phase lag of a wing
 //! that does not rotate, the imbalance percentages when `τR_peak = 0`.
 
+pub mod needs;
+pub use needs::{StrokeNeeds, is_stroke_metric};
 use std::f64::consts::{PI, TAU};
 
 use crate::device::Device;
@@ -137,71 +139,6 @@ pub struct MetricsAccumulator {
     lean: Option<StrokeNeeds>,
 }
 
-/// Metrics read from the work integrals.
-const WORK_METRICS: [&str; 3] = [
-    "work_actuator_per_cycle",
-    "work_aero_per_cycle",
-    "mean_actuator_power",
-];
-
-/// What a [`StrokeSample`] computes beyond the stroke kinematics, as the asked metrics need.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct StrokeNeeds {
-    /// The actuator force (`actuator_force_peak`).
-    pub force: bool,
-    /// The body reaction torques: per-wing and net `{roll,yaw,pitch}_{mean,rms,peak}` (the
-    /// stroke accelerations, so one drivetrain solve per sample; the force comes with them).
-    pub torques: bool,
-    /// The work integrals (`work_*_per_cycle`, `mean_actuator_power`): the recorded window
-    /// integrates them.
-    pub work: bool,
-}
-
-impl StrokeNeeds {
-    /// Everything (every metric).
-    pub const ALL: Self = Self {
-        force: true,
-        torques: true,
-        work: true,
-    };
-
-    /// What the metrics `names` need (`None`: all of them). Unknown names count as torque
-    /// metrics (they are reported NaN by the caller's selection).
-    pub fn of(names: Option<&[String]>) -> Self {
-        let Some(names) = names else {
-            return Self::ALL;
-        };
-        let mut needs = Self {
-            force: false,
-            torques: false,
-            work: false,
-        };
-        for name in names {
-            if name == "actuator_force_peak" {
-                needs.force = true;
-            } else if WORK_METRICS.contains(&name.as_str()) {
-                needs.work = true;
-            } else if !is_stroke_metric(name) {
-                needs.torques = true;
-            }
-        }
-        // The torques solve the drivetrain dynamics, which evaluate the force anyway.
-        needs.force |= needs.torques;
-        needs
-    }
-
-    /// Whether samples computing this much give metric `name`.
-    pub fn provides(&self, name: &str) -> bool {
-        if name == "actuator_force_peak" {
-            self.force
-        } else if WORK_METRICS.contains(&name) {
-            self.work
-        } else {
-            is_stroke_metric(name) || self.torques
-        }
-    }
-}
-
 /// The per-sample values every metric path shares.
 struct Core {
     time: f64,
@@ -210,38 +147,6 @@ struct Core {
     roll_aero: [f64; 2],
     force: f64,
     q2: f64,
-}
-
-/// Metrics a [`StrokeSample`] suffices for (fixed wings in drivetrain coordinates): stroke
-/// angles, drag roll torques, Table 3.2, `q2_amplitude`, `actuator_force_peak` (the rotation
-/// metrics are those of ψ ≡ 0).
-pub fn is_stroke_metric(name: &str) -> bool {
-    const WING: [&str; 8] = [
-        "stroke_amplitude",
-        "stroke_peak_to_peak",
-        "stroke_mean",
-        "rotation_amplitude",
-        "rotation_mean",
-        "rotation_phase_lag",
-        "roll_aero_peak",
-        "roll_aero_mean",
-    ];
-    const DEVICE: [&str; 7] = [
-        "actuator_force_peak",
-        "q2_amplitude",
-        "delta_tau_peak",
-        "tau_l_peak",
-        "tau_r_peak",
-        "imbalance_instantaneous_pct",
-        "imbalance_peak_pct",
-    ];
-    let wing = ["left_", "right_", "wing_"]
-        .iter()
-        .find_map(|p| name.strip_prefix(p));
-    match wing {
-        Some(rest) => WING.contains(&rest),
-        None => DEVICE.contains(&name),
-    }
 }
 
 impl MetricsAccumulator {
