@@ -396,6 +396,24 @@ impl Wing {
     /// `J6 = [(cψ, −sψ, 0), cos φ (sψ, cψ, 0), ẑ]` and `J̇6 ṗ = φ̇ ψ̇ (−sψ, −cψ, 0)`. Valid without
     /// springs on joints 2, 3, 5; tested against [`Self::terms`].
     pub fn stroke_plane_terms(&self, p: &Vector3<f64>, p_dot: &Vector3<f64>) -> WingTerms {
+        let k = self.stroke_plane_kinematics(p, p_dot);
+        let i_omega = self.inertia * k.omega;
+        let aero_frame6 = self.aero.torque(p_dot, &k.omega, &k.rotation);
+        WingTerms {
+            mass: k.j6.transpose() * self.inertia * k.j6,
+            coriolis: k.j6.transpose() * (self.inertia * k.jdot_pdot + k.omega.cross(&i_omega)),
+            aero: k.j6.transpose() * aero_frame6,
+            aero_frame6,
+            kinetic: 0.5 * k.omega.dot(&i_omega),
+            ..k
+        }
+    }
+
+    /// The kinematic part of [`Self::stroke_plane_terms`] (rotation, `J6`, `ω`, `J̇6 ṗ`) and the
+    /// joint springs with the tunable hinge, without the inertial and aerodynamic terms (the
+    /// free-flight model assembles its own): `mass` is the identity, `coriolis`, `aero`,
+    /// `aero_frame6` and `kinetic` are zero.
+    pub fn stroke_plane_kinematics(&self, p: &Vector3<f64>, p_dot: &Vector3<f64>) -> WingTerms {
         let (phi, psi) = (p.x, p.z);
         let (sp, cp) = phi.sin_cos();
         // ψ ≡ 0 on fixed (stroke-only) wings: skip its rotation.
@@ -413,25 +431,23 @@ impl Wing {
         let j6 = Matrix3::new(cs, cp * ss, 0.0, -ss, cp * cs, 0.0, 0.0, 0.0, 1.0);
         let omega = j6 * p_dot;
         let jdot_pdot = Vector3::new(-ss, -cs, 0.0) * (p_dot.x * p_dot.z);
-        let i_omega = self.inertia * omega;
         let sp_ = &self.springs;
         let mut spring = Vector3::new(sp_[0].torque(phi), sp_[3].torque(0.0), sp_[5].torque(psi));
         let mut potential = sp_[0].energy(phi) + sp_[3].energy(0.0) + sp_[5].energy(psi);
         self.add_tunable_hinge(0.0, psi, &mut spring, &mut potential);
-        let aero_frame6 = self.aero.torque(p_dot, &omega, &rotation);
         WingTerms {
-            mass: j6.transpose() * self.inertia * j6,
-            coriolis: j6.transpose() * (self.inertia * jdot_pdot + omega.cross(&i_omega)),
+            mass: Matrix3::identity(),
+            coriolis: Vector3::zeros(),
             spring,
-            aero: j6.transpose() * aero_frame6,
-            aero_frame6,
+            aero: Vector3::zeros(),
+            aero_frame6: Vector3::zeros(),
             j6,
             omega,
             jdot_pdot,
             rotation,
             theta_w: 0.0,
             potential,
-            kinetic: 0.5 * omega.dot(&i_omega),
+            kinetic: 0.0,
         }
     }
 

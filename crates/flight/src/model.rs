@@ -454,7 +454,7 @@ impl FlightModel {
             let vw = Vector3::new(p_dot[o], p_dot[o + 1], p_dot[o + 2]);
             let wing = &self.device.spec().wings[k];
             let terms = if self.stroke_plane[k] && wing.tunable_hinge().is_none() {
-                stroke_plane_kinematics(wing, &pw, &vw)
+                wing.stroke_plane_kinematics(&pw, &vw)
             } else if self.stroke_plane[k] {
                 wing.stroke_plane_terms(&pw, &vw)
             } else {
@@ -700,7 +700,7 @@ impl FlightModel {
             let wing = &self.device.spec().wings[k];
             let mut terms = if self.stroke_plane[k] && !reactions && wing.tunable_hinge().is_none()
             {
-                stroke_plane_kinematics(wing, &pw, &vw)
+                wing.stroke_plane_kinematics(&pw, &vw)
             } else if self.stroke_plane[k] {
                 wing.stroke_plane_terms(&pw, &vw)
             } else {
@@ -1026,40 +1026,6 @@ fn solve_block<const N: usize>(mass: &MatU, force: &VecU, off: usize, u_dot: &mu
     true
 }
 
-/// [`Wing::stroke_plane_terms`] without the mass matrix, Coriolis and aerodynamic terms (the
-/// flight model assembles its own; a wing without a tunable hinge): the same closed forms.
-#[inline]
-fn stroke_plane_kinematics(wing: &Wing, p: &Vector3<f64>, p_dot: &Vector3<f64>) -> WingTerms {
-    let (phi, psi) = (p.x, p.z);
-    let (sp, cp) = phi.sin_cos();
-    let (ss, cs) = if psi == 0.0 {
-        (0.0, 1.0)
-    } else {
-        psi.sin_cos()
-    };
-    let roll = Matrix3::new(1.0, 0.0, 0.0, 0.0, cp, -sp, 0.0, sp, cp);
-    let rotation = if psi == 0.0 {
-        roll
-    } else {
-        roll * Matrix3::new(cs, -ss, 0.0, ss, cs, 0.0, 0.0, 0.0, 1.0)
-    };
-    let j6 = Matrix3::new(cs, cp * ss, 0.0, -ss, cp * cs, 0.0, 0.0, 0.0, 1.0);
-    let omega = j6 * p_dot;
-    let jdot_pdot = Vector3::new(-ss, -cs, 0.0) * (p_dot.x * p_dot.z);
-    let sp_ = wing.springs();
-    let spring = Vector3::new(sp_[0].torque(phi), sp_[3].torque(0.0), sp_[5].torque(psi));
-    let potential = sp_[0].energy(phi) + sp_[3].energy(0.0) + sp_[5].energy(psi);
-    WingTerms {
-        j6,
-        omega,
-        jdot_pdot,
-        rotation,
-        spring,
-        potential,
-        ..empty_terms()
-    }
-}
-
 /// Solves `A x = b` for a symmetric positive definite `A` (the `n × n` block at `(off, off)`
 /// of a row-major `NU × NU` array, `b`'s entries `off..off + n`) by an in-place Cholesky
 /// factorisation; `b` becomes `x`. False when `A` is not positive definite.
@@ -1140,7 +1106,7 @@ mod tests {
             (Vector3::new(0.7, 0.0, -1.1), Vector3::new(0.2, 0.0, 0.5)),
             (Vector3::new(-0.4, 0.0, 0.0), Vector3::new(-0.3, 0.0, 0.1)),
         ] {
-            let a = stroke_plane_kinematics(&wing, &p, &v);
+            let a = wing.stroke_plane_kinematics(&p, &v);
             let b = wing.stroke_plane_terms(&p, &v);
             assert_eq!(a.rotation, b.rotation);
             assert_eq!(a.j6, b.j6);

@@ -28,6 +28,26 @@ pub use events::{MAX_SWITCHES, Sides};
 /// Largest number of integrated coordinates.
 pub const MAX_DOF: usize = 6;
 
+/// Checks an integration window: finite `t0 < t_end`, sample `times` sorted within it.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `t_end` or `times[i]`.
+fn check_window(t0: f64, t_end: f64, times: &[f64]) -> Result<()> {
+    if t_end.is_nan() || t_end <= t0 || !t0.is_finite() || !t_end.is_finite() {
+        return Err(Error::invalid("t_end", t_end, format!("> t0 = {t0}")));
+    }
+    if let Some(i) = (0..times.len())
+        .find(|&i| !(times[i] >= t0 && times[i] <= t_end) || (i > 0 && times[i] < times[i - 1]))
+    {
+        return Err(Error::invalid(
+            format!("times[{i}]"),
+            times[i],
+            format!("sorted and within [{t0}, {t_end}]"),
+        ));
+    }
+    Ok(())
+}
+
 /// Integrator state: integrated coordinates and their rates (entries past the system's
 /// [`OdeSystem::n_active`] stay zero) and the two work integrals.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -343,18 +363,7 @@ impl RungeKutta {
         sink: &mut Sink<'_>,
         on_step: &mut dyn FnMut(f64, &State),
     ) -> Result<(State, IntegrationStats)> {
-        if t_end.is_nan() || t_end <= t0 || !t0.is_finite() || !t_end.is_finite() {
-            return Err(Error::invalid("t_end", t_end, format!("> t0 = {t0}")));
-        }
-        if let Some(i) = (0..times.len())
-            .find(|&i| !(times[i] >= t0 && times[i] <= t_end) || (i > 0 && times[i] < times[i - 1]))
-        {
-            return Err(Error::invalid(
-                format!("times[{i}]"),
-                times[i],
-                format!("sorted and within [{t0}, {t_end}]"),
-            ));
-        }
+        check_window(t0, t_end, times)?;
         // Smaller arrays make every stage cheaper; unused slots would only be zeros.
         let n = match system.n_active() {
             0..=2 => 2,
@@ -1107,18 +1116,7 @@ pub fn integrate_system<const M: usize>(
     sink: &mut ArraySink<'_, M>,
 ) -> Result<([f64; M], IntegrationStats)> {
     RungeKutta::new(method, rtol, atol, max_steps)?;
-    if t_end.is_nan() || t_end <= t0 || !t0.is_finite() || !t_end.is_finite() {
-        return Err(Error::invalid("t_end", t_end, format!("> t0 = {t0}")));
-    }
-    if let Some(i) = (0..times.len())
-        .find(|&i| !(times[i] >= t0 && times[i] <= t_end) || (i > 0 && times[i] < times[i - 1]))
-    {
-        return Err(Error::invalid(
-            format!("times[{i}]"),
-            times[i],
-            format!("sorted and within [{t0}, {t_end}]"),
-        ));
-    }
+    check_window(t0, t_end, times)?;
     let n_switches = system.n_switches();
     if n_switches > MAX_SWITCHES {
         return Err(Error::invalid(
