@@ -205,7 +205,7 @@ def test_no_grid_runs_the_base_design_and_an_empty_table_runs_nothing(parity: ps
     assert df.height == 1 and df["q2_amplitude"][0] == ps.simulate(parity).metrics["q2_amplitude"]
     empty = sweep(parity, pl.DataFrame({"drivetrain.balance_spring": []}, schema={"drivetrain.balance_spring": pl.Float64}), metrics=["q2_amplitude"], progress=False)
     assert empty.height == 0
-    assert empty.columns == ["point", "drivetrain.balance_spring", "q2_amplitude", "converged", "cycles_run", "status", "error", "error_kind"]
+    assert empty.columns == ["point", "drivetrain.balance_spring", "q2_amplitude", "converged", "cycles_run", "orbit_cycles", "status", "error", "error_kind"]
 
 
 def test_keep_cycle_returns_the_last_cycle_as_list_columns(hmf: ps.Simulation) -> None:

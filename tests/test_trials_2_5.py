@@ -35,3 +35,28 @@ def test_hinge_validation_is_typed() -> None:
         spec = s25.device("lift_parity", "Uncut", hinge_k2=1.0, **FAST)
         bad = ps.Wing.from_moments(49, 50.5, 1.56, 4.2, aero=spec.wings[0].aero, tunable_hinge=ps.TunableHinge(1.0, 5.0, 1.0))
         ps.simulate(spec.replace(wings=(bad, bad)))
+
+
+def test_lift_parity_1cut_is_a_period_doubled_orbit_and_the_result_says_so() -> None:
+    """The shipped §2.5 Lift PARITY 1-Cut device settles on an orbit that repeats every second
+    wingbeat (its period-1 orbit lost stability through a flip). The run converges on it and
+    records both wingbeats: the state one wingbeat into the window differs, two wingbeats in
+    it returns."""
+    spec = ps.devices.load("sreetharan2012_2_5_lift_parity_1cut")
+    r = ps.simulate(spec, columns=["left_theta", "left_psi", "left_theta_dot", "left_psi_dot"])
+    assert r.converged and r.orbit_cycles == 2
+    n = spec.options.samples_per_cycle
+    df = r.cycle
+    assert df.height == 2 * n + 1
+    for name in ("left_theta", "left_psi", "left_theta_dot", "left_psi_dot"):
+        v = df[name].to_numpy()
+        scale = np.abs(v).max()
+        assert abs(v[2 * n] - v[0]) < 1e-5 * scale, name
+    one_beat = max(abs(df[c][n] - df[c][0]) / np.abs(df[c].to_numpy()).max() for c in ("left_theta", "left_psi"))
+    assert one_beat > 1e-2
+    # A sweep says which points doubled; the §3.4 Drag PARITY baseline does not.
+    rows = ps.sweep(spec, {"wings[*].tunable_hinge.stiffness_curvature": [20.0]}, metrics=["right_rotation_amplitude"], progress=False)
+    assert rows["orbit_cycles"].to_list() == [2]
+    assert abs(rows["right_rotation_amplitude"][0] - r.metrics["right_rotation_amplitude"]) < 1e-9
+    base = ps.simulate(ps.devices.load("sreetharan2012_3_4_parity_1cut"), columns=[], metrics=["right_rotation_amplitude"])
+    assert base.orbit_cycles == 1

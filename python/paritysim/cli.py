@@ -78,6 +78,8 @@ def _run(args: argparse.Namespace) -> int:
     result.plot(out / f"{stem}.png")
     if not args.quiet:
         state = "converged" if result.converged else "NOT converged"
+        if result.orbit_cycles > 1:
+            state += f", period-{result.orbit_cycles} orbit"
         print(f"{stem}: {result.cycles_run} cycles ({state}) in {time.perf_counter() - start:.2f} s -> {out}/{stem}_*")
         for key in sorted(result.metrics):
             if key.endswith(("stroke_amplitude", "roll_aero_peak", "work_actuator_per_cycle")):

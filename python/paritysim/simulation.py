@@ -40,6 +40,11 @@ class SimulationResult:
     residual:
         Relative change of the state over the last cycle before recording (the Newton residual
         with ``options.steady_state = "shooting"``); ``None`` without a periodic drive.
+    orbit_cycles:
+        Drive periods per period of the steady state: 1, or 2 when the orbit has
+        period-doubled (the state repeats every second wingbeat: the period-1 orbit lost
+        stability through a flip). The recorded window, :attr:`cycle` and the metrics then span
+        ``orbit_cycles`` wingbeats per recorded cycle, and ``residual`` is the two-cycle change.
     """
 
     metrics: dict[str, float | None]
@@ -49,6 +54,7 @@ class SimulationResult:
     spec: Simulation
     residual: float | None
     columns: dict[str, np.ndarray] = field(repr=False)
+    orbit_cycles: int = 1
 
     @cached_property
     def trajectory(self) -> pl.DataFrame:
@@ -58,11 +64,12 @@ class SimulationResult:
 
     @property
     def cycle(self) -> pl.DataFrame:
-        """The last steady cycle of the recorded window (including its closing sample)."""
+        """The last period of the steady state in the recorded window (``orbit_cycles``
+        wingbeats, including the closing sample)."""
         if not np.isfinite(self.period_ms):
             return self.trajectory
         t_end = self.trajectory["time_ms"][-1]
-        return self.trajectory.filter(pl.col("time_ms") >= t_end - self.period_ms - 1e-9)
+        return self.trajectory.filter(pl.col("time_ms") >= t_end - self.orbit_cycles * self.period_ms - 1e-9)
 
     @property
     def metrics_frame(self) -> pl.DataFrame:
@@ -197,4 +204,5 @@ def simulate(
         spec=spec,
         residual=raw.residual if math.isfinite(raw.residual) else None,
         columns={"time_ms": raw.time_ms, **raw.columns},
+        orbit_cycles=raw.orbit_cycles,
     )

@@ -14,8 +14,10 @@ fails on cut wings: its whippletree mode is unstable at small K2 (docs/findings.
 Each point is the base spec with some fields overridden, run to periodic steady state by the
 Rust engine on a local thread pool (GIL released). The result has one row per point in input
 order: ``point`` (its index), one column per swept parameter, the metrics, ``converged``,
-``cycles_run``, ``status`` (``"ok"`` or ``"error"``), ``error`` and ``error_kind`` (the message
-and class of a failing point; every other row is kept).
+``cycles_run``, ``orbit_cycles`` (drive periods per period of the steady state: 1, or 2 where
+the point's orbit has period-doubled; its metrics then span both cycles), ``status`` (``"ok"``
+or ``"error"``), ``error`` and ``error_kind`` (the message and class of a failing point; every
+other row is kept).
 
 Parameter paths
 ---------------
@@ -105,7 +107,7 @@ logger = logging.getLogger(__name__)
 THREADS_ENV: str = _core.SWEEP_THREADS_ENV
 
 #: Result columns besides the parameters and metrics.
-STATUS_COLUMNS = ("converged", "cycles_run", "status", "error", "error_kind")
+STATUS_COLUMNS = ("converged", "cycles_run", "orbit_cycles", "status", "error", "error_kind")
 
 _METADATA_KEY = "paritysim.sweep"
 _FORMAT = 1
@@ -195,7 +197,7 @@ def _prepare(chunk: _Chunk) -> _core.SweepRun:
     return _core.SweepRun(chunk.spec, list(chunk.names), _dumps([list(r) for r in chunk.rows]), chunk.metrics, chunk.keep_cycle, chunk.threads)
 
 
-_RESULT_FIELDS = ("finished", "ok", "metrics", "converged", "cycles_run", "error", "error_kind", "cycle")
+_RESULT_FIELDS = ("finished", "ok", "metrics", "converged", "cycles_run", "orbit_cycles", "error", "error_kind", "cycle")
 
 
 def _raw(result: _core.SweepResult) -> dict[str, Any]:
@@ -241,6 +243,7 @@ def _failed_raw(n: int, n_metrics: int, cycle_columns: Sequence[str], exc: BaseE
         "metrics": np.full((n, n_metrics), np.nan),
         "converged": np.zeros(n, bool),
         "cycles_run": np.full(n, -1, np.int64),
+        "orbit_cycles": np.full(n, -1, np.int64),
         "error": [message] * n,
         "error_kind": [kind] * n,
         "cycle": {c: [None] * n for c in cycle_columns} if cycle_columns else None,
@@ -268,6 +271,8 @@ def _frame(raw: dict[str, Any], params: pl.DataFrame, points: Sequence[int], met
     cycles = np.asarray(raw["cycles_run"], dtype=np.int64)[idx]
     cols["converged"] = pl.Series("converged", [bool(c) if o else None for c, o in zip(converged, ok_f, strict=True)], dtype=pl.Boolean)
     cols["cycles_run"] = pl.Series("cycles_run", [int(c) if o else None for c, o in zip(cycles, ok_f, strict=True)], dtype=pl.Int64)
+    orbit = np.asarray(raw["orbit_cycles"], dtype=np.int64)[idx]
+    cols["orbit_cycles"] = pl.Series("orbit_cycles", [int(c) if o else None for c, o in zip(orbit, ok_f, strict=True)], dtype=pl.Int64)
     cols["status"] = pl.Series("status", np.where(ok_f, "ok", "error").tolist(), dtype=pl.String)
     errors = [raw["error"][i] for i in idx]
     kinds = [raw["error_kind"][i] for i in idx]
@@ -618,7 +623,7 @@ def _assemble(frames: list[pl.DataFrame], table: pl.DataFrame, metrics: Sequence
     if not frames:
         empty = _frame(
             {"finished": np.zeros(0, bool), "ok": np.zeros(0, bool), "metrics": np.zeros((0, len(metrics))), "converged": np.zeros(0, bool),
-             "cycles_run": np.zeros(0, np.int64), "error": [], "error_kind": [], "cycle": {c: [] for c in cycle}},
+             "cycles_run": np.zeros(0, np.int64), "orbit_cycles": np.zeros(0, np.int64), "error": [], "error_kind": [], "cycle": {c: [] for c in cycle}},
             table.clear() if table.width else table, [], metrics, cycle,
         )  # fmt: skip
         return empty

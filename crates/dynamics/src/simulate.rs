@@ -162,9 +162,25 @@ pub struct SimulationResult {
     /// The Jacobian of the stroboscopic map the shooting ended with (exact or
     /// Broyden-updated; `None` for transient runs): the multipliers are its eigenvalues.
     pub monodromy: Option<nalgebra::DMatrix<f64>>,
-    /// The shooting's step grid over one period (empty for transient runs).
+    /// The shooting's step grid over one period of the orbit (empty for transient runs).
     pub step_grid: Vec<f64>,
+    /// Drive periods per period of the steady state: 1, or 2 for a period-doubled orbit (the
+    /// state repeats every second cycle: the period-1 orbit has lost stability through a flip,
+    /// a multiplier below −1). The recorded window, its samples and metrics then span
+    /// `orbit_cycles × record_cycles` drive periods, the residual is that of the two-cycle map,
+    /// and the multipliers and `monodromy` are of the two-cycle map.
+    pub orbit_cycles: usize,
 }
+
+/// A transient whose state changes by less than this over two cycles (relative, as the
+/// residual) but not over one has settled near a period-doubled orbit: shooting on the
+/// two-cycle map takes it from there (the warm-up's threshold).
+pub const PERIOD_DOUBLED_SETTLED: f64 = 1e-3;
+
+/// A transient whose two-cycle change is below `steady_tol` has settled on a period-doubled
+/// orbit when its one-cycle change is more than this many times larger (else it is a period-1
+/// orbit approached with a multiplier within 1e-3 of −1).
+pub const PERIOD_DOUBLED_SEPARATION: f64 = 1e3;
 
 pub(crate) fn validate(options: &SimulationOptions) -> Result<()> {
     check_positive("steady_tol", options.steady_tol)?;
@@ -280,6 +296,7 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
     let mut multipliers = Vec::new();
     let mut monodromy = None;
     let mut step_grid = Vec::new();
+    let mut orbit_cycles = 1;
     // The recorded window when the shooting's last period already was it.
     let mut recorded: Option<(Trajectory, Vec<(String, f64)>)> = None;
     let stroke = stroke_sampling(device, options.metrics.as_deref(), &columns);
@@ -294,7 +311,7 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
             let mut transient_needed = true;
             if options.steady_state == SteadyState::Shooting {
                 if let Some(found) = shooting_steady_state(
-                    device, options, &recording, &transient, period, &y, &columns, stroke,
+                    device, options, &recording, &transient, period, 1, &y, &columns, stroke,
                 )? {
                     (y, t, cycles_run, residual, converged) =
                         (found.state, found.t, found.cycles_run, found.residual, true);
@@ -317,22 +334,76 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
                     t = t_end;
                     cycles_run = warm_up;
                 }
+                // The state two cycles back: a period-doubled orbit repeats over two cycles.
+                let mut two_back: Option<State> = None;
+                let mut shot_two_cycles = options.steady_state != SteadyState::Shooting;
                 while cycles_run < options.max_cycles {
                     crate::integrate::budget::check(t)?;
                     let next = transient.advance(device, t, &y, t + period)?;
                     residual = state_change(&next, &y);
+                    let residual_two = two_back.map(|b| state_change(&next, &b));
+                    two_back = Some(y);
                     y = next;
                     t += period;
                     cycles_run += 1;
-                    if cycles_run >= options.min_cycles && residual < options.steady_tol {
+                    if cycles_run < options.min_cycles {
+                        continue;
+                    }
+                    if residual < options.steady_tol {
                         converged = true;
                         break;
                     }
+                    let Some(residual_two) = residual_two else {
+                        continue;
+                    };
+                    // Doubled when the two cycles stay apart: a period-1 orbit approached
+                    // with a multiplier μ near −1 has residual / residual_two = |μ / (1 + μ)|.
+                    if residual_two < options.steady_tol
+                        && residual > PERIOD_DOUBLED_SEPARATION * residual_two
+                    {
+                        (residual, converged, orbit_cycles) = (residual_two, true, 2);
+                        break;
+                    }
+                    if !shot_two_cycles && residual_two < PERIOD_DOUBLED_SETTLED.min(residual) {
+                        // Once per run: Newton on the two-cycle map from here.
+                        shot_two_cycles = true;
+                        if let Some(found) = shooting_steady_state(
+                            device, options, &recording, &transient, period, 2, &y, &columns,
+                            stroke,
+                        )? {
+                            // A period-1 orbit is a fixed point of the two-cycle map too (a
+                            // transient spiralling in with a multiplier near −1 looks doubled):
+                            // then the one-cycle window is recorded as usual.
+                            let half = transient.advance(device, 0.0, &found.state, period)?;
+                            if state_change(&half, &found.state) < options.steady_tol {
+                                (y, residual, converged) = (found.state, found.residual, true);
+                                t += found.t;
+                                cycles_run += found.cycles_run;
+                                break;
+                            }
+                            (y, residual, converged, orbit_cycles) =
+                                (found.state, found.residual, true, 2);
+                            recorded = found.recorded;
+                            if let Some((trajectory, _)) = &mut recorded {
+                                // Labelled after the transient's cycles too.
+                                for time in &mut trajectory.time {
+                                    *time += t;
+                                }
+                            }
+                            t += found.t;
+                            cycles_run += found.cycles_run;
+                            multipliers = found.multipliers;
+                            monodromy = Some(found.jacobian);
+                            step_grid = found.grid;
+                            break;
+                        }
+                    }
                 }
             }
+            let window_cycles = orbit_cycles * options.record_cycles;
             (
-                period * options.record_cycles as f64,
-                options.samples_per_cycle * options.record_cycles,
+                period * window_cycles as f64,
+                options.samples_per_cycle * window_cycles,
             )
         }
         None => {
@@ -379,6 +450,7 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
         multipliers,
         monodromy,
         step_grid,
+        orbit_cycles,
     })
 }
 
@@ -403,8 +475,10 @@ struct ShotSteadyState {
 }
 
 /// [`SteadyState::Shooting`]: warm-up (without a neighbour's Jacobian), then Newton on the
-/// frozen grid ([`crate::grid_shooting`]); the final Newton period records the window when it
-/// is one plain cycle. `Ok(None)`: not converged (the caller runs the transient).
+/// frozen grid ([`crate::grid_shooting`]) of the `orbit_cycles`-period map (2: a
+/// period-doubled orbit, from a state the caller's transient settled: no warm-up); the final
+/// Newton period records the window when it is one plain orbit. `Ok(None)`: not converged (the
+/// caller runs the transient).
 #[allow(clippy::too_many_arguments)]
 fn shooting_steady_state(
     device: &Device,
@@ -412,6 +486,7 @@ fn shooting_steady_state(
     recording: &RungeKutta,
     transient: &RungeKutta,
     period: f64,
+    orbit_cycles: usize,
     y0: &State,
     columns: &[crate::trajectory::Column],
     stroke: Option<StrokeNeeds>,
@@ -419,7 +494,8 @@ fn shooting_steady_state(
     let mut y = *y0;
     let mut cycles = 0;
     let guess = options.shooting_jacobian.as_ref();
-    if guess.is_none() {
+    let map_period = period * orbit_cycles as f64;
+    if guess.is_none() && orbit_cycles == 1 {
         // Far from the orbit Newton's model is poor: settle the fast modes first.
         while cycles < options.min_cycles {
             crate::integrate::budget::check(cycles as f64 * period)?;
@@ -439,7 +515,7 @@ fn shooting_steady_state(
     }
     // Below the integration's own accuracy (~rtol) a tighter orbit changes nothing.
     let tol = (1e-2 * options.steady_tol).min(0.1 * options.rtol);
-    let n_samples = options.samples_per_cycle;
+    let n_samples = options.samples_per_cycle * orbit_cycles;
     let records = options.record_cycles == 1 && options.perturbation.is_none();
     let mut recorded = None;
     let mut finish = |grid: &[f64], y: &State| -> Result<State> {
@@ -456,7 +532,7 @@ fn shooting_steady_state(
             integrator,
             grid[0],
             y,
-            period,
+            map_period,
             n_samples,
             Some(period),
             None,
@@ -470,7 +546,7 @@ fn shooting_steady_state(
     let Some(orbit) = crate::grid_shooting::shoot(
         device,
         transient,
-        period,
+        map_period,
         &y,
         guess,
         options.shooting_grid.as_deref(),
@@ -482,7 +558,7 @@ fn shooting_steady_state(
     else {
         return Ok(None);
     };
-    cycles += orbit.periods;
+    cycles += orbit.periods * orbit_cycles;
     let multipliers = crate::floquet::eigenvalues(&orbit.jacobian).unwrap_or_default();
     if multipliers
         .first()

@@ -298,6 +298,8 @@ pub struct PointOutput {
     pub monodromy: Option<nalgebra::DMatrix<f64>>,
     /// The shooting's step grid (the next point's, while it meets the tolerances).
     pub step_grid: Vec<f64>,
+    /// Drive periods per period of the steady state ([`crate::SimulationResult::orbit_cycles`]).
+    pub orbit_cycles: usize,
 }
 
 /// Simulates one point and keeps what the sweep asked for.
@@ -333,8 +335,8 @@ pub fn run_point(
 
 impl PointOutput {
     /// What a sweep keeps of one run: the asked metrics in order (NaN where absent) and, with
-    /// `keep_cycle`, the last recorded cycle (`samples_per_cycle + 1` samples; the whole
-    /// trajectory of an aperiodic run).
+    /// `keep_cycle`, the last recorded orbit (`orbit_cycles × samples_per_cycle + 1` samples;
+    /// the whole trajectory of an aperiodic run).
     pub fn keep(
         result: SimulationResult,
         metric_names: &[String],
@@ -356,7 +358,7 @@ impl PointOutput {
             let traj = result.trajectory;
             let len = traj.time.len();
             let keep = if result.period_ms.is_finite() {
-                (samples_per_cycle + 1).min(len)
+                (result.orbit_cycles * samples_per_cycle + 1).min(len)
             } else {
                 len
             };
@@ -379,6 +381,7 @@ impl PointOutput {
             steady_state,
             monodromy: result.monodromy,
             step_grid: result.step_grid,
+            orbit_cycles: result.orbit_cycles,
         }
     }
 }
@@ -612,7 +615,7 @@ pub(crate) fn chain_point(
         Ok(o)
             if start.guess.is_some()
                 && continued(points, i)
-                && !(o.converged && o.monodromy.is_some()) =>
+                && !(o.converged && o.monodromy.is_some() && o.orbit_cycles == 1) =>
         {
             run_point(device, options, metric_names, keep_cycle)
         }
@@ -624,7 +627,9 @@ pub(crate) fn chain_point(
 /// found by shooting (a stable one, with its monodromy) continues into the next point.
 pub(crate) fn remember(previous: &mut Vec<Converged>, i: usize, result: &Result<PointOutput>) {
     if let Ok(o) = result {
-        if let (true, Some(state), true) = (o.converged, o.steady_state, o.monodromy.is_some()) {
+        // A period-doubled orbit's map (two cycles) is no guess for a neighbour's one-cycle map.
+        let continues = o.monodromy.is_some() && o.orbit_cycles == 1;
+        if let (true, Some(state), true) = (o.converged, o.steady_state, continues) {
             if previous.len() == 2 {
                 previous.remove(0);
             }

@@ -682,6 +682,7 @@ pub fn fly_controlled(
         // describes the torque stand, not this run.
         monodromy: None,
         step_grid: Vec::new(),
+        orbit_cycles: 1,
     })
 }
 

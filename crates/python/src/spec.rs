@@ -98,6 +98,7 @@ pub struct SimulationOutput {
     period_ms: f64,
     residual: f64,
     multipliers: Vec<(f64, f64)>,
+    orbit_cycles: usize,
 }
 
 /// How often a waiting call checks for Python signals (Ctrl-C).
@@ -212,5 +213,6 @@ fn output(py: Python<'_>, r: paritysim_dynamics::SimulationResult) -> PyResult<S
         period_ms: r.period_ms,
         residual: r.residual,
         multipliers: r.multipliers.iter().map(|m| (m.re, m.im)).collect(),
+        orbit_cycles: r.orbit_cycles,
     })
 }

@@ -161,6 +161,9 @@ pub struct SweepOutcome {
     pub converged: Vec<bool>,
     /// Cycles simulated before recording (-1 where not ok).
     pub cycles_run: Vec<i64>,
+    /// Drive periods per period of the steady state: 1, 2 for a period-doubled orbit (-1
+    /// where not ok; [`paritysim_dynamics::SimulationResult::orbit_cycles`]).
+    pub orbit_cycles: Vec<i64>,
     /// Error message of a failed point.
     pub error: Vec<Option<String>>,
     /// Error kind (the Python class without `Error`) of a failed point.
@@ -183,6 +186,7 @@ impl SweepOutcome {
             metrics: vec![f64::NAN; n * n_metrics],
             converged: vec![false; n],
             cycles_run: vec![-1; n],
+            orbit_cycles: vec![-1; n],
             error: vec![None; n],
             error_kind: vec![None; n],
             cycle: None,
@@ -195,6 +199,7 @@ impl SweepOutcome {
                     out.metrics[i * n_metrics..(i + 1) * n_metrics].copy_from_slice(&p.metrics);
                     out.converged[i] = p.converged;
                     out.cycles_run[i] = i64::try_from(p.cycles_run).unwrap_or(i64::MAX);
+                    out.orbit_cycles[i] = i64::try_from(p.orbit_cycles).unwrap_or(i64::MAX);
                 }
                 Some(Err(e)) => {
                     out.error[i] = Some(e.to_string());

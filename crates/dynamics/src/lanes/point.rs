@@ -517,6 +517,7 @@ impl<'a> LanePoint<'a> {
             multipliers,
             monodromy: Some(self.jac.clone()),
             step_grid: self.grid.to_vec(),
+            orbit_cycles: 1,
         };
         let coordinates = self.device.coordinates(&steady_state).ok();
         COMPLETED_IN_LANES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
