@@ -471,6 +471,7 @@ fn shooting_steady_state(
         device,
         transient,
         period,
+        0.0,
         &y,
         guess,
         options.shooting_grid.as_deref(),
