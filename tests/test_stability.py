@@ -65,7 +65,8 @@ def test_stability_chart_matches_an_independent_integration() -> None:
     in Region II)."""
     beta0, kappa = np.array([-0.5, 0.0, 1.0, 4.0]), np.array([-0.5, 0.1, 1.0, 3.0, 3.5])
     df = st.stability_chart(beta0, kappa)
-    assert df.columns == ["beta0", "kappa", "a", "b", "spectral_radius", "region", "stable", "multiplier_error", "marginal", "region_name", "brockett_bounded"]
+    assert df.columns == ["beta0", "kappa", "a", "b", "spectral_radius", "region", "stable", "multiplier_error", "marginal", "error", "region_name", "brockett_bounded"]
+    assert df["error"].null_count() == df.height
     assert df["beta0"].to_list() == np.repeat(beta0, 5).tolist() and df["kappa"].to_list() == np.tile(kappa, 4).tolist()
     for row in df.iter_rows(named=True):
         m = _monodromy_by_scipy(row["beta0"], row["kappa"])
@@ -83,6 +84,22 @@ def test_stability_chart_matches_an_independent_integration() -> None:
         if row["brockett_bounded"]:
             assert row["spectral_radius"] <= 1 + row["multiplier_error"]  # Brockett's guarantee holds
         assert 0 < row["multiplier_error"] < 1e-6  # √(round-off) near a double root, else ~1e-14
+
+
+def test_a_failing_chart_point_is_marked_and_the_others_are_kept() -> None:
+    """κ = -1e6 passes the axis checks but its solution overflows (growth e^{1000π}): that
+    point is a marked row (region 0, ``failed``, NaN numbers, its error), the others equal a
+    chart without it, and the map plot marks it."""
+    df = st.stability_chart([0.5], [1.0, -1e6, 0.2])
+    assert df["region"].to_list()[1] == 0 and df["region_name"].to_list()[1] == "failed"
+    bad = df.row(1, named=True)
+    assert math.isnan(bad["a"]) and math.isnan(bad["spectral_radius"]) and not bad["stable"] and not bad["brockett_bounded"]
+    assert "overflow" in bad["error"] and "index 1" in bad["error"]
+    good = st.stability_chart([0.5], [1.0, 0.2])
+    kept = df.filter(pl.col("error").is_null())
+    assert kept.drop("error").equals(good.drop("error"))
+    fig = st.plot_chart_map(st.stability_chart([0.0, 0.5, 1.0], [-1e6, 0.5, 1.0, 2.0]))
+    assert any("analysis failed (3 points" in t.get_text() for t in fig.axes[0].get_legend().get_texts())
 
 
 def test_marginal_line_of_a_51_by_51_chart() -> None:

@@ -60,6 +60,8 @@ __all__ = [
 REGIONS = {1: "I", 2: "II", 3: "III", 4: "IV"}
 #: ``region_name`` of points whose largest multiplier is within its error of the unit circle.
 MARGINAL = "marginal"
+#: ``region_name`` of a chart point whose analysis failed (see :func:`stability_chart`).
+FAILED = "failed"
 
 
 def _f64(x: Any, name: str) -> np.ndarray:
@@ -115,23 +117,32 @@ def stability_chart(beta0: Any, kappa: Any, *, brockett: bool = True) -> pl.Data
     region`` (1-4, of the computed ``a``, ``b``), ``stable`` (Region I and not marginal),
     ``multiplier_error`` (error estimate of the multipliers' moduli: round-off of the
     monodromy and its Liouville residual, eq. 2.45), ``marginal`` (``|max|ρ| − 1|`` within
-    that error: the undamped line β0 = 0 and the κ = 0 line), ``region_name`` (I-IV, or
-    ``marginal``) and, with ``brockett=True``, ``brockett_bounded`` (Brockett's guarantee of
-    eqs. 2.57-2.58; false where it does not apply, κ <= 0).
+    that error: the undamped line β0 = 0 and the κ = 0 line), ``error`` (null, or the message
+    of a point whose analysis failed: its solution overflows, e.g. κ = -1e6; such a point has
+    ``region`` 0, ``region_name`` ``failed``, NaN numbers, and the other points are kept),
+    ``region_name`` (I-IV, ``marginal`` or ``failed``) and, with ``brockett=True``,
+    ``brockett_bounded`` (Brockett's guarantee of eqs. 2.57-2.58; false where it does not
+    apply, κ <= 0, or the point failed).
     """
     raw = _core.stability_chart(_f64(beta0, "beta0"), _f64(kappa, "kappa"))
-    df = pl.DataFrame(raw).with_columns(
-        pl.col("region").cast(pl.Int8),
-        pl.when(pl.col("marginal"))
+    error_index, messages = raw.pop("error_index"), raw.pop("error")
+    errors = pl.Series("error", [], dtype=pl.String).extend_constant(None, raw["beta0"].size)
+    if messages:
+        errors = errors.scatter(error_index, messages)
+    df = pl.DataFrame(raw).with_columns(pl.col("region").cast(pl.Int8), errors)
+    df = df.with_columns(
+        pl.when(pl.col("region") == 0)
+        .then(pl.lit(FAILED))
+        .when(pl.col("marginal"))
         .then(pl.lit(MARGINAL))
-        .otherwise(pl.col("region").replace_strict(REGIONS, return_dtype=pl.String))
+        .otherwise(pl.col("region").replace_strict(REGIONS, default=None, return_dtype=pl.String))
         .alias("region_name"),
     )
     if brockett:
         beta = raw["beta0"]
         kap = raw["kappa"]
         guaranteed = np.zeros(beta.size, dtype=bool)
-        for i in np.flatnonzero(kap > 0):
+        for i in np.flatnonzero((kap > 0) & (raw["region"] > 0)):
             guaranteed[i] = _core.stability_brockett_hill(float(beta[i]), float(kap[i]))["bounded"]
         df = df.with_columns(pl.Series("brockett_bounded", guaranteed))
     return df
@@ -467,11 +478,17 @@ def plot_chart_map(chart: pl.DataFrame, points: dict[str, tuple[float, float]] |
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
+    handles = [
+        Line2D([], [], color="k", lw=1.2, label="Region I boundary (stable inside)"),
+        Patch(facecolor="none", edgecolor="0.3", hatch="//", label="Brockett: bounded guaranteed"),
+    ]
+    # Points whose analysis failed (overflow) are blank in the map: mark them.
+    failed = chart.filter(pl.col("error").is_not_null()) if "error" in chart.columns else chart.clear()
+    if failed.height:
+        ax.scatter(failed["beta0"], failed["kappa"], marker="x", s=14, color="k")
+        handles.append(Line2D([], [], color="k", marker="x", lw=0, label=f"analysis failed ({failed.height} points, see `error`)"))
     ax.legend(
-        handles=[
-            Line2D([], [], color="k", lw=1.2, label="Region I boundary (stable inside)"),
-            Patch(facecolor="none", edgecolor="0.3", hatch="//", label="Brockett: bounded guaranteed"),
-        ],
+        handles=handles,
         loc="upper right",
         fontsize=8,
     )

@@ -33,7 +33,9 @@ pub(crate) struct GridOrbit {
     pub jacobian: DMatrix<f64>,
     /// Period integrations before the final one.
     pub periods: usize,
-    /// The step grid (from 0 to the period).
+    /// Newton steps taken (each a trial period).
+    pub iterations: usize,
+    /// The step grid (from the section time `t0` to `t0 + period`).
     pub grid: Vec<f64>,
 }
 
@@ -86,7 +88,7 @@ pub(crate) fn least_squares_step(
 /// torques 3.5e-7 off the rtol-1e-12 reference, amplified by slow multipliers up to 0.98).
 pub(crate) const GRID_TOLERANCE_FACTOR: f64 = 1e-2;
 
-/// Newton on the frozen-grid map from `y0` on the section `t = 0`, to a state whose predicted
+/// Newton on the frozen-grid map from `y0` on the section `t = t0` (mod the period), to a state whose predicted
 /// error (relative to `1 + ‖y‖∞`) is below `tol`; `finish(grid, y)` integrates the final
 /// period (recording it) and returns its end state. The final period is accepted when its
 /// residual is below `tol`, or below `accept_tol` with a negligible further Newton step (the
@@ -102,6 +104,7 @@ pub(crate) fn shoot(
     device: &Device,
     integrator: &RungeKutta,
     period: f64,
+    t0: f64,
     y0: &State,
     guess: Option<&DMatrix<f64>>,
     guess_grid: Option<&[f64]>,
@@ -118,8 +121,9 @@ pub(crate) fn shoot(
     let guess = guess.filter(|j| j.shape() == (m, m));
     // A neighbour's grid is kept while every step's error estimate stays within the grid
     // tolerances: the first map then costs one fixed-grid period instead of an adaptive one.
+    let t_end = t0 + period;
     let inherited = match (guess, guess_grid) {
-        (Some(j), Some(grid)) if grid.first() == Some(&0.0) && grid.last() == Some(&period) => {
+        (Some(j), Some(grid)) if grid.first() == Some(&t0) && grid.last() == Some(&t_end) => {
             match chooser.integrate_on_grid_counted(device, grid, &y, &[], &mut |_, _, _| Ok(())) {
                 Ok((py, stats)) if stats.over_tolerance == 0 => {
                     Some(Ok((py, j.clone(), grid.to_vec(), false)))
@@ -133,10 +137,10 @@ pub(crate) fn shoot(
     let first = match (inherited, guess) {
         (Some(done), _) => done,
         (None, Some(j)) => chooser
-            .advance_with_steps(device, 0.0, &y, period)
+            .advance_with_steps(device, t0, &y, t_end)
             .map(|(py, grid)| (py, j.clone(), grid, false)),
         (None, None) => chooser
-            .flow_with_sensitivity_and_steps(device, 0.0, &y, period)
+            .flow_with_sensitivity_and_steps(device, t0, &y, t_end)
             .map(|(py, j, grid)| (py, j, grid, true)),
     };
     let (py, mut jac, grid, mut fresh) = match first {
@@ -208,6 +212,7 @@ pub(crate) fn shoot(
                 residual: res_new,
                 jacobian: jac,
                 periods: periods - 1,
+                iterations,
                 grid,
             }));
         }

@@ -547,6 +547,7 @@ fn shooting_steady_state(
         device,
         transient,
         map_period,
+        0.0,
         &y,
         guess,
         options.shooting_grid.as_deref(),

@@ -133,8 +133,9 @@ bindings! {
 }
 
 /// The (β0, κ) grid `beta0 × kappa` (row-major, β0 outer) computed in parallel: flat arrays
-/// `beta0, kappa, a, b, spectral_radius, region` (int 1-4), `multiplier_error`, `marginal`
-/// and `stable` (Region I and not marginal).
+/// `beta0, kappa, a, b, spectral_radius, region` (int 1-4; 0 for a failed point, whose numbers
+/// are NaN), `multiplier_error`, `marginal` and `stable` (Region I and not marginal), and the
+/// failed points as `error_index` (flat indices) with their messages `error`.
 #[pyfunction]
 fn stability_chart<'py>(
     py: Python<'py>,
@@ -162,6 +163,13 @@ fn stability_chart<'py>(
         PyArray1::from_vec(py, c.multiplier_error),
     )?;
     out.set_item("marginal", PyArray1::from_vec(py, c.marginal))?;
+    let (index, messages): (Vec<i64>, Vec<String>) = c
+        .errors
+        .iter()
+        .map(|(i, e)| (*i as i64, e.to_string()))
+        .unzip();
+    out.set_item("error_index", PyArray1::from_vec(py, index))?;
+    out.set_item("error", messages)?;
     Ok(out)
 }
 

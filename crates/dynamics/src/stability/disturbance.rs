@@ -8,7 +8,7 @@ use nalgebra::{Complex, Matrix2, Vector2};
 use paritysim_error::{Error, Result, bail, check_finite, check_positive};
 
 use crate::device::{Device, DeviceSpec, Formulation, Transmission};
-use crate::integrate::{Integrator, Method, OdeSystem, RungeKutta, State, budget};
+use crate::integrate::{Integrator, Method, OdeSystem, RungeKutta, State};
 
 use super::*;
 
@@ -472,12 +472,9 @@ pub fn disturbance_response(
         }
         Ok(acc.map(|a| a * (2.0 / n as f64)))
     };
-    let run_budget = budget::current();
-    let (plus, minus) = rayon::join(
-        || budget::carry(&run_budget, || run(1.0)),
-        || budget::carry(&run_budget, || run(-1.0)),
-    );
-    let (plus, minus) = (plus?, minus?);
+    // The two signs in parallel on the sweep engine's pool, under the caller's budget.
+    let signs = super::rows::run_parts(2, |i| run(if i == 0 { 1.0 } else { -1.0 }))?;
+    let (plus, minus) = (signs[0], signs[1]);
     // d(t) = A sin(ωt) has complex amplitude −iA under the same projection.
     let [first, transfer] =
         [0, 1].map(|w| (plus[w] - minus[w]) * 0.5 / Complex::new(0.0, -amplitude));

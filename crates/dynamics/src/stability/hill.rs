@@ -304,37 +304,45 @@ pub fn multiplier_error(m: &Matrix2<f64>, beta0: f64, steps: usize) -> f64 {
     MULTIPLIER_ERROR_SAFETY * (entry + root)
 }
 
-/// A Floquet stability chart over a (β0, κ) grid: row-major, β0 outer, κ inner.
+/// A Floquet stability chart over a (β0, κ) grid: row-major, β0 outer, κ inner. A point whose
+/// analysis failed (its solution overflows f64) is kept as a marked entry: region `None`,
+/// NaN numbers, not marginal, and its error in [`Self::errors`].
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct StabilityChart {
     /// β0 of each point.
     pub beta0: Vec<f64>,
     /// κ of each point.
     pub kappa: Vec<f64>,
-    /// Half trace `a` of the monodromy matrix.
+    /// Half trace `a` of the monodromy matrix (NaN for a failed point).
     pub a: Vec<f64>,
-    /// Determinant `b`.
+    /// Determinant `b` (NaN for a failed point).
     pub b: Vec<f64>,
-    /// `max |ρ|`.
+    /// `max |ρ|` (NaN for a failed point).
     pub spectral_radius: Vec<f64>,
-    /// Region of Fig. 2.13.
-    pub region: Vec<Region>,
-    /// [`HillFloquet::multiplier_error`].
+    /// Region of Fig. 2.13 (`None` for a failed point).
+    pub region: Vec<Option<Region>>,
+    /// [`HillFloquet::multiplier_error`] (NaN for a failed point).
     pub multiplier_error: Vec<f64>,
-    /// [`HillFloquet::is_marginal`].
+    /// [`HillFloquet::is_marginal`] (false for a failed point).
     pub marginal: Vec<bool>,
+    /// The failed points: flat index (`i_beta0 * kappa.len() + i_kappa`) and error, in index
+    /// order.
+    pub errors: Vec<(usize, Error)>,
 }
 
 impl StabilityChart {
-    /// Whether each point is stable: Region I and not marginal.
+    /// Whether each point is stable: Region I and not marginal (false for a failed point).
     pub fn stable(&self) -> Vec<bool> {
         let points = self.region.iter().zip(&self.marginal);
-        points.map(|(r, &m)| r.is_stable() && !m).collect()
+        points
+            .map(|(r, &m)| r.is_some_and(Region::is_stable) && !m)
+            .collect()
     }
 
-    /// The region of each point as its number 1-4.
+    /// The region of each point as its number 1-4, 0 for a failed point.
     pub fn region_numbers(&self) -> Vec<i64> {
-        self.region.iter().map(|r| i64::from(r.index())).collect()
+        let number = |r: &Option<Region>| r.map_or(0, |r| i64::from(r.index()));
+        self.region.iter().map(number).collect()
     }
 }
 
@@ -347,9 +355,13 @@ pub const MAX_CHART_POINTS: usize = 4_000_000;
 /// Evaluates [`hill_floquet`] on every `(β0, κ)` of the grid `beta0 × kappa`, in parallel on
 /// the sweep engine's own pool ([`super::rows`]; `PARITYSIM_THREADS`).
 ///
+/// A point that fails (its solution overflows: [`Error::OutOfDomain`], e.g. κ = −1e6) is a
+/// marked entry of the chart (see [`StabilityChart`]); the other points are kept.
+///
 /// # Errors
 /// [`Error::InvalidParameter`] naming the first bad element (`beta0[i]`, `kappa[j]`), an
-/// empty axis or more than [`MAX_CHART_POINTS`] points; [`Error::OutOfDomain`] on overflow.
+/// empty axis or more than [`MAX_CHART_POINTS`] points; [`Error::Cancelled`] or the wall
+/// budget's error when the caller's budget stops the chart.
 pub fn stability_chart(beta0: &[f64], kappa: &[f64]) -> Result<StabilityChart> {
     if beta0.is_empty() || kappa.is_empty() {
         bail!(invalid "beta0, kappa", format!("{} x {}", beta0.len(), kappa.len()), "non-empty axes");
@@ -366,19 +378,19 @@ pub fn stability_chart(beta0: &[f64], kappa: &[f64]) -> Result<StabilityChart> {
     }
     let nk = kappa.len();
     // On the sweep engine's own pool, in chunks (a point takes microseconds). Every point
-    // checks the caller's budget (its cancel flag). A point fails only by overflow once the
-    // axes are validated: the chart then fails with that point's error (a chart has no row
-    // for it).
+    // checks the caller's budget (its cancel flag): a spent budget fails the chunk, hence the
+    // chart; a failing point (only by overflow once the axes are validated) is its entry.
     let chunks = n.div_ceil(CHART_CHUNK);
     let rows = super::rows::run_rows(chunks, None, |c| {
         (c * CHART_CHUNK..((c + 1) * CHART_CHUNK).min(n))
             .map(|idx| {
                 budget::check(0.0)?;
-                hill_floquet(beta0[idx / nk], kappa[idx % nk]).map_err(|e| e.at_index(idx, None))
+                Ok(hill_floquet(beta0[idx / nk], kappa[idx % nk])
+                    .map_err(|e| e.at_index(idx, None)))
             })
-            .collect::<Result<Vec<HillFloquet>>>()
+            .collect::<Result<Vec<Result<HillFloquet>>>>()
     })?;
-    let points: Vec<HillFloquet> = rows
+    let points: Vec<Result<HillFloquet>> = rows
         .into_iter()
         .collect::<Result<Vec<_>>>()?
         .into_iter()
@@ -393,14 +405,34 @@ pub fn stability_chart(beta0: &[f64], kappa: &[f64]) -> Result<StabilityChart> {
         region: Vec::with_capacity(n),
         multiplier_error: Vec::with_capacity(n),
         marginal: Vec::with_capacity(n),
+        errors: Vec::new(),
     };
-    for p in points {
+    for (idx, point) in points.into_iter().enumerate() {
+        let p = match point {
+            Ok(p) => p,
+            Err(e) => {
+                chart.beta0.push(beta0[idx / nk]);
+                chart.kappa.push(kappa[idx % nk]);
+                for column in [
+                    &mut chart.a,
+                    &mut chart.b,
+                    &mut chart.spectral_radius,
+                    &mut chart.multiplier_error,
+                ] {
+                    column.push(f64::NAN);
+                }
+                chart.region.push(None);
+                chart.marginal.push(false);
+                chart.errors.push((idx, e));
+                continue;
+            }
+        };
         chart.beta0.push(p.beta0);
         chart.kappa.push(p.kappa);
         chart.a.push(p.a);
         chart.b.push(p.b);
         chart.spectral_radius.push(p.spectral_radius());
-        chart.region.push(p.region);
+        chart.region.push(Some(p.region));
         chart.multiplier_error.push(p.multiplier_error);
         chart.marginal.push(p.is_marginal());
     }

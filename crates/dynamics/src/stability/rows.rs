@@ -49,3 +49,30 @@ where
     }
     Ok(rows)
 }
+
+/// The independent parts `part(i)`, `i in 0..n`, of one analysis (the two monodromies of
+/// [`super::floquet`], the columns of [`super::map_jacobian`], the two signs of
+/// [`super::disturbance_response`]), all under the caller's wall budget and cancel flag
+/// ([`budget::carry`]).
+///
+/// Where they run: called from a pool thread (a point of a sweep, or a part of an outer
+/// analysis) on that pool, whose threads the sweep already budgets; from a plain call on the
+/// sweep engine's own pool ([`run_rows`]), never rayon's global one.
+///
+/// # Errors
+/// The first failing part's error (in index order); [`Error::Cancelled`] as [`run_rows`].
+pub(crate) fn run_parts<T, F>(n: usize, part: F) -> Result<Vec<T>>
+where
+    T: Send,
+    F: Fn(usize) -> Result<T> + Sync,
+{
+    use rayon::prelude::*;
+    if rayon::current_thread_index().is_some() {
+        let run_budget = budget::current();
+        return (0..n)
+            .into_par_iter()
+            .map(|i| budget::carry(&run_budget, || part(i)))
+            .collect();
+    }
+    run_rows(n, None, part)?.into_iter().collect()
+}

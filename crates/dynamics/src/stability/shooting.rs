@@ -4,7 +4,6 @@
 use nalgebra::{Complex, DMatrix, DVector, Matrix2};
 use paritysim_constraints::Vec6;
 use paritysim_error::{Error, Result, bail, check_positive};
-use rayon::prelude::*;
 
 use crate::device::{Device, Formulation};
 use crate::integrate::{Integrator, Method, OdeSystem, RungeKutta, State, budget};
@@ -216,43 +215,40 @@ pub fn map_jacobian(
 ) -> Result<DMatrix<f64>> {
     let steps = fd_steps(n, y, fd_step);
     let base = compact(n, y);
-    let run_budget = budget::current();
-    let columns: Vec<DVector<f64>> = (0..2 * n)
-        .into_par_iter()
-        .map(|j| {
-            let _budget = run_budget.clone().map(budget::Budget::enter);
-            let mut plus = base.clone();
-            let mut minus = base.clone();
-            plus[j] += steps[j];
-            minus[j] -= steps[j];
-            let fp = stroboscopic_map(system, integrator, t0, period, &expand(n, &plus))?;
-            let fm = stroboscopic_map(system, integrator, t0, period, &expand(n, &minus))?;
-            Ok((compact(n, &fp) - compact(n, &fm)) / (2.0 * steps[j]))
-        })
-        .collect::<Result<_>>()?;
+    let columns = super::rows::run_parts(2 * n, |j| {
+        let mut plus = base.clone();
+        let mut minus = base.clone();
+        plus[j] += steps[j];
+        minus[j] -= steps[j];
+        let fp = stroboscopic_map(system, integrator, t0, period, &expand(n, &plus))?;
+        let fm = stroboscopic_map(system, integrator, t0, period, &expand(n, &minus))?;
+        Ok((compact(n, &fp) - compact(n, &fm)) / (2.0 * steps[j]))
+    })?;
     Ok(DMatrix::from_columns(&columns))
 }
 
 /// Finds the periodic orbit of a driven device on the section `t ≡ t0 (mod T)`.
 ///
-/// Warm-up: up to `warmup_cycles` cycles of simulation (stopping at the last good state if an
-/// integration fails). Then Newton on `F(y) = P(y) − y` with
-/// the exact Jacobian of the computed map (forward sensitivities, [`RungeKutta::flow_with_sensitivity`]); the step solves `(DP − I)Δ = −F` by SVD in the
-/// least-squares sense, so a neutral direction (multiplier 1, e.g. K2 = 0 with the linear
-/// drivetrain, where every constant `q2` is an orbit) does not break it; steps are halved until
-/// the residual decreases. If Newton stalls, cycle-to-cycle simulation continues from the best
-/// state (this converges only to a stable orbit).
+/// Warm-up: up to `warmup_cycles` cycles of simulation at the options' tolerances (stopping at
+/// the last good state if an integration fails). Then the engine's frozen-grid Newton
+/// ([`crate::grid_shooting`], as [`crate::SteadyState::Shooting`]): one adaptive period with the
+/// variational equations at `rtol / 100` picks the steps from `t0` to `t0 + T`, every Newton
+/// trial retraces them (a map smooth in `y`, so Newton converges to round-off), Broyden
+/// updates the Jacobian between exact ones, and the step solves `(DP − I)Δ = −F` by SVD in the
+/// least-squares sense with the neutral directions left out, so a multiplier 1 (e.g. K2 = 0
+/// with the linear drivetrain, where every constant `q2` is an orbit) does not break it. The
+/// monodromy is the variational period of the converged orbit on that grid (the exact
+/// derivative of the map whose fixed point it is). If Newton fails, cycle-to-cycle simulation
+/// continues from the warm-up's state (this converges only to a stable orbit).
 ///
 /// # Errors
 /// [`Error::Constraint`] without an actuator; [`Error::InvalidParameter`] for bad options;
 /// [`Error::Integration`] when an integration fails or no method converges (with the best
-/// state and its residual).
+/// state and its residual), or the wall budget is spent; [`Error::Cancelled`].
 pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<PeriodicOrbit> {
     // The per-point wall budget of `simulate` bounds a pathological orbit search too (an outer
     // run's earlier deadline or cancel flag still applies).
-    let _budget =
-        crate::integrate::budget::Budget::new(Some(crate::simulate::DEFAULT_MAX_WALL_MS), None)
-            .enter();
+    let _budget = budget::Budget::new(Some(crate::simulate::DEFAULT_MAX_WALL_MS), None).enter();
     let period = drive_period(device)?;
     let integrator = options.validate(period)?;
     let n = device.n_dof();
@@ -275,91 +271,86 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
         res = residual_norm(n, &y, &py);
         cycles += 1;
     }
-    let mut iterations = 0;
-    // Chord Newton: the exact derivative of the computed map (forward sensitivities, one
-    // augmented period integration) is evaluated once and reused while it keeps the residual
-    // falling fast; trial states cost one plain period each. It is re-evaluated at the
-    // current iterate when a step stalls.
-    let sensitivity = |y: &State| -> Result<(State, DMatrix<f64>)> {
-        let (py, phi) = integrator.with_work(false).flow_with_sensitivity(
-            device,
-            t0,
-            &y.without_work(),
-            t0 + period,
-        )?;
-        Ok((py.without_work(), phi))
-    };
-    let mut monodromy: Option<(DMatrix<f64>, State)> = None;
-    if res > options.tol && options.max_newton > 0 {
-        if let Ok((p, phi)) = sensitivity(&y) {
-            py = p;
-            res = residual_norm(n, &y, &py);
-            monodromy = Some((phi, y));
-        }
-    }
-    while res > options.tol && iterations < options.max_newton {
-        let Some((jac, at)) = monodromy.clone() else {
-            break;
-        };
-        let fresh = at == y;
-        iterations += 1;
-        let a = jac - DMatrix::<f64>::identity(2 * n, 2 * n);
-        let f = compact(n, &py) - compact(n, &y);
-        // The same step as the frozen-grid shooting: neutral directions are left alone.
-        let delta = crate::grid_shooting::least_squares_step(a, &f).ok_or_else(|| {
-            Error::Singular("Newton step of the shooting method: non-finite Jacobian".into())
-        })?;
-        let mut lambda = 1.0;
-        let mut accepted = false;
-        for _ in 0..if fresh { 8 } else { 1 } {
-            let trial = expand(n, &(compact(n, &y) + &delta * lambda));
-            // A trial step may leave the linkage's reach: treat it as a failed step.
-            if let Ok(pt) = stroboscopic_map(device, &integrator, t0, period, &trial) {
-                let rt = residual_norm(n, &trial, &pt);
-                // A stale Jacobian must still contract fast; a fresh one only needs descent.
-                if rt < if fresh { res } else { 0.3 * res } {
-                    (y, py, res) = (trial, pt, rt);
-                    accepted = true;
-                    break;
-                }
-            }
-            lambda *= 0.5;
-        }
-        if accepted {
-            continue;
-        }
-        if fresh {
-            break;
-        }
-        // Stalled on a stale Jacobian: re-evaluate it here.
-        match sensitivity(&y) {
-            Ok((p, phi)) => {
-                py = p;
-                res = residual_norm(n, &y, &py);
-                monodromy = Some((phi, y));
-            }
-            Err(_) => break,
-        }
-    }
-    if res <= options.tol {
-        let (monodromy, monodromy_offset) = match monodromy {
-            Some((m, at)) => {
-                let offset = (compact(n, &at) - compact(n, &y)).amax();
-                (Some(m), offset)
-            }
-            None => (None, f64::NAN),
-        };
-        return Ok(PeriodicOrbit {
-            state: y,
+    let orbit =
+        |state: State, residual: f64, newton_iterations: usize, cycles: usize| PeriodicOrbit {
+            state,
             t0,
             period,
-            residual: res,
-            newton_iterations: iterations,
+            residual,
+            newton_iterations,
             cycles_simulated: cycles,
             method: OrbitMethod::Newton,
-            monodromy,
-            monodromy_offset,
-        });
+            monodromy: None,
+            monodromy_offset: f64::NAN,
+        };
+    if res <= options.tol {
+        return Ok(orbit(y, res, 0, cycles));
+    }
+    let plain = integrator.with_work(false);
+    let mut iterations = 0;
+    // The frozen-grid Newton from `y`, its monodromy the variational period of the converged
+    // orbit on that grid (the exact derivative of the map whose fixed point it is).
+    let grid_orbit =
+        |y: &State, guess: Option<&DMatrix<f64>>, before: usize| -> Result<Option<PeriodicOrbit>> {
+            let mut finish = |grid: &[f64], y: &State| -> Result<State> {
+                plain.integrate_on_grid(device, grid, y, &[], &mut |_, _, _| Ok(()))
+            };
+            let Some(shot) = crate::grid_shooting::shoot(
+                device,
+                &integrator,
+                period,
+                t0,
+                y,
+                guess,
+                None,
+                options.tol,
+                options.tol,
+                options.max_newton,
+                &mut finish,
+            )?
+            else {
+                return Ok(None);
+            };
+            let monodromy =
+                match plain.flow_with_sensitivity_on_grid(device, &shot.grid, &shot.state) {
+                    Ok((_, m)) => Some(m),
+                    Err(e) if crate::grid_shooting::out_of_budget(&e) => return Err(e),
+                    // Left to `floquet`'s adaptive variational period.
+                    Err(_) => None,
+                };
+            let iterations = before + shot.iterations;
+            Ok(Some(PeriodicOrbit {
+                monodromy_offset: if monodromy.is_some() { 0.0 } else { f64::NAN },
+                monodromy,
+                ..orbit(shot.state.without_work(), shot.residual, iterations, cycles)
+            }))
+        };
+    if options.max_newton > 0 {
+        if let Some(found) = grid_orbit(&y, None, 0)? {
+            return Ok(found);
+        }
+        // Too far for full Newton steps (measured: the unstable orbit of a cut wing at K2 = 1
+        // after a warm-up that ran away): a damped Newton on the adaptive map brings the state
+        // into the frozen-grid Newton's basin, which then finishes.
+        let near = damped_newton(
+            device,
+            &integrator,
+            t0,
+            period,
+            &y,
+            &py,
+            BASIN_TOL.max(options.tol),
+            options,
+        )?;
+        iterations = near.iterations;
+        if near.residual < res {
+            // Its Jacobian saves the frozen-grid Newton the variational period.
+            let guess = near.jacobian.as_ref();
+            if let Some(found) = grid_orbit(&near.state, guess, iterations)? {
+                return Ok(found);
+            }
+        }
+        (y, py, res) = (near.state, near.image, near.residual);
     }
     // Fallback: plain cycle-to-cycle simulation.
     for _ in 0..options.fallback_cycles {
@@ -385,10 +376,124 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
         time: t0,
         state: y.to_vec(),
         reason: format!(
-            "no periodic orbit: Newton ({iterations} iterations) and {cycles} simulated cycles \
+            "no periodic orbit: frozen-grid Newton ({iterations} steps allowed) and {cycles} \
+             simulated cycles \
              left the residual at {res:e} > tol = {:e}",
             options.tol
         ),
+    })
+}
+
+/// Residual below which [`periodic_orbit`] hands a damped Newton's state to the frozen-grid
+/// Newton (its full steps then contract: the residual is far below the orbit's scale).
+const BASIN_TOL: f64 = 1e-6;
+
+/// A damped Newton's last state.
+struct Damped {
+    state: State,
+    /// `P(state)` on the adaptive map.
+    image: State,
+    residual: f64,
+    iterations: usize,
+    /// The last Jacobian of the map (at a state near `state`).
+    jacobian: Option<DMatrix<f64>>,
+}
+
+/// Chord Newton with step halving on the adaptive map from `y` (`py = P(y)`) until the
+/// residual is below `until`, a step fails or `max_newton` steps: the globalisation of
+/// [`periodic_orbit`] far from the orbit. The exact derivative of the computed map (forward
+/// sensitivities, one augmented period) is reused while it keeps the residual falling fast;
+/// a trial costs one plain period; a stalled step re-evaluates it at the current iterate.
+///
+/// # Errors
+/// A spent budget or cancel; [`Error::Singular`] for a non-finite Jacobian.
+#[allow(clippy::too_many_arguments)]
+fn damped_newton(
+    device: &Device,
+    integrator: &RungeKutta,
+    t0: f64,
+    period: f64,
+    y: &State,
+    py: &State,
+    until: f64,
+    options: &ShootingOptions,
+) -> Result<Damped> {
+    let n = device.n_dof();
+    let (mut y, mut py) = (*y, *py);
+    let mut res = residual_norm(n, &y, &py);
+    let mut iterations = 0;
+    let sensitivity = |y: &State| -> Result<(State, DMatrix<f64>)> {
+        let (py, phi) = integrator.with_work(false).flow_with_sensitivity(
+            device,
+            t0,
+            &y.without_work(),
+            t0 + period,
+        )?;
+        Ok((py.without_work(), phi))
+    };
+    let mut jacobian: Option<(DMatrix<f64>, State)> = None;
+    match sensitivity(&y) {
+        Ok((p, phi)) => {
+            py = p;
+            res = residual_norm(n, &y, &py);
+            jacobian = Some((phi, y));
+        }
+        Err(e) if crate::grid_shooting::out_of_budget(&e) => return Err(e),
+        Err(_) => {}
+    }
+    while res > until && iterations < options.max_newton {
+        let Some((jac, at)) = jacobian.clone() else {
+            break;
+        };
+        let fresh = at == y;
+        iterations += 1;
+        let a = jac - DMatrix::<f64>::identity(2 * n, 2 * n);
+        let f = compact(n, &py) - compact(n, &y);
+        let delta = crate::grid_shooting::least_squares_step(a, &f).ok_or_else(|| {
+            Error::Singular("Newton step of the shooting method: non-finite Jacobian".into())
+        })?;
+        let mut lambda = 1.0;
+        let mut accepted = false;
+        for _ in 0..if fresh { 8 } else { 1 } {
+            let trial = expand(n, &(compact(n, &y) + &delta * lambda));
+            // A trial step may leave the linkage's reach: treat it as a failed step.
+            match stroboscopic_map(device, integrator, t0, period, &trial) {
+                Ok(pt) => {
+                    let rt = residual_norm(n, &trial, &pt);
+                    // A stale Jacobian must still contract fast; a fresh one only needs descent.
+                    if rt < if fresh { res } else { 0.3 * res } {
+                        (y, py, res) = (trial, pt, rt);
+                        accepted = true;
+                        break;
+                    }
+                }
+                Err(e) if crate::grid_shooting::out_of_budget(&e) => return Err(e),
+                Err(_) => {}
+            }
+            lambda *= 0.5;
+        }
+        if accepted {
+            continue;
+        }
+        if fresh {
+            break;
+        }
+        match sensitivity(&y) {
+            Ok((p, phi)) => {
+                py = p;
+                res = residual_norm(n, &y, &py);
+                jacobian = Some((phi, y));
+            }
+            Err(e) if crate::grid_shooting::out_of_budget(&e) => return Err(e),
+            Err(_) => break,
+        }
+    }
+    Ok(Damped {
+        state: y,
+        image: py,
+        residual: res,
+        iterations,
+        jacobian: jacobian.map(|(j, _)| j),
     })
 }
 
@@ -541,12 +646,13 @@ pub fn floquet(device: &Device, options: &ShootingOptions) -> Result<NonlinearFl
             options.fd_step,
         )
     };
-    let run_budget = budget::current();
-    let (monodromy, coarse) = rayon::join(
-        || budget::carry(&run_budget, variational),
-        || budget::carry(&run_budget, differences),
+    // Both in parallel on the sweep engine's pool, under the caller's budget.
+    let mut both =
+        super::rows::run_parts(2, |i| if i == 0 { variational() } else { differences() })?;
+    let (coarse, monodromy) = (
+        both.pop().expect("two parts"),
+        both.pop().expect("two parts"),
     );
-    let (monodromy, coarse) = (monodromy?, coarse?);
     let monodromy_uncertainty = (&monodromy - coarse).amax();
     let multipliers = eigenvalues(&monodromy)?;
     let drivetrain_coords = device.formulation() == Formulation::DrivetrainCoordinates;

@@ -296,7 +296,7 @@ fn chart_is_row_major_parallel_and_matches_pointwise() {
             assert_eq!((chart.beta0[idx], chart.kappa[idx]), (b0, k));
             assert_eq!(chart.a[idx], f.a);
             assert_eq!(chart.b[idx], f.b);
-            assert_eq!(chart.region[idx], f.region);
+            assert_eq!(chart.region[idx], Some(f.region));
             assert_eq!(chart.spectral_radius[idx], f.spectral_radius());
             // Negative damping: b = e^{-2β0} > 1, never stable (eq. 2.51). A negative spring
             // has a real multiplier above 1.
@@ -980,4 +980,259 @@ fn cancelling_a_k2_sweep_from_another_thread_returns_cancelled() {
     });
     assert_eq!(out.unwrap_err().kind(), "Cancelled");
     assert!(started.elapsed().as_secs_f64() < 30.0);
+}
+
+// ------------------------------------------------------------------ issue 12: stability leftovers
+
+#[test]
+fn a_failing_chart_point_is_a_marked_entry_and_the_others_are_kept() {
+    // κ = −1e6 passes the axis checks but its solution grows like e^{1000π}: overflow. The
+    // chart formerly failed as a whole on it.
+    assert_eq!(hill_floquet(0.5, -1e6).unwrap_err().kind(), "OutOfDomain");
+    let beta0 = [0.5, 2.0];
+    let kappa = [1.0, -1e6, 0.2];
+    let chart = stability_chart(&beta0, &kappa).unwrap();
+    assert_eq!(chart.a.len(), 6);
+    let failed: Vec<usize> = chart.errors.iter().map(|(i, _)| *i).collect();
+    assert_eq!(failed, [1, 4]);
+    for (idx, err) in &chart.errors {
+        assert_eq!(err.kind(), "OutOfDomain", "{err}");
+        assert!(
+            err.to_string().contains(&format!("at index {idx}:")),
+            "{err}"
+        );
+    }
+    let numbers = chart.region_numbers();
+    let stable = chart.stable();
+    for (i, &b0) in beta0.iter().enumerate() {
+        for (j, &k) in kappa.iter().enumerate() {
+            let idx = i * kappa.len() + j;
+            assert_eq!((chart.beta0[idx], chart.kappa[idx]), (b0, k));
+            if j == 1 {
+                assert_eq!(chart.region[idx], None);
+                assert_eq!(numbers[idx], 0);
+                assert!(!stable[idx] && !chart.marginal[idx]);
+                assert!(chart.a[idx].is_nan() && chart.spectral_radius[idx].is_nan());
+                continue;
+            }
+            let f = hill_floquet(b0, k).unwrap();
+            assert_eq!(chart.a[idx], f.a);
+            assert_eq!(chart.b[idx], f.b);
+            assert_eq!(chart.region[idx], Some(f.region));
+            assert_eq!(numbers[idx], i64::from(f.region.index()));
+        }
+    }
+}
+
+#[test]
+fn multipliers_and_orbit_do_not_depend_on_the_section_time() {
+    // The monodromies at sections t0 and t1 are similar (M1 = Φ(t1, t0) M0 Φ(t1, t0)⁻¹): same
+    // eigenvalues. The orbit found on section t0 is the t = 0 orbit carried to t0 by the flow.
+    for device in [
+        section_3_3_at(0.599 * 31.3, 500.0, 70.0),
+        section_3_3(31.3, 1.0),
+    ] {
+        let at_zero = floquet(&device, &options()).unwrap();
+        let period = at_zero.orbit.period;
+        let rk = RungeKutta::new(Method::Dop853, 1e-12, 1e-14, 1_000_000).unwrap();
+        for fraction in [0.3, 0.71] {
+            let t0 = fraction * period;
+            let f = floquet(&device, &ShootingOptions { t0, ..options() }).unwrap();
+            assert_eq!(f.orbit.method, OrbitMethod::Newton);
+            assert_eq!(f.orbit.t0, t0);
+            assert!(f.orbit.residual <= options().tol);
+            for (a, b) in f.multipliers.iter().zip(&at_zero.multipliers) {
+                assert!(
+                    (a - b).norm() < 1e-8 * (1.0 + b.norm()),
+                    "t0 {t0}: {a} vs {b}"
+                );
+            }
+            let carried = rk
+                .integrate(&device, 0.0, &at_zero.orbit.state, t0, &[t0])
+                .unwrap()[0];
+            for s in [0, 1, 6, 7] {
+                let (x, y) = (carried.to_vec()[s], f.orbit.state.to_vec()[s]);
+                assert!(
+                    (x - y).abs() < 1e-8 * (1.0 + y.abs()),
+                    "t0 {t0} slot {s}: {x} vs {y}"
+                );
+            }
+        }
+    }
+}
+
+/// `∫₀ᵀ tr ∂f/∂y dt` along the orbit: for `[q, q̇]` the trace is `Σ ∂q̈ᵢ/∂q̇ᵢ` (central
+/// differences of the right-hand side), integrated by the trapezoidal rule on `samples`.
+fn integrated_trace(device: &Device, orbit: &PeriodicOrbit, samples: usize) -> f64 {
+    let rk = RungeKutta::new(Method::Dop853, 1e-12, 1e-14, 1_000_000).unwrap();
+    let (t0, period) = (orbit.t0, orbit.period);
+    let times: Vec<f64> = (0..=samples)
+        .map(|j| t0 + period * j as f64 / samples as f64)
+        .collect();
+    let states = rk
+        .integrate(device, t0, &orbit.state, t0 + period, &times)
+        .unwrap();
+    let trace = |t: f64, y: &State| -> f64 {
+        (0..device.n_dof())
+            .map(|i| {
+                let h = 1e-6 * (1.0 + y.rates[i].abs());
+                let (mut plus, mut minus) = (*y, *y);
+                plus.rates[i] += h;
+                minus.rates[i] -= h;
+                let (mut fp, mut fm) = (State::default(), State::default());
+                device.rhs(t, &plus, &mut fp).unwrap();
+                device.rhs(t, &minus, &mut fm).unwrap();
+                (fp.rates[i] - fm.rates[i]) / (2.0 * h)
+            })
+            .sum()
+    };
+    let values: Vec<f64> = times
+        .iter()
+        .zip(&states)
+        .map(|(t, y)| trace(*t, y))
+        .collect();
+    let h = period / samples as f64;
+    h * (values.iter().sum::<f64>() - 0.5 * (values[0] + values[samples]))
+}
+
+#[test]
+fn monodromy_determinant_obeys_liouville() {
+    // Liouville: det Φ(T) = exp(∫ tr J dt) for any ODE. The monodromy comes from the
+    // variational equations on the frozen grid; the trace integral from the right-hand side
+    // alone (two independent formulations). Linear map and nonlinear linkage (symmetric
+    // orbits, measured agreement 2e-10 and 1e-9 relative in ln det), and a cut-wing orbit whose
+    // det ≈ e^{−28} is the product of multipliers down to 1e-9, known to the monodromy's
+    // absolute accuracy only (measured 8e-7).
+    for (device, tol) in [
+        (eq_2_16_device(linear_map(), 200.0), 1e-8),
+        (
+            eq_2_16_device(
+                Drivetrain::LinkageDifferential(LinkageDifferential::thesis()),
+                200.0,
+            ),
+            1e-8,
+        ),
+        (section_3_3_at(0.599 * 31.3, 100.0, 70.0), 1e-5),
+    ] {
+        let f = floquet(&device, &options()).unwrap();
+        let ln_det = f.monodromy.determinant().ln();
+        let want = integrated_trace(&device, &f.orbit, 40_000);
+        assert!(
+            (ln_det - want).abs() < tol * want.abs(),
+            "ln det M = {ln_det} vs ∫ tr J = {want}"
+        );
+    }
+}
+
+/// A driven damped oscillator `ẍ + c ẋ + k x = cos(2π t / T)` that records the threads it is
+/// evaluated on.
+struct Recording {
+    c: f64,
+    k: f64,
+    period: f64,
+    threads: std::sync::Mutex<std::collections::BTreeSet<String>>,
+}
+
+impl OdeSystem for Recording {
+    fn rhs(&self, t: f64, y: &State, dydt: &mut State) -> paritysim_dynamics::Result<()> {
+        let name = std::thread::current()
+            .name()
+            .unwrap_or("<unnamed>")
+            .to_string();
+        self.threads.lock().unwrap().insert(name);
+        *dydt = State::default();
+        dydt.coords[0] = y.rates[0];
+        dydt.rates[0] =
+            (2.0 * PI * t / self.period).cos() - self.c * y.rates[0] - self.k * y.coords[0];
+        Ok(())
+    }
+    fn n_active(&self) -> usize {
+        1
+    }
+}
+
+#[test]
+fn map_jacobian_runs_on_the_sweep_engine_pool_and_equals_the_closed_form() {
+    // Formerly the columns ran on rayon's global pool (unnamed threads) from a plain call.
+    let system = Recording {
+        c: 0.3,
+        k: 2.0,
+        period: 2.0,
+        threads: Default::default(),
+    };
+    let rk = RungeKutta::new(Method::Dop853, 1e-12, 1e-14, 1_000_000).unwrap();
+    let mut y = State::default();
+    y.coords[0] = 0.2;
+    let jac = map_jacobian(&system, 1, &rk, 0.0, system.period, &y, 1e-5).unwrap();
+    // Linear: the map's Jacobian is exp(A T), A = [[0, 1], [−k, −c]]:
+    // e^{−cT/2} [cos(ωd T) I + sin(ωd T)/ωd (A + c/2 I)], ωd = √(k − c²/4).
+    let (c, k, t) = (system.c, system.k, system.period);
+    let wd = (k - 0.25 * c * c).sqrt();
+    let (cs, sn) = ((wd * t).cos(), (wd * t).sin() / wd);
+    let e = (-0.5 * c * t).exp();
+    let want = [
+        [e * (cs + sn * 0.5 * c), e * sn],
+        [-e * sn * k, e * (cs - sn * 0.5 * c)],
+    ];
+    for (i, row) in want.iter().enumerate() {
+        for (j, w) in row.iter().enumerate() {
+            assert!(
+                (jac[(i, j)] - w).abs() < 1e-8,
+                "({i}, {j}): {} vs {w}",
+                jac[(i, j)]
+            );
+        }
+    }
+    let caller = std::thread::current()
+        .name()
+        .unwrap_or("<unnamed>")
+        .to_string();
+    for name in system.threads.lock().unwrap().iter() {
+        assert!(
+            *name == caller || name.starts_with("paritysim-sweep-"),
+            "ran on {name:?}"
+        );
+    }
+}
+
+#[test]
+fn a_spent_wall_budget_or_a_cancel_stops_the_parallel_parts_of_an_analysis() {
+    use paritysim_dynamics::integrate::budget::{Budget, CancelFlag};
+    let device = section_3_3(31.3, 500.0);
+    let f = floquet(&device, &options()).unwrap();
+    let rk = RungeKutta::new(Method::Dop853, 1e-12, 1e-14, 1_000_000).unwrap();
+    let wall = |e: paritysim_dynamics::Error| match e {
+        paritysim_dynamics::Error::Integration { reason, .. } => {
+            assert!(reason.contains("max_wall_ms"), "{reason}")
+        }
+        other => panic!("{other:?}"),
+    };
+    {
+        // A deadline 1 ns from now: spent at the parts' first budget check.
+        let _budget = Budget::new(Some(1e-6), None).enter();
+        let m = map_jacobian(&device, 2, &rk, 0.0, f.orbit.period, &f.orbit.state, 1e-5);
+        wall(m.unwrap_err());
+        wall(floquet(&device, &options()).unwrap_err());
+        let r = disturbance_response(
+            &device,
+            &f.orbit,
+            300.0,
+            0.5,
+            &DisturbanceOptions::default(),
+        );
+        wall(r.unwrap_err());
+    }
+    let flag = CancelFlag::new();
+    flag.cancel();
+    let _budget = Budget::new(None, Some(flag)).enter();
+    let m = map_jacobian(&device, 2, &rk, 0.0, f.orbit.period, &f.orbit.state, 1e-5);
+    assert_eq!(m.unwrap_err().kind(), "Cancelled");
+    let r = disturbance_response(
+        &device,
+        &f.orbit,
+        300.0,
+        0.5,
+        &DisturbanceOptions::default(),
+    );
+    assert_eq!(r.unwrap_err().kind(), "Cancelled");
 }
