@@ -17,6 +17,7 @@ use crate::integrate::State;
 use crate::wing::{Wing, WingTerms};
 
 mod stroke_plane;
+use stroke_plane::branches;
 
 /// A drivetrain with its balance-beam spring.
 #[derive(Clone, Debug, PartialEq)]
@@ -1034,5 +1035,32 @@ impl crate::integrate::OdeSystem for Device {
 
     fn n_active(&self) -> usize {
         self.n_dof()
+    }
+
+    fn n_switches(&self) -> usize {
+        self.stroke_plane_switches()
+    }
+
+    fn switches(
+        &self,
+        _t: f64,
+        y: &State,
+        g: &mut [f64; crate::integrate::MAX_SWITCHES],
+    ) -> Result<()> {
+        self.stroke_plane_switching_functions(y, g);
+        Ok(())
+    }
+
+    fn rhs_on(
+        &self,
+        t: f64,
+        y: &State,
+        sides: crate::integrate::Sides,
+        dydt: &mut State,
+    ) -> Result<()> {
+        match &self.stroke_plane_rhs {
+            Some(lean) => self.rhs_stroke_plane(lean, t, y, Some(branches(sides)), dydt),
+            None => Device::rhs(self, t, y, dydt),
+        }
     }
 }
