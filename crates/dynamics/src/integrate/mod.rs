@@ -837,6 +837,9 @@ fn drive_on_grid<const M: usize, S: Stepper<M>>(
     let mut f0 = [0.0; M];
     let mut f1 = [0.0; M];
     rhs.eval(t0, &y, &mut f0)?;
+    let n_switches = rhs.n_switches().min(MAX_SWITCHES);
+    let mut sides = None;
+    let mut g = [0.0; MAX_SWITCHES];
     for (k, pair) in grid.windows(2).enumerate() {
         let (t, t_new) = (pair[0], pair[1]);
         if k % budget::CHECK_EVERY == 0 {
@@ -845,6 +848,23 @@ fn drive_on_grid<const M: usize, S: Stepper<M>>(
             }
         }
         let h = t_new - t;
+        if n_switches > 0 {
+            // Each step on one smooth branch, the sides half a step in (Euler predictor): the
+            // adaptive run that chose the grid cut its steps at the roots, so a step's middle
+            // is far from them and its sides do not change under a Newton trial's small
+            // perturbation (the frozen map stays smooth).
+            let mut middle = [0.0; M];
+            for i in 0..M {
+                middle[i] = y[i] + 0.5 * h * f0[i];
+            }
+            rhs.switches(t + 0.5 * h, &middle, &mut g)?;
+            let here = Sides::of(&g[..n_switches]);
+            if sides != Some(here) {
+                sides = Some(here);
+                rhs.set_sides(here);
+                rhs.eval(t, &y, &mut f0)?;
+            }
+        }
         let err = stepper.attempt(rhs, t, &y, &f0, h, tol)?;
         if !err.is_finite() {
             return Err(integration_error(
