@@ -359,8 +359,10 @@ mod tests {
     fn lean_path_is_used_and_reports_implausible_coordinates() {
         let d = device(true, false, 0.0);
         assert!(d.stroke_plane_rhs.is_some());
-        let mut y = State::default();
-        y.coords = [1e5, -1e5, 1e5, -1e5, 0.0, 0.0];
+        let y = State {
+            coords: [1e5, -1e5, 1e5, -1e5, 0.0, 0.0],
+            ..State::default()
+        };
         let mut out = State::default();
         let lean = d.rhs(0.0, &y, &mut out);
         let general = d.rhs_null_space(0.0, &y, &mut out);
