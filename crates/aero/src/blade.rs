@@ -561,6 +561,63 @@ impl<C: CoefficientModel> BladeElementModel<C> {
         }
     }
 
+    /// [`Self::moments_omega`] (`branch` None) or [`Self::moments_omega_branch`] of a wing on
+    /// its stroke plane (deviation θ ≡ 0): `ω = φ̇ (cos ψ, −sin ψ, 0) + ψ̇ ẑ`, so that
+    /// `W² = φ̇²`, `α = π/2 + σ ψ`, `sin α = cos ψ` and `cos α = −σ sin ψ` (for |ψ| < π/2,
+    /// `cos ψ > 0`): no `atan2` and no `sin_cos(α)`. `(sin ψ, cos ψ)` are the caller's. On a
+    /// branch, σ is held and α continues in ψ (analytic in the state; the moments carry `W²`,
+    /// which vanishes at the stroke reversal).
+    #[inline]
+    pub fn moments_stroke_plane(
+        &self,
+        phi_dot: f64,
+        psi: f64,
+        (sin_psi, cos_psi): (f64, f64),
+        psi_dot: f64,
+        branch: Option<Branch>,
+    ) -> AeroMoments {
+        let o = &self.omegas;
+        let (wx, wy, wz) = (cos_psi * phi_dot, -sin_psi * phi_dot, psi_dot);
+        let w2 = wx * wx + wy * wy;
+        let damping = match branch {
+            None => wz * wz.abs(),
+            Some(b) => unit_sign(b.spanwise_positive) * wz * wz,
+        };
+        let rotational_damping = -o.omega2 * self.rotational_damping * damping; // eq. 3.10
+        if w2 == 0.0 {
+            return AeroMoments {
+                rotational_damping,
+                alpha: FRAC_PI_2,
+                ..AeroMoments::default()
+            };
+        }
+        let sigma = match branch {
+            None => sign(wx),
+            Some(b) => unit_sign(b.chordwise_positive),
+        };
+        let alpha = FRAC_PI_2 + sigma * psi;
+        let below = match branch {
+            None => alpha <= FRAC_PI_2,
+            Some(b) => b.normal_positive,
+        };
+        let (cn, ct) = match self.law {
+            NormalForceLaw::Coefficient => {
+                let (cl, cd) = self.coefficients.lift_drag_branch(alpha, below);
+                let (sin_a, cos_a) = (cos_psi, -sigma * sin_psi);
+                (cl * cos_a + cd * sin_a, cd * cos_a - cl * sin_a)
+            }
+            NormalForceLaw::Unit => (1.0, 0.0),
+        };
+        let d_cp = 0.82 / PI * alpha + 0.05; // eq. 3.7 (α in (0, π))
+        AeroMoments {
+            normal: -o.omega1 * sigma * w2 * cn, // eq. 3.8
+            tangential: -o.omega1 * w2 * ct,     // eq. 3.9
+            rotational: -(o.omega3 * d_cp - o.omega4) * sigma * w2 * cn, // eq. 3.11
+            rotational_damping,
+            alpha,
+        }
+    }
+
     /// [`Self::loads_omega`] on a [`Branch`] (its values on the branch's own side).
     ///
     /// # Errors

@@ -16,6 +16,9 @@ use crate::actuator::Actuator;
 use crate::integrate::State;
 use crate::wing::{Wing, WingTerms};
 
+mod stroke_plane;
+use stroke_plane::branches;
+
 /// A drivetrain with its balance-beam spring.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Transmission {
@@ -183,6 +186,8 @@ pub struct Device {
     /// The constant Jacobian of a 2-DOF linear-map drivetrain (eq. 2.15): its inverse
     /// kinematics need no drivetrain evaluations.
     linear_jacobian: Option<Matrix2<f64>>,
+    /// The lean right-hand side of a stroke-plane device (§3.4), when it applies.
+    stroke_plane_rhs: Option<stroke_plane::StrokePlane>,
 }
 
 /// Stroke angles `(φL, φR)`, their rates and the whippletree angle `q2` (see
@@ -317,7 +322,7 @@ impl Device {
             Some(Drivetrain::LinearDifferential(map)) => Some(map.evaluate(0.0, 0.0).jacobian),
             _ => None,
         };
-        Ok(Self {
+        let mut device = Self {
             spec,
             n_coords,
             basis,
@@ -328,7 +333,10 @@ impl Device {
             stroke_plane,
             free_deviation,
             linear_jacobian,
-        })
+            stroke_plane_rhs: None,
+        };
+        device.stroke_plane_rhs = stroke_plane::StrokePlane::of(&device);
+        Ok(device)
     }
 
     /// The spec this model was built from.
@@ -694,6 +702,14 @@ impl Device {
         if let Some(fast) = &self.stroke_only {
             return self.rhs_drivetrain(fast, t, y, dydt);
         }
+        if let Some(lean) = &self.stroke_plane_rhs {
+            return self.rhs_stroke_plane(lean, t, y, None, dydt);
+        }
+        self.rhs_null_space(t, y, dydt)
+    }
+
+    /// [`Self::rhs`] through [`Self::evaluate`] (null space or projection, any wing).
+    fn rhs_null_space(&self, t: f64, y: &State, dydt: &mut State) -> Result<()> {
         let (p, p_dot) = self.coordinates(y)?;
         let e = self.evaluate(t, &p, &p_dot)?;
         let x_ddot = self.basis.transpose() * e.p_ddot;
@@ -1019,5 +1035,32 @@ impl crate::integrate::OdeSystem for Device {
 
     fn n_active(&self) -> usize {
         self.n_dof()
+    }
+
+    fn n_switches(&self) -> usize {
+        self.stroke_plane_switches()
+    }
+
+    fn switches(
+        &self,
+        _t: f64,
+        y: &State,
+        g: &mut [f64; crate::integrate::MAX_SWITCHES],
+    ) -> Result<()> {
+        self.stroke_plane_switching_functions(y, g);
+        Ok(())
+    }
+
+    fn rhs_on(
+        &self,
+        t: f64,
+        y: &State,
+        sides: crate::integrate::Sides,
+        dydt: &mut State,
+    ) -> Result<()> {
+        match &self.stroke_plane_rhs {
+            Some(lean) => self.rhs_stroke_plane(lean, t, y, Some(branches(sides)), dydt),
+            None => Device::rhs(self, t, y, dydt),
+        }
     }
 }

@@ -543,6 +543,37 @@ fn shooting_steady_state(
         recorded = Some((trajectory, metrics));
         Ok(end)
     };
+    // A right-hand side with switches (event location): the adaptive period cuts the grid at
+    // the roots of its start state, which move by the distance to the orbit, and the steps
+    // next to them then integrate a continued branch (measured on the §3.4 device: the true
+    // map's residual 3e-7 at the frozen grid's orbit). So a first orbit on that grid, then
+    // the grid picked again from it (its roots within Newton's last correction); a
+    // neighbour's grid is not reused. Lanes never run such devices (no lane model).
+    let switched = crate::integrate::OdeSystem::n_switches(device) > 0;
+    let mut first_guess = None;
+    if switched && guess.is_none() {
+        let mut plain = |grid: &[f64], y: &State| -> Result<State> {
+            transient.integrate_on_grid(device, grid, y, &[], &mut |_, _, _| Ok(()))
+        };
+        if let Some(first) = crate::grid_shooting::shoot(
+            device,
+            transient,
+            period,
+            &y,
+            None,
+            None,
+            tol,
+            options.steady_tol,
+            20,
+            &mut plain,
+        )? {
+            y = first.state;
+            cycles += first.periods + 1;
+            first_guess = Some(first.jacobian);
+        }
+    }
+    let guess = first_guess.as_ref().or(guess);
+    let guess_grid = options.shooting_grid.as_deref().filter(|_| !switched);
     let Some(orbit) = crate::grid_shooting::shoot(
         device,
         transient,
@@ -550,7 +581,7 @@ fn shooting_steady_state(
         0.0,
         &y,
         guess,
-        options.shooting_grid.as_deref(),
+        guess_grid,
         tol,
         options.steady_tol,
         20,

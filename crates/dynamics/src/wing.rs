@@ -14,7 +14,7 @@
 //! finite-differenced link rotations and Christoffel symbols of a finite-differenced `M`.
 
 use nalgebra::{Matrix3, Vector2, Vector3};
-use paritysim_aero::{BladeElementModel, CoefficientSet};
+use paritysim_aero::{BladeElementModel, Branch, CoefficientSet};
 use paritysim_error::{Error, Result, check_finite, check_non_negative};
 use paritysim_kinematics::SphericalShoulder;
 
@@ -169,17 +169,32 @@ impl WingAero {
         omega: &Vector3<f64>,
         r61: &Matrix3<f64>,
     ) -> Vector3<f64> {
+        self.torque_about(p_dot.x, omega, &r61.row(0).transpose(), None)
+    }
+
+    /// [`Self::torque`] from the stroke rate `φ̇`, `ω⁶` and the stroke axis x̂ (ground) in
+    /// frame 6 (row 0 of `R_6^1`), the blade element on `branch` when given (event location:
+    /// the smooth branch held between switches, [`Branch`]).
+    #[inline]
+    pub(crate) fn torque_about(
+        &self,
+        phi_dot: f64,
+        omega: &Vector3<f64>,
+        stroke_axis_6: &Vector3<f64>,
+        branch: Option<Branch>,
+    ) -> Vector3<f64> {
         match self {
             WingAero::None => Vector3::zeros(),
-            WingAero::BladeElement(model) => model.moments_omega(omega).torque(),
+            WingAero::BladeElement(model) => match branch {
+                None => model.moments_omega(omega).torque(),
+                Some(b) => model.moments_omega_branch(omega, b).torque(),
+            },
             WingAero::StrokeDrag {
                 omega1,
                 coefficient,
             } => {
-                let rate = p_dot.x;
                 // Torque about the stroke axis x̂ (ground), expressed in frame 6.
-                let stroke_axis_6 = r61.row(0).transpose();
-                stroke_axis_6 * (-omega1 * coefficient * rate.abs() * rate)
+                *stroke_axis_6 * (-omega1 * coefficient * phi_dot.abs() * phi_dot)
             }
         }
     }
@@ -610,6 +625,17 @@ impl Wing {
             spring.y += 0.5 * (h.k1 + 2.0 * h.k2 * theta) * psi * psi;
             *potential += 0.5 * k * psi * psi;
         }
+    }
+
+    /// The joint-spring loads `(∂V/∂φ, ∂V/∂ψ)` on the stroke plane (θ = 0; joints 1 and 6
+    /// and the tunable hinge, as [`Self::stroke_plane_kinematics`] adds them).
+    #[inline]
+    pub(crate) fn stroke_plane_springs(&self, phi: f64, psi: f64) -> (f64, f64) {
+        let s = &self.springs;
+        let mut spring = Vector3::new(s[0].torque(phi), 0.0, s[5].torque(psi));
+        let mut potential = 0.0;
+        self.add_tunable_hinge(0.0, psi, &mut spring, &mut potential);
+        (spring.x, spring.z)
     }
 
     /// Whether [`Self::free_deviation_terms`] applies to this wing (α2 = 90°, α3 = 0, no

@@ -122,6 +122,30 @@ pub trait OdeSystem {
     fn n_active(&self) -> usize {
         MAX_DOF
     }
+
+    /// Number of switching functions (at most [`MAX_SWITCHES`]; 0, the default: smooth). With
+    /// switching functions the adaptive integrator locates their roots and holds the branch
+    /// between them ([`Self::rhs_on`]; the module `events`); fixed-grid runs evaluate
+    /// [`Self::rhs`].
+    fn n_switches(&self) -> usize {
+        0
+    }
+
+    /// Writes the switching functions `g(t, y)` into `g[..n_switches]`.
+    ///
+    /// # Errors
+    /// Any model error.
+    fn switches(&self, _t: f64, _y: &State, _g: &mut [f64; MAX_SWITCHES]) -> Result<()> {
+        Ok(())
+    }
+
+    /// [`Self::rhs`] on the smooth branch `sides` names (also slightly past its surface).
+    ///
+    /// # Errors
+    /// As [`Self::rhs`].
+    fn rhs_on(&self, t: f64, y: &State, _sides: Sides, dydt: &mut State) -> Result<()> {
+        self.rhs(t, y, dydt)
+    }
 }
 
 /// Explicit Runge-Kutta pair.
@@ -403,6 +427,7 @@ impl RungeKutta {
             system,
             template: *y0,
             calls: 0,
+            sides: None,
         };
         let tol = Tolerances {
             rtol: self.rtol,
@@ -519,6 +544,8 @@ struct Adapter<'a> {
     /// integrated).
     template: State,
     calls: usize,
+    /// The branch held by event location (None: the state's own sides, e.g. on fixed grids).
+    sides: Option<Sides>,
 }
 
 impl Adapter<'_> {
@@ -537,7 +564,11 @@ impl<const M: usize> Rhs<M> for Adapter<'_> {
         self.calls += 1;
         let y = Rhs::<M>::expand(self, c);
         let mut dydt = State::default();
-        if let Err(e) = self.system.rhs(t, &y, &mut dydt) {
+        let evaluated = match self.sides {
+            None => self.system.rhs(t, &y, &mut dydt),
+            Some(sides) => self.system.rhs_on(t, &y, sides, &mut dydt),
+        };
+        if let Err(e) = evaluated {
             return Err(integration_error(t, &y, format!("the model failed: {e}")));
         }
         let n = Self::active::<M>();
@@ -564,6 +595,21 @@ impl<const M: usize> Rhs<M> for Adapter<'_> {
             y.work_aero = self.template.work_aero;
         }
         y
+    }
+
+    fn n_switches(&self) -> usize {
+        self.system.n_switches().min(MAX_SWITCHES)
+    }
+
+    fn switches(&mut self, t: f64, c: &[f64; M], g: &mut [f64; MAX_SWITCHES]) -> Result<()> {
+        let y = Rhs::<M>::expand(self, c);
+        self.system
+            .switches(t, &y, g)
+            .map_err(|e| integration_error(t, &y, format!("the model failed: {e}")))
+    }
+
+    fn set_sides(&mut self, sides: Sides) {
+        self.sides = Some(sides);
     }
 }
 
@@ -791,6 +837,9 @@ fn drive_on_grid<const M: usize, S: Stepper<M>>(
     let mut f0 = [0.0; M];
     let mut f1 = [0.0; M];
     rhs.eval(t0, &y, &mut f0)?;
+    let n_switches = rhs.n_switches().min(MAX_SWITCHES);
+    let mut sides = None;
+    let mut g = [0.0; MAX_SWITCHES];
     for (k, pair) in grid.windows(2).enumerate() {
         let (t, t_new) = (pair[0], pair[1]);
         if k % budget::CHECK_EVERY == 0 {
@@ -799,6 +848,23 @@ fn drive_on_grid<const M: usize, S: Stepper<M>>(
             }
         }
         let h = t_new - t;
+        if n_switches > 0 {
+            // Each step on one smooth branch, the sides half a step in (Euler predictor): the
+            // adaptive run that chose the grid cut its steps at the roots, so a step's middle
+            // is far from them and its sides do not change under a Newton trial's small
+            // perturbation (the frozen map stays smooth).
+            let mut middle = [0.0; M];
+            for i in 0..M {
+                middle[i] = y[i] + 0.5 * h * f0[i];
+            }
+            rhs.switches(t + 0.5 * h, &middle, &mut g)?;
+            let here = Sides::of(&g[..n_switches]);
+            if sides != Some(here) {
+                sides = Some(here);
+                rhs.set_sides(here);
+                rhs.eval(t, &y, &mut f0)?;
+            }
+        }
         let err = stepper.attempt(rhs, t, &y, &f0, h, tol)?;
         if !err.is_finite() {
             return Err(integration_error(

@@ -11,8 +11,8 @@ use nalgebra::DMatrix;
 use paritysim_error::Result;
 
 use super::{
-    OdeSystem, Rhs, RungeKutta, State, Tolerances, check_grid, drive_method, drive_method_on_grid,
-    integration_error,
+    MAX_SWITCHES, OdeSystem, Rhs, RungeKutta, Sides, State, Tolerances, check_grid, drive_method,
+    drive_method_on_grid, integration_error,
 };
 
 /// Relative size of the directional difference step.
@@ -22,6 +22,8 @@ struct Variational<'a> {
     system: &'a dyn OdeSystem,
     n: usize,
     calls: usize,
+    /// The branch held by event location (switches of the state part; None on fixed grids).
+    sides: Option<Sides>,
 }
 
 fn to_state(n: usize, c: &[f64]) -> State {
@@ -35,7 +37,11 @@ impl Variational<'_> {
     fn f(&mut self, t: f64, y: &State, out: &mut [f64]) -> Result<()> {
         self.calls += 1;
         let mut d = State::default();
-        if let Err(e) = self.system.rhs(t, y, &mut d) {
+        let evaluated = match self.sides {
+            None => self.system.rhs(t, y, &mut d),
+            Some(sides) => self.system.rhs_on(t, y, sides, &mut d),
+        };
+        if let Err(e) = evaluated {
             return Err(integration_error(t, y, format!("the model failed: {e}")));
         }
         let n = self.n;
@@ -77,6 +83,21 @@ impl<const M: usize> Rhs<M> for Variational<'_> {
 
     fn expand(&self, c: &[f64; M]) -> State {
         to_state(self.n, &c[..2 * self.n])
+    }
+
+    fn n_switches(&self) -> usize {
+        self.system.n_switches().min(MAX_SWITCHES)
+    }
+
+    fn switches(&mut self, t: f64, c: &[f64; M], g: &mut [f64; MAX_SWITCHES]) -> Result<()> {
+        let y = to_state(self.n, &c[..2 * self.n]);
+        self.system
+            .switches(t, &y, g)
+            .map_err(|e| integration_error(t, &y, format!("the model failed: {e}")))
+    }
+
+    fn set_sides(&mut self, sides: Sides) {
+        self.sides = Some(sides);
     }
 }
 
@@ -183,6 +204,7 @@ impl RungeKutta {
             system,
             n,
             calls: 0,
+            sides: None,
         };
         let tol = Tolerances {
             rtol: self.rtol,
