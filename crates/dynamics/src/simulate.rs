@@ -558,7 +558,8 @@ fn shooting_steady_state(
         if let Some(first) = crate::grid_shooting::shoot(
             device,
             transient,
-            period,
+            map_period,
+            0.0,
             &y,
             None,
             None,
@@ -568,7 +569,7 @@ fn shooting_steady_state(
             &mut plain,
         )? {
             y = first.state;
-            cycles += first.periods + 1;
+            cycles += (first.periods + 1) * orbit_cycles;
             first_guess = Some(first.jacobian);
         }
     }
