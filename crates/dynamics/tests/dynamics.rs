@@ -7,6 +7,8 @@ mod continuation;
 mod floquet;
 #[path = "dynamics/lanes.rs"]
 mod lanes;
+#[path = "dynamics/linear_jacobian.rs"]
+mod linear_jacobian;
 #[path = "dynamics/lean.rs"]
 mod lean;
 #[path = "dynamics/metrics.rs"]
