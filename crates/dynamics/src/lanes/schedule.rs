@@ -15,7 +15,7 @@ use crate::sweep::{
     continued_options, remember, run_tasks,
 };
 
-/// The last forcing table built in a group: its grid, actuator and forces.
+/// The last forcing table built in a lane: its grid, actuator and forces.
 type ForcingCache = Option<(Rc<[f64]>, crate::actuator::Actuator, Rc<[f64]>)>;
 
 /// `point`'s forcing table, from `cache` when a previous point had the same grid and drive.
@@ -168,7 +168,9 @@ fn run_group(
     };
     let mut models = LinearStrokeLanes::new();
     let mut times_cache = None;
-    let mut forcing_cache: ForcingCache = None;
+    // One per lane: a lane's next point usually has its chain predecessor's grid (one cache
+    // for the group was overwritten by the other lanes' chains: 366 tables for 256 points).
+    let mut forcing_cache: Vec<ForcingCache> = (0..lanes).map(|_| None).collect();
     loop {
         if control.is_cancelled() {
             break;
@@ -226,7 +228,7 @@ fn run_group(
                     &mut point,
                     &mut steppers,
                     &mut models,
-                    &mut forcing_cache,
+                    &mut forcing_cache[l],
                 ) {
                     None => cursor.point = Some((i, start, point)),
                     Some(done) => finish_point(
@@ -296,7 +298,7 @@ fn run_group(
                 &mut point,
                 &mut steppers,
                 &mut models,
-                &mut forcing_cache,
+                &mut forcing_cache[l],
             ) {
                 None => cursor.point = Some((i, start, point)),
                 Some(done) => finish_point(
