@@ -7,10 +7,10 @@ mod continuation;
 mod floquet;
 #[path = "dynamics/lanes.rs"]
 mod lanes;
-#[path = "dynamics/linear_jacobian.rs"]
-mod linear_jacobian;
 #[path = "dynamics/lean.rs"]
 mod lean;
+#[path = "dynamics/linear_jacobian.rs"]
+mod linear_jacobian;
 #[path = "dynamics/metrics.rs"]
 mod metrics;
 #[path = "dynamics/steady_state.rs"]

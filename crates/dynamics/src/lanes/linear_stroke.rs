@@ -14,8 +14,8 @@ use crate::actuator::Actuator;
 use crate::device::{Device, Formulation};
 use std::rc::Rc;
 
-use crate::linear_map_jacobian::{self, LinearMapTerms};
 use crate::integrate::lanes::{LANES, LaneRhs, stage_times};
+use crate::linear_map_jacobian::{self, LinearMapTerms};
 use crate::wing::WingAero;
 
 type V = f64x4;

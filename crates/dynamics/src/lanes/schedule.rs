@@ -285,7 +285,15 @@ fn run_group(
                 Err(_) => steppers.variational.take_timeout(l),
             };
             if let Some(error) = timeout {
-                finish_point(points, metric_names, cursor, i, &start, Some(Err(error)), control);
+                finish_point(
+                    points,
+                    metric_names,
+                    cursor,
+                    i,
+                    &start,
+                    Some(Err(error)),
+                    control,
+                );
                 continue;
             }
             let next = match outcome {

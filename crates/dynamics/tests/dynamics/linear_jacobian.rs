@@ -113,7 +113,10 @@ fn analytic_jacobian_equals_central_differences_on_random_states() {
                 let (mut plus, mut minus) = (v, v);
                 plus[j] += delta;
                 minus[j] -= delta;
-                let (fp, fm) = (compact_rhs(&device, t, plus), compact_rhs(&device, t, minus));
+                let (fp, fm) = (
+                    compact_rhs(&device, t, plus),
+                    compact_rhs(&device, t, minus),
+                );
                 let column = &jac[4 * j..4 * j + 4];
                 let size = column.iter().fold(1.0f64, |a, x| a.max(x.abs()));
                 for i in 0..4 {
@@ -171,7 +174,9 @@ fn monodromy_equals_finite_differences_of_the_period_map_and_the_difference_fall
             .flow_with_sensitivity_and_steps(&device, 0.0, &y0, PERIOD)
             .unwrap();
         // On a fixed grid the period map is a smooth function of y0: Φ is its derivative.
-        let (_, phi) = rk.flow_with_sensitivity_on_grid(&device, &grid, &y0).unwrap();
+        let (_, phi) = rk
+            .flow_with_sensitivity_on_grid(&device, &grid, &y0)
+            .unwrap();
         let (_, phi_differences) = rk
             .flow_with_sensitivity_on_grid(&WithoutJacobian(&device), &grid, &y0)
             .unwrap();
@@ -262,9 +267,7 @@ fn liouville_det_monodromy_equals_exp_of_the_integrated_trace() {
         (sprung_device(), [24.0, 31.0], [17.0, 31.3]),
     ] {
         let y0 = start(&device, &rk);
-        let (_, phi) = rk
-            .flow_with_sensitivity(&device, 0.0, &y0, PERIOD)
-            .unwrap();
+        let (_, phi) = rk.flow_with_sensitivity(&device, 0.0, &y0, PERIOD).unwrap();
         let traced = WithTrace {
             device: &device,
             inertia,
