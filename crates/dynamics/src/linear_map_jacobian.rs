@@ -150,8 +150,7 @@ pub(crate) fn variational<S: Real>(
     let zero = S::splat(0.0);
     let (mut gq00, mut gq01, mut gq11) = (-terms.k1, zero, -terms.k2);
     let (mut gv00, mut gv01, mut gv11) = (zero, zero, zero);
-    for k in 0..2 {
-        let (a, b) = rows[k];
+    for (k, (a, b)) in rows.into_iter().enumerate() {
         let stroke = a * q1 + b * q2;
         let rate = a * q1_dot + b * q2_dot;
         let d = stroke - terms.rest[k];
