@@ -4,7 +4,8 @@
 //! (`valgrind --tool=callgrind target/release/examples/trial 5`) and wall-clock comparisons
 //! against older engines. Second argument `metrics` builds no trajectory column.
 //!
-//! Environment: `SAMPLES` overrides the 4000 samples, `RTOL` the relative tolerance, and
+//! Environment: `SAMPLES` overrides the 4000 samples, `RTOL` the relative tolerance,
+//! `METRICS` (with `metrics`) lists the asked metrics, and
 //! `DEVICE` picks another device for the same workload: `rotating` (§3.4 Drag PARITY, Table
 //! 3.3 1-Cut wings, blade element, hinge spring), `lift` / `dual` (§2.5 Lift / Dual PARITY on
 //! those wings: free deviation θ with a deviation spring and the tunable hinge, as
@@ -138,6 +139,10 @@ fn main() {
     if metrics_only {
         // COLUMNS-LINE (absent in engines without streamed metrics)
         options.columns = Some(Vec::new());
+        // `METRICS=a,b,...`: only these metrics (vs_jax.py's trial asks the five of Table 3.2).
+        if let Ok(names) = std::env::var("METRICS") {
+            options.metrics = Some(names.split(',').map(String::from).collect());
+        }
         // STEADY-LINE: `STEADY=shooting` uses Newton shooting (default cycles as configured).
         if std::env::var("STEADY").is_ok_and(|s| s == "shooting") {
             options.steady_state = paritysim_dynamics::SteadyState::Shooting;

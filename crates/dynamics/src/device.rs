@@ -14,6 +14,7 @@ use paritysim_kinematics::Drivetrain;
 
 use crate::actuator::Actuator;
 use crate::integrate::State;
+use crate::linear_map_jacobian::LinearMapTerms;
 use crate::wing::{Wing, WingTerms};
 
 mod stroke_plane;
@@ -72,6 +73,8 @@ struct StrokeOnly {
     stroke_inertia: [f64; 2],
     /// The linear map's constants (None for the linkages).
     linear: Option<ConstantMap>,
+    /// The linear map's analytic Jacobian constants (None where it does not apply).
+    jacobian: Option<LinearMapTerms<f64>>,
 }
 
 /// A drivetrain with a constant Jacobian (the linear map, eq. 2.15): `φ = J q`, `h = 0` and a
@@ -148,6 +151,7 @@ fn stroke_only(spec: &DeviceSpec) -> std::result::Result<StrokeOnly, String> {
     Ok(StrokeOnly {
         stroke_inertia,
         linear: ConstantMap::of(&tr.kinematics, stroke_inertia),
+        jacobian: LinearMapTerms::of(spec),
     })
 }
 
@@ -1062,5 +1066,30 @@ impl crate::integrate::OdeSystem for Device {
             Some(lean) => self.rhs_stroke_plane(lean, t, y, Some(branches(sides)), dydt),
             None => Device::rhs(self, t, y, dydt),
         }
+    }
+
+    fn variational(
+        &self,
+        _t: f64,
+        y: &State,
+        n: usize,
+        phi: &[f64],
+        dphi: &mut [f64],
+    ) -> Option<Result<()>> {
+        let terms = self.stroke_only.as_ref()?.jacobian.as_ref()?;
+        if n != 2 {
+            return None;
+        }
+        let y = [y.coords[0], y.coords[1], y.rates[0], y.rates[1]];
+        crate::linear_map_jacobian::variational(terms, &y, phi, dphi);
+        Some(Ok(()))
+    }
+}
+
+impl Device {
+    /// The linear map's analytic Jacobian constants (drivetrain coordinates of a two-DOF
+    /// linear differential with stroke drag; see [`crate::linear_map_jacobian`]).
+    pub(crate) fn linear_map_terms(&self) -> Option<&LinearMapTerms<f64>> {
+        self.stroke_only.as_ref()?.jacobian.as_ref()
     }
 }

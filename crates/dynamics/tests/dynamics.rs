@@ -9,6 +9,8 @@ mod floquet;
 mod lanes;
 #[path = "dynamics/lean.rs"]
 mod lean;
+#[path = "dynamics/linear_jacobian.rs"]
+mod linear_jacobian;
 #[path = "dynamics/metrics.rs"]
 mod metrics;
 #[path = "dynamics/steady_state.rs"]

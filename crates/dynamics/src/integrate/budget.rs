@@ -72,14 +72,10 @@ impl Drop for BudgetGuard {
 impl Budget {
     /// `max_wall_ms` from now (None or non-finite: no deadline) and an optional cancel flag.
     pub fn new(max_wall_ms: Option<f64>, cancel: Option<CancelFlag>) -> Self {
-        let deadline = max_wall_ms
-            .filter(|ms| ms.is_finite() && *ms > 0.0)
-            .and_then(|ms| {
-                Instant::now()
-                    .checked_add(Duration::from_secs_f64(ms / 1e3))
-                    .map(|d| (d, ms))
-            });
-        Self { deadline, cancel }
+        Self {
+            deadline: deadline(max_wall_ms),
+            cancel,
+        }
     }
 
     /// Installs this budget on the current thread until the guard drops. A budget already
@@ -141,6 +137,17 @@ pub(crate) enum Stop {
     Cancelled,
     /// The wall-clock budget (ms) is spent.
     Wall(f64),
+}
+
+/// The instant `max_wall_ms` from now, with the budget (None or non-finite: no deadline).
+pub(crate) fn deadline(max_wall_ms: Option<f64>) -> Option<(Instant, f64)> {
+    max_wall_ms
+        .filter(|ms| ms.is_finite() && *ms > 0.0)
+        .and_then(|ms| {
+            Instant::now()
+                .checked_add(Duration::from_secs_f64(ms / 1e3))
+                .map(|d| (d, ms))
+        })
 }
 
 /// Checks the current thread's budget (no budget: always fine).

@@ -22,9 +22,13 @@
 #![allow(clippy::needless_range_loop)]
 
 use std::rc::Rc;
+use std::time::Instant;
+
+use paritysim_error::Error;
 
 use wide::f64x4;
 
+use super::super::budget::{self, CHECK_EVERY};
 use super::super::{SAFE, State};
 use super::*;
 
@@ -179,6 +183,12 @@ pub(crate) struct LaneStepper<const M: usize> {
     rtol: V,
     atol: V,
     lanes: [Progress; LANES],
+    /// Each lane's point's wall-time deadline and budget (ms), checked every
+    /// [`CHECK_EVERY`] steps as the scalar integrator checks its run's budget.
+    deadlines: [Option<(Instant, f64)>; LANES],
+    /// Lanes stopped by their deadline: the budget error (taken by [`Self::take_timeout`]).
+    timeouts: [Option<Error>; LANES],
+    steps: usize,
 }
 
 /// `y + h Σ aᵢ kᵢ` on vectors (the scalar `stage!` of dop853.rs, same operation order).
@@ -203,6 +213,45 @@ impl<const M: usize> LaneStepper<M> {
             rtol: V::splat(1.0),
             atol: V::splat(1.0),
             lanes: std::array::from_fn(|_| Progress::default()),
+            deadlines: [None; LANES],
+            timeouts: std::array::from_fn(|_| None),
+            steps: 0,
+        }
+    }
+
+    /// The wall-time deadline of lane `l`'s point (`budget::deadline`), for the problems it
+    /// is given from now on.
+    pub(crate) fn set_deadline(&mut self, l: usize, deadline: Option<(Instant, f64)>) {
+        self.deadlines[l] = deadline;
+    }
+
+    /// The budget error of lane `l` if its last problem was stopped by its deadline (it then
+    /// finished as [`LaneOutcome::Failed`]).
+    pub(crate) fn take_timeout(&mut self, l: usize) -> Option<Error> {
+        self.timeouts[l].take()
+    }
+
+    /// Stops the busy lanes past their deadline (the budget error, as the scalar integrator
+    /// raises it, with the lane's time and state).
+    fn check_deadlines(&mut self, finished: &mut Vec<(usize, LaneOutcome<M>)>) {
+        if !self.deadlines.iter().any(Option::is_some) {
+            return;
+        }
+        let now = Instant::now();
+        for l in 0..LANES {
+            let (p, deadline) = (&mut self.lanes[l], self.deadlines[l]);
+            let Some((_, ms)) = deadline.filter(|(d, _)| p.active && now >= *d) else {
+                continue;
+            };
+            let t = p.adaptive.as_ref().map_or(p.grid[p.step], |a| a.t);
+            let mut y = State::default();
+            for i in 0..2 {
+                y.coords[i] = lane(self.y[i], l);
+                y.rates[i] = lane(self.y[2 + i], l);
+            }
+            p.active = false;
+            self.timeouts[l] = Some(budget::stop_error(budget::Stop::Wall(ms), t, y.to_vec()));
+            finished.push((l, LaneOutcome::Failed));
         }
     }
 
@@ -304,6 +353,10 @@ impl<const M: usize> LaneStepper<M> {
         }
         while finished.is_empty() && self.any_busy() {
             self.step(rhs, sink, &mut finished);
+            self.steps += 1;
+            if self.steps % CHECK_EVERY == 0 {
+                self.check_deadlines(&mut finished);
+            }
         }
         finished
     }

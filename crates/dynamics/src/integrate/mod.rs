@@ -19,7 +19,6 @@ mod variational;
 
 /// DOP853 on fixed grids for several problems in SIMD lanes.
 pub(crate) use dop853::lanes;
-pub(crate) use variational::DIRECTIONAL_STEP;
 
 use paritysim_error::{Error, Result, check_positive};
 
@@ -145,6 +144,24 @@ pub trait OdeSystem {
     /// As [`Self::rhs`].
     fn rhs_on(&self, t: f64, y: &State, _sides: Sides, dydt: &mut State) -> Result<()> {
         self.rhs(t, y, dydt)
+    }
+
+    /// The variational equations' right-hand side `dphi = J(t, y) phi` from an analytic
+    /// Jacobian `J = ∂f/∂y` of the `2n` entries `[coords (n), rates (n)]`, `phi` and `dphi`
+    /// `2n × 2n` by columns; `None` (the default) when the system has none for this `n`: the
+    /// variational equations then form `J phi` by central differences of [`Self::rhs`].
+    ///
+    /// # Errors
+    /// Any model error (as [`Self::rhs`]).
+    fn variational(
+        &self,
+        _t: f64,
+        _y: &State,
+        _n: usize,
+        _phi: &[f64],
+        _dphi: &mut [f64],
+    ) -> Option<Result<()>> {
+        None
     }
 }
 

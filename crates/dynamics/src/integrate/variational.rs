@@ -2,9 +2,11 @@
 //! period: the monodromy matrix) by integrating the variational equations `Φ̇ = J(t, y) Φ`
 //! alongside the state, on the same steps.
 //!
-//! `J Φ` is formed column by column by central differences of the right-hand side along each
-//! column (`J v ≈ (f(y + δv) − f(y − δv)) / 2δ`, `δ` scaled to `y` and `v`), so no analytic
-//! Jacobian is needed; the step size is chosen by the state alone (the sensitivities do not
+//! `J Φ` comes from the system's analytic Jacobian when it has one
+//! ([`OdeSystem::variational`]: the linear-map drivetrain coordinates); otherwise it is formed
+//! column by column by central differences of the right-hand side along each column
+//! (`J v ≈ (f(y + δv) − f(y − δv)) / 2δ`, `δ` scaled to `y` and `v`: two more evaluations per
+//! column and stage). The step size is chosen by the state alone (the sensitivities do not
 //! take part in the error control).
 
 use nalgebra::DMatrix;
@@ -56,6 +58,10 @@ impl<const M: usize> Rhs<M> for Variational<'_> {
         let m = 2 * self.n;
         let y = to_state(self.n, &c[..m]);
         self.f(t, &y, &mut dc[..m])?;
+        let (phi, dphi) = (&c[m..m + m * m], &mut dc[m..m + m * m]);
+        if let Some(done) = self.system.variational(t, &y, self.n, phi, dphi) {
+            return done.map_err(|e| integration_error(t, &y, format!("the model failed: {e}")));
+        }
         let scale = 1.0 + c[..m].iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let (mut fp, mut fm) = ([0.0; 12], [0.0; 12]);
         for j in 0..m {

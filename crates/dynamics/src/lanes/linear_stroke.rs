@@ -14,10 +14,9 @@ use crate::actuator::Actuator;
 use crate::device::{Device, Formulation};
 use std::rc::Rc;
 
-use crate::integrate::DIRECTIONAL_STEP;
 use crate::integrate::lanes::{LANES, LaneRhs, stage_times};
+use crate::linear_map_jacobian::{self, LinearMapTerms};
 use crate::wing::WingAero;
-use paritysim_kinematics::Drivetrain;
 
 type V = f64x4;
 
@@ -25,19 +24,10 @@ type V = f64x4;
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct LinearStroke<'a> {
     actuator: &'a Actuator,
-    /// `J` by rows: `(J00, J01, J10, J11)`.
-    jacobian: [f64; 4],
-    /// `M_q` entries `(m00, m01, m11)` and `det M_q`, summed as the scalar path sums them.
-    mass: [f64; 3],
-    det: f64,
-    /// `−Ω1 C` per wing (0 without aerodynamics).
-    drag: [f64; 2],
+    /// The constants of the equations and of their Jacobian, the device's own.
+    terms: LinearMapTerms<f64>,
     /// Wings without aerodynamics (their torque is exactly 0).
     vacuum: [bool; 2],
-    /// Stroke springs per wing: `(stiffness, cubic, rest angle)`.
-    springs: [[f64; 3]; 2],
-    k1: f64,
-    k2: f64,
 }
 
 impl<'a> LinearStroke<'a> {
@@ -48,55 +38,14 @@ impl<'a> LinearStroke<'a> {
         if device.formulation() != Formulation::DrivetrainCoordinates || device.n_dof() != 2 {
             return None;
         }
+        let terms = *device.linear_map_terms()?;
         let spec = device.spec();
-        let transmission = spec.transmission.as_ref()?;
-        let Drivetrain::LinearDifferential(d) = transmission.kinematics() else {
-            return None;
-        };
         let actuator = spec.actuator.as_ref()?;
-        let t = d.transmission_ratio();
-        let (hl, hr) = d.arms();
-        // As `LinearDifferential::evaluate` builds it.
-        let jacobian = [-t, t * hl, -t, -t * hr];
-        let (mut m00, mut m01, mut m11) = (0.0, 0.0, 0.0);
-        let mut drag = [0.0; 2];
-        let mut vacuum = [false; 2];
-        let mut springs = [[0.0; 3]; 2];
-        for k in 0..2 {
-            let wing = spec.wings.get(k)?;
-            let (a, b) = (jacobian[2 * k], jacobian[2 * k + 1]);
-            let inertia = wing.inertia()[(0, 0)];
-            m00 += inertia * a * a;
-            m01 += inertia * a * b;
-            m11 += inertia * b * b;
-            drag[k] = match wing.aero() {
-                WingAero::None => {
-                    vacuum[k] = true;
-                    0.0
-                }
-                WingAero::StrokeDrag {
-                    omega1,
-                    coefficient,
-                } => -omega1 * coefficient,
-                WingAero::BladeElement(_) => return None,
-            };
-            let s = &wing.springs()[0];
-            springs[k] = [s.stiffness(), s.cubic(), s.rest_angle()];
-        }
-        let det = m00 * m11 - m01 * m01;
-        if det == 0.0 || !det.is_finite() {
-            return None;
-        }
+        let vacuum = [0, 1].map(|k| matches!(spec.wings[k].aero(), WingAero::None));
         Some(Self {
             actuator,
-            jacobian,
-            mass: [m00, m01, m11],
-            det,
-            drag,
+            terms,
             vacuum,
-            springs,
-            k1: actuator.stiffness(),
-            k2: transmission.balance_stiffness(),
         })
     }
 }
@@ -134,14 +83,14 @@ impl LinearStroke<'_> {
             & q2.abs()
                 .simd_le(V::splat(paritysim_error::plausible::ANGLE_RAD)))
         .to_bitmask();
-        let j = self.jacobian.map(V::splat);
+        let j = self.terms.jacobian.map(V::splat);
         let stroke = [j[0] * q1 + j[1] * q2, j[2] * q1 + j[3] * q2];
         let rate = [j[0] * q1_dot + j[1] * q2_dot, j[2] * q1_dot + j[3] * q2_dot];
         let torque = |k: usize| {
             if self.vacuum[k] {
                 V::splat(0.0)
             } else {
-                V::splat(self.drag[k]) * rate[k].abs() * rate[k]
+                V::splat(self.terms.drag[k]) * rate[k].abs() * rate[k]
             }
         };
         (inside, stroke, [-torque(0), torque(1)])
@@ -153,17 +102,8 @@ pub(crate) struct LinearStrokeLanes<'a> {
     actuators: [Option<&'a Actuator>; LANES],
     /// Each lane's [`LinearStroke::forcing`] of its current grid.
     forcing: [Option<Rc<[f64]>>; LANES],
-    j: [V; 4],
-    m00: V,
-    m01: V,
-    m11: V,
-    det: V,
-    drag: [V; 2],
-    stiffness: [V; 2],
-    cubic: [V; 2],
-    rest: [V; 2],
-    k1: V,
-    k2: V,
+    /// Each lane's device constants.
+    terms: LinearMapTerms<V>,
 }
 
 fn set(v: &mut V, l: usize, x: f64) {
@@ -179,17 +119,17 @@ impl<'a> LinearStrokeLanes<'a> {
         Self {
             actuators: [None; LANES],
             forcing: std::array::from_fn(|_| None),
-            j: [one, z, z, one],
-            m00: one,
-            m01: z,
-            m11: one,
-            det: one,
-            drag: [z; 2],
-            stiffness: [z; 2],
-            cubic: [z; 2],
-            rest: [z; 2],
-            k1: z,
-            k2: z,
+            terms: LinearMapTerms {
+                jacobian: [one, z, z, one],
+                mass: [one, z, one],
+                det: one,
+                drag: [z; 2],
+                stiffness: [z; 2],
+                cubic: [z; 2],
+                rest: [z; 2],
+                k1: z,
+                k2: z,
+            },
         }
     }
 
@@ -201,21 +141,22 @@ impl<'a> LinearStrokeLanes<'a> {
     /// Puts `model` into lane `l`.
     pub(crate) fn load(&mut self, l: usize, model: &LinearStroke<'a>) {
         self.actuators[l] = Some(model.actuator);
+        let (lane, device) = (&mut self.terms, &model.terms);
         for i in 0..4 {
-            set(&mut self.j[i], l, model.jacobian[i]);
+            set(&mut lane.jacobian[i], l, device.jacobian[i]);
         }
-        set(&mut self.m00, l, model.mass[0]);
-        set(&mut self.m01, l, model.mass[1]);
-        set(&mut self.m11, l, model.mass[2]);
-        set(&mut self.det, l, model.det);
+        for i in 0..3 {
+            set(&mut lane.mass[i], l, device.mass[i]);
+        }
+        set(&mut lane.det, l, device.det);
         for k in 0..2 {
-            set(&mut self.drag[k], l, model.drag[k]);
-            set(&mut self.stiffness[k], l, model.springs[k][0]);
-            set(&mut self.cubic[k], l, model.springs[k][1]);
-            set(&mut self.rest[k], l, model.springs[k][2]);
+            set(&mut lane.drag[k], l, device.drag[k]);
+            set(&mut lane.stiffness[k], l, device.stiffness[k]);
+            set(&mut lane.cubic[k], l, device.cubic[k]);
+            set(&mut lane.rest[k], l, device.rest[k]);
         }
-        set(&mut self.k1, l, model.k1);
-        set(&mut self.k2, l, model.k2);
+        set(&mut lane.k1, l, device.k1);
+        set(&mut lane.k2, l, device.k2);
     }
 }
 
@@ -243,25 +184,27 @@ impl LinearStrokeLanes<'_> {
             & q2.abs()
                 .simd_le(V::splat(paritysim_error::plausible::ANGLE_RAD));
         let failed = !inside.to_bitmask() & ((1 << LANES) - 1);
-        let [j00, j01, j10, j11] = self.j;
+        let c = &self.terms;
+        let [j00, j01, j10, j11] = c.jacobian;
         let stroke = [j00 * q1 + j01 * q2, j10 * q1 + j11 * q2];
         let phi_dot = [j00 * q1_dot + j01 * q2_dot, j10 * q1_dot + j11 * q2_dot];
-        let mut g0 = force - self.k1 * q1;
-        let mut g1 = -self.k2 * q2;
+        let mut g0 = force - c.k1 * q1;
+        let mut g1 = -c.k2 * q2;
         let rows = [(j00, j01), (j10, j11)];
         for k in 0..2 {
             let (a, b) = rows[k];
-            let tau_aero = self.drag[k] * phi_dot[k].abs() * phi_dot[k];
-            let d = stroke[k] - self.rest[k];
-            let spring = self.stiffness[k] * d + self.cubic[k] * d * d * d;
+            let tau_aero = c.drag[k] * phi_dot[k].abs() * phi_dot[k];
+            let d = stroke[k] - c.rest[k];
+            let spring = c.stiffness[k] * d + c.cubic[k] * d * d * d;
             let tau = tau_aero - spring;
             g0 += a * tau;
             g1 += b * tau;
         }
+        let [m00, m01, m11] = c.mass;
         dydt[0] = q1_dot;
         dydt[1] = q2_dot;
-        dydt[2] = (self.m11 * g0 - self.m01 * g1) / self.det;
-        dydt[3] = (self.m00 * g1 - self.m01 * g0) / self.det;
+        dydt[2] = (m11 * g0 - m01 * g1) / c.det;
+        dydt[3] = (m00 * g1 - m01 * g0) / c.det;
         failed
     }
 }
@@ -275,44 +218,19 @@ impl LaneRhs<4> for LinearStrokeLanes<'_> {
 }
 
 /// The variational equations of [`LinearStrokeLanes`] on `[y (4), Φ (4 × 4, by columns)]`,
-/// formed as integrate/variational.rs forms them (`J Φ` column by column by central
-/// differences along each column, the same steps and operations), one device per lane.
+/// as integrate/variational.rs forms them for the scalar device: the right-hand side, then
+/// `J Φ` from the analytic Jacobian ([`crate::linear_map_jacobian::variational`], the same
+/// function, so the same operations), one device per lane.
 pub(crate) struct VariationalLanes<'m, 'a>(pub(crate) &'m LinearStrokeLanes<'a>);
 
 impl LaneRhs<20> for VariationalLanes<'_, '_> {
     fn eval(&self, t: [f64; LANES], stage: [usize; LANES], c: &[V; 20], dc: &mut [V; 20]) -> u32 {
         let rhs = self.0;
-        let force = rhs.force(t, stage);
         let y: [V; 4] = std::array::from_fn(|i| c[i]);
         let mut f = [V::splat(0.0); 4];
-        let mut failed = rhs.eval_with(force, &y, &mut f);
+        let failed = rhs.eval_with(rhs.force(t, stage), &y, &mut f);
         dc[..4].copy_from_slice(&f);
-        let mut largest = V::splat(0.0);
-        for v in &y {
-            largest = largest.max(v.abs());
-        }
-        let scale = V::splat(1.0) + largest;
-        for j in 0..4 {
-            let col = 4 + 4 * j;
-            let v: [V; 4] = std::array::from_fn(|i| c[col + i]);
-            let mut size = V::splat(0.0);
-            for x in &v {
-                size = size.max(x.abs());
-            }
-            // A zero column stays zero (and its differences are never evaluated).
-            let zero = size.simd_eq(V::splat(0.0));
-            let delta = V::splat(DIRECTIONAL_STEP) * scale / size;
-            let yp: [V; 4] = std::array::from_fn(|i| y[i] + delta * v[i]);
-            let ym: [V; 4] = std::array::from_fn(|i| y[i] - delta * v[i]);
-            let (mut fp, mut fm) = ([V::splat(0.0); 4], [V::splat(0.0); 4]);
-            let mut column_failed = rhs.eval_with(force, &yp, &mut fp);
-            column_failed |= rhs.eval_with(force, &ym, &mut fm);
-            failed |= column_failed & !zero.to_bitmask();
-            for i in 0..4 {
-                let d = (fp[i] - fm[i]) / (V::splat(2.0) * delta);
-                dc[col + i] = zero.bitselect(V::splat(0.0), d);
-            }
-        }
+        linear_map_jacobian::variational(&rhs.terms, &y, &c[4..], &mut dc[4..]);
         failed
     }
 }

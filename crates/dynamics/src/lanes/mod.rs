@@ -24,8 +24,10 @@
 //! * **Failures are rows**: a failing point fails on the scalar rerun, with the scalar error.
 //!   A panic (an engine bug) fails the points of its group of chains (up to `2 × LANES`
 //!   chains) rather than of its chain.
-//! * **Not covered**: the per-run wall budget `max_wall_ms` is not checked inside the lanes
-//!   (a lane period is bounded by `max_steps`; the sweep's cancel is checked between periods).
+//! * **Budgets**: each point's `max_wall_ms` runs from its start in a lane and is checked
+//!   every `CHECK_EVERY` steps inside its periods (as the scalar integrator checks a run's);
+//!   a spent budget is the point's row, the scalar path's budget error (not a rerun). The
+//!   sweep's cancel is checked between periods.
 
 pub(crate) mod linear_stroke;
 mod point;

@@ -90,6 +90,8 @@ pub(super) struct LanePoint<'a> {
     pending: Pending,
     metrics: MetricsAccumulator,
     with_force: bool,
+    /// The wall-time deadline of `options.max_wall_ms` from the point's start.
+    pub(super) deadline: Option<(std::time::Instant, f64)>,
 }
 
 /// The compact `[q1, q2, q̇1, q̇2]` of a two-DOF state.
@@ -232,6 +234,7 @@ impl<'a> LanePoint<'a> {
             pending: Pending::Map,
             metrics: MetricsAccumulator::new(device, Some(period)),
             with_force: metric_names.iter().any(|m| m == "actuator_force_peak"),
+            deadline: crate::integrate::budget::deadline(options.max_wall_ms),
         };
         let mut point = point;
         let first = if !cold {

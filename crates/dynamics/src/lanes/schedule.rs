@@ -15,7 +15,7 @@ use crate::sweep::{
     continued_options, remember, run_tasks,
 };
 
-/// The last forcing table built in a group: its grid, actuator and forces.
+/// The last forcing table built in a lane: its grid, actuator and forces.
 type ForcingCache = Option<(Rc<[f64]>, crate::actuator::Actuator, Rc<[f64]>)>;
 
 /// `point`'s forcing table, from `cache` when a previous point had the same grid and drive.
@@ -115,6 +115,7 @@ fn launch<'a>(
                 .is_none()
                 .then(|| forcing(point, forcing_cache));
             models.load_forcing(l, table);
+            steppers.state.set_deadline(l, point.deadline);
             let mut sink = |_: usize, block: &SampleBlock| point.sample(block);
             if steppers.state.start(l, problem, &mut sink) {
                 steppers.fresh[0] |= 1 << l;
@@ -129,6 +130,7 @@ fn launch<'a>(
                 .is_none()
                 .then(|| forcing(point, forcing_cache));
             models.load_forcing(l, table);
+            steppers.variational.set_deadline(l, point.deadline);
             if steppers
                 .variational
                 .start(l, problem, &mut |_: usize, _: &SampleBlock| true)
@@ -166,7 +168,9 @@ fn run_group(
     };
     let mut models = LinearStrokeLanes::new();
     let mut times_cache = None;
-    let mut forcing_cache: ForcingCache = None;
+    // One per lane: a lane's next point usually has its chain predecessor's grid (one cache
+    // for the group was overwritten by the other lanes' chains: 366 tables for 256 points).
+    let mut forcing_cache: Vec<ForcingCache> = (0..lanes).map(|_| None).collect();
     loop {
         if control.is_cancelled() {
             break;
@@ -224,12 +228,18 @@ fn run_group(
                     &mut point,
                     &mut steppers,
                     &mut models,
-                    &mut forcing_cache,
+                    &mut forcing_cache[l],
                 ) {
                     None => cursor.point = Some((i, start, point)),
-                    Some(done) => {
-                        finish_point(points, metric_names, cursor, i, &start, done, control)
-                    }
+                    Some(done) => finish_point(
+                        points,
+                        metric_names,
+                        cursor,
+                        i,
+                        &start,
+                        done.map(Ok),
+                        control,
+                    ),
                 }
             }
         }
@@ -268,6 +278,24 @@ fn run_group(
         for (l, outcome) in finished {
             let cursor = cursors[l].as_mut().expect("a busy lane has a chain");
             let (i, start, mut point) = cursor.point.take().expect("a busy lane has a point");
+            // The point's `max_wall_ms` is spent: its row is the budget error (as the scalar
+            // run's), not a scalar rerun.
+            let timeout = match outcome {
+                Ok(_) => steppers.state.take_timeout(l),
+                Err(_) => steppers.variational.take_timeout(l),
+            };
+            if let Some(error) = timeout {
+                finish_point(
+                    points,
+                    metric_names,
+                    cursor,
+                    i,
+                    &start,
+                    Some(Err(error)),
+                    control,
+                );
+                continue;
+            }
             let next = match outcome {
                 Ok(o) => point.resume(o),
                 Err(o) => point.resume_sensitivity(o),
@@ -278,10 +306,18 @@ fn run_group(
                 &mut point,
                 &mut steppers,
                 &mut models,
-                &mut forcing_cache,
+                &mut forcing_cache[l],
             ) {
                 None => cursor.point = Some((i, start, point)),
-                Some(done) => finish_point(points, metric_names, cursor, i, &start, done, control),
+                Some(done) => finish_point(
+                    points,
+                    metric_names,
+                    cursor,
+                    i,
+                    &start,
+                    done.map(Ok),
+                    control,
+                ),
             }
         }
     }
@@ -291,18 +327,18 @@ fn run_group(
     results
 }
 
-/// Completes point `i` of the chain in `cursor`: `done` is its lane result, else it runs on
-/// the scalar path; then the chain's bookkeeping of `sweep::run_points`.
+/// Completes point `i` of the chain in `cursor`: `done` is its lane result (or error), else
+/// it runs on the scalar path; then the chain's bookkeeping of `sweep::run_points`.
 fn finish_point(
     points: &[Result<(Device, SimulationOptions)>],
     metric_names: &[String],
     cursor: &mut Cursor<'_>,
     i: usize,
     start: &ChainStart,
-    done: Option<PointOutput>,
+    done: Option<Result<PointOutput>>,
     control: &SweepControl,
 ) {
-    let result = chain_point(points, i, start, metric_names, false, done.map(Ok));
+    let result = chain_point(points, i, start, metric_names, false, done);
     remember(&mut cursor.previous, i, &result);
     control.count_point(&result);
     cursor.out.push(result);

@@ -232,6 +232,42 @@ fn failing_points_are_rows_with_their_errors_in_the_lane_path() {
 }
 
 #[test]
+fn a_spent_wall_budget_is_the_budget_error_row_in_the_lanes() {
+    // A chain's cold start and a continued point with a 1 µs `max_wall_ms`: the lanes stop
+    // them inside their first period (before, they ran to the end: the lanes checked no
+    // budget) and give the scalar path's budget error; the other rows are unchanged.
+    let mut points = design_points();
+    let spent = |omega: f64, k2: f64| {
+        let options = SimulationOptions {
+            max_wall_ms: Some(1e-3),
+            ..shooting_options()
+        };
+        Ok((linear_device(omega, k2), options))
+    };
+    points[0] = spent(0.45 * 31.3, 0.0);
+    points[5] = spent(0.45 * 31.3, 500.0 / 19.0);
+    let scalar = run(&points, 1, 1);
+    let lanes = run(&points, 2, MAX_LANES);
+    for (i, (a, b)) in scalar.iter().zip(&lanes).enumerate() {
+        match (a, b) {
+            (Ok(a), Ok(b)) => assert_eq!(fingerprint(a), fingerprint(b), "point {i}"),
+            (Err(a), Err(b)) => {
+                assert!(i == 0 || i == 5, "point {i}: {a}");
+                for e in [a, b] {
+                    assert!(
+                        matches!(e, Error::Integration { reason, .. }
+                            if reason.contains("options.max_wall_ms")),
+                        "point {i}: {e}"
+                    );
+                }
+            }
+            _ => panic!("point {i}: {a:?} vs {b:?}"),
+        }
+    }
+    assert!(lanes[0].is_err() && lanes[5].is_err() && lanes[1].is_ok() && lanes[6].is_ok());
+}
+
+#[test]
 fn lane_widths_are_validated() {
     assert_eq!(resolve_lanes(Some(1)).unwrap(), 1);
     assert_eq!(resolve_lanes(Some(MAX_LANES)).unwrap(), MAX_LANES);
