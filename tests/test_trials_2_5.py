@@ -60,3 +60,18 @@ def test_lift_parity_1cut_is_a_period_doubled_orbit_and_the_result_says_so() -> 
     assert abs(rows["right_rotation_amplitude"][0] - r.metrics["right_rotation_amplitude"]) < 1e-9
     base = ps.simulate(ps.devices.load("sreetharan2012_3_4_parity_1cut"), columns=[], metrics=["right_rotation_amplitude"])
     assert base.orbit_cycles == 1
+
+
+def test_dual_parity_1cut_is_a_period_1_orbit_though_its_transient_alternates() -> None:
+    """The §2.5 Dual PARITY 1-Cut transient approaches its orbit alternating from cycle to
+    cycle (a multiplier in (−1, 0)), so the engine also tries the two-cycle map; the orbit it
+    finds repeats every wingbeat, and is reported as period 1 with a one-wingbeat window."""
+    spec = ps.devices.load("sreetharan2012_2_5_dual_parity_1cut")
+    r = ps.simulate(spec, columns=["left_theta", "right_psi"])
+    assert r.converged and r.orbit_cycles == 1
+    n = spec.options.samples_per_cycle
+    assert r.cycle.height == n + 1
+    # The window closes on its start: one wingbeat is the whole orbit.
+    for name in ("left_theta", "right_psi"):
+        v = r.cycle[name].to_numpy()
+        assert abs(v[-1] - v[0]) < 1e-6 * np.abs(v).max(), name

@@ -372,10 +372,14 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
                             stroke,
                         )? {
                             // A period-1 orbit is a fixed point of the two-cycle map too (a
-                            // transient spiralling in with a multiplier near −1 looks doubled):
-                            // then the one-cycle window is recorded as usual.
+                            // transient spiralling in with a multiplier in (−1, 0) looks
+                            // doubled): then the one-cycle window is recorded as usual. The
+                            // one-cycle change of a doubled orbit is macroscopic; that of a
+                            // period-1 orbit is the integration error (measured 4e-8 on the
+                            // §2.5 Dual PARITY, 0.8 on the doubled Lift PARITY).
                             let half = transient.advance(device, 0.0, &found.state, period)?;
-                            if state_change(&half, &found.state) < options.steady_tol {
+                            let apart = PERIOD_DOUBLED_SEPARATION * options.steady_tol;
+                            if state_change(&half, &found.state) < apart {
                                 (y, residual, converged) = (found.state, found.residual, true);
                                 t += found.t;
                                 cycles_run += found.cycles_run;
