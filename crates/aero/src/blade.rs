@@ -377,6 +377,27 @@ pub struct AeroMoments {
 }
 
 impl AeroMoments {
+    /// Eqs. 3.8, 3.9 and 3.11 from the chordwise sign `σ`, `W² = ω_x² + ω_y²`, `(C_N, C_T)`
+    /// and the centre of pressure `d_cp` (eq. 3.7): the one assembly of every path.
+    #[inline]
+    fn of_strip(
+        o: &Omegas,
+        sigma: f64,
+        w2: f64,
+        (cn, ct): (f64, f64),
+        d_cp: f64,
+        rotational_damping: f64,
+        alpha: f64,
+    ) -> Self {
+        Self {
+            normal: -o.omega1 * sigma * w2 * cn, // eq. 3.8
+            tangential: -o.omega1 * w2 * ct,     // eq. 3.9
+            rotational: -(o.omega3 * d_cp - o.omega4) * sigma * w2 * cn, // eq. 3.11
+            rotational_damping,
+            alpha,
+        }
+    }
+
     /// Torque vector in the wing frame: `(M_N, M_T, M_r + M_rd)`.
     #[inline]
     pub fn torque(&self) -> Vector3<f64> {
@@ -552,13 +573,7 @@ impl<C: CoefficientModel> BladeElementModel<C> {
         let alpha = branch_alpha(sigma * wx, wy);
         let (cn, ct) = self.normal_tangential_branch(alpha, branch.normal_positive);
         let d_cp = 0.82 / PI * alpha + 0.05; // eq. 3.7, |α| = α on the branch's own side
-        AeroMoments {
-            normal: -o.omega1 * sigma * w2 * cn, // eq. 3.8
-            tangential: -o.omega1 * w2 * ct,     // eq. 3.9
-            rotational: -(o.omega3 * d_cp - o.omega4) * sigma * w2 * cn, // eq. 3.11
-            rotational_damping,
-            alpha,
-        }
+        AeroMoments::of_strip(o, sigma, w2, (cn, ct), d_cp, rotational_damping, alpha)
     }
 
     /// [`Self::moments_omega`] (`branch` None) or [`Self::moments_omega_branch`] of a wing on
@@ -609,13 +624,7 @@ impl<C: CoefficientModel> BladeElementModel<C> {
             NormalForceLaw::Unit => (1.0, 0.0),
         };
         let d_cp = 0.82 / PI * alpha + 0.05; // eq. 3.7 (α in (0, π))
-        AeroMoments {
-            normal: -o.omega1 * sigma * w2 * cn, // eq. 3.8
-            tangential: -o.omega1 * w2 * ct,     // eq. 3.9
-            rotational: -(o.omega3 * d_cp - o.omega4) * sigma * w2 * cn, // eq. 3.11
-            rotational_damping,
-            alpha,
-        }
+        AeroMoments::of_strip(o, sigma, w2, (cn, ct), d_cp, rotational_damping, alpha)
     }
 
     /// [`Self::loads_omega`] on a [`Branch`] (its values on the branch's own side).
@@ -758,13 +767,8 @@ impl<C: CoefficientModel> BladeElementModel<C> {
         let sigma = sign(wx);
         let (cn, ct) = self.normal_tangential(alpha);
         let d_cp = center_of_pressure(alpha); // eq. 3.7
-        AeroMoments {
-            normal: -o.omega1 * sigma * w2 * cn, // eq. 3.8
-            tangential: -o.omega1 * w2 * ct,     // eq. 3.9 (C_T chord-referred, module docs)
-            rotational: -(o.omega3 * d_cp - o.omega4) * sigma * w2 * cn, // eq. 3.11
-            rotational_damping,
-            alpha,
-        }
+        // C_T is chord-referred (module docs).
+        AeroMoments::of_strip(o, sigma, w2, (cn, ct), d_cp, rotational_damping, alpha)
     }
 
     /// Lift and drag forces and torques in the body frame (see [`AeroLoads`]).
