@@ -14,10 +14,11 @@ use paritysim_kinematics::Drivetrain;
 
 use crate::actuator::Actuator;
 use crate::integrate::State;
-use crate::linear_map_jacobian::LinearMapTerms;
 use crate::wing::{Wing, WingTerms};
 
+pub(crate) mod linear_map_jacobian;
 mod stroke_plane;
+use linear_map_jacobian::LinearMapTerms;
 use stroke_plane::branches;
 
 /// A drivetrain with its balance-beam spring.
@@ -1081,14 +1082,14 @@ impl crate::integrate::OdeSystem for Device {
             return None;
         }
         let y = [y.coords[0], y.coords[1], y.rates[0], y.rates[1]];
-        crate::linear_map_jacobian::variational(terms, &y, phi, dphi);
+        linear_map_jacobian::variational(terms, &y, phi, dphi);
         Some(Ok(()))
     }
 }
 
 impl Device {
     /// The linear map's analytic Jacobian constants (drivetrain coordinates of a two-DOF
-    /// linear differential with stroke drag; see [`crate::linear_map_jacobian`]).
+    /// linear differential with stroke drag; see [`linear_map_jacobian`]).
     pub(crate) fn linear_map_terms(&self) -> Option<&LinearMapTerms<f64>> {
         self.stroke_only.as_ref()?.jacobian.as_ref()
     }

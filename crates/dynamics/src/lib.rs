@@ -21,7 +21,6 @@ pub mod device;
 mod grid_shooting;
 pub mod integrate;
 pub mod lanes;
-mod linear_map_jacobian;
 pub mod metrics;
 pub mod simulate;
 pub mod stability;

@@ -14,8 +14,8 @@ use crate::actuator::Actuator;
 use crate::device::{Device, Formulation};
 use std::rc::Rc;
 
+use crate::device::linear_map_jacobian::{self, LinearMapTerms};
 use crate::integrate::lanes::{LANES, LaneRhs, stage_times};
-use crate::linear_map_jacobian::{self, LinearMapTerms};
 use crate::wing::WingAero;
 
 type V = f64x4;
@@ -219,7 +219,7 @@ impl LaneRhs<4> for LinearStrokeLanes<'_> {
 
 /// The variational equations of [`LinearStrokeLanes`] on `[y (4), Φ (4 × 4, by columns)]`,
 /// as integrate/variational.rs forms them for the scalar device: the right-hand side, then
-/// `J Φ` from the analytic Jacobian ([`crate::linear_map_jacobian::variational`], the same
+/// `J Φ` from the analytic Jacobian ([`crate::device::linear_map_jacobian::variational`], the same
 /// function, so the same operations), one device per lane.
 pub(crate) struct VariationalLanes<'m, 'a>(pub(crate) &'m LinearStrokeLanes<'a>);
 

@@ -231,7 +231,7 @@ pub fn map_jacobian(
 ///
 /// Warm-up: up to `warmup_cycles` cycles of simulation at the options' tolerances (stopping at
 /// the last good state if an integration fails). Then the engine's frozen-grid Newton
-/// ([`crate::grid_shooting`], as [`crate::SteadyState::Shooting`]): one adaptive period with the
+/// (as [`crate::SteadyState::Shooting`]): one adaptive period with the
 /// variational equations at `rtol / 100` picks the steps from `t0` to `t0 + T`, every Newton
 /// trial retraces them (a map smooth in `y`, so Newton converges to round-off), Broyden
 /// updates the Jacobian between exact ones, and the step solves `(DP − I)Δ = −F` by SVD in the

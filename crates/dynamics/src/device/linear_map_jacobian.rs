@@ -18,7 +18,7 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 
 use wide::f64x4;
 
-use crate::device::DeviceSpec;
+use super::DeviceSpec;
 use crate::wing::WingAero;
 use paritysim_kinematics::Drivetrain;
 
