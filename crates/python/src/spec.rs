@@ -10,7 +10,7 @@ use numpy::PyArray1;
 use paritysim_dynamics::integrate::budget;
 use paritysim_dynamics::{CancelFlag, Device};
 use paritysim_error::Result;
-use paritysim_spec::watch::run_watched;
+use paritysim_spec::watch::{run_inline, run_watched};
 use paritysim_spec::{Simulation, paths, schema};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -117,6 +117,22 @@ pub(crate) fn interruptible<T: Send>(
         .py_err()
 }
 
+/// [`interruptible`] for work that stays on this thread (one simulation): run here with the
+/// GIL released, Python's signals checked from the work's budget checks every [`SIGNAL_POLL`]
+/// (`paritysim_spec::watch::run_inline`), no worker thread to spawn and join.
+pub(crate) fn interruptible_here<T>(
+    py: Python<'_>,
+    cancel: &CancelFlag,
+    work: impl FnOnce() -> Result<T> + Send,
+) -> PyResult<T>
+where
+    T: Send,
+{
+    let signals = || Python::attach(|py| py.check_signals());
+    py.detach(|| run_inline(cancel, SIGNAL_POLL, signals, work))?
+        .py_err()
+}
+
 /// Runs a long core call like [`interruptible`], with a fresh cancel flag installed as the
 /// call's budget (`budget::cancellable`): Ctrl-C reaches every integration it makes, on any
 /// thread, and raises `KeyboardInterrupt`.
@@ -147,7 +163,7 @@ fn simulate(
         .py_err()?;
     let cancel = CancelFlag::new();
     options.cancel = Some(cancel.clone());
-    let r = interruptible(py, &cancel, || {
+    let r = interruptible_here(py, &cancel, || {
         // A spec with a moving body flies (paritysim-flight); otherwise the fixed-body engine.
         spec.run(&device, &options).map_err(|e| spec.attribute(e))
     })?;

@@ -48,7 +48,7 @@ use serde_json::Value;
 pub fn from_value(mut value: Value) -> Result<(Simulation, Vec<String>)> {
     let notes = migrate::migrate(&mut value);
     let mut problems = Vec::new();
-    schema::check(&value, schema::schema(), "", &mut problems);
+    schema::check(&value, &mut problems);
     if !problems.is_empty() {
         return Err(problems.into());
     }
@@ -85,8 +85,7 @@ pub fn drivetrain_from_json(text: &str) -> Result<Drivetrain> {
     let value: Value = serde_json::from_str(text)
         .map_err(|e| Error::invalid("drivetrain", e.to_string(), "valid JSON"))?;
     let mut problems = Vec::new();
-    let reference = serde_json::json!({"$ref": "#/$defs/Drivetrain"});
-    schema::check(&value, &reference, "drivetrain", &mut problems);
+    schema::check_definition(&value, "Drivetrain", "drivetrain", &mut problems);
     if !problems.is_empty() {
         return Err(problems.into());
     }

@@ -54,6 +54,65 @@ pub struct Budget {
 
 thread_local! {
     static CURRENT: RefCell<Option<Budget>> = const { RefCell::new(None) };
+    static WATCH: RefCell<Option<Watch>> = const { RefCell::new(None) };
+}
+
+/// A poll run by the budget checks of the thread that installed it ([`watched`]), at most
+/// once per `every`: a binding's signal check when the work runs on the caller's own thread.
+struct Watch {
+    poll: Box<dyn FnMut() -> bool>,
+    every: Duration,
+    next: Instant,
+    cancel: CancelFlag,
+}
+
+/// Runs `work` on this thread with `cancel` installed as its budget (as [`cancellable`]) and
+/// `poll` called from its budget checks on this thread, at most once per `every`; when `poll`
+/// returns `true` (an interruption) `cancel` is set and the work stops at its next check.
+/// Tasks the work hands to other threads ([`carry`]) see the flag but never run `poll`.
+///
+/// Why: a short call then needs no worker thread (measured: spawning and joining one costs
+/// 20-400 µs of wall time on a loaded 2-core machine, against a 0.6 ms trial).
+///
+/// # Errors
+/// Those of `work`; [`Error::Cancelled`] when `cancel` is set before `work` starts.
+pub fn watched<T>(
+    cancel: &CancelFlag,
+    every: Duration,
+    poll: impl FnMut() -> bool + 'static,
+    work: impl FnOnce() -> Result<T>,
+) -> Result<T> {
+    struct Restore(Option<Watch>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            let previous = self.0.take();
+            WATCH.with(|w| *w.borrow_mut() = previous);
+        }
+    }
+    let watch = Watch {
+        poll: Box::new(poll),
+        every,
+        next: Instant::now() + every,
+        cancel: cancel.clone(),
+    };
+    let _restore = Restore(WATCH.with(|w| w.borrow_mut().replace(watch)));
+    cancellable(cancel, work)
+}
+
+/// Runs this thread's [`Watch`] when it is due. Taken out while it polls: the poll may run
+/// code that checks a budget itself.
+fn run_watch() {
+    let Some(mut watch) = WATCH.with(|w| w.borrow_mut().take()) else {
+        return;
+    };
+    let now = Instant::now();
+    if now >= watch.next {
+        watch.next = now + watch.every;
+        if (watch.poll)() {
+            watch.cancel.cancel();
+        }
+    }
+    WATCH.with(|w| *w.borrow_mut() = Some(watch));
 }
 
 /// Restores the previous budget of the thread when dropped.
@@ -152,6 +211,7 @@ pub(crate) fn deadline(max_wall_ms: Option<f64>) -> Option<(Instant, f64)> {
 
 /// Checks the current thread's budget (no budget: always fine).
 pub(crate) fn check_current() -> Result<(), Stop> {
+    run_watch();
     CURRENT.with(|c| c.borrow().as_ref().map_or(Ok(()), Budget::check))
 }
 

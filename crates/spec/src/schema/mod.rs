@@ -8,10 +8,12 @@
 use std::borrow::Cow;
 use std::sync::OnceLock;
 
-use paritysim_error::Problem;
 use serde_json::{Map, Value};
 
 use crate::spec::Simulation;
+
+mod check;
+pub(crate) use check::{check, check_definition};
 
 /// The JSON Schema (draft 2020-12) of [`Simulation`].
 pub fn schema() -> &'static Value {
@@ -246,179 +248,6 @@ fn short(v: &Value) -> String {
         format!("{}...", &s[..57])
     } else {
         s
-    }
-}
-
-/// Walks `value` against `schema`, pushing every problem.
-pub(crate) fn check(value: &Value, schema: &Value, path: &str, problems: &mut Vec<Problem>) {
-    let s = node(schema);
-    match classify(&s) {
-        Branch::Plain => {}
-        Branch::Optional(inner) => {
-            if !value.is_null() {
-                check(value, inner, path, problems);
-            }
-            return;
-        }
-        Branch::Tagged(variants) => {
-            let Some(obj) = value.as_object() else {
-                problems.push(Problem::new(path, short(value), describe(schema)));
-                return;
-            };
-            let tags: Vec<&str> = variants.iter().map(|(t, _)| t.as_str()).collect();
-            match obj.get("kind") {
-                None => problems.push(Problem::new(
-                    join(path, "kind"),
-                    "missing",
-                    format!("one of {}", tags.join(", ")),
-                )),
-                Some(Value::String(kind)) => match variants.iter().find(|(t, _)| t == kind) {
-                    Some((_, branch)) => check_plain(value, branch, path, problems),
-                    None => problems.push(Problem::new(
-                        join(path, "kind"),
-                        format!("{kind:?}"),
-                        suggestion(kind, tags.iter().copied()),
-                    )),
-                },
-                Some(other) => problems.push(Problem::new(
-                    join(path, "kind"),
-                    short(other),
-                    format!("one of {}", tags.join(", ")),
-                )),
-            }
-            return;
-        }
-        Branch::Untagged(list) => {
-            if value.is_null() && list.iter().any(is_null_schema) {
-                return;
-            }
-            let fits = list.iter().any(|b| {
-                let mut sub = Vec::new();
-                check(value, b, path, &mut sub);
-                sub.is_empty()
-            });
-            if !fits {
-                problems.push(Problem::new(path, short(value), describe(schema)));
-            }
-            return;
-        }
-    }
-    check_plain(value, &s, path, problems);
-}
-
-fn check_plain(value: &Value, s: &Map<String, Value>, path: &str, problems: &mut Vec<Problem>) {
-    // Only built when a problem is reported (cloning every node would dominate the walk).
-    let described = || describe(&Value::Object(s.clone()));
-    if let Some(allowed) = s.get("enum").and_then(Value::as_array) {
-        if !allowed.contains(value) {
-            let names: Vec<&str> = allowed.iter().filter_map(Value::as_str).collect();
-            let text = match value.as_str() {
-                Some(word) => suggestion(word, names.iter().copied()),
-                None => format!("one of {}", join_values(allowed)),
-            };
-            problems.push(Problem::new(path, short(value), text));
-        }
-        return;
-    }
-    if let Some(c) = s.get("const") {
-        if c != value {
-            problems.push(Problem::new(path, short(value), format!("{c}")));
-        }
-        return;
-    }
-    let t = types(s);
-    if t.is_empty() {
-        return;
-    }
-    let fits = match value {
-        Value::Null => t.contains(&"null"),
-        Value::Bool(_) => t.contains(&"boolean"),
-        Value::Number(n) => {
-            t.contains(&"number") || (t.contains(&"integer") && (n.is_u64() || n.is_i64()))
-        }
-        Value::String(_) => t.contains(&"string"),
-        Value::Array(_) => t.contains(&"array"),
-        Value::Object(_) => t.contains(&"object"),
-    };
-    if !fits {
-        let allowed = described();
-        let allowed = if value.is_string() && (t.contains(&"number") || t.contains(&"integer")) {
-            format!("{allowed} (finite)")
-        } else {
-            allowed
-        };
-        problems.push(Problem::new(path, short(value), allowed));
-        return;
-    }
-    match value {
-        Value::Number(n) => {
-            let x = n.as_f64().unwrap_or(f64::NAN);
-            let below = num(s, "minimum").is_some_and(|m| x < m)
-                || num(s, "exclusiveMinimum").is_some_and(|m| x <= m);
-            let above = num(s, "maximum").is_some_and(|m| x > m)
-                || num(s, "exclusiveMaximum").is_some_and(|m| x >= m);
-            if below || above || !x.is_finite() {
-                problems.push(Problem::new(path, n.to_string(), described()));
-            }
-        }
-        Value::Array(items) => {
-            let len = items.len() as f64;
-            if num(s, "minItems").is_some_and(|m| len < m)
-                || num(s, "maxItems").is_some_and(|m| len > m)
-            {
-                let (lo, hi) = (num(s, "minItems"), num(s, "maxItems"));
-                let want = match (lo, hi) {
-                    (Some(a), Some(b)) if a == b => format!("exactly {a} items"),
-                    (Some(a), Some(b)) => format!("{a} to {b} items"),
-                    (Some(a), None) => format!("at least {a} items"),
-                    (None, Some(b)) => format!("at most {b} items"),
-                    (None, None) => String::new(),
-                };
-                problems.push(Problem::new(path, format!("{} items", items.len()), want));
-            }
-            if let Some(item) = s.get("items") {
-                for (i, v) in items.iter().enumerate() {
-                    check(v, item, &format!("{path}[{i}]"), problems);
-                }
-            }
-        }
-        Value::Object(obj) => {
-            let props = s.get("properties").and_then(Value::as_object);
-            let closed = s.get("additionalProperties") == Some(&Value::Bool(false))
-                || s.get("unevaluatedProperties") == Some(&Value::Bool(false));
-            let known: Vec<&str> = props
-                .map(|p| p.keys().map(String::as_str).collect())
-                .unwrap_or_default();
-            for (k, v) in obj {
-                match props.and_then(|p| p.get(k)) {
-                    // The tag of a tagged enum was checked by the caller.
-                    Some(_) if k == "kind" && tag_of(s).is_some() => {}
-                    Some(sub) => check(v, sub, &join(path, k), problems),
-                    None if closed => problems.push(Problem::new(
-                        join(path, k),
-                        "<unknown field>",
-                        suggestion(k, known.iter().copied()),
-                    )),
-                    None => {}
-                }
-            }
-            for r in s
-                .get("required")
-                .and_then(Value::as_array)
-                .into_iter()
-                .flatten()
-            {
-                if let Some(r) = r.as_str() {
-                    if !obj.contains_key(r) {
-                        let allowed = props
-                            .and_then(|p| p.get(r))
-                            .map_or_else(|| "required".to_string(), describe);
-                        problems.push(Problem::new(join(path, r), "missing", allowed));
-                    }
-                }
-            }
-        }
-        _ => {}
     }
 }
 
