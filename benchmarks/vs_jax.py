@@ -7,6 +7,10 @@ I = 29 mg·mm², drag −Ω φ̇|φ̇| with C = 1, Ω^R = 31.3, K1 = 467 mN/mm, 
 grid over Ω^L/Ω^R ∈ [0.3, 1] × K2 ∈ [0, 100]; Table 3.2 metrics (Δτ peak, τR and τL peaks,
 instantaneous and peak imbalance %) of the last cycle from ``--samples`` samples.
 
+Also timed in the same rounds: one §3.4 rotating trial (the shipped
+``sreetharan2012_3_4_parity_1cut`` device at its default options: blade-element wings on the
+stroke plane), against the same run at rtol 1e-12.
+
 Every peer's metrics are compared with an rtol 1e-12 reference (paritysim, Newton shooting to a
 residual of 1e-11 at rtol 1e-12; checked against a 1e-12 long transient on a few points).
 The script peers run a fixed number of cycles from rest (``--cycles``), as a script would.
@@ -36,6 +40,8 @@ from scipy.integrate import solve_ivp
 import paritysim as ps
 
 T_RATIO, ARM, INERTIA, C, OMEGA_R = 2.5, 2.5, 29.0, 1.0, 31.3
+ROTATING_DEVICE = "sreetharan2012_3_4_parity_1cut"
+ROTATING_PEER = "paritysim simulate, §3.4 rotating 1-Cut trial"
 K1, FORCE_PER_VOLT, AMPLITUDE_V, FREQUENCY_HZ = 467.0, 1.2, 100.0, 110.0
 W = 2 * math.pi * FREQUENCY_HZ * 1e-3  # rad/ms
 PERIOD = 2 * math.pi / W
@@ -275,6 +281,13 @@ def main() -> None:
         [list(ps.simulate(s, columns=[], metrics=METRICS).metrics.values()) for s in trial_specs]
     )
     sizes["paritysim simulate, one cold trial per point"] = len(pick)
+    # The §3.4 rotating trial (issue 12: <= 3 ms): the shipped 1-Cut Drag PARITY device
+    # (blade-element wings, stroke plane, hinge spring) at its default options, the same five
+    # metrics, against the same run at rtol 1e-12.
+    rotating = ps.devices.load(ROTATING_DEVICE)
+    rotating_reference = np.array([list(ps.simulate(rotating, columns=[], metrics=METRICS, rtol=1e-12, atol=1e-14).metrics.values())])
+    peers[ROTATING_PEER] = lambda: np.array([list(ps.simulate(rotating, columns=[], metrics=METRICS).metrics.values())])
+    sizes[ROTATING_PEER] = 1
 
     times: dict[str, list[float]] = {name: [] for name in peers}
     results: dict[str, np.ndarray] = {}
@@ -289,6 +302,7 @@ def main() -> None:
     print(f"\n{'implementation':48s} {'ms/point':>10s} {'vs paritysim':>13s} {'torque err':>11s} {'pct err':>9s}")
     for name in peers:
         ref = reference[pick] if name.startswith(("scipy", "paritysim simulate")) else reference
+        ref = rotating_reference if name == ROTATING_PEER else ref
         rel, pct = errors(results[name], ref)
         print(f"{name:48s} {ms[name]:10.3f} {ms[name] / ours:12.1f}x {rel:11.1e} {pct:9.1e}")
     ours_on_scipy_points = errors(results["paritysim sweep, shooting (metrics only)"][pick], reference[pick])

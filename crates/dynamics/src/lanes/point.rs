@@ -8,7 +8,7 @@ use nalgebra::{DMatrix, DVector};
 use super::COMPLETED_IN_LANES;
 use super::linear_stroke::LinearStroke;
 use crate::device::Device;
-use crate::grid_shooting::GRID_TOLERANCE_FACTOR;
+use crate::grid_shooting::{GRID_TOLERANCE_FACTOR, REPICK_RESIDUAL};
 use crate::integrate::lanes::{LaneOutcome, LaneProblem, LaneTolerances, SampleBlock};
 use crate::integrate::{Method, RungeKutta, State};
 use crate::metrics::{MetricsAccumulator, StrokeBlock};
@@ -35,6 +35,9 @@ enum Pending {
     Relinearise {
         candidate: Option<(State, DVector<f64>, f64)>,
     },
+    /// The adaptive period that picks the grid again at the converged `y_new` (the grid was
+    /// picked far from the orbit: `grid_shooting::REPICK_RESIDUAL`).
+    Repick { y_new: State },
     /// A Newton trial from `y_new`; `last`: the recorded window.
     Trial {
         y_new: State,
@@ -77,6 +80,9 @@ pub(super) struct LanePoint<'a> {
     jac: DMatrix<f64>,
     /// Whether `jac` is an exact Jacobian at `y` (after a re-linearisation).
     fresh: bool,
+    /// Whether the grid was picked far from the orbit and is to be picked again once Newton
+    /// converges on it (`grid_shooting::REPICK_RESIDUAL`).
+    repick: bool,
     /// Warm-up periods of a cold point: at most `min_cycles`.
     min_cycles: usize,
     warm_cycles: usize,
@@ -222,6 +228,7 @@ impl<'a> LanePoint<'a> {
             times,
             jac,
             fresh: false,
+            repick: false,
             min_cycles,
             warm_cycles: 0,
             eye: DMatrix::identity(4, 4),
@@ -302,6 +309,7 @@ impl<'a> LanePoint<'a> {
         self.fresh = true;
         self.periods = 1;
         (self.f, self.res) = residual(&self.y, &py);
+        self.repick = self.res > REPICK_RESIDUAL;
         self.iterate()
     }
 
@@ -317,7 +325,9 @@ impl<'a> LanePoint<'a> {
                 Rc::from([])
             },
             tol: match self.pending {
-                Pending::Map | Pending::Pick | Pending::Sensitivity => self.grid_tol,
+                Pending::Map | Pending::Pick | Pending::Repick { .. } | Pending::Sensitivity => {
+                    self.grid_tol
+                }
                 Pending::Trial { .. } | Pending::WarmUp | Pending::Relinearise { .. } => {
                     self.newton_tol
                 }
@@ -373,6 +383,11 @@ impl<'a> LanePoint<'a> {
         .min(1.0);
         let y_new = State::from_compact(2, &(self.y.compact(2) + &delta));
         let last = contraction * step <= self.tol || step <= 1e-3 * self.tol;
+        if last && self.repick {
+            self.repick = false;
+            self.pending = Pending::Repick { y_new };
+            return Next::Integrate(self.adaptive_grid_period(&y_new));
+        }
         self.pending = Pending::Trial {
             y_new,
             delta,
@@ -419,22 +434,25 @@ impl<'a> LanePoint<'a> {
                 // The neighbour's grid no longer suits: one adaptive period picks another
                 // (`chooser.advance_with_steps`, in the lane).
                 self.pending = Pending::Pick;
-                Next::Integrate(LaneProblem {
-                    grid: Rc::from([0.0, self.period]),
-                    adaptive: Some(self.max_steps),
-                    y0: compact4(&self.y),
-                    times: Rc::from([]),
-                    tol: self.grid_tol,
-                })
+                Next::Integrate(self.adaptive_grid_period(&self.y.clone()))
             }
             (Pending::Pick, LaneOutcome::Done { y, steps, .. }) => {
                 self.grid = steps.into();
                 self.forcing = None;
                 self.periods = 1;
                 (self.f, self.res) = residual(&self.y, &expand4(&y));
+                self.repick = self.res > REPICK_RESIDUAL;
                 self.iterate()
             }
-            (Pending::Pick, LaneOutcome::Failed) => Next::Scalar,
+            (Pending::Repick { y_new }, LaneOutcome::Done { y, steps, .. }) => {
+                self.grid = steps.into();
+                self.forcing = None;
+                self.periods += 1;
+                (self.f, self.res) = residual(&y_new, &expand4(&y));
+                self.y = y_new;
+                self.iterate()
+            }
+            (Pending::Pick | Pending::Repick { .. }, LaneOutcome::Failed) => Next::Scalar,
             (Pending::Trial { .. }, LaneOutcome::Failed) => Next::Scalar,
             (
                 Pending::Trial {
@@ -478,6 +496,18 @@ impl<'a> LanePoint<'a> {
                 self.last_step = Some(step);
                 self.iterate()
             }
+        }
+    }
+
+    /// One adaptive period from `y` at the grid tolerances that picks a grid
+    /// (`chooser.advance_with_steps`, in the lane).
+    fn adaptive_grid_period(&self, y: &State) -> LaneProblem<4> {
+        LaneProblem {
+            grid: Rc::from([0.0, self.period]),
+            adaptive: Some(self.max_steps),
+            y0: compact4(y),
+            times: Rc::from([]),
+            tol: self.grid_tol,
         }
     }
 
