@@ -495,6 +495,27 @@ impl Device {
         (force, load, 0.5 * k1 * q.x * q.x + 0.5 * k2 * q.y * q.y)
     }
 
+    /// Whether the device has the closed-form stroke-plane model (§3.4 rotating wings:
+    /// `device/stroke_plane.rs`), whose lean samples are [`crate::trajectory::PlaneSample`]s.
+    pub fn has_stroke_plane_model(&self) -> bool {
+        self.stroke_plane_rhs.is_some()
+    }
+
+    /// `∂Q/∂q` of [`Self::drive_load`] (constant: the actuator and balance springs,
+    /// `−diag(K1, K2)`, or `−K1` on both drives of a dual drivetrain).
+    pub(crate) fn drive_load_slope(&self) -> nalgebra::Matrix2<f64> {
+        let k1 = self.spec.actuator.as_ref().map_or(0.0, |a| a.stiffness());
+        let k2 = match (&self.spec.actuator, self.is_dual()) {
+            (Some(_), true) => k1,
+            _ => self
+                .spec
+                .transmission
+                .as_ref()
+                .map_or(0.0, |tr| tr.balance_stiffness),
+        };
+        nalgebra::Matrix2::new(-k1, 0.0, 0.0, -k2)
+    }
+
     /// Whether the drivetrain is a dual one (one actuator per wing, `q2` the right drive).
     #[inline]
     pub fn is_dual(&self) -> bool {
@@ -1071,12 +1092,22 @@ impl crate::integrate::OdeSystem for Device {
 
     fn variational(
         &self,
-        _t: f64,
+        t: f64,
         y: &State,
         n: usize,
         phi: &[f64],
         dphi: &mut [f64],
     ) -> Option<Result<()>> {
+        if let Some(lean) = &self.stroke_plane_rhs {
+            if n != self.n_dof {
+                return None;
+            }
+            let mut f = State::default();
+            if let Err(e) = self.rhs_stroke_plane(lean, t, y, None, &mut f) {
+                return Some(Err(e));
+            }
+            return self.stroke_plane_variational(lean, y, None, &f.rates[..n], phi, dphi);
+        }
         let terms = self.stroke_only.as_ref()?.jacobian.as_ref()?;
         if n != 2 {
             return None;
@@ -1085,9 +1116,44 @@ impl crate::integrate::OdeSystem for Device {
         linear_map_jacobian::variational(terms, &y, phi, dphi);
         Some(Ok(()))
     }
+
+    fn variational_on(
+        &self,
+        t: f64,
+        y: &State,
+        sides: Option<crate::integrate::Sides>,
+        n: usize,
+        f: &[f64],
+        phi: &[f64],
+        dphi: &mut [f64],
+    ) -> Option<Result<()>> {
+        self.variational_given(t, y, sides, n, f, phi, dphi)
+    }
 }
 
 impl Device {
+    /// [`crate::integrate::OdeSystem::variational_on`]: the stroke-plane Jacobian on the held
+    /// branch, reusing the right-hand side `f` the variational system already evaluated.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn variational_given(
+        &self,
+        t: f64,
+        y: &State,
+        sides: Option<crate::integrate::Sides>,
+        n: usize,
+        f: &[f64],
+        phi: &[f64],
+        dphi: &mut [f64],
+    ) -> Option<Result<()>> {
+        match &self.stroke_plane_rhs {
+            Some(lean) if n == self.n_dof => {
+                self.stroke_plane_variational(lean, y, sides.map(branches), &f[n..2 * n], phi, dphi)
+            }
+            Some(_) => None,
+            None => crate::integrate::OdeSystem::variational(self, t, y, n, phi, dphi),
+        }
+    }
+
     /// The linear map's analytic Jacobian constants (drivetrain coordinates of a two-DOF
     /// linear differential with stroke drag; see [`linear_map_jacobian`]).
     pub(crate) fn linear_map_terms(&self) -> Option<&LinearMapTerms<f64>> {

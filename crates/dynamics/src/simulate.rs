@@ -8,7 +8,7 @@ use crate::device::Device;
 use crate::integrate::budget::{Budget, CancelFlag};
 use crate::integrate::{Integrator, Method, RungeKutta, State};
 use crate::metrics::{MetricsAccumulator, StrokeNeeds};
-use crate::trajectory::{Recorder, Sample, StrokeSample, select_columns};
+use crate::trajectory::{PlaneSample, Recorder, Sample, StrokeSample, select_columns};
 pub use crate::trajectory::{Trajectory, record};
 
 /// An instantaneous velocity change.
@@ -85,8 +85,9 @@ pub struct SimulationOptions {
     pub columns: Option<Vec<String>>,
     /// Metrics the caller reads (`None`: all). When no column is built and the device
     /// integrates drivetrain coordinates, the samples are [`crate::trajectory::StrokeSample`]s
-    /// computing only what these need ([`crate::metrics::StrokeNeeds`]) and the metrics they do
-    /// not provide come back NaN.
+    /// (stroke-plane devices: [`crate::trajectory::PlaneSample`]s) computing only what these
+    /// need ([`crate::metrics::StrokeNeeds`]) and the metrics they do not provide come back
+    /// NaN.
     pub metrics: Option<Vec<String>>,
     /// How the periodic steady state is found (driven devices).
     pub steady_state: SteadyState,
@@ -664,14 +665,16 @@ pub fn orbit_metrics(
 }
 
 /// How samples are taken (see [`SimulationOptions::metrics`]): `Some(needs)` for lean
-/// [`StrokeSample`]s (no column asked, drivetrain coordinates), else `None` (full samples).
+/// [`StrokeSample`]s (no column asked, drivetrain coordinates) or [`PlaneSample`]s (no column
+/// asked, the stroke-plane model), else `None` (full samples).
 fn stroke_sampling(
     device: &Device,
     metrics: Option<&[String]>,
     columns: &[crate::trajectory::Column],
 ) -> Option<StrokeNeeds> {
     let lean = columns.is_empty()
-        && device.formulation() == crate::device::Formulation::DrivetrainCoordinates;
+        && (device.formulation() == crate::device::Formulation::DrivetrainCoordinates
+            || device.has_stroke_plane_model());
     lean.then(|| StrokeNeeds::of(metrics))
 }
 
@@ -707,13 +710,23 @@ fn record_window(
         })
         .collect();
     let mut metrics = MetricsAccumulator::new(device, period);
+    let plane = device.formulation() != crate::device::Formulation::DrivetrainCoordinates;
     let mut recorder = Recorder::new(columns, times.len());
     let mut sink = |i: usize, t: f64, y: &State| -> Result<()> {
-        // `stroke` is only set for drivetrain-coordinate devices (see `stroke_sampling`).
+        // `stroke` is only set for drivetrain-coordinate and stroke-plane devices (see
+        // `stroke_sampling`).
         if let Some(needs) = stroke {
-            let sample = StrokeSample::of_stroke_device(device, t, y, needs)?;
-            metrics.add_stroke(&sample, i == n_samples);
-            return Ok(());
+            if plane {
+                if let Some(sample) = PlaneSample::new(device, t, y, needs) {
+                    metrics.add_plane(&sample?, i == n_samples);
+                    return Ok(());
+                }
+                // Outside the closed form: the general sample (which reports why).
+            } else {
+                let sample = StrokeSample::of_stroke_device(device, t, y, needs)?;
+                metrics.add_stroke(&sample, i == n_samples);
+                return Ok(());
+            }
         }
         let sample = Sample::new(device, t, y)?;
         metrics.add(&sample, i == n_samples);

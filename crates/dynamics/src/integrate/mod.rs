@@ -163,6 +163,27 @@ pub trait OdeSystem {
     ) -> Option<Result<()>> {
         None
     }
+
+    /// [`Self::variational`] on the branch `sides` held by event location (`None`: the
+    /// state's own sides), given the right-hand side `f = [coords', rates']` (`2n` entries)
+    /// already evaluated at `(t, y)`. The default ignores both and calls
+    /// [`Self::variational`].
+    ///
+    /// # Errors
+    /// As [`Self::variational`].
+    #[allow(clippy::too_many_arguments)]
+    fn variational_on(
+        &self,
+        t: f64,
+        y: &State,
+        _sides: Option<Sides>,
+        n: usize,
+        _f: &[f64],
+        phi: &[f64],
+        dphi: &mut [f64],
+    ) -> Option<Result<()>> {
+        self.variational(t, y, n, phi, dphi)
+    }
 }
 
 /// Explicit Runge-Kutta pair.
