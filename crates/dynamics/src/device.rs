@@ -1102,11 +1102,8 @@ impl crate::integrate::OdeSystem for Device {
             if n != self.n_dof {
                 return None;
             }
-            let mut f = State::default();
-            if let Err(e) = self.rhs_stroke_plane(lean, t, y, None, &mut f) {
-                return Some(Err(e));
-            }
-            return self.stroke_plane_variational(lean, y, None, &f.rates[..n], phi, dphi);
+            let mut f = [0.0; 2 * stroke_plane::N];
+            return self.stroke_plane_variational(lean, t, y, None, &mut f, phi, dphi);
         }
         let terms = self.stroke_only.as_ref()?.jacobian.as_ref()?;
         if n != 2 {
@@ -1117,43 +1114,22 @@ impl crate::integrate::OdeSystem for Device {
         Some(Ok(()))
     }
 
-    fn variational_on(
+    fn variational_with_rhs(
         &self,
         t: f64,
         y: &State,
         sides: Option<crate::integrate::Sides>,
         n: usize,
-        f: &[f64],
+        f: &mut [f64],
         phi: &[f64],
         dphi: &mut [f64],
     ) -> Option<Result<()>> {
-        self.variational_given(t, y, sides, n, f, phi, dphi)
+        let lean = self.stroke_plane_rhs.as_ref().filter(|_| n == self.n_dof)?;
+        self.stroke_plane_variational(lean, t, y, sides.map(branches), f, phi, dphi)
     }
 }
 
 impl Device {
-    /// [`crate::integrate::OdeSystem::variational_on`]: the stroke-plane Jacobian on the held
-    /// branch, reusing the right-hand side `f` the variational system already evaluated.
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn variational_given(
-        &self,
-        t: f64,
-        y: &State,
-        sides: Option<crate::integrate::Sides>,
-        n: usize,
-        f: &[f64],
-        phi: &[f64],
-        dphi: &mut [f64],
-    ) -> Option<Result<()>> {
-        match &self.stroke_plane_rhs {
-            Some(lean) if n == self.n_dof => {
-                self.stroke_plane_variational(lean, y, sides.map(branches), &f[n..2 * n], phi, dphi)
-            }
-            Some(_) => None,
-            None => crate::integrate::OdeSystem::variational(self, t, y, n, phi, dphi),
-        }
-    }
-
     /// The linear map's analytic Jacobian constants (drivetrain coordinates of a two-DOF
     /// linear differential with stroke drag; see [`linear_map_jacobian`]).
     pub(crate) fn linear_map_terms(&self) -> Option<&LinearMapTerms<f64>> {

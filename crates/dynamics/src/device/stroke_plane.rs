@@ -20,7 +20,7 @@ use crate::metrics::StrokeNeeds;
 use crate::trajectory::PlaneSample;
 
 /// Integrated coordinates of a stroke-plane device: `(φ, ψ)` of two wings.
-const N: usize = 4;
+pub(super) const N: usize = 4;
 
 /// The constants of [`Device::rhs_stroke_plane`], precomputed from the null basis and the
 /// linear map.
@@ -217,23 +217,25 @@ impl Device {
             }
             wings[w] = PlaneWing {
                 angles: (phi, psi),
+                rates: (phi_dot, psi_dot),
                 sin_cos_psi: (s, c),
                 omega,
+                i_a,
                 i_omega,
                 jdot_pdot,
+                coriolis: v,
                 aero: tau,
             };
         }
-        let x_ddot = mass
-            .cholesky()
-            .ok_or_else(|| {
-                Error::Singular(format!(
-                    "reduced mass matrix is not positive definite at x = {:?}",
-                    &y.coords[..N]
-                ))
-            })?
-            .solve(&generalised);
+        let factor = mass.cholesky().ok_or_else(|| {
+            Error::Singular(format!(
+                "reduced mass matrix is not positive definite at x = {:?}",
+                &y.coords[..N]
+            ))
+        })?;
+        let x_ddot = factor.solve(&generalised);
         Ok(Some(PlaneStep {
+            factor,
             x_ddot,
             q,
             q_dot,
@@ -247,19 +249,25 @@ impl Device {
 /// One wing of a [`PlaneStep`].
 #[derive(Clone, Copy, Debug, Default)]
 struct PlaneWing {
-    /// `(φ, ψ)` and `(sin ψ, cos ψ)`.
+    /// `(φ, ψ)`, `(φ̇, ψ̇)` and `(sin ψ, cos ψ)`.
     angles: (f64, f64),
+    rates: (f64, f64),
     sin_cos_psi: (f64, f64),
-    /// `ω`, `I ω`, `J̇6 ṗ` and the aerodynamic torque, in frame 6.
+    /// `ω`, `I a`, `I ω`, `J̇6 ṗ`, `v = I J̇6 ṗ + ω × Iω` and the aerodynamic torque, in
+    /// frame 6.
     omega: Vector3<f64>,
+    i_a: Vector3<f64>,
     i_omega: Vector3<f64>,
     jdot_pdot: Vector3<f64>,
+    coriolis: Vector3<f64>,
     aero: Vector3<f64>,
 }
 
 /// The stroke-plane equations at one state.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 struct PlaneStep {
+    /// Cholesky factor of the reduced mass matrix.
+    factor: nalgebra::Cholesky<f64, nalgebra::Const<N>>,
     x_ddot: SVector<f64, N>,
     q: Vector2<f64>,
     q_dot: Vector2<f64>,
@@ -340,9 +348,9 @@ impl Device {
 }
 
 impl Device {
-    /// `J Φ` of the stroke-plane equations ([`Self::rhs_stroke_plane`]) from their analytic
-    /// Jacobian, given `x_ddot` (the right-hand side's accelerations at `y`), `Φ` (`8 × 8`
-    /// by columns) into `dphi`; blade elements on `branches` as the right-hand side.
+    /// The right-hand side `f = [ẋ, ẍ]` of [`Self::rhs_stroke_plane`] (the same numbers)
+    /// into `f` and `J Φ` from the analytic Jacobian into `dphi` (`Φ` `8 × 8` by columns),
+    /// the blade elements on `branches` as the right-hand side.
     ///
     /// With `M(x) ẍ = G(t, x, ẋ)`: `∂ẍ = M⁻¹ (∂G − (∂M) ẍ)`, where `M` depends on the hinge
     /// angles only (`∂(aᵀ I a)/∂ψ = 2 a'ᵀ I a`, `∂(I a)_z/∂ψ = (I a')_z`, `a' = ∂a/∂ψ`),
@@ -355,42 +363,33 @@ impl Device {
     pub(super) fn stroke_plane_variational(
         &self,
         lean: &StrokePlane,
+        t: f64,
         y: &State,
         branches: Option<[Branch; 2]>,
-        x_ddot: &[f64],
+        f: &mut [f64],
         phi: &[f64],
         dphi: &mut [f64],
     ) -> Option<Result<()>> {
-        let (x, x_dot) = (&y.coords[..N], &y.rates[..N]);
-        let mut stroke = Vector2::zeros();
-        for w in 0..2 {
-            stroke[w] = lean.offset[w][0] + dot(&lean.rows[w][0], x);
-        }
-        let q = lean.inverse * stroke;
-        if !(q.x.abs() <= paritysim_error::plausible::OFFSET_MM
-            && q.y.abs() <= paritysim_error::plausible::ANGLE_RAD)
-        {
-            return None;
-        }
+        let step = match self.stroke_plane_step(lean, t, y, branches) {
+            Ok(Some(step)) => step,
+            Ok(None) => return None,
+            Err(e) => return Some(Err(e)),
+        };
         let drive = lean.inverse_transpose * self.drive_load_slope() * lean.inverse;
-        let mut mass = SMatrix::<f64, N, N>::zeros();
+        let x_ddot: [f64; N] = step.x_ddot.into();
         // [∂G/∂x − (∂M/∂x) ẍ | ∂G/∂ẋ].
         let mut slope = SMatrix::<f64, N, { 2 * N }>::zeros();
         let z = Vector3::z();
         for (w, wing) in self.spec.wings.iter().enumerate() {
             let [row_phi, row_psi] = &lean.rows[w];
-            let phi_dot = dot(row_phi, x_dot);
-            let psi = lean.offset[w][1] + dot(row_psi, x);
-            let psi_dot = dot(row_psi, x_dot);
-            let (s, c) = psi.sin_cos();
+            let k = &step.wings[w];
+            let ((phi, psi), (phi_dot, psi_dot), (s, c)) = (k.angles, k.rates, k.sin_cos_psi);
+            let (omega, i_a, i_omega, v, tau) = (k.omega, k.i_a, k.i_omega, k.coriolis, k.aero);
             let inertia = wing.inertia();
             let a = Vector3::new(c, -s, 0.0);
             let a1 = Vector3::new(-s, -c, 0.0);
-            let (i_a, i_a1) = (inertia * a, inertia * a1);
+            let i_a1 = inertia * a1;
             let i_z = inertia.column(2).into_owned();
-            let omega = Vector3::new(c * phi_dot, -s * phi_dot, psi_dot);
-            let i_omega = i_a * phi_dot + i_z * psi_dot;
-            let v = i_a1 * (phi_dot * psi_dot) + omega.cross(&i_omega);
             // ∂v by φ̇, ψ̇ and ψ (a'' = −a).
             let v_phi_dot = i_a1 * psi_dot + a.cross(&i_omega) + omega.cross(&i_a);
             let v_psi_dot = i_a1 * phi_dot + z.cross(&i_omega) + omega.cross(&i_z);
@@ -398,9 +397,11 @@ impl Device {
                 + (a1 * phi_dot).cross(&i_omega)
                 + omega.cross(&(i_a1 * phi_dot));
             let branch = branches.map(|b| b[w]);
-            let (tau, [tau_phi_dot, tau_psi, tau_psi_dot]) = match wing.aero() {
+            let [tau_phi_dot, tau_psi, tau_psi_dot] = match wing.aero() {
                 WingAero::BladeElement(model) => {
-                    model.moments_stroke_plane_jacobian(phi_dot, psi, (s, c), psi_dot, branch)?
+                    model
+                        .moments_stroke_plane_jacobian(phi_dot, psi, (s, c), psi_dot, branch)?
+                        .1
                 }
                 WingAero::StrokeDrag {
                     omega1,
@@ -409,12 +410,11 @@ impl Device {
                     // τ = −Ω C |φ̇| φ̇ a (eq. 2.16).
                     let k = -omega1 * coefficient;
                     let m = k * phi_dot.abs() * phi_dot;
-                    let d = 2.0 * k * phi_dot.abs();
-                    (a * m, [a * d, a1 * m, Vector3::zeros()])
+                    [a * (2.0 * k * phi_dot.abs()), a1 * m, Vector3::zeros()]
                 }
-                WingAero::None => (Vector3::zeros(), [Vector3::zeros(); 3]),
+                WingAero::None => [Vector3::zeros(); 3],
             };
-            let (spring_phi, spring_psi) = wing.stroke_plane_spring_slopes(stroke[w], psi);
+            let (spring_phi, spring_psi) = wing.stroke_plane_spring_slopes(phi, psi);
             // Rows f_φ = a·τ − a·v − V_φ + τ_drive, f_ψ = τ_z − v_z − V_ψ; columns φ, ψ, φ̇, ψ̇.
             let f_phi = [
                 -spring_phi,
@@ -428,21 +428,23 @@ impl Device {
                 tau_phi_dot.z - v_phi_dot.z,
                 tau_psi_dot.z - v_psi_dot.z,
             ];
-            let (m_pp, m_ps, m_ss) = (a.dot(&i_a), i_a.z, inertia[(2, 2)]);
             let (dm_pp, dm_ps) = (a1.dot(&i_a) + a.dot(&i_a1), i_a1.z);
-            let (phi_ddot, psi_ddot) = (dot(row_phi, x_ddot), dot(row_psi, x_ddot));
+            let (phi_ddot, psi_ddot) = (dot(row_phi, &x_ddot), dot(row_psi, &x_ddot));
             // (∂M/∂ψ) ẍ on the wing's (φ, ψ) rows.
             let (dm_phi, dm_psi) = (dm_pp * phi_ddot + dm_ps * psi_ddot, dm_ps * phi_ddot);
+            // The wing's rows by the reduced coordinates: (φ, ψ) ← x, (φ̇, ψ̇) ← ẋ.
+            let mut local = [[0.0; 2 * N]; 2];
+            for j in 0..N {
+                let (rj, sj) = (row_phi[j], row_psi[j]);
+                local[0][j] = f_phi[0] * rj + (f_phi[1] - dm_phi) * sj;
+                local[1][j] = f_psi[0] * rj + (f_psi[1] - dm_psi) * sj;
+                local[0][N + j] = f_phi[2] * rj + f_phi[3] * sj;
+                local[1][N + j] = f_psi[2] * rj + f_psi[3] * sj;
+            }
             for i in 0..N {
                 let (ri, si) = (row_phi[i], row_psi[i]);
-                let (u, v) = (m_pp * ri + m_ps * si, m_ps * ri + m_ss * si);
-                for j in 0..N {
-                    let (rj, sj) = (row_phi[j], row_psi[j]);
-                    mass[(j, i)] += row_phi[j] * u + row_psi[j] * v;
-                    slope[(i, j)] += ri * (f_phi[0] * rj + (f_phi[1] - dm_phi) * sj)
-                        + si * (f_psi[0] * rj + (f_psi[1] - dm_psi) * sj);
-                    slope[(i, N + j)] +=
-                        ri * (f_phi[2] * rj + f_phi[3] * sj) + si * (f_psi[2] * rj + f_psi[3] * sj);
+                for j in 0..2 * N {
+                    slope[(i, j)] += ri * local[0][j] + si * local[1][j];
                 }
             }
         }
@@ -456,18 +458,18 @@ impl Device {
                 }
             }
         }
-        let Some(factor) = mass.cholesky() else {
-            return Some(Err(Error::Singular(format!(
-                "reduced mass matrix is not positive definite at x = {:?}",
-                &y.coords[..N]
-            ))));
-        };
-        let jacobian = factor.solve(&slope);
+        let jacobian = step.factor.solve(&slope);
         let m = 2 * N;
+        f[..N].copy_from_slice(&y.rates[..N]);
+        f[N..m].copy_from_slice(&x_ddot);
         for (column, out) in phi.chunks_exact(m).zip(dphi.chunks_exact_mut(m)).take(m) {
             out[..N].copy_from_slice(&column[N..m]);
             for i in 0..N {
-                out[N + i] = (0..m).map(|j| jacobian[(i, j)] * column[j]).sum();
+                let mut sum = 0.0;
+                for j in 0..m {
+                    sum += jacobian[(i, j)] * column[j];
+                }
+                out[N + i] = sum;
             }
         }
         Some(Ok(()))
@@ -675,10 +677,12 @@ mod tests {
                                 out.compact(N)
                             };
                             let f0 = f(&y);
-                            let mut jac = vec![0.0; m * m];
-                            d.variational_on(t, &y, sides, N, f0.as_slice(), &eye, &mut jac)
+                            let (mut jac, mut f1) = (vec![0.0f64; m * m], vec![0.0f64; m]);
+                            d.variational_with_rhs(t, &y, sides, N, &mut f1, &eye, &mut jac)
                                 .expect("an analytic Jacobian")
                                 .unwrap();
+                            // The right-hand side it returns is the device's, bit for bit.
+                            assert_eq!(f1.as_slice(), f0.as_slice());
                             let y0 = y.compact(N);
                             for j in 0..m {
                                 let delta = 1e-5 * (1.0 + y0[j].abs());

@@ -164,25 +164,26 @@ pub trait OdeSystem {
         None
     }
 
-    /// [`Self::variational`] on the branch `sides` held by event location (`None`: the
-    /// state's own sides), given the right-hand side `f = [coords', rates']` (`2n` entries)
-    /// already evaluated at `(t, y)`. The default ignores both and calls
-    /// [`Self::variational`].
+    /// The right-hand side `f = [coords', rates']` (`2n` entries) at `(t, y)` and the
+    /// variational equations' `dphi = J phi` in one evaluation, on the branch `sides` held
+    /// by event location (`None`: the state's own sides; `f` as [`Self::rhs_on`] /
+    /// [`Self::rhs`] give it); `None` (the default) when the system has no such form here:
+    /// the variational equations then call [`Self::rhs_on`] and [`Self::variational`].
     ///
     /// # Errors
-    /// As [`Self::variational`].
+    /// Any model error (as [`Self::rhs`]).
     #[allow(clippy::too_many_arguments)]
-    fn variational_on(
+    fn variational_with_rhs(
         &self,
-        t: f64,
-        y: &State,
+        _t: f64,
+        _y: &State,
         _sides: Option<Sides>,
-        n: usize,
-        _f: &[f64],
-        phi: &[f64],
-        dphi: &mut [f64],
+        _n: usize,
+        _f: &mut [f64],
+        _phi: &[f64],
+        _dphi: &mut [f64],
     ) -> Option<Result<()>> {
-        self.variational(t, y, n, phi, dphi)
+        None
     }
 }
 

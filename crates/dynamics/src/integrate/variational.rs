@@ -57,13 +57,18 @@ impl<const M: usize> Rhs<M> for Variational<'_> {
     fn eval(&mut self, t: f64, c: &[f64; M], dc: &mut [f64; M]) -> Result<()> {
         let m = 2 * self.n;
         let y = to_state(self.n, &c[..m]);
-        self.f(t, &y, &mut dc[..m])?;
         let (f, rest) = dc.split_at_mut(m);
         let (phi, dphi) = (&c[m..m + m * m], &mut rest[..m * m]);
         if let Some(done) = self
             .system
-            .variational_on(t, &y, self.sides, self.n, f, phi, dphi)
+            .variational_with_rhs(t, &y, self.sides, self.n, f, phi, dphi)
         {
+            self.calls += 1;
+            return done.map_err(|e| integration_error(t, &y, format!("the model failed: {e}")));
+        }
+        self.f(t, &y, &mut dc[..m])?;
+        let (phi, dphi) = (&c[m..m + m * m], &mut dc[m..m + m * m]);
+        if let Some(done) = self.system.variational(t, &y, self.n, phi, dphi) {
             return done.map_err(|e| integration_error(t, &y, format!("the model failed: {e}")));
         }
         let scale = 1.0 + c[..m].iter().fold(0.0f64, |a, v| a.max(v.abs()));
