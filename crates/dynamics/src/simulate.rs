@@ -465,6 +465,11 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
 /// multiplier 1 stays a steady state).
 pub const UNSTABLE_MARGIN: f64 = 1e-2;
 
+/// The tolerances of the switched devices' warm-up and first grid, relative to the run's
+/// (see [`shooting_steady_state`]): the start of Newton's iteration, whose accuracy the
+/// second grid's Newton does not inherit.
+const STEPPING_STONE_LOOSENING: f64 = 1e4;
+
 /// What [`shooting_steady_state`] found.
 struct ShotSteadyState {
     state: State,
@@ -500,11 +505,20 @@ fn shooting_steady_state(
     let mut cycles = 0;
     let guess = options.shooting_jacobian.as_ref();
     let map_period = period * orbit_cycles as f64;
+    let switched = crate::integrate::OdeSystem::n_switches(device) > 0;
     if guess.is_none() && orbit_cycles == 1 {
-        // Far from the orbit Newton's model is poor: settle the fast modes first.
+        // Far from the orbit Newton's model is poor: settle the fast modes first. Only the
+        // start of Newton's iteration: for the switched devices, whose Jacobian is taken
+        // again at the first orbit (below), at looser tolerances (the others' warm-up state
+        // is where their Jacobian is taken, and the lanes repeat it).
+        let warm_up = if switched {
+            transient.loosened(STEPPING_STONE_LOOSENING)
+        } else {
+            *transient
+        };
         while cycles < options.min_cycles {
             crate::integrate::budget::check(cycles as f64 * period)?;
-            let next = match transient.advance(device, 0.0, &y, period) {
+            let next = match warm_up.advance(device, 0.0, &y, period) {
                 Ok(next) => next,
                 // A spent budget ends the run; any other failure is left to the fallback.
                 Err(e) if crate::grid_shooting::out_of_budget(&e) => return Err(e),
@@ -554,16 +568,18 @@ fn shooting_steady_state(
     // map's residual 3e-7 at the frozen grid's orbit). So a first orbit on that grid, then
     // the grid picked again from it (its roots within Newton's last correction); a
     // neighbour's grid is not reused. Lanes never run such devices (no lane model).
-    let switched = crate::integrate::OdeSystem::n_switches(device) > 0;
-    let mut first_guess = None;
+    // The first grid is a stepping stone: picked and solved at the run's tolerances rather
+    // than the grid's (its orbit only places the second grid's roots), its last Newton trial
+    // not integrated (the second grid's Newton starts from that state and checks it), and its
+    // Jacobian, taken off the orbit and Broyden-updated, not passed on: the second grid's
+    // Newton starts with the variational equations at the first orbit, so the multipliers
+    // are those of a Jacobian at the orbit.
     if switched && guess.is_none() {
-        // The first grid is a stepping stone: its last Newton trial (started once the
-        // predicted error is below `tol`) is not integrated, since the second grid's Newton
-        // starts from the same state and checks it on the grid that counts.
         let mut plain = |_: &[f64], y: &State| -> Result<State> { Ok(*y) };
+        let first_rk = transient.loosened(STEPPING_STONE_LOOSENING);
         if let Some(first) = crate::grid_shooting::shoot(
             device,
-            transient,
+            &first_rk,
             map_period,
             0.0,
             &y,
@@ -576,10 +592,8 @@ fn shooting_steady_state(
         )? {
             y = first.state;
             cycles += first.periods * orbit_cycles;
-            first_guess = Some(first.jacobian);
         }
     }
-    let guess = first_guess.as_ref().or(guess);
     let guess_grid = options.shooting_grid.as_deref().filter(|_| !switched);
     let Some(orbit) = crate::grid_shooting::shoot(
         device,

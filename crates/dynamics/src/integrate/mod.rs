@@ -318,6 +318,15 @@ impl RungeKutta {
         self
     }
 
+    /// The same integrator with `rtol` and `atol` multiplied by `factor >= 1`, `rtol` at most
+    /// 1e-3 (a loose pass whose accuracy does not matter, e.g. a warm-up).
+    pub(crate) fn loosened(mut self, factor: f64) -> Self {
+        let factor = factor.max(1.0).min(1e-3 / self.rtol).max(1.0);
+        self.rtol *= factor;
+        self.atol *= factor;
+        self
+    }
+
     /// The method.
     pub fn method(&self) -> Method {
         self.method
