@@ -33,6 +33,8 @@ pub(super) struct StrokePlane {
     /// `J⁻¹` and `J⁻ᵀ` of the linear map.
     inverse: Matrix2<f64>,
     inverse_transpose: Matrix2<f64>,
+    /// The drive's constant part of `∂G/∂x`: `Σ_wk N_φwᵀ (J⁻ᵀ ∂Q/∂q J⁻¹)_wk N_φk`.
+    drive_slope: [[f64; N]; N],
 }
 
 impl StrokePlane {
@@ -45,8 +47,21 @@ impl StrokePlane {
             && device.n_dof == N;
         let jacobian = device.linear_jacobian.filter(|_| applies)?;
         let inverse = jacobian.try_inverse()?;
-        let row = |i: usize| std::array::from_fn(|k| device.basis[(i, k)]);
+        let row = |i: usize| -> [f64; N] { std::array::from_fn(|k| device.basis[(i, k)]) };
+        let drive = inverse.transpose() * device.drive_load_slope() * inverse;
+        let strokes = [row(0), row(3)];
+        let mut drive_slope = [[0.0; N]; N];
+        for (w, row_w) in strokes.iter().enumerate() {
+            for (k, row_k) in strokes.iter().enumerate() {
+                for i in 0..N {
+                    for j in 0..N {
+                        drive_slope[i][j] += row_w[i] * drive[(w, k)] * row_k[j];
+                    }
+                }
+            }
+        }
         Some(Self {
+            drive_slope,
             rows: [[row(0), row(2)], [row(3), row(5)]],
             offset: [
                 [device.offset[0], device.offset[2]],
@@ -375,7 +390,6 @@ impl Device {
             Ok(None) => return None,
             Err(e) => return Some(Err(e)),
         };
-        let drive = lean.inverse_transpose * self.drive_load_slope() * lean.inverse;
         let x_ddot: [f64; N] = step.x_ddot.into();
         // [∂G/∂x − (∂M/∂x) ẍ | ∂G/∂ẋ].
         let mut slope = SMatrix::<f64, N, { 2 * N }>::zeros();
@@ -448,14 +462,9 @@ impl Device {
                 }
             }
         }
-        for (w, [row_w, _]) in lean.rows.iter().enumerate() {
-            for (k, [row_k, _]) in lean.rows.iter().enumerate() {
-                let d = drive[(w, k)];
-                for i in 0..N {
-                    for j in 0..N {
-                        slope[(i, j)] += row_w[i] * d * row_k[j];
-                    }
-                }
+        for i in 0..N {
+            for j in 0..N {
+                slope[(i, j)] += lean.drive_slope[i][j];
             }
         }
         let jacobian = step.factor.solve(&slope);
