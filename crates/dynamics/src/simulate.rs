@@ -156,9 +156,10 @@ pub struct SimulationResult {
     /// The state at the start of the recorded window (on the periodic orbit when converged).
     pub steady_state: State,
     /// Floquet multipliers, largest modulus first, of the Jacobian the shooting used (evaluated
-    /// within the warm-up tolerance of the orbit: accurate to about that; use
-    /// [`crate::stability::floquet`] for multipliers at the orbit itself). Newton shooting
-    /// only; empty otherwise.
+    /// within the warm-up tolerance of the orbit: accurate to about that; devices with
+    /// switching functions, the §3.4 blade elements, take it at the first grid's orbit:
+    /// measured 1.7e-9 off; use [`crate::stability::floquet`] for multipliers at the orbit
+    /// itself). Newton shooting only; empty otherwise.
     pub multipliers: Vec<nalgebra::Complex<f64>>,
     /// The Jacobian of the stroboscopic map the shooting ended with (exact or
     /// Broyden-updated; `None` for transient runs): the multipliers are its eigenvalues.
