@@ -627,6 +627,106 @@ impl<C: CoefficientModel> BladeElementModel<C> {
         AeroMoments::of_strip(o, sigma, w2, (cn, ct), d_cp, rotational_damping, alpha)
     }
 
+    /// The torque `(M_N, M_T, M_r + M_rd)` a stroke-plane device's right-hand side takes from
+    /// this model (θ ≡ 0, `ω = φ̇ (cos ψ, −sin ψ, 0) + ψ̇ ẑ`: [`Self::moments_stroke_plane`]
+    /// for `cos ψ > 0` on the branch's own side, else [`Self::moments_omega_branch`]) and its
+    /// partial derivatives by `φ̇`, `ψ` and `ψ̇` (the three vectors), in closed form on the
+    /// branch (σ, the side of α = π/2 and `sgn ω_z` held, as the right-hand side holds them
+    /// between switches): `W² = φ̇²`, `∂α/∂ψ = σ` on either form (`α = atan2(σ ω_x, ω_y)`
+    /// is homogeneous in φ̇), `(C_N, C_T)` the rotation of `(C_L, C_D)` by α, so
+    /// `dC_N/dα = C_L' cos α + C_D' sin α + C_T`, `dC_T/dα = C_D' cos α − C_L' sin α − C_N`
+    /// (eqs. 3.5–3.11). For the variational equations. `None` for `cos ψ <= 0` without a
+    /// branch (the right-hand side's `atan2(|ω_x|, ω_y)` form, not differentiated here).
+    #[inline]
+    pub fn moments_stroke_plane_jacobian(
+        &self,
+        phi_dot: f64,
+        psi: f64,
+        (sin_psi, cos_psi): (f64, f64),
+        psi_dot: f64,
+        branch: Option<Branch>,
+    ) -> Option<(Vector3<f64>, [Vector3<f64>; 3])> {
+        let o = &self.omegas;
+        let (wx, wy, wz) = (cos_psi * phi_dot, -sin_psi * phi_dot, psi_dot);
+        let w2 = wx * wx + wy * wy;
+        let (damping, damping_slope) = match branch {
+            None => (wz * wz.abs(), 2.0 * wz.abs()),
+            Some(b) => {
+                let sz = unit_sign(b.spanwise_positive);
+                (sz * wz * wz, 2.0 * sz * wz)
+            }
+        };
+        let k_rd = -o.omega2 * self.rotational_damping; // eq. 3.10
+        let d_psi_dot = Vector3::new(0.0, 0.0, k_rd * damping_slope);
+        if w2 == 0.0 {
+            // Every strip moment carries W² = φ̇², whose derivatives vanish with φ̇.
+            let torque = Vector3::new(0.0, 0.0, k_rd * damping);
+            return Some((torque, [Vector3::zeros(), Vector3::zeros(), d_psi_dot]));
+        }
+        let own_side = branch.is_none_or(|b| {
+            b.chordwise_positive == (wx >= 0.0) && b.normal_positive == (wy >= 0.0)
+        });
+        let (sigma, alpha, (sin_a, cos_a), below) = match branch {
+            None if cos_psi <= 0.0 => return None,
+            None => {
+                let sigma = sign(wx);
+                let alpha = FRAC_PI_2 + sigma * psi;
+                (
+                    sigma,
+                    alpha,
+                    (cos_psi, -sigma * sin_psi),
+                    alpha <= FRAC_PI_2,
+                )
+            }
+            Some(b) => {
+                let sigma = unit_sign(b.chordwise_positive);
+                if cos_psi > 0.0 && own_side {
+                    let alpha = FRAC_PI_2 + sigma * psi;
+                    (sigma, alpha, (cos_psi, -sigma * sin_psi), b.normal_positive)
+                } else {
+                    let alpha = branch_alpha(sigma * wx, wy);
+                    (sigma, alpha, alpha.sin_cos(), b.normal_positive)
+                }
+            }
+        };
+        let ((cn, ct), (dcn, dct)) = match self.law {
+            NormalForceLaw::Coefficient => {
+                let ((cl, cd), (dcl, dcd)) = self.coefficients.lift_drag_slope_branch(alpha, below);
+                let (cn, ct) = (cl * cos_a + cd * sin_a, cd * cos_a - cl * sin_a);
+                // d/dψ = σ d/dα.
+                (
+                    (cn, ct),
+                    (
+                        sigma * (dcl * cos_a + dcd * sin_a + ct),
+                        sigma * (dcd * cos_a - dcl * sin_a - cn),
+                    ),
+                )
+            }
+            NormalForceLaw::Unit => ((1.0, 0.0), (0.0, 0.0)),
+        };
+        let d_cp = 0.82 / PI * alpha + 0.05; // eq. 3.7 on the branch
+        let lever = o.omega3 * d_cp - o.omega4;
+        let dw2 = 2.0 * phi_dot;
+        let normal = -o.omega1 * sigma; // M_N = normal W² C_N (eq. 3.8)
+        let tangential = -o.omega1; // M_T = tangential W² C_T (eq. 3.9)
+        let torque = Vector3::new(
+            normal * w2 * cn,
+            tangential * w2 * ct,
+            -lever * sigma * w2 * cn + k_rd * damping, // eqs. 3.11, 3.10
+        );
+        let d_phi_dot = Vector3::new(
+            normal * dw2 * cn,
+            tangential * dw2 * ct,
+            -lever * sigma * dw2 * cn,
+        );
+        let d_psi = Vector3::new(
+            normal * w2 * dcn,
+            tangential * w2 * dct,
+            -(o.omega3 * 0.82 / PI) * w2 * cn - lever * sigma * w2 * dcn,
+        );
+        Some((torque, [d_phi_dot, d_psi, d_psi_dot]))
+    }
+
     /// [`Self::loads_omega`] on a [`Branch`] (its values on the branch's own side).
     ///
     /// # Errors

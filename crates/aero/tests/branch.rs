@@ -111,3 +111,93 @@ fn branches_are_smooth_where_the_model_jumps() {
     let ww = model(CoefficientSet::WhitneyWood2010(WhitneyWood2010::default()));
     assert_eq!(ww.switching_functions(&w), [0.1, 1.0, 0.3]);
 }
+
+/// The closed-form slopes of the coefficient branches equal central differences of the
+/// branches (both built-in fits, both sides of α = π/2, continued past it), and the stroke-plane
+/// moments' derivatives by `(φ̇, ψ, ψ̇)` equal central differences of the torque the stroke-plane
+/// right-hand side takes (closed form on the own side, the `atan2` form past a surface), for
+/// both force laws.
+#[test]
+fn coefficient_slopes_and_stroke_plane_moment_derivatives_equal_central_differences() {
+    use paritysim_aero::CoefficientModel;
+    let sets = [
+        CoefficientSet::default(),
+        CoefficientSet::WhitneyWood2010(WhitneyWood2010::default()),
+    ];
+    for set in sets {
+        for k in 0..=40 {
+            let alpha = -0.2 + 3.5 * k as f64 / 40.0;
+            for below in [true, false] {
+                let ((cl, cd), (dcl, dcd)) = set.lift_drag_slope_branch(alpha, below);
+                assert_eq!((cl, cd), set.lift_drag_branch(alpha, below));
+                let h = 1e-6;
+                let (lp, dp) = set.lift_drag_branch(alpha + h, below);
+                let (lm, dm) = set.lift_drag_branch(alpha - h, below);
+                assert!(
+                    (dcl - (lp - lm) / (2.0 * h)).abs() < 1e-8,
+                    "{set:?} C_L' at {alpha}"
+                );
+                assert!(
+                    (dcd - (dp - dm) / (2.0 * h)).abs() < 1e-8,
+                    "{set:?} C_D' at {alpha}"
+                );
+            }
+        }
+    }
+    let torque = |m: &BladeElementModel, v: [f64; 3], branch: Option<Branch>| {
+        let (s, c) = v[1].sin_cos();
+        let omega = Vector3::new(c * v[0], -s * v[0], v[2]);
+        // The stroke-plane right-hand side's rule: the closed form on the branch's own side.
+        let own = branch.is_none_or(|b| {
+            b.chordwise_positive == (omega.x >= 0.0) && b.normal_positive == (omega.y >= 0.0)
+        });
+        match branch {
+            Some(b) if !(c > 0.0 && own) => m.moments_omega_branch(&omega, b).torque(),
+            _ => m
+                .moments_stroke_plane(v[0], v[1], (s, c), v[2], branch)
+                .torque(),
+        }
+    };
+    let mut checked = 0;
+    for set in sets {
+        for law in [NormalForceLaw::Coefficient, NormalForceLaw::Unit] {
+            let m = model(set).with_normal_force_law(law);
+            for v in [
+                [2.1f64, 0.4, -1.3],
+                [-3.0, -0.7, 0.9],
+                [0.8, 0.05, 2.0],
+                [-1.2, 0.3, -0.4],
+            ] {
+                let (s, c) = v[1].sin_cos();
+                let own = Branch::of(&Vector3::new(c * v[0], -s * v[0], v[2]));
+                let past = Branch {
+                    chordwise_positive: !own.chordwise_positive,
+                    normal_positive: !own.normal_positive,
+                    spanwise_positive: own.spanwise_positive,
+                };
+                for branch in [None, Some(own), Some(past)] {
+                    let (t0, slopes) = m
+                        .moments_stroke_plane_jacobian(v[0], v[1], (s, c), v[2], branch)
+                        .expect("cos ψ > 0");
+                    let reference = torque(&m, v, branch);
+                    assert!((t0 - reference).norm() <= 1e-12 * (1.0 + reference.norm()));
+                    for (j, slope) in slopes.iter().enumerate() {
+                        let h = 1e-6;
+                        let (mut plus, mut minus) = (v, v);
+                        plus[j] += h;
+                        minus[j] -= h;
+                        let difference =
+                            (torque(&m, plus, branch) - torque(&m, minus, branch)) / (2.0 * h);
+                        let size = 1.0 + difference.norm();
+                        assert!(
+                            (slope - difference).norm() <= 1e-7 * size,
+                            "{set:?} {law:?} {v:?} {branch:?} d/d{j}: {slope:?} vs {difference:?}"
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(checked, 2 * 2 * 4 * 3 * 3);
+}

@@ -495,6 +495,27 @@ impl Device {
         (force, load, 0.5 * k1 * q.x * q.x + 0.5 * k2 * q.y * q.y)
     }
 
+    /// Whether the device has the closed-form stroke-plane model (§3.4 rotating wings:
+    /// `device/stroke_plane.rs`), whose lean samples are [`crate::trajectory::PlaneSample`]s.
+    pub fn has_stroke_plane_model(&self) -> bool {
+        self.stroke_plane_rhs.is_some()
+    }
+
+    /// `∂Q/∂q` of [`Self::drive_load`] (constant: the actuator and balance springs,
+    /// `−diag(K1, K2)`, or `−K1` on both drives of a dual drivetrain).
+    pub(crate) fn drive_load_slope(&self) -> nalgebra::Matrix2<f64> {
+        let k1 = self.spec.actuator.as_ref().map_or(0.0, |a| a.stiffness());
+        let k2 = match (&self.spec.actuator, self.is_dual()) {
+            (Some(_), true) => k1,
+            _ => self
+                .spec
+                .transmission
+                .as_ref()
+                .map_or(0.0, |tr| tr.balance_stiffness),
+        };
+        nalgebra::Matrix2::new(-k1, 0.0, 0.0, -k2)
+    }
+
     /// Whether the drivetrain is a dual one (one actuator per wing, `q2` the right drive).
     #[inline]
     pub fn is_dual(&self) -> bool {
@@ -1071,12 +1092,19 @@ impl crate::integrate::OdeSystem for Device {
 
     fn variational(
         &self,
-        _t: f64,
+        t: f64,
         y: &State,
         n: usize,
         phi: &[f64],
         dphi: &mut [f64],
     ) -> Option<Result<()>> {
+        if let Some(lean) = &self.stroke_plane_rhs {
+            if n != self.n_dof {
+                return None;
+            }
+            let mut f = [0.0; 2 * stroke_plane::N];
+            return self.stroke_plane_variational(lean, t, y, None, &mut f, phi, dphi);
+        }
         let terms = self.stroke_only.as_ref()?.jacobian.as_ref()?;
         if n != 2 {
             return None;
@@ -1084,6 +1112,20 @@ impl crate::integrate::OdeSystem for Device {
         let y = [y.coords[0], y.coords[1], y.rates[0], y.rates[1]];
         linear_map_jacobian::variational(terms, &y, phi, dphi);
         Some(Ok(()))
+    }
+
+    fn variational_with_rhs(
+        &self,
+        t: f64,
+        y: &State,
+        sides: Option<crate::integrate::Sides>,
+        n: usize,
+        f: &mut [f64],
+        phi: &[f64],
+        dphi: &mut [f64],
+    ) -> Option<Result<()>> {
+        let lean = self.stroke_plane_rhs.as_ref().filter(|_| n == self.n_dof)?;
+        self.stroke_plane_variational(lean, t, y, sides.map(branches), f, phi, dphi)
     }
 }
 

@@ -59,6 +59,13 @@ impl JointSpring {
         self.stiffness * d + self.cubic * d * d * d
     }
 
+    /// `∂²V/∂γ² = k + 3 k3 (γ − γ0)²` (the spring's contribution to a Jacobian).
+    #[inline]
+    pub fn slope(&self, gamma: f64) -> f64 {
+        let d = gamma - self.rest_angle;
+        self.stiffness + 3.0 * self.cubic * d * d
+    }
+
     /// Stored energy `V(γ)` (µJ).
     #[inline]
     pub fn energy(&self, gamma: f64) -> f64 {
@@ -636,6 +643,15 @@ impl Wing {
         let mut potential = 0.0;
         self.add_tunable_hinge(0.0, psi, &mut spring, &mut potential);
         (spring.x, spring.z)
+    }
+
+    /// The derivatives `(∂²V/∂φ², ∂²V/∂ψ²)` of [`Self::stroke_plane_springs`] (θ = 0: the
+    /// tunable hinge adds `k(0)`; the loads do not couple φ and ψ).
+    #[inline]
+    pub(crate) fn stroke_plane_spring_slopes(&self, phi: f64, psi: f64) -> (f64, f64) {
+        let s = &self.springs;
+        let hinge = self.tunable_hinge.map_or(0.0, |h| h.stiffness(0.0));
+        (s[0].slope(phi), s[5].slope(psi) + hinge)
     }
 
     /// Whether [`Self::free_deviation_terms`] applies to this wing (α2 = 90°, α3 = 0, no

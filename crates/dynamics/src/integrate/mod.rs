@@ -163,6 +163,28 @@ pub trait OdeSystem {
     ) -> Option<Result<()>> {
         None
     }
+
+    /// The right-hand side `f = [coords', rates']` (`2n` entries) at `(t, y)` and the
+    /// variational equations' `dphi = J phi` in one evaluation, on the branch `sides` held
+    /// by event location (`None`: the state's own sides; `f` as [`Self::rhs_on`] /
+    /// [`Self::rhs`] give it); `None` (the default) when the system has no such form here:
+    /// the variational equations then call [`Self::rhs_on`] and [`Self::variational`].
+    ///
+    /// # Errors
+    /// Any model error (as [`Self::rhs`]).
+    #[allow(clippy::too_many_arguments)]
+    fn variational_with_rhs(
+        &self,
+        _t: f64,
+        _y: &State,
+        _sides: Option<Sides>,
+        _n: usize,
+        _f: &mut [f64],
+        _phi: &[f64],
+        _dphi: &mut [f64],
+    ) -> Option<Result<()>> {
+        None
+    }
 }
 
 /// Explicit Runge-Kutta pair.
@@ -291,6 +313,15 @@ impl RungeKutta {
     /// The same integrator with both tolerances scaled by `factor` (in (0, 1]).
     pub fn tightened(mut self, factor: f64) -> Self {
         let factor = factor.clamp(f64::MIN_POSITIVE, 1.0);
+        self.rtol *= factor;
+        self.atol *= factor;
+        self
+    }
+
+    /// The same integrator with `rtol` and `atol` multiplied by `factor >= 1`, `rtol` at most
+    /// 1e-3 (a loose pass whose accuracy does not matter, e.g. a warm-up).
+    pub(crate) fn loosened(mut self, factor: f64) -> Self {
+        let factor = factor.max(1.0).min(1e-3 / self.rtol).max(1.0);
         self.rtol *= factor;
         self.atol *= factor;
         self

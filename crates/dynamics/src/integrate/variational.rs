@@ -57,6 +57,15 @@ impl<const M: usize> Rhs<M> for Variational<'_> {
     fn eval(&mut self, t: f64, c: &[f64; M], dc: &mut [f64; M]) -> Result<()> {
         let m = 2 * self.n;
         let y = to_state(self.n, &c[..m]);
+        let (f, rest) = dc.split_at_mut(m);
+        let (phi, dphi) = (&c[m..m + m * m], &mut rest[..m * m]);
+        if let Some(done) = self
+            .system
+            .variational_with_rhs(t, &y, self.sides, self.n, f, phi, dphi)
+        {
+            self.calls += 1;
+            return done.map_err(|e| integration_error(t, &y, format!("the model failed: {e}")));
+        }
         self.f(t, &y, &mut dc[..m])?;
         let (phi, dphi) = (&c[m..m + m * m], &mut dc[m..m + m * m]);
         if let Some(done) = self.system.variational(t, &y, self.n, phi, dphi) {

@@ -24,7 +24,7 @@ pub use needs::{StrokeNeeds, is_stroke_metric};
 use std::f64::consts::{PI, TAU};
 
 use crate::device::Device;
-use crate::trajectory::{Sample, StrokeSample};
+use crate::trajectory::{PlaneSample, Sample, StrokeSample};
 
 const AXES: [&str; 3] = ["roll", "yaw", "pitch"];
 
@@ -227,6 +227,49 @@ impl MetricsAccumulator {
         }
         self.work_actuator = s.state.work_actuator;
         self.work_aero = s.state.work_aero;
+    }
+
+    /// Adds a [`PlaneSample`] with [`Self::add`]'s operations in its order (the same metrics
+    /// from the same values); the metrics its [`StrokeNeeds`] do not provide are NaN.
+    pub fn add_plane(&mut self, s: &PlaneSample, closing: bool) {
+        let body = !closing;
+        self.lean.get_or_insert(s.needs);
+        self.add_core(
+            &Core {
+                time: s.time,
+                phi: s.phi,
+                psi: s.psi,
+                roll_aero: s.roll_aero,
+                force: s.actuator_force,
+                q2: s.q2,
+            },
+            body,
+        );
+        let (cos, sin) = if body && self.period.is_some() {
+            let (s_, c_) = (self.omega * s.time).sin_cos();
+            (c_, s_)
+        } else {
+            (0.0, 0.0)
+        };
+        for w in 0..self.n_wings {
+            let acc = &mut self.wings[w];
+            let (phi, psi) = (s.phi[w], s.psi[w]);
+            if s.needs.torques {
+                for (k, stats) in acc.torque.iter_mut().enumerate() {
+                    stats.add(s.torque[w][k], body);
+                }
+            }
+            acc.phi_f.0 += phi * cos;
+            acc.phi_f.1 -= phi * sin;
+            acc.psi_f.0 += psi * cos;
+            acc.psi_f.1 -= psi * sin;
+        }
+        if s.needs.torques {
+            for (k, stats) in self.total.iter_mut().enumerate() {
+                stats.add(s.total[k], body);
+            }
+        }
+        (self.work_actuator, self.work_aero) = s.work;
     }
 
     /// Adds a [`StrokeSample`]; an accumulator fed this way reports NaN for the metrics its
