@@ -9,7 +9,10 @@
 //! `DEVICE` picks another device for the same workload: `rotating` (§3.4 Drag PARITY, Table
 //! 3.3 1-Cut wings, blade element, hinge spring), `lift` / `dual` (§2.5 Lift / Dual PARITY on
 //! those wings: free deviation θ with a deviation spring and the tunable hinge, as
-//! `paritysim.devices`' `sreetharan2012_2_5_*_parity_1cut`).
+//! `paritysim.devices`' `sreetharan2012_2_5_*_parity_1cut`). `STEADY=default` runs the
+//! shipped devices' options instead (default shooting, 200 samples, `max_cycles` 200);
+//! `STATS=1` also prints the run's cycles, convergence and the transient's step counters,
+//! `PRINT=1` the last run's metrics.
 
 use nalgebra::{Matrix3, Vector3};
 use paritysim_constraints::Constraints;
@@ -151,15 +154,48 @@ fn main() {
             options.steady_tol = 1e-7;
         }
     }
+    if std::env::var("STEADY").is_ok_and(|s| s == "default") {
+        let default = SimulationOptions::default();
+        // `RTOL` (with atol 1e-2 × rtol as the shipped options) for a tight reference.
+        let rtol = std::env::var("RTOL")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(default.rtol);
+        options = SimulationOptions {
+            rtol,
+            atol: 1e-2 * rtol,
+            max_cycles: 200,
+            columns: options.columns.clone(),
+            metrics: options.metrics.clone(),
+            ..Default::default()
+        };
+    }
     let start = std::time::Instant::now();
     let mut check = 0.0;
+    let mut last = None;
     for _ in 0..repeat {
         let r = simulate(&device, &options).unwrap();
         check += r.metrics[0].1;
+        last = Some(r);
     }
     let ms = start.elapsed().as_secs_f64() * 1e3 / repeat as f64;
     let n_dof = device.n_dof();
     println!("{ms:.3} ms per trial (checksum {check:.12e}; {n_dof} DOF)");
+    if let (Ok(_), Some(r)) = (std::env::var("STATS"), &last) {
+        println!(
+            "run: {} cycles, converged {}, orbit cycles {}, residual {:e}, shooting {}",
+            r.cycles_run,
+            r.converged,
+            r.orbit_cycles,
+            r.residual,
+            r.monodromy.is_some()
+        );
+    }
+    if let (Ok(_), Some(r)) = (std::env::var("PRINT"), &last) {
+        for (name, value) in &r.metrics {
+            println!("{name} {value:.17e}");
+        }
+    }
     if std::env::var("STATS").is_ok() {
         // The transient's step counters (the 19 cycles before the recorded one).
         use paritysim_dynamics::integrate::RungeKutta;

@@ -8,6 +8,7 @@
 //! on the drivetrain map.
 
 use nalgebra::{Matrix2, Vector2, Vector3};
+use paritysim_aero::Branch;
 use paritysim_constraints::{Constraints, Mat6, Vec6};
 use paritysim_error::{Error, Result, bail, check_non_negative};
 use paritysim_kinematics::Drivetrain;
@@ -18,8 +19,9 @@ use crate::wing::{Wing, WingTerms};
 
 pub(crate) mod linear_map_jacobian;
 mod stroke_plane;
+mod switches;
 use linear_map_jacobian::LinearMapTerms;
-use stroke_plane::branches;
+use switches::branches;
 
 /// A drivetrain with its balance-beam spring.
 #[derive(Clone, Debug, PartialEq)]
@@ -193,6 +195,9 @@ pub struct Device {
     linear_jacobian: Option<Matrix2<f64>>,
     /// The lean right-hand side of a stroke-plane device (§3.4), when it applies.
     stroke_plane_rhs: Option<stroke_plane::StrokePlane>,
+    /// Switching functions of the right-hand side (three per wing with blade elements whose
+    /// `ω` has a closed form; see [`Self::blade_switching_functions`]).
+    n_switches: usize,
 }
 
 /// Stroke angles `(φL, φR)`, their rates and the whippletree angle `q2` (see
@@ -339,8 +344,10 @@ impl Device {
             free_deviation,
             linear_jacobian,
             stroke_plane_rhs: None,
+            n_switches: 0,
         };
         device.stroke_plane_rhs = stroke_plane::StrokePlane::of(&device);
+        device.n_switches = device.blade_switches();
         Ok(device)
     }
 
@@ -641,6 +648,17 @@ impl Device {
 
     /// Full evaluation at `(t, p, ṗ)`, including the constrained accelerations.
     pub fn evaluate(&self, t: f64, p: &Vec6, p_dot: &Vec6) -> Result<Evaluation> {
+        self.evaluate_on(t, p, p_dot, None)
+    }
+
+    /// [`Self::evaluate`] with the blade elements on `branches` when given (event location).
+    fn evaluate_on(
+        &self,
+        t: f64,
+        p: &Vec6,
+        p_dot: &Vec6,
+        branches: Option<[Branch; 2]>,
+    ) -> Result<Evaluation> {
         let mut wings = [empty_terms(); 2];
         let mut mass = Mat6::identity();
         let mut force = Vec6::zeros();
@@ -648,15 +666,16 @@ impl Device {
             let k = 3 * w;
             let pw = Vector3::new(p[k], p[k + 1], p[k + 2]);
             let vw = Vector3::new(p_dot[k], p_dot[k + 1], p_dot[k + 2]);
+            let branch = branches.map(|b| b[w]);
             let terms = if self.stroke_plane[w] {
-                wing.stroke_plane_terms(&pw, &vw)
+                wing.stroke_plane_terms_on(&pw, &vw, branch)
             } else if let Some(terms) = self.free_deviation[w]
-                .then(|| wing.free_deviation_terms(&pw, &vw))
+                .then(|| wing.free_deviation_terms_on(&pw, &vw, branch))
                 .flatten()
             {
                 terms
             } else {
-                wing.terms(&pw, &vw)?
+                wing.terms_on(&pw, &vw, branch)?
             };
             mass.fixed_view_mut::<3, 3>(k, k).copy_from(&terms.mass);
             let f = terms.aero - terms.coriolis - terms.spring;
@@ -736,8 +755,19 @@ impl Device {
 
     /// [`Self::rhs`] through [`Self::evaluate`] (null space or projection, any wing).
     fn rhs_null_space(&self, t: f64, y: &State, dydt: &mut State) -> Result<()> {
+        self.rhs_null_space_on(t, y, None, dydt)
+    }
+
+    /// [`Self::rhs_null_space`] with the blade elements on `branches` when given.
+    fn rhs_null_space_on(
+        &self,
+        t: f64,
+        y: &State,
+        branches: Option<[Branch; 2]>,
+        dydt: &mut State,
+    ) -> Result<()> {
         let (p, p_dot) = self.coordinates(y)?;
-        let e = self.evaluate(t, &p, &p_dot)?;
+        let e = self.evaluate_on(t, &p, &p_dot, branches)?;
         let x_ddot = self.basis.transpose() * e.p_ddot;
         for i in 0..6 {
             dydt.coords[i] = if i < self.n_dof { y.rates[i] } else { 0.0 };
@@ -1064,7 +1094,7 @@ impl crate::integrate::OdeSystem for Device {
     }
 
     fn n_switches(&self) -> usize {
-        self.stroke_plane_switches()
+        self.n_switches
     }
 
     fn switches(
@@ -1073,8 +1103,11 @@ impl crate::integrate::OdeSystem for Device {
         y: &State,
         g: &mut [f64; crate::integrate::MAX_SWITCHES],
     ) -> Result<()> {
-        self.stroke_plane_switching_functions(y, g);
-        Ok(())
+        if self.stroke_plane_rhs.is_some() {
+            self.stroke_plane_switching_functions(y, g);
+            return Ok(());
+        }
+        self.blade_switching_functions(y, g)
     }
 
     fn rhs_on(
@@ -1086,6 +1119,9 @@ impl crate::integrate::OdeSystem for Device {
     ) -> Result<()> {
         match &self.stroke_plane_rhs {
             Some(lean) => self.rhs_stroke_plane(lean, t, y, Some(branches(sides)), dydt),
+            None if self.n_switches > 0 => {
+                self.rhs_null_space_on(t, y, Some(branches(sides)), dydt)
+            }
             None => Device::rhs(self, t, y, dydt),
         }
     }
@@ -1132,6 +1168,13 @@ impl crate::integrate::OdeSystem for Device {
 impl Device {
     /// The linear map's analytic Jacobian constants (drivetrain coordinates of a two-DOF
     /// linear differential with stroke drag; see [`linear_map_jacobian`]).
+    /// Whether the variational equations have an analytic Jacobian (the stroke-plane model,
+    /// the linear map's drivetrain coordinates) rather than central differences of the
+    /// right-hand side.
+    pub(crate) fn has_analytic_jacobian(&self) -> bool {
+        self.stroke_plane_rhs.is_some() || self.linear_map_terms().is_some()
+    }
+
     pub(crate) fn linear_map_terms(&self) -> Option<&LinearMapTerms<f64>> {
         self.stroke_only.as_ref()?.jacobian.as_ref()
     }

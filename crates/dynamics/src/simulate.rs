@@ -184,6 +184,14 @@ pub const PERIOD_DOUBLED_SETTLED: f64 = 1e-3;
 /// orbit approached with a multiplier within 1e-3 of −1).
 pub const PERIOD_DOUBLED_SEPARATION: f64 = 1e3;
 
+/// A transient fallback after shooting found an unstable orbit shoots once more when it has
+/// settled (one-cycle change below [`PERIOD_DOUBLED_SETTLED`]) farther than this (relative, as
+/// the residual) from that orbit: near another, stable orbit, which Newton then finishes
+/// (measured on the §2.5 Dual PARITY: unstable orbit μ = 1.99 from the warm-up, the transient's
+/// orbit μ = 0.855, 0.9 apart). A transient that settles on the rejected orbit itself (held
+/// there by symmetry, docs/findings.md §10) is left alone.
+pub const SHOOTING_RETRY_APART: f64 = 1e-2;
+
 pub(crate) fn validate(options: &SimulationOptions) -> Result<()> {
     check_positive("steady_tol", options.steady_tol)?;
     if let Some(ms) = options.max_wall_ms {
@@ -311,17 +319,24 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
     let (window, n_samples) = match period {
         Some(period) => {
             let mut transient_needed = true;
+            // After a first shooting that failed (`Some(None)`) or found an unstable orbit
+            // (its state), the transient shoots once more when settled away from it.
+            let mut retry: Option<Option<State>> = None;
             if options.steady_state == SteadyState::Shooting {
-                if let Some(found) = shooting_steady_state(
-                    device, options, &recording, &transient, period, 1, &y, &columns, stroke,
+                match shooting_steady_state(
+                    device, options, &recording, &transient, period, 1, false, &y, &columns, stroke,
                 )? {
-                    (y, t, cycles_run, residual, converged) =
-                        (found.state, found.t, found.cycles_run, found.residual, true);
-                    multipliers = found.multipliers;
-                    monodromy = Some(found.jacobian);
-                    step_grid = found.grid;
-                    recorded = found.recorded;
-                    transient_needed = false;
+                    Shot::Found(found) => {
+                        (y, t, cycles_run, residual, converged) =
+                            (found.state, found.t, found.cycles_run, found.residual, true);
+                        multipliers = found.multipliers;
+                        monodromy = Some(found.jacobian);
+                        step_grid = found.grid;
+                        recorded = found.recorded;
+                        transient_needed = false;
+                    }
+                    Shot::Unstable(state) => retry = Some(Some(state)),
+                    Shot::Failed => retry = Some(None),
                 }
             }
             if transient_needed {
@@ -366,11 +381,41 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
                         (residual, converged, orbit_cycles) = (residual_two, true, 2);
                         break;
                     }
+                    if residual < PERIOD_DOUBLED_SETTLED
+                        && residual <= residual_two
+                        && retry.as_ref().is_some_and(|r| {
+                            r.as_ref()
+                                .is_none_or(|r| state_change(&y, r) > SHOOTING_RETRY_APART)
+                        })
+                    {
+                        // Settled, and not on the unstable orbit the shooting found from the
+                        // warm-up (the §2.5 Dual PARITY has one next to its stable orbit):
+                        // Newton once more, from here.
+                        retry = None;
+                        if let Shot::Found(found) = shooting_steady_state(
+                            device, options, &recording, &transient, period, 1, true, &y, &columns,
+                            stroke,
+                        )? {
+                            (y, residual, converged) = (found.state, found.residual, true);
+                            recorded = found.recorded;
+                            if let Some((trajectory, _)) = &mut recorded {
+                                for time in &mut trajectory.time {
+                                    *time += t;
+                                }
+                            }
+                            t += found.t;
+                            cycles_run += found.cycles_run;
+                            multipliers = found.multipliers;
+                            monodromy = Some(found.jacobian);
+                            step_grid = found.grid;
+                            break;
+                        }
+                    }
                     if !shot_two_cycles && residual_two < PERIOD_DOUBLED_SETTLED.min(residual) {
                         // Once per run: Newton on the two-cycle map from here.
                         shot_two_cycles = true;
-                        if let Some(found) = shooting_steady_state(
-                            device, options, &recording, &transient, period, 2, &y, &columns,
+                        if let Shot::Found(found) = shooting_steady_state(
+                            device, options, &recording, &transient, period, 2, true, &y, &columns,
                             stroke,
                         )? {
                             // A period-1 orbit is a fixed point of the two-cycle map too (a
@@ -471,6 +516,16 @@ pub const UNSTABLE_MARGIN: f64 = 1e-2;
 /// second grid's Newton does not inherit.
 const STEPPING_STONE_LOOSENING: f64 = 1e4;
 
+/// What [`shooting_steady_state`] ended with.
+enum Shot {
+    /// A stable orbit.
+    Found(Box<ShotSteadyState>),
+    /// An orbit with a multiplier beyond `1 + UNSTABLE_MARGIN`: its state.
+    Unstable(State),
+    /// Newton did not converge.
+    Failed,
+}
+
 /// What [`shooting_steady_state`] found.
 struct ShotSteadyState {
     state: State,
@@ -487,9 +542,9 @@ struct ShotSteadyState {
 
 /// [`SteadyState::Shooting`]: warm-up (without a neighbour's Jacobian), then Newton on the
 /// frozen grid ([`crate::grid_shooting`]) of the `orbit_cycles`-period map (2: a
-/// period-doubled orbit, from a state the caller's transient settled: no warm-up); the final
-/// Newton period records the window when it is one plain orbit. `Ok(None)`: not converged (the
-/// caller runs the transient).
+/// period-doubled orbit), with a warm-up first unless `settled` (a state the caller's
+/// transient settled); the final Newton period records the window when it is one plain orbit.
+/// Not [`Shot::Found`]: the caller runs the transient.
 #[allow(clippy::too_many_arguments)]
 fn shooting_steady_state(
     device: &Device,
@@ -498,21 +553,28 @@ fn shooting_steady_state(
     transient: &RungeKutta,
     period: f64,
     orbit_cycles: usize,
+    settled: bool,
     y0: &State,
     columns: &[crate::trajectory::Column],
     stroke: Option<StrokeNeeds>,
-) -> Result<Option<ShotSteadyState>> {
+) -> Result<Shot> {
     let mut y = *y0;
     let mut cycles = 0;
     let guess = options.shooting_jacobian.as_ref();
     let map_period = period * orbit_cycles as f64;
     let switched = crate::integrate::OdeSystem::n_switches(device) > 0;
-    if guess.is_none() && orbit_cycles == 1 {
+    // The stepping stones need a cheap exact Jacobian at the first orbit (the stroke-plane
+    // model's analytic one). The free-θ devices' comes from central differences (two
+    // right-hand sides per column and stage): their first pass runs at the run's tolerances and hands
+    // its Jacobian to the second (measured on the §2.5 Dual PARITY with stepping stones: the
+    // orbit returned within 1.05e-9 instead of 8.8e-11).
+    let stepping_stone = switched && device.has_analytic_jacobian();
+    if guess.is_none() && !settled {
         // Far from the orbit Newton's model is poor: settle the fast modes first. Only the
-        // start of Newton's iteration: for the switched devices, whose Jacobian is taken
+        // start of Newton's iteration: for the stepping-stone devices, whose Jacobian is taken
         // again at the first orbit (below), at looser tolerances (the others' warm-up state
         // is where their Jacobian is taken, and the lanes repeat it).
-        let warm_up = if switched {
+        let warm_up = if stepping_stone {
             transient.loosened(STEPPING_STONE_LOOSENING)
         } else {
             *transient
@@ -568,16 +630,23 @@ fn shooting_steady_state(
     // next to them then integrate a continued branch (measured on the §3.4 device: the true
     // map's residual 3e-7 at the frozen grid's orbit). So a first orbit on that grid, then
     // the grid picked again from it (its roots within Newton's last correction); a
-    // neighbour's grid is not reused. Lanes never run such devices (no lane model).
+    // neighbour's grid is not reused. Lanes never run such devices (no lane model). (One pass
+    // on the first grid, whose steps are cut at the trial's own roots, left the §3.4 orbit
+    // 1.3e-9 off the true map's; 2.4e-12 with two.)
     // The first grid is a stepping stone: picked and solved at the run's tolerances rather
     // than the grid's (its orbit only places the second grid's roots), its last Newton trial
     // not integrated (the second grid's Newton starts from that state and checks it), and its
     // Jacobian, taken off the orbit and Broyden-updated, not passed on: the second grid's
     // Newton starts with the variational equations at the first orbit, so the multipliers
     // are those of a Jacobian at the orbit.
+    let mut first_guess = None;
     if switched && guess.is_none() {
         let mut plain = |_: &[f64], y: &State| -> Result<State> { Ok(*y) };
-        let first_rk = transient.loosened(STEPPING_STONE_LOOSENING);
+        let first_rk = if stepping_stone {
+            transient.loosened(STEPPING_STONE_LOOSENING)
+        } else {
+            *transient
+        };
         if let Some(first) = crate::grid_shooting::shoot(
             device,
             &first_rk,
@@ -593,8 +662,12 @@ fn shooting_steady_state(
         )? {
             y = first.state;
             cycles += first.periods * orbit_cycles;
+            if !stepping_stone {
+                first_guess = Some(first.jacobian);
+            }
         }
     }
+    let guess = first_guess.as_ref().or(guess);
     let guess_grid = options.shooting_grid.as_deref().filter(|_| !switched);
     let Some(orbit) = crate::grid_shooting::shoot(
         device,
@@ -610,7 +683,7 @@ fn shooting_steady_state(
         &mut finish,
     )?
     else {
-        return Ok(None);
+        return Ok(Shot::Failed);
     };
     cycles += orbit.periods * orbit_cycles;
     let multipliers = crate::floquet::eigenvalues(&orbit.jacobian).unwrap_or_default();
@@ -619,7 +692,7 @@ fn shooting_steady_state(
         .is_some_and(|m| m.norm() > 1.0 + UNSTABLE_MARGIN)
     {
         // An unstable orbit is not a state a run settles on: the transient decides.
-        return Ok(None);
+        return Ok(Shot::Unstable(orbit.state));
     }
     let t = cycles as f64 * period;
     if let Some((trajectory, _)) = &mut recorded {
@@ -629,7 +702,7 @@ fn shooting_steady_state(
             *time += t;
         }
     }
-    Ok(Some(ShotSteadyState {
+    Ok(Shot::Found(Box::new(ShotSteadyState {
         state: orbit.state,
         t,
         cycles_run: cycles,
@@ -638,7 +711,7 @@ fn shooting_steady_state(
         grid: orbit.grid,
         multipliers,
         recorded,
-    }))
+    })))
 }
 
 /// The metrics of one drive period recorded from `state` at `t = 0` (a state on the section

@@ -168,15 +168,16 @@ impl WingAero {
         }
     }
 
-    /// Aerodynamic torque on the wing, in frame 6.
+    /// Aerodynamic torque on the wing, in frame 6 (the blade element on `branch` when given).
     #[inline]
     fn torque(
         &self,
         p_dot: &Vector3<f64>,
         omega: &Vector3<f64>,
         r61: &Matrix3<f64>,
+        branch: Option<Branch>,
     ) -> Vector3<f64> {
-        self.torque_about(p_dot.x, omega, &r61.row(0).transpose(), None)
+        self.torque_about(p_dot.x, omega, &r61.row(0).transpose(), branch)
     }
 
     /// [`Self::torque`] from the stroke rate `φ̇`, `ω⁶` and the stroke axis x̂ (ground) in
@@ -418,9 +419,20 @@ impl Wing {
     /// `J6 = [(cψ, −sψ, 0), cos φ (sψ, cψ, 0), ẑ]` and `J̇6 ṗ = φ̇ ψ̇ (−sψ, −cψ, 0)`. Valid without
     /// springs on joints 2, 3, 5; tested against [`Self::terms`].
     pub fn stroke_plane_terms(&self, p: &Vector3<f64>, p_dot: &Vector3<f64>) -> WingTerms {
+        self.stroke_plane_terms_on(p, p_dot, None)
+    }
+
+    /// [`Self::stroke_plane_terms`] with the blade element on `branch` when given (event
+    /// location).
+    pub(crate) fn stroke_plane_terms_on(
+        &self,
+        p: &Vector3<f64>,
+        p_dot: &Vector3<f64>,
+        branch: Option<Branch>,
+    ) -> WingTerms {
         let k = self.stroke_plane_kinematics(p, p_dot);
         let i_omega = self.inertia * k.omega;
-        let aero_frame6 = self.aero.torque(p_dot, &k.omega, &k.rotation);
+        let aero_frame6 = self.aero.torque(p_dot, &k.omega, &k.rotation, branch);
         WingTerms {
             mass: k.j6.transpose() * self.inertia * k.j6,
             coriolis: k.j6.transpose() * (self.inertia * k.jdot_pdot + k.omega.cross(&i_omega)),
@@ -513,7 +525,7 @@ impl Wing {
             other => {
                 let omega = Vector3::new(phi_dot, 0.0, 0.0);
                 let rotation = Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c);
-                rotate(&other.torque(&omega, &omega, &rotation))
+                rotate(&other.torque(&omega, &omega, &rotation, None))
             }
         };
         let i_omega = inertia_x * phi_dot;
@@ -544,6 +556,17 @@ impl Wing {
         &self,
         p: &Vector3<f64>,
         p_dot: &Vector3<f64>,
+    ) -> Option<WingTerms> {
+        self.free_deviation_terms_on(p, p_dot, None)
+    }
+
+    /// [`Self::free_deviation_terms`] with the blade element on `branch` when given (event
+    /// location).
+    pub(crate) fn free_deviation_terms_on(
+        &self,
+        p: &Vector3<f64>,
+        p_dot: &Vector3<f64>,
+        branch: Option<Branch>,
     ) -> Option<WingTerms> {
         let (phi, theta, psi) = (p.x, p.y, p.z);
         if !(phi.is_finite() && theta.is_finite() && psi.is_finite()) {
@@ -598,7 +621,7 @@ impl Wing {
         let mut potential = s[0].energy(phi) + s[3].energy(theta) + s[5].energy(psi);
         self.add_tunable_hinge(theta, psi, &mut spring, &mut potential);
 
-        let aero_frame6 = self.aero.torque(p_dot, &omega, &r61);
+        let aero_frame6 = self.aero.torque(p_dot, &omega, &r61, branch);
         Some(WingTerms {
             mass,
             coriolis,
@@ -613,6 +636,36 @@ impl Wing {
             potential,
             kinetic: 0.5 * omega.dot(&i_omega),
         })
+    }
+
+    /// `ω⁶ = J6 ṗ` of [`Self::free_deviation_terms`] alone (the same operations: the blade
+    /// element's switching functions read it once per step): `J6 = [ŷ4⁶ ∂γ5/∂φ + x̂3⁶,
+    /// ŷ4⁶ ∂γ5/∂θ, ẑ]` with `x̂3⁶ = (cos γ5 cos ψ, −cos γ5 sin ψ, sin γ5)`, the first row of
+    /// `R_6^1 = R_x(φ) R_y(γ5) R_z(ψ)`. `None` where the closed form does not apply.
+    pub(crate) fn free_deviation_omega(
+        &self,
+        p: &Vector3<f64>,
+        p_dot: &Vector3<f64>,
+    ) -> Option<Vector3<f64>> {
+        let (phi, theta, psi) = (p.x, p.y, p.z);
+        if !(phi.is_finite() && theta.is_finite() && psi.is_finite()) {
+            return None;
+        }
+        let (sp, cp) = phi.sin_cos();
+        let (st, ct) = theta.sin_cos();
+        let d = ct * ct + cp * cp * st * st;
+        if d < 1e-12 || cp * cp + ct * ct * sp * sp < 1e-12 {
+            return None;
+        }
+        let root = d.sqrt();
+        let (s5, c5) = (cp * st / root, ct / root);
+        let g5_phi = -sp * st * ct / d;
+        let g5_theta = cp / d;
+        let (ss, cs) = psi.sin_cos();
+        let y4 = Vector3::new(ss, cs, 0.0);
+        let x3 = Vector3::new(c5 * cs, c5 * -ss, s5);
+        let j6 = Matrix3::from_columns(&[y4 * g5_phi + x3, y4 * g5_theta, Vector3::z()]);
+        Some(j6 * p_dot)
     }
 
     /// Adds the tunable hinge's load (§3.4: stiffness `k(θ)` on ψ, and its `∂/∂θ` on θ) and
@@ -675,6 +728,19 @@ impl Wing {
     /// [`Error::OutOfDomain`] outside the shoulder's joint limit, [`Error::Singular`] at a
     /// singular shoulder pose.
     pub fn terms(&self, p: &Vector3<f64>, p_dot: &Vector3<f64>) -> Result<WingTerms> {
+        self.terms_on(p, p_dot, None)
+    }
+
+    /// [`Self::terms`] with the blade element on `branch` when given (event location).
+    ///
+    /// # Errors
+    /// As [`Self::terms`].
+    pub(crate) fn terms_on(
+        &self,
+        p: &Vector3<f64>,
+        p_dot: &Vector3<f64>,
+        branch: Option<Branch>,
+    ) -> Result<WingTerms> {
         let (phi, theta, psi) = (p.x, p.y, p.z);
         let pose = self.shoulder.pose(phi, theta, psi)?;
         let [_, g2, g3, _, g5, _] = pose.joint_angles;
@@ -718,7 +784,7 @@ impl Wing {
 
         self.add_tunable_hinge(theta, psi, &mut spring, &mut potential);
 
-        let aero_frame6 = self.aero.torque(p_dot, &omega, &r61);
+        let aero_frame6 = self.aero.torque(p_dot, &omega, &r61, branch);
         Ok(WingTerms {
             mass,
             coriolis,

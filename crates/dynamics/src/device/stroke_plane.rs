@@ -15,7 +15,7 @@ use paritysim_error::{Error, Result};
 
 use super::Device;
 use crate::WingAero;
-use crate::integrate::{MAX_SWITCHES, Sides, State};
+use crate::integrate::{MAX_SWITCHES, State};
 use crate::metrics::StrokeNeeds;
 use crate::trajectory::PlaneSample;
 
@@ -78,33 +78,7 @@ fn dot(a: &[f64; N], b: &[f64]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]
 }
 
-/// The blade elements' branches named by the sides of [`Device::stroke_plane_switching_functions`]
-/// (three per wing).
-pub(super) fn branches(sides: Sides) -> [Branch; 2] {
-    std::array::from_fn(|w| Branch {
-        chordwise_positive: sides.positive(3 * w),
-        normal_positive: sides.positive(3 * w + 1),
-        spanwise_positive: sides.positive(3 * w + 2),
-    })
-}
-
 impl Device {
-    /// Number of switching functions of the right-hand side: three per wing
-    /// ([`paritysim_aero::BladeElementModel::switching_functions`]) for a stroke-plane device
-    /// with blade-element wings, else none (its right-hand side is then evaluated as smooth).
-    pub(super) fn stroke_plane_switches(&self) -> usize {
-        let blade = self
-            .spec
-            .wings
-            .iter()
-            .any(|w| matches!(w.aero(), WingAero::BladeElement(_)));
-        if self.stroke_plane_rhs.is_some() && blade {
-            6
-        } else {
-            0
-        }
-    }
-
     /// The switching functions of a stroke-plane device's blade elements at `y`: per wing
     /// `(ω_x, ω_y, ω_z)` of `ω = φ̇ (cos ψ, −sin ψ, 0) + ψ̇ ẑ` where the model switches (the
     /// stroke reversal, α = π/2 where the fit jumps, the rotational damping's `ω_z = 0`),
@@ -495,6 +469,7 @@ mod tests {
 
     use super::*;
     use crate::device::{DeviceSpec, Formulation, Transmission};
+    use crate::integrate::Sides;
     use crate::{Actuator, DcOffset, JointSpring, TunableHinge, Waveform, Wing, WingAero};
 
     /// A Table 3.3 wing (full inertia with I_xz, blade element Ω1..Ω4, hinge spring 2.53).
@@ -792,10 +767,10 @@ mod tests {
         assert!(with.rhs_calls < without.rhs_calls && with.rejected < without.rejected);
     }
 
-    /// Shooting on a grid picked with located switches (the grid retraced on the state's own
-    /// sides, the grid picked again from a first orbit) ends on an orbit of the true map: one
-    /// adaptive period from it at rtol 1e-11 returns to it within 1e-10 (measured 2.3e-12;
-    /// 1.6e-9 before event location, 3.2e-7 on the first grid with held branches).
+    /// Shooting on a grid picked with located switches (the grid's steps cut at the trial's
+    /// own roots, the grid picked again from a first orbit) ends on an orbit of the true map:
+    /// one adaptive period from it at rtol 1e-11 returns to it within 1e-10 (measured 2.4e-12;
+    /// 1.6e-9 before event location, 3.2e-7 on the first grid with branches held per step).
     #[test]
     fn shooting_with_located_switches_finds_the_orbit_of_the_true_map() {
         use crate::integrate::{Integrator, Method, RungeKutta};

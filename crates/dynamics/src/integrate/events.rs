@@ -85,7 +85,12 @@ pub(crate) struct Event<const M: usize> {
 }
 
 /// Relative bracket width of the root search (of the step size).
-const ROOT_TOLERANCE: f64 = 1e-10;
+pub(crate) const ROOT_TOLERANCE: f64 = 1e-10;
+
+/// The same on fixed grids, to round-off: there the root's time is part of the frozen map,
+/// which Newton solves to `0.1 rtol` (a bracket of `1e-10 h` left the map non-smooth at
+/// about `1e-10` of the state and Newton at rtol 1e-12 without descent).
+pub(crate) const GRID_ROOT_TOLERANCE: f64 = 1e-15;
 
 /// Roots this close after the first (relative to the step size) are one event: the step ends
 /// there with all of them switched. Mirror-symmetric wings cross together up to round-off;
@@ -93,7 +98,8 @@ const ROOT_TOLERANCE: f64 = 1e-10;
 const CLUSTER: f64 = 1e-8;
 
 /// Locates the first root inside the accepted step `[t, t + h]` (dense output prepared) among
-/// the switching functions whose end value `g1` lies across `sides` (`g0` their values at `t`).
+/// the switching functions whose end value `g1` lies across `sides` (`g0` their values at `t`),
+/// to a bracket of `root_tolerance × h`.
 ///
 /// # Errors
 /// A failing switching function.
@@ -107,9 +113,10 @@ pub(crate) fn locate<const M: usize, S: Stepper<M>>(
     h: f64,
     g0: &[f64; MAX_SWITCHES],
     g1: &[f64; MAX_SWITCHES],
+    root_tolerance: f64,
 ) -> Result<Event<M>> {
     let t1 = t + h;
-    let tol = ROOT_TOLERANCE * h.abs() + 4.0 * f64::EPSILON * t1.abs();
+    let tol = root_tolerance * h.abs() + 4.0 * f64::EPSILON * t1.abs();
     let mut first = t1;
     let mut y = [0.0; M];
     let mut g = [0.0; MAX_SWITCHES];
