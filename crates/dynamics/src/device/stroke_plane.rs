@@ -16,8 +16,8 @@ use paritysim_error::{Error, Result};
 use super::Device;
 use crate::WingAero;
 use crate::integrate::{MAX_SWITCHES, State};
-use crate::metrics::StrokeNeeds;
-use crate::trajectory::PlaneSample;
+use crate::metrics::needs::StrokeNeeds;
+use crate::metrics::plane_sample::PlaneSample;
 
 /// Integrated coordinates of a stroke-plane device: `(φ, ψ)` of two wings.
 pub(super) const N: usize = 4;

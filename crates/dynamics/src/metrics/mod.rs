@@ -20,11 +20,13 @@
 //! that does not rotate, the imbalance percentages when `τR_peak = 0`.
 
 pub mod needs;
+pub mod plane_sample;
 pub use needs::{StrokeNeeds, is_stroke_metric};
 use std::f64::consts::{PI, TAU};
 
 use crate::device::Device;
-use crate::trajectory::{PlaneSample, Sample, StrokeSample};
+use crate::trajectory::{Sample, StrokeSample};
+use plane_sample::PlaneSample;
 
 const AXES: [&str; 3] = ["roll", "yaw", "pitch"];
 
