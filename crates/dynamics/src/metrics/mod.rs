@@ -206,12 +206,7 @@ impl MetricsAccumulator {
             },
             body,
         );
-        let (cos, sin) = if body && self.period.is_some() {
-            let (s_, c_) = (self.omega * s.time).sin_cos();
-            (c_, s_)
-        } else {
-            (0.0, 0.0)
-        };
+        let (cos, sin) = self.drive_phase(s.time, body);
         for w in 0..self.n_wings {
             let acc = &mut self.wings[w];
             let (phi, psi) = (p[3 * w], p[3 * w + 2]);
@@ -231,6 +226,17 @@ impl MetricsAccumulator {
         self.work_aero = s.state.work_aero;
     }
 
+    /// `(cos ωt, sin ωt)` of the drive at a body sample (the first harmonics of φ and ψ), else
+    /// zeros.
+    fn drive_phase(&self, time: f64, body: bool) -> (f64, f64) {
+        if body && self.period.is_some() {
+            let (sin, cos) = (self.omega * time).sin_cos();
+            (cos, sin)
+        } else {
+            (0.0, 0.0)
+        }
+    }
+
     /// Adds a [`PlaneSample`] with [`Self::add`]'s operations in its order (the same metrics
     /// from the same values); the metrics its [`StrokeNeeds`] do not provide are NaN.
     pub fn add_plane(&mut self, s: &PlaneSample, closing: bool) {
@@ -247,12 +253,7 @@ impl MetricsAccumulator {
             },
             body,
         );
-        let (cos, sin) = if body && self.period.is_some() {
-            let (s_, c_) = (self.omega * s.time).sin_cos();
-            (c_, s_)
-        } else {
-            (0.0, 0.0)
-        };
+        let (cos, sin) = self.drive_phase(s.time, body);
         for w in 0..self.n_wings {
             let acc = &mut self.wings[w];
             let (phi, psi) = (s.phi[w], s.psi[w]);

@@ -81,7 +81,12 @@ struct Compiled {
 /// A schema node with `$ref` resolved, as a `'static` map: merged nodes (a `$ref` with
 /// sibling keywords) are leaked once; the compiled table lives for the process.
 fn resolved(s: &'static Value) -> &'static Map<String, Value> {
-    match node(s) {
+    leaked(node(s))
+}
+
+/// A borrowed node as is, a merged one leaked (compiled once per process).
+fn leaked(map: std::borrow::Cow<'static, Map<String, Value>>) -> &'static Map<String, Value> {
+    match map {
         std::borrow::Cow::Borrowed(map) => map,
         std::borrow::Cow::Owned(map) => Box::leak(Box::new(map)),
     }
@@ -114,10 +119,7 @@ impl Compiled {
                 let tags = variants
                     .into_iter()
                     .map(|(tag, branch)| {
-                        let map: &'static Map<String, Value> = match branch {
-                            std::borrow::Cow::Borrowed(map) => map,
-                            std::borrow::Cow::Owned(map) => Box::leak(Box::new(map)),
-                        };
+                        let map = leaked(branch);
                         let tag: &'static str = Box::leak(tag.into_boxed_str());
                         (tag, self.plain(map))
                     })
