@@ -190,6 +190,12 @@ fn main() {
             r.residual,
             r.monodromy.is_some()
         );
+        let moduli: Vec<String> = r
+            .multipliers
+            .iter()
+            .map(|m| format!("{:.3e}", m.norm()))
+            .collect();
+        println!("multiplier moduli: {}", moduli.join(" "));
     }
     if let (Ok(_), Some(r)) = (std::env::var("PRINT"), &last) {
         for (name, value) in &r.metrics {

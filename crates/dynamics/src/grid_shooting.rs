@@ -37,6 +37,30 @@ pub(crate) struct GridOrbit {
     pub iterations: usize,
     /// The step grid (from the section time `t0` to `t0 + period`).
     pub grid: Vec<f64>,
+    /// Whether `jacobian` is the exact derivative of the grid map at `state` (the final
+    /// period integrated the variational equations, see [`Finished`]).
+    pub jacobian_at_orbit: bool,
+    /// The contraction of the error Newton's model predicted for its last step (the step's
+    /// size over the previous one's, the step itself after a fresh Jacobian: the quadratic
+    /// model): how good `jacobian` is as another pass's Newton model.
+    pub contraction: Option<f64>,
+}
+
+/// What the final period of [`shoot`] returns: its end state, and the Jacobian of the grid map
+/// at its start when that period integrated the variational equations (the exact monodromy
+/// at the accepted orbit, at the cost of one variational period instead of a plain one and a
+/// separate variational one).
+pub(crate) type Finished = (State, Option<DMatrix<f64>>);
+
+/// A starting model for [`shoot`]'s Newton: a Jacobian of the map (a converged neighbour's,
+/// or an earlier pass's), optionally the grid it was taken on (kept while its error estimates
+/// stay within tolerance) and the contraction its Newton steps achieved
+/// ([`GridOrbit::contraction`]), which predicts this pass's first error.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Guess<'a> {
+    pub jacobian: &'a DMatrix<f64>,
+    pub grid: Option<&'a [f64]>,
+    pub contraction: Option<f64>,
 }
 
 /// `(P(y) − y, ‖P(y) − y‖∞ / (1 + ‖y‖∞))`.
@@ -101,7 +125,9 @@ pub(crate) const REPICK_RESIDUAL: f64 = 1e-3;
 
 /// Newton on the frozen-grid map from `y0` on the section `t = t0` (mod the period), to a state whose predicted
 /// error (relative to `1 + ‖y‖∞`) is below `tol`; `finish(grid, y)` integrates the final
-/// period (recording it) and returns its end state. The final period is accepted when its
+/// period (recording it) and returns its end state, with the map's Jacobian at its start when it
+/// integrated the variational equations (Newton then goes on from it if the period is not
+/// accepted). The final period is accepted when its
 /// residual is below `tol`, or below `accept_tol` with a negligible further Newton step (the
 /// residual then lies along a neutral direction: a cyclic coordinate such as `q2` at K2 = 0
 /// drifting by a constant per period). `Ok(None)` when Newton does not converge within
@@ -117,19 +143,21 @@ pub(crate) fn shoot(
     period: f64,
     t0: f64,
     y0: &State,
-    guess: Option<&DMatrix<f64>>,
-    guess_grid: Option<&[f64]>,
+    guess: Option<Guess<'_>>,
     tol: f64,
     accept_tol: f64,
     max_newton: usize,
-    finish: &mut dyn FnMut(&[f64], &State) -> Result<State>,
+    finish: &mut dyn FnMut(&[f64], &State) -> Result<Finished>,
 ) -> Result<Option<GridOrbit>> {
     let rk = integrator.with_work(false);
     let chooser = rk.tightened(GRID_TOLERANCE_FACTOR);
     let n = device.n_dof();
     let m = 2 * n;
     let mut y = y0.without_work();
-    let guess = guess.filter(|j| j.shape() == (m, m));
+    let guess = guess.filter(|g| g.jacobian.shape() == (m, m));
+    let guess_contraction = guess.and_then(|g| g.contraction);
+    let guess_grid = guess.and_then(|g| g.grid);
+    let guess = guess.map(|g| g.jacobian);
     // A neighbour's grid is kept while every step's error estimate stays within the grid
     // tolerances: the first map then costs one fixed-grid period instead of an adaptive one.
     let t_end = t0 + period;
@@ -180,7 +208,7 @@ pub(crate) fn shoot(
         let contraction = match last_step {
             Some(s) => step / s,
             None if fresh => step,
-            None => 1.0,
+            None => guess_contraction.unwrap_or(1.0),
         }
         .min(1.0);
         let y_new = State::from_compact(n, &(y.compact(n) + &delta));
@@ -204,8 +232,9 @@ pub(crate) fn shoot(
             finish(&grid, &y_new)
         } else {
             rk.integrate_on_grid(device, &grid, &y_new, &[], &mut |_, _, _| Ok(()))
+                .map(|p| (p, None))
         };
-        let p_new = match trial {
+        let (p_new, exact) = match trial {
             Ok(p) => p,
             Err(e) if out_of_budget(&e) => return Err(e),
             // `finish` failing is the recorded window's error: report it.
@@ -214,6 +243,14 @@ pub(crate) fn shoot(
         };
         periods += 1;
         let (f_new, res_new) = residual(n, &y_new, &p_new);
+        let exact = exact.filter(|j| j.shape() == (m, m));
+        let at_orbit = exact.is_some();
+        if let Some(j) = exact {
+            // The final period's own variational equations: the exact Jacobian at `y_new`.
+            jac = j;
+            fresh = true;
+            last_step = None;
+        }
         // Only an exact Jacobian tells a neutral direction from a stale model's small step
         // (measured: a neighbour's Broyden-updated Jacobian accepted a residual of 2.5e-9
         // with the state 4e-7 off the orbit).
@@ -243,7 +280,14 @@ pub(crate) fn shoot(
                 periods: periods - 1,
                 iterations,
                 grid,
+                jacobian_at_orbit: at_orbit,
+                contraction: Some(contraction),
             }));
+        }
+        if at_orbit {
+            // Not accepted, but linearised at `y_new`: Newton goes on from there.
+            (y, f, res) = (y_new, f_new, res_new);
+            continue;
         }
         if res_new >= res || res_new.is_nan() {
             if fresh {

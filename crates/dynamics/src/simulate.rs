@@ -5,6 +5,7 @@ use paritysim_constraints::Vec6;
 use paritysim_error::{Error, Result, bail, check_positive};
 
 use crate::device::Device;
+use crate::grid_shooting::{Finished, Guess};
 use crate::integrate::budget::{Budget, CancelFlag};
 use crate::integrate::{Integrator, Method, RungeKutta, State};
 use crate::metrics::{MetricsAccumulator, StrokeNeeds};
@@ -156,10 +157,10 @@ pub struct SimulationResult {
     /// The state at the start of the recorded window (on the periodic orbit when converged).
     pub steady_state: State,
     /// Floquet multipliers, largest modulus first, of the Jacobian the shooting used (evaluated
-    /// within the warm-up tolerance of the orbit: accurate to about that; devices with
-    /// switching functions, the §3.4 blade elements, take it at the first grid's orbit:
-    /// measured 1.7e-9 off; use [`crate::stability::floquet`] for multipliers at the orbit
-    /// itself). Newton shooting only; empty otherwise.
+    /// within the warm-up tolerance of the orbit: accurate to about that; the stroke-plane
+    /// devices with switching functions, the §3.4 blade elements, take it at the accepted
+    /// orbit on the coarser first grid: measured 4.9e-9 off; use [`crate::stability::floquet`]
+    /// for multipliers at the orbit itself). Newton shooting only; empty otherwise.
     pub multipliers: Vec<nalgebra::Complex<f64>>,
     /// The Jacobian of the stroboscopic map the shooting ended with (exact or
     /// Broyden-updated; `None` for transient runs): the multipliers are its eigenvalues.
@@ -574,14 +575,20 @@ fn shooting_steady_state(
         // start of Newton's iteration: for the stepping-stone devices, whose Jacobian is taken
         // again at the first orbit (below), at looser tolerances (the others' warm-up state
         // is where their Jacobian is taken, and the lanes repeat it).
-        let warm_up = if stepping_stone {
-            transient.loosened(STEPPING_STONE_LOOSENING)
+        // The loose warm-up does not locate the blade elements' switches: at its long steps
+        // each root's cut step and search cost more than the rejected steps they save
+        // (measured on the §3.4 device: 3.9 M → 2.2 M instructions for its three cycles).
+        let (warm_up, warm_up_system): (_, &dyn crate::integrate::OdeSystem) = if stepping_stone {
+            (
+                transient.loosened(STEPPING_STONE_LOOSENING),
+                &crate::integrate::WithoutEvents(device),
+            )
         } else {
-            *transient
+            (*transient, device)
         };
         while cycles < options.min_cycles {
             crate::integrate::budget::check(cycles as f64 * period)?;
-            let next = match warm_up.advance(device, 0.0, &y, period) {
+            let next = match warm_up.advance(warm_up_system, 0.0, &y, period) {
                 Ok(next) => next,
                 // A spent budget ends the run; any other failure is left to the fallback.
                 Err(e) if crate::grid_shooting::out_of_budget(&e) => return Err(e),
@@ -600,9 +607,11 @@ fn shooting_steady_state(
     let n_samples = options.samples_per_cycle * orbit_cycles;
     let records = options.record_cycles == 1 && options.perturbation.is_none();
     let mut recorded = None;
-    let mut finish = |grid: &[f64], y: &State| -> Result<State> {
+    let mut finish = |grid: &[f64], y: &State| -> Result<Finished> {
         if !records {
-            return transient.integrate_on_grid(device, grid, y, &[], &mut |_, _, _| Ok(()));
+            return transient
+                .integrate_on_grid(device, grid, y, &[], &mut |_, _, _| Ok(()))
+                .map(|end| (end, None));
         }
         // Samples that read no work integral: the lighter state suffices.
         let integrator = match stroke {
@@ -623,7 +632,7 @@ fn shooting_steady_state(
             Some(grid),
         )?;
         recorded = Some((trajectory, metrics));
-        Ok(end)
+        Ok((end, None))
     };
     // A right-hand side with switches (event location): the adaptive period cuts the grid at
     // the roots of its start state, which move by the distance to the orbit, and the steps
@@ -633,19 +642,29 @@ fn shooting_steady_state(
     // neighbour's grid is not reused. Lanes never run such devices (no lane model). (One pass
     // on the first grid, whose steps are cut at the trial's own roots, left the §3.4 orbit
     // 1.3e-9 off the true map's; 2.4e-12 with two.)
-    // The first grid is a stepping stone: picked and solved at the run's tolerances rather
-    // than the grid's (its orbit only places the second grid's roots), its last Newton trial
-    // not integrated (the second grid's Newton starts from that state and checks it), and its
-    // Jacobian, taken off the orbit and Broyden-updated, not passed on: the second grid's
-    // Newton starts with the variational equations at the first orbit, so the multipliers
-    // are those of a Jacobian at the orbit.
-    let mut first_guess = None;
+    // The first grid is a stepping stone: picked and solved at 1e4 × the run's tolerances
+    // (its orbit only places the second grid's roots) to a tenth of `steady_tol`, its last
+    // Newton trial not integrated (the second grid's Newton starts from that state and checks
+    // it). Its Jacobian (taken at the warm-up state, Broyden-updated) and the contraction it
+    // achieved start the second grid's Newton, whose first step is then usually the recorded
+    // period itself; the multipliers come from the variational equations at the accepted
+    // orbit on the first grid (measured on the §3.4 device: 4.9e-9 off an rtol-1e-12
+    // reference, where one variational period at the start of the second grid cost 3 × as
+    // much; 25.8 M → 21.5 M instructions per trial).
+    let mut first_pass = None;
+    let first_rk = if stepping_stone {
+        transient.loosened(STEPPING_STONE_LOOSENING)
+    } else {
+        *transient
+    };
     if switched && guess.is_none() {
-        let mut plain = |_: &[f64], y: &State| -> Result<State> { Ok(*y) };
-        let first_rk = if stepping_stone {
-            transient.loosened(STEPPING_STONE_LOOSENING)
+        let mut plain = |_: &[f64], y: &State| -> Result<Finished> { Ok((*y, None)) };
+        // A stepping stone's orbit is only the second grid's start, which that grid's Newton
+        // corrects: a tenth of `steady_tol` (its first Newton step from the warm-up suffices).
+        let first_tol = if stepping_stone {
+            tol.max(0.1 * options.steady_tol)
         } else {
-            *transient
+            tol
         };
         if let Some(first) = crate::grid_shooting::shoot(
             device,
@@ -654,29 +673,37 @@ fn shooting_steady_state(
             0.0,
             &y,
             None,
-            None,
-            tol,
+            first_tol,
             options.steady_tol,
             20,
             &mut plain,
         )? {
             y = first.state;
             cycles += first.periods * orbit_cycles;
-            if !stepping_stone {
-                first_guess = Some(first.jacobian);
-            }
+            first_pass = Some(first);
         }
     }
-    let guess = first_guess.as_ref().or(guess);
-    let guess_grid = options.shooting_grid.as_deref().filter(|_| !switched);
-    let Some(orbit) = crate::grid_shooting::shoot(
+    let guess = match &first_pass {
+        Some(first) => Some(Guess {
+            jacobian: &first.jacobian,
+            grid: None,
+            // The stepping stone's contraction predicts the second grid's first error: its
+            // first Newton step is the final period when that is below `tol`.
+            contraction: first.contraction.filter(|_| stepping_stone),
+        }),
+        None => guess.map(|jacobian| Guess {
+            jacobian,
+            grid: options.shooting_grid.as_deref().filter(|_| !switched),
+            contraction: None,
+        }),
+    };
+    let Some(mut orbit) = crate::grid_shooting::shoot(
         device,
         transient,
         map_period,
         0.0,
         &y,
         guess,
-        guess_grid,
         tol,
         options.steady_tol,
         20,
@@ -686,6 +713,16 @@ fn shooting_steady_state(
         return Ok(Shot::Failed);
     };
     cycles += orbit.periods * orbit_cycles;
+    if let Some(first) = first_pass.filter(|_| stepping_stone && !orbit.jacobian_at_orbit) {
+        // The second grid's Newton ran on the stepping stone's Broyden-updated Jacobian
+        // (taken off the orbit): the multipliers from the variational equations at the
+        // orbit, on the stepping stone's coarser grid (a third of the second grid's steps).
+        match first_rk.flow_with_sensitivity_on_grid(device, &first.grid, &orbit.state) {
+            Ok((_, jacobian)) => orbit.jacobian = jacobian,
+            Err(e) if crate::grid_shooting::out_of_budget(&e) => return Err(e),
+            Err(_) => {}
+        }
+    }
     let multipliers = crate::floquet::eigenvalues(&orbit.jacobian).unwrap_or_default();
     if multipliers
         .first()

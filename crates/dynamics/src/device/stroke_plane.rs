@@ -912,8 +912,10 @@ mod tests {
             "multipliers {:?}\nreference {:?}\ndominant {dominant:e}, worst {worst:e}",
             r.multipliers, reference
         );
-        assert!(dominant < 1.5e-4, "dominant multiplier off by {dominant:e}");
-        assert!(worst < 5e-3, "multipliers off the reference by {worst:e}");
+        // The variational equations at the accepted orbit (on the stepping stone's grid):
+        // measured 4.9e-9 / 8.5e-9; the warm-up state's Broyden-updated Jacobian was 1.8e-4 off.
+        assert!(dominant < 1e-7, "dominant multiplier off by {dominant:e}");
+        assert!(worst < 1e-7, "multipliers off the reference by {worst:e}");
     }
 
     /// The lean samples (no column asked: [`PlaneSample`]) give every metric of the full

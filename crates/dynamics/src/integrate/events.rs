@@ -17,8 +17,23 @@
 //! step are not seen (the step is then computed on one branch throughout; its error estimate
 //! still controls it), and a switching function that only touches zero is no event.
 
-use super::{Rhs, Stepper};
+use super::{OdeSystem, Rhs, State, Stepper};
 use paritysim_error::Result;
+
+/// A system integrated without event location: its right-hand side on each state's own sides
+/// (for a loose pass, whose long steps make each located root, a cut step and a search on the
+/// dense output, cost more than the rejected steps it saves).
+pub(crate) struct WithoutEvents<'a>(pub &'a dyn OdeSystem);
+
+impl OdeSystem for WithoutEvents<'_> {
+    fn rhs(&self, t: f64, y: &State, dydt: &mut State) -> Result<()> {
+        self.0.rhs(t, y, dydt)
+    }
+
+    fn n_active(&self) -> usize {
+        self.0.n_active()
+    }
+}
 
 /// Largest number of switching functions of one system.
 pub const MAX_SWITCHES: usize = 16;

@@ -22,6 +22,7 @@ pub(crate) use dop853::lanes;
 
 use paritysim_error::{Error, Result, check_positive};
 
+pub(crate) use events::WithoutEvents;
 pub use events::{MAX_SWITCHES, Sides};
 
 /// Largest number of integrated coordinates.

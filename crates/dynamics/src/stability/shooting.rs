@@ -292,9 +292,18 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
     // orbit on that grid (the exact derivative of the map whose fixed point it is).
     let grid_orbit =
         |y: &State, guess: Option<&DMatrix<f64>>, before: usize| -> Result<Option<PeriodicOrbit>> {
-            let mut finish = |grid: &[f64], y: &State| -> Result<State> {
-                plain.integrate_on_grid(device, grid, y, &[], &mut |_, _, _| Ok(()))
+            // The final period integrates the variational equations: the monodromy at the
+            // orbit it accepts comes with it.
+            let mut finish = |grid: &[f64], y: &State| -> Result<crate::grid_shooting::Finished> {
+                plain
+                    .flow_with_sensitivity_on_grid(device, grid, y)
+                    .map(|(end, monodromy)| (end, Some(monodromy)))
             };
+            let guess = guess.map(|jacobian| crate::grid_shooting::Guess {
+                jacobian,
+                grid: None,
+                contraction: None,
+            });
             let Some(shot) = crate::grid_shooting::shoot(
                 device,
                 &integrator,
@@ -302,7 +311,6 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
                 t0,
                 y,
                 guess,
-                None,
                 options.tol,
                 options.tol,
                 options.max_newton,
@@ -311,13 +319,7 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
             else {
                 return Ok(None);
             };
-            let monodromy =
-                match plain.flow_with_sensitivity_on_grid(device, &shot.grid, &shot.state) {
-                    Ok((_, m)) => Some(m),
-                    Err(e) if crate::grid_shooting::out_of_budget(&e) => return Err(e),
-                    // Left to `floquet`'s adaptive variational period.
-                    Err(_) => None,
-                };
+            let monodromy = shot.jacobian_at_orbit.then_some(shot.jacobian);
             let iterations = before + shot.iterations;
             Ok(Some(PeriodicOrbit {
                 monodromy_offset: if monodromy.is_some() { 0.0 } else { f64::NAN },
