@@ -8,6 +8,11 @@
 //! matrix, no 3 × 3 mass products, no cos φ (it only multiplies θ̇). The drivetrain's inverse
 //! kinematics are the constant `J⁻¹` of the linear map (`q = J⁻¹ φ`, `τ_φ = J⁻ᵀ Q`). Same
 //! state as the null-space path (`x`, `ẋ`); tested against it to 1e-12.
+//!
+//! The reduced mass matrix needs no 4 × 4 factorisation: with θ held, the null basis `N`
+//! (orthonormal columns) has zero θ rows, so its `(φ, ψ)` rows form an orthogonal `S`
+//! (`(φL, ψL, φR, ψR) = S x`), `M = Sᵀ B S` with `B` the two wings' 2 × 2 blocks, and
+//! `M⁻¹ = Sᵀ B⁻¹ S`: `ẍ = Sᵀ B⁻¹ f` for the wings' generalised forces `f = (f_φ, f_ψ)`.
 
 use nalgebra::{Matrix2, SMatrix, SVector, Vector2, Vector3};
 use paritysim_aero::Branch;
@@ -24,6 +29,11 @@ pub(super) const N: usize = 4;
 
 /// The constants of [`Device::rhs_stroke_plane`], precomputed from the null basis and the
 /// linear map.
+///
+/// Its `(φ, ψ)` rows must form an orthogonal matrix (see the module): beyond this deviation of
+/// `SᵀS` from `I` the device takes the general path.
+const ORTHOGONALITY_TOL: f64 = 1e-12;
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct StrokePlane {
     /// Rows `φ` (3w) and `ψ` (3w + 2) of the null basis `N`, per wing.
@@ -33,8 +43,8 @@ pub(super) struct StrokePlane {
     /// `J⁻¹` and `J⁻ᵀ` of the linear map.
     inverse: Matrix2<f64>,
     inverse_transpose: Matrix2<f64>,
-    /// The drive's constant part of `∂G/∂x`: `Σ_wk N_φwᵀ (J⁻ᵀ ∂Q/∂q J⁻¹)_wk N_φk`.
-    drive_slope: [[f64; N]; N],
+    /// The drive's part of `∂f_φw/∂x` per wing (constant): `Σ_k (J⁻ᵀ ∂Q/∂q J⁻¹)_wk N_φk`.
+    drive_rows: [[f64; N]; 2],
 }
 
 impl StrokePlane {
@@ -49,19 +59,21 @@ impl StrokePlane {
         let inverse = jacobian.try_inverse()?;
         let row = |i: usize| -> [f64; N] { std::array::from_fn(|k| device.basis[(i, k)]) };
         let drive = inverse.transpose() * device.drive_load_slope() * inverse;
-        let strokes = [row(0), row(3)];
-        let mut drive_slope = [[0.0; N]; N];
-        for (w, row_w) in strokes.iter().enumerate() {
-            for (k, row_k) in strokes.iter().enumerate() {
-                for i in 0..N {
-                    for j in 0..N {
-                        drive_slope[i][j] += row_w[i] * drive[(w, k)] * row_k[j];
-                    }
-                }
-            }
+        let s_rows = [row(0), row(2), row(3), row(5)];
+        let orthogonal = (0..N).all(|i| {
+            (0..N).all(|j| {
+                let sts: f64 = s_rows.iter().map(|r| r[i] * r[j]).sum();
+                (sts - f64::from(u8::from(i == j))).abs() <= ORTHOGONALITY_TOL
+            })
+        });
+        if !orthogonal {
+            return None;
         }
+        let strokes = [row(0), row(3)];
+        let drive_rows = [0, 1]
+            .map(|w| std::array::from_fn(|j| (0..2).map(|k| drive[(w, k)] * strokes[k][j]).sum()));
         Some(Self {
-            drive_slope,
+            drive_rows,
             rows: [[row(0), row(2)], [row(3), row(5)]],
             offset: [
                 [device.offset[0], device.offset[2]],
@@ -157,8 +169,8 @@ impl Device {
         let q_dot = lean.inverse * stroke_rate;
         let (force, load, _) = self.drive_load(t, &q);
         let drive_torque = lean.inverse_transpose * load;
-        let mut mass = SMatrix::<f64, N, N>::zeros();
-        let mut generalised = SVector::<f64, N>::zeros();
+        let mut inverse_blocks = [[0.0; 3]; 2];
+        let mut x_ddot = SVector::<f64, N>::zeros();
         let mut aero_power = 0.0;
         let mut wings = [PlaneWing::default(); 2];
         for (w, wing) in self.spec.wings.iter().enumerate() {
@@ -194,16 +206,24 @@ impl Device {
             let f_phi = aero_phi - a.dot(&v) - spring_phi + drive_torque[w];
             let f_psi = tau.z - v.z - spring_psi;
             aero_power += aero_phi * phi_dot + tau.z * psi_dot;
-            // M = J6ᵀ I J6 on (φ, ψ): aᵀ I a, aᵀ I ẑ, I_zz; reduced by Nᵀ M N.
+            // B = J6ᵀ I J6 on (φ, ψ): aᵀ I a, aᵀ I ẑ, I_zz; (φ̈, ψ̈) = B⁻¹ f, ẍ += Sᵀ (φ̈, ψ̈).
             let (m_pp, m_ps, m_ss) = (a.dot(&i_a), i_a.z, inertia[(2, 2)]);
-            for i in 0..N {
-                let (ri, si) = (row_phi[i], row_psi[i]);
-                let (u, v) = (m_pp * ri + m_ps * si, m_ps * ri + m_ss * si);
-                for j in 0..N {
-                    mass[(j, i)] += row_phi[j] * u + row_psi[j] * v;
-                }
-                generalised[i] += ri * f_phi + si * f_psi;
+            let det = m_pp * m_ss - m_ps * m_ps;
+            if !(m_pp > 0.0 && det > 0.0) {
+                return Err(Error::Singular(format!(
+                    "reduced mass matrix is not positive definite at x = {:?}",
+                    &y.coords[..N]
+                )));
             }
+            let inverse = [m_ss / det, -m_ps / det, m_pp / det];
+            let (phi_ddot, psi_ddot) = (
+                inverse[0] * f_phi + inverse[1] * f_psi,
+                inverse[1] * f_phi + inverse[2] * f_psi,
+            );
+            for i in 0..N {
+                x_ddot[i] += row_phi[i] * phi_ddot + row_psi[i] * psi_ddot;
+            }
+            inverse_blocks[w] = inverse;
             wings[w] = PlaneWing {
                 angles: (phi, psi),
                 rates: (phi_dot, psi_dot),
@@ -216,15 +236,8 @@ impl Device {
                 aero: tau,
             };
         }
-        let factor = mass.cholesky().ok_or_else(|| {
-            Error::Singular(format!(
-                "reduced mass matrix is not positive definite at x = {:?}",
-                &y.coords[..N]
-            ))
-        })?;
-        let x_ddot = factor.solve(&generalised);
         Ok(Some(PlaneStep {
-            factor,
+            inverse_blocks,
             x_ddot,
             q,
             q_dot,
@@ -255,8 +268,8 @@ struct PlaneWing {
 /// The stroke-plane equations at one state.
 #[derive(Clone, Debug)]
 struct PlaneStep {
-    /// Cholesky factor of the reduced mass matrix.
-    factor: nalgebra::Cholesky<f64, nalgebra::Const<N>>,
+    /// `B_w⁻¹` per wing (`[(0,0), (0,1), (1,1)]`): `M⁻¹ = Sᵀ B⁻¹ S` (see the module).
+    inverse_blocks: [[f64; 3]; 2],
     x_ddot: SVector<f64, N>,
     q: Vector2<f64>,
     q_dot: Vector2<f64>,
@@ -365,8 +378,8 @@ impl Device {
             Err(e) => return Some(Err(e)),
         };
         let x_ddot: [f64; N] = step.x_ddot.into();
-        // [∂G/∂x − (∂M/∂x) ẍ | ∂G/∂ẋ].
-        let mut slope = SMatrix::<f64, N, { 2 * N }>::zeros();
+        // ∂ẍ = Sᵀ B⁻¹ [∂f − (∂B) (φ̈, ψ̈)] per wing on [∂x | ∂ẋ] (see the module).
+        let mut jacobian = SMatrix::<f64, N, { 2 * N }>::zeros();
         let z = Vector3::z();
         for (w, wing) in self.spec.wings.iter().enumerate() {
             let [row_phi, row_psi] = &lean.rows[w];
@@ -424,24 +437,20 @@ impl Device {
             let mut local = [[0.0; 2 * N]; 2];
             for j in 0..N {
                 let (rj, sj) = (row_phi[j], row_psi[j]);
-                local[0][j] = f_phi[0] * rj + (f_phi[1] - dm_phi) * sj;
+                local[0][j] = f_phi[0] * rj + (f_phi[1] - dm_phi) * sj + lean.drive_rows[w][j];
                 local[1][j] = f_psi[0] * rj + (f_psi[1] - dm_psi) * sj;
                 local[0][N + j] = f_phi[2] * rj + f_phi[3] * sj;
                 local[1][N + j] = f_psi[2] * rj + f_psi[3] * sj;
             }
-            for i in 0..N {
-                let (ri, si) = (row_phi[i], row_psi[i]);
-                for j in 0..2 * N {
-                    slope[(i, j)] += ri * local[0][j] + si * local[1][j];
+            let [b00, b01, b11] = step.inverse_blocks[w];
+            for j in 0..2 * N {
+                let (u, v) = (local[0][j], local[1][j]);
+                let (phi_part, psi_part) = (b00 * u + b01 * v, b01 * u + b11 * v);
+                for i in 0..N {
+                    jacobian[(i, j)] += row_phi[i] * phi_part + row_psi[i] * psi_part;
                 }
             }
         }
-        for i in 0..N {
-            for j in 0..N {
-                slope[(i, j)] += lean.drive_slope[i][j];
-            }
-        }
-        let jacobian = step.factor.solve(&slope);
         let m = 2 * N;
         f[..N].copy_from_slice(&y.rates[..N]);
         f[N..m].copy_from_slice(&x_ddot);
