@@ -572,8 +572,8 @@ fn shooting_steady_state(
     let stepping_stone = switched && device.has_analytic_jacobian();
     if guess.is_none() && !settled {
         // Far from the orbit Newton's model is poor: settle the fast modes first. Only the
-        // start of Newton's iteration: for the stepping-stone devices, whose Jacobian is taken
-        // again at the first orbit (below), at looser tolerances (the others' warm-up state
+        // start of Newton's iteration: for the stepping-stone devices, whose multipliers are
+        // taken at the accepted orbit (below), at looser tolerances (the others' warm-up state
         // is where their Jacobian is taken, and the lanes repeat it).
         // The loose warm-up does not locate the blade elements' switches: at its long steps
         // each root's cut step and search cost more than the rejected steps they save
@@ -650,7 +650,7 @@ fn shooting_steady_state(
     // period itself; the multipliers come from the variational equations at the accepted
     // orbit on the first grid (measured on the §3.4 device: 4.9e-9 off an rtol-1e-12
     // reference, where one variational period at the start of the second grid cost 3 × as
-    // much; 25.8 M → 21.5 M instructions per trial).
+    // much; with the loose warm-up below, 25.8 M → 19.8 M instructions per trial).
     let mut first_pass = None;
     let first_rk = if stepping_stone {
         transient.loosened(STEPPING_STONE_LOOSENING)
