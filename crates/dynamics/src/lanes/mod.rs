@@ -7,8 +7,8 @@
 //! point per lane: every lane carries its own grid or step control, time, step and state
 //! through the DOP853 stages (`integrate::dop853_lanes`, `wide::f64x4`), and a lane whose
 //! period ends is handed its point's next period (or the next point of its chain, or the next
-//! chain of its group) while the others keep stepping: the ensemble technique of heyoka and
-//! MPGOS. Groups of chains run in parallel on the sweep's rayon pool.
+//! chain from the sweep's shared queue) while the others keep stepping: the ensemble technique
+//! of heyoka and MPGOS. One such worker runs on each thread of the sweep's rayon pool.
 //!
 //! * **Which points.** A shooting point qualifies when it reads stroke metrics only, records
 //!   one plain cycle, uses DOP853, and its device integrates drivetrain coordinates of the
@@ -22,8 +22,8 @@
 //!   bit-identical to the scalar sweep (`PARITYSIM_LANES=1`; tested for lane widths 1 to 4 and
 //!   thread counts).
 //! * **Failures are rows**: a failing point fails on the scalar rerun, with the scalar error.
-//!   A panic (an engine bug) fails the points of its group of chains (up to `2 × LANES`
-//!   chains) rather than of its chain.
+//!   A panic (an engine bug) fails the chains its worker had taken and not completed (up to
+//!   `LANES` chains) rather than only its chain.
 //! * **Budgets**: each point's `max_wall_ms` runs from its start in a lane and is checked
 //!   every `CHECK_EVERY` steps inside its periods (as the scalar integrator checks a run's);
 //!   a spent budget is the point's row, the scalar path's budget error (not a rerun). The

@@ -1,7 +1,10 @@
-//! The lanes of a group of chains: which point each lane works on, refilled from its chain and
-//! the group's queue of chains; groups on the sweep's rayon pool (see the module `lanes`).
+//! The lanes of a worker: which point each lane works on, refilled from its chain and the
+//! sweep's shared queue of chains; one worker per thread of the sweep's rayon pool (see the
+//! module `lanes`).
 
 use std::rc::Rc;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use paritysim_error::Result;
 
@@ -57,8 +60,49 @@ struct Cursor<'a> {
 
 type ChainResults = Vec<Option<Result<Vec<Result<PointOutput>>>>>;
 
-/// Runs the `n_chains` chains of `points` with `lanes` lanes per group of chains (see the
+/// The chains of a sweep, handed out one at a time to the workers' lanes, and each chain's
+/// results as its worker completes it.
+struct ChainQueue {
+    next: AtomicUsize,
+    n_chains: usize,
+    /// Whether chain `c` was taken by a worker.
+    taken: Vec<AtomicBool>,
+    done: Mutex<Vec<Option<Vec<Result<PointOutput>>>>>,
+}
+
+impl ChainQueue {
+    fn new(n_chains: usize) -> Self {
+        Self {
+            next: AtomicUsize::new(0),
+            n_chains,
+            taken: (0..n_chains).map(|_| AtomicBool::new(false)).collect(),
+            done: Mutex::new((0..n_chains).map(|_| None).collect()),
+        }
+    }
+
+    /// The next chain nobody has taken.
+    fn take(&self) -> Option<usize> {
+        let c = self.next.fetch_add(1, Ordering::Relaxed);
+        (c < self.n_chains).then(|| {
+            self.taken[c].store(true, Ordering::Release);
+            c
+        })
+    }
+
+    fn complete(&self, chain: usize, results: Vec<Result<PointOutput>>) {
+        // A poisoned lock means a worker panicked while storing: the slots are still valid.
+        let mut done = self.done.lock().unwrap_or_else(|p| p.into_inner());
+        done[chain] = Some(results);
+    }
+}
+
+/// Runs the `n_chains` chains of `points` on `threads` workers of `lanes` lanes each (see the
 /// module); slot `c` is chain `c`'s results as `sweep::run_points` collects them.
+///
+/// Every worker takes the next chain from one shared queue whenever one of its lanes runs out
+/// of points, so the workers stay busy until the last chains (fixed groups of chains left one
+/// thread idle while the other finished its group). A point's result does not depend on its
+/// lane or on the points beside it, so results are the same for any thread count.
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for a bad thread count.
@@ -70,26 +114,32 @@ pub(crate) fn run_chains(
     lanes: usize,
     control: &SweepControl,
 ) -> Result<ChainResults> {
-    // Groups small enough to keep every thread busy, large enough to refill the lanes.
-    let per_group = n_chains.div_ceil(threads.max(1)).clamp(1, 2 * lanes);
-    let n_groups = n_chains.div_ceil(per_group);
-    let groups = run_tasks(n_groups, threads, control, false, |g| {
-        let chains = g * per_group..((g + 1) * per_group).min(n_chains);
-        Ok(run_group(points, metric_names, chains, lanes, control))
+    let queue = ChainQueue::new(n_chains);
+    // Few chains: spread over the threads (wall time) rather than packed into one worker's
+    // lanes.
+    let workers = threads.max(1).min(n_chains.max(1));
+    let outcomes = run_tasks(workers, threads, control, false, |_| {
+        run_worker(points, metric_names, &queue, lanes, control);
+        Ok(())
     })?;
-    let mut out: ChainResults = Vec::with_capacity(n_chains);
-    for (g, group) in groups.into_iter().enumerate() {
-        let len = ((g + 1) * per_group).min(n_chains) - g * per_group;
-        match group {
-            Some(Ok(chains)) => out.extend(chains.into_iter().map(|c| Some(Ok(c)))),
-            Some(Err(e)) => out.extend((0..len).map(|_| Some(Err(e.clone())))),
-            None => out.extend((0..len).map(|_| None)),
-        }
-    }
-    Ok(out)
+    // A worker's panic (an engine bug) fails the chains it had taken and not completed.
+    let panic = outcomes.into_iter().find_map(|o| match o {
+        Some(Err(e)) => Some(e),
+        _ => None,
+    });
+    let done = queue.done.into_inner().unwrap_or_else(|p| p.into_inner());
+    Ok(done
+        .into_iter()
+        .zip(&queue.taken)
+        .map(|(results, taken)| match (results, &panic) {
+            (Some(results), _) => Some(Ok(results)),
+            (None, Some(e)) if taken.load(Ordering::Acquire) => Some(Err(e.clone())),
+            (None, _) => None,
+        })
+        .collect())
 }
 
-/// The group's two lane steppers (the state, and the state with its variational equations).
+/// The worker's two lane steppers (the state, and the state with its variational equations).
 struct Steppers {
     state: LaneStepper<4>,
     variational: LaneStepper<20>,
@@ -146,20 +196,17 @@ fn launch<'a>(
     }
 }
 
-/// One group of chains on `lanes` lanes; each chain's results in order (cut short by a
-/// cancel).
+/// One worker: `lanes` lanes fed from `queue` until it is empty; each chain's results (cut
+/// short by a cancel) go to the queue as the chain completes.
 // The lane index addresses the cursors and both steppers: an index loop reads clearest.
 #[allow(clippy::needless_range_loop)]
-fn run_group(
+fn run_worker(
     points: &[Result<(Device, SimulationOptions)>],
     metric_names: &[String],
-    chains: std::ops::Range<usize>,
+    queue: &ChainQueue,
     lanes: usize,
     control: &SweepControl,
-) -> Vec<Vec<Result<PointOutput>>> {
-    let first_chain = chains.start;
-    let mut results: Vec<Vec<Result<PointOutput>>> = chains.clone().map(|_| Vec::new()).collect();
-    let mut queue = chains;
+) {
     let mut cursors: Vec<Option<Cursor<'_>>> = (0..lanes).map(|_| None).collect();
     let mut steppers = Steppers {
         state: LaneStepper::new(),
@@ -169,7 +216,7 @@ fn run_group(
     let mut models = LinearStrokeLanes::new();
     let mut times_cache = None;
     // One per lane: a lane's next point usually has its chain predecessor's grid (one cache
-    // for the group was overwritten by the other lanes' chains: 366 tables for 256 points).
+    // for the worker was overwritten by the other lanes' chains: 366 tables for 256 points).
     let mut forcing_cache: Vec<ForcingCache> = (0..lanes).map(|_| None).collect();
     loop {
         if control.is_cancelled() {
@@ -184,9 +231,9 @@ fn run_group(
                 }
                 if cursors[l].as_ref().is_none_or(|c| c.next == c.end) {
                     if let Some(done) = cursors[l].take() {
-                        results[done.chain - first_chain] = done.out;
+                        queue.complete(done.chain, done.out);
                     }
-                    let Some(chain) = queue.next() else {
+                    let Some(chain) = queue.take() else {
                         break;
                     };
                     let range = chain_range(chain, points.len());
@@ -322,9 +369,8 @@ fn run_group(
         }
     }
     for cursor in cursors.into_iter().flatten() {
-        results[cursor.chain - first_chain] = cursor.out;
+        queue.complete(cursor.chain, cursor.out);
     }
-    results
 }
 
 /// Completes point `i` of the chain in `cursor`: `done` is its lane result (or error), else
