@@ -23,7 +23,11 @@ import importlib
 import logging
 from typing import TYPE_CHECKING, Any
 
-from ._core import (
+from . import _cpu
+
+_cpu.check()  # before the extension loads: it is compiled for AVX2 on x86-64 (.cargo/config.toml)
+
+from ._core import (  # noqa: E402
     CancelledError,
     ConstraintError,
     GeometryError,

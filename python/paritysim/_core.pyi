@@ -8,6 +8,8 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
+#: The x86-64 SIMD features the build may execute (``paritysim._cpu`` checks the CPU for them).
+__target_features__: list[str]
 
 _F64 = npt.NDArray[np.float64]
 
