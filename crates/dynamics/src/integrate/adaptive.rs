@@ -1,0 +1,288 @@
+//! The adaptive integration loop (Hairer's `DP86CO` / `DOPCOR`): step-size control, event
+//! location and sampling.
+
+use paritysim_error::Result;
+
+use super::{
+    IntegrationStats, MAX_SWITCHES, Method, Rhs, Sides, Sink, State, Stepper, Tolerances, budget,
+    dop853, dopri5, events, integration_error, sample_step,
+};
+
+/// Safety factor of the step-size controller.
+pub(super) const SAFE: f64 = 0.9;
+
+/// Hairer's initial step size (`HINIT`): one extra evaluation.
+pub(super) fn initial_step<const M: usize>(
+    rhs: &mut dyn Rhs<M>,
+    order: i32,
+    tol: &Tolerances,
+    t0: f64,
+    y0: &[f64; M],
+    f0: &[f64; M],
+    h_max: f64,
+) -> Result<f64> {
+    let (mut dnf, mut dny) = (0.0, 0.0);
+    for i in 0..tol.controlled {
+        let sk = tol.atol + tol.rtol * y0[i].abs();
+        dnf += (f0[i] / sk).powi(2);
+        dny += (y0[i] / sk).powi(2);
+    }
+    let mut h = if dnf <= 1e-10 || dny <= 1e-10 {
+        1e-6
+    } else {
+        (dny / dnf).sqrt() * 0.01
+    };
+    h = h.min(h_max);
+    let mut y1 = [0.0; M];
+    for i in 0..M {
+        y1[i] = y0[i] + h * f0[i];
+    }
+    let mut f1 = [0.0; M];
+    rhs.eval(t0 + h, &y1, &mut f1)?;
+    let mut der2: f64 = 0.0;
+    for i in 0..tol.controlled {
+        let sk = tol.atol + tol.rtol * y0[i].abs();
+        der2 += ((f1[i] - f0[i]) / sk).powi(2);
+    }
+    let der2 = der2.sqrt() / h;
+    let der12 = der2.abs().max(dnf.sqrt());
+    let h1 = if der12 <= 1e-15 {
+        (h * 1e-3).max(1e-6)
+    } else {
+        (0.01 / der12).powf(1.0 / order as f64)
+    };
+    Ok((100.0 * h).min(h1).min(h_max))
+}
+
+/// [`drive`] with the stepper of `method`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn drive_method<const M: usize>(
+    method: Method,
+    rhs: &mut dyn Rhs<M>,
+    tol: &Tolerances,
+    max_steps: usize,
+    t0: f64,
+    y0: [f64; M],
+    t_end: f64,
+    times: &[f64],
+    sink: &mut Sink<'_>,
+    on_step: &mut dyn FnMut(f64, &State),
+) -> Result<([f64; M], IntegrationStats)> {
+    match method {
+        Method::Dop853 => drive(
+            &mut dop853::Dop853::<M>::new(),
+            rhs,
+            tol,
+            max_steps,
+            t0,
+            y0,
+            t_end,
+            times,
+            sink,
+            on_step,
+        ),
+        Method::Dopri5 => drive(
+            &mut dopri5::Dopri5::<M>::new(),
+            rhs,
+            tol,
+            max_steps,
+            t0,
+            y0,
+            t_end,
+            times,
+            sink,
+            on_step,
+        ),
+    }
+}
+
+/// The integration loop shared by both pairs (Hairer's `DP86CO` / `DOPCOR`).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn drive<const M: usize, S: Stepper<M>>(
+    stepper: &mut S,
+    rhs: &mut dyn Rhs<M>,
+    tol: &Tolerances,
+    max_steps: usize,
+    t0: f64,
+    y0: [f64; M],
+    t_end: f64,
+    times: &[f64],
+    sink: &mut Sink<'_>,
+    on_step: &mut dyn FnMut(f64, &State),
+) -> Result<([f64; M], IntegrationStats)> {
+    let mut stats = IntegrationStats::default();
+    let mut y = y0;
+    let mut t = t0;
+    let mut next = 0;
+    if next < times.len() && times[next] <= t0 {
+        let state = rhs.expand(&y);
+        while next < times.len() && times[next] <= t0 {
+            sink(next, times[next], &state)?;
+            next += 1;
+        }
+    }
+    // Switching functions: their sides at the start name the branch.
+    let n_switches = rhs.n_switches().min(MAX_SWITCHES);
+    let mut g0 = [0.0; MAX_SWITCHES];
+    let mut g1 = [0.0; MAX_SWITCHES];
+    let mut sides = Sides::default();
+    let mut redone_at = None;
+    if n_switches > 0 {
+        rhs.switches(t, &y, &mut g0)?;
+        sides = Sides::of(&g0[..n_switches]);
+        rhs.set_sides(sides);
+    }
+    let mut f0 = [0.0; M];
+    rhs.eval(t, &y, &mut f0)?;
+    let h_max = t_end - t0;
+    let mut h = initial_step(rhs, S::ORDER, tol, t0, &y, &f0, h_max)?;
+    let fac_lo = 1.0 / S::FAC_MAX;
+    let fac_hi = 1.0 / S::FAC_MIN;
+    let mut fac_old: f64 = 1e-4;
+    let mut rejected_last = false;
+    let mut f1 = [0.0; M];
+    loop {
+        let attempts = stats.accepted + stats.rejected;
+        if attempts >= max_steps {
+            return Err(integration_error(
+                t,
+                &rhs.expand(&y),
+                format!(
+                    "more than {max_steps} steps in one integration (the step budget \
+                     `options.max_steps`)"
+                ),
+            ));
+        }
+        if attempts % budget::CHECK_EVERY == 0 {
+            if let Err(stop) = budget::check_current() {
+                return Err(budget::stop_error(stop, t, rhs.expand(&y).to_vec()));
+            }
+        }
+        if 0.1 * h.abs() <= t.abs() * f64::EPSILON || !h.is_finite() {
+            return Err(integration_error(t, &rhs.expand(&y), "step size underflow"));
+        }
+        let last = t + 1.01 * h >= t_end;
+        if last {
+            h = t_end - t;
+        }
+        let err = stepper.attempt(rhs, t, &y, &f0, h, tol)?;
+        if !err.is_finite() {
+            // A non-finite trial (e.g. a state thrown out of range): shrink hard and retry.
+            stats.rejected += 1;
+            rejected_last = true;
+            h *= S::FAC_MIN;
+            continue;
+        }
+        let fac11 = err.powf(S::EXPONENT);
+        if err <= 1.0 {
+            // Lund stabilisation (PI control): divide by the previous error's factor.
+            let fac = (fac11 / fac_old.powf(S::BETA) / SAFE).clamp(fac_lo, fac_hi);
+            let mut h_new = h / fac;
+            fac_old = err.max(1e-4);
+            let t_new = if last { t_end } else { t + h };
+            stepper.new_derivative(rhs, t_new, &mut f1)?;
+            let y1 = *stepper.y1();
+            let mut event = None;
+            if n_switches > 0 {
+                rhs.switches(t_new, &y1, &mut g1)?;
+                if (0..n_switches).any(|i| events::crossed(sides, i, g1[i])) {
+                    stepper.prepare_dense(rhs, t, &y, &f0, &f1, h)?;
+                    stats.dense_steps += 1;
+                    let found = events::locate(
+                        stepper,
+                        rhs,
+                        n_switches,
+                        sides,
+                        t,
+                        h,
+                        &g0,
+                        &g1,
+                        events::ROOT_TOLERANCE,
+                    )?;
+                    if found.at_start && redone_at != Some(t) {
+                        // The step began on the wrong branch (a switch sitting at zero there):
+                        // take the far side and redo it.
+                        redone_at = Some(t);
+                        sides = found.sides;
+                        rhs.set_sides(sides);
+                        rhs.eval(t, &y, &mut f0)?;
+                        stats.rejected += 1;
+                        continue;
+                    }
+                    event = Some(found);
+                }
+            }
+            stats.accepted += 1;
+            match event {
+                Some(ev) if !ev.at_start && ev.t < t_new => {
+                    // Cut the step at the first switch and restart there on the new branch.
+                    let state = sample_step(
+                        stepper,
+                        rhs,
+                        t,
+                        &y,
+                        &f0,
+                        &f1,
+                        h,
+                        (ev.t, &ev.y),
+                        true,
+                        times,
+                        &mut next,
+                        sink,
+                        &mut stats,
+                    )?;
+                    stats.events += 1;
+                    y = ev.y;
+                    t = ev.t;
+                    g0 = ev.g;
+                    sides = ev.sides;
+                    rhs.set_sides(sides);
+                    rhs.eval(t, &y, &mut f0)?;
+                    on_step(t, &state);
+                }
+                other => {
+                    let dense_ready = other.is_some();
+                    let state = sample_step(
+                        stepper,
+                        rhs,
+                        t,
+                        &y,
+                        &f0,
+                        &f1,
+                        h,
+                        (t_new, &y1),
+                        dense_ready,
+                        times,
+                        &mut next,
+                        sink,
+                        &mut stats,
+                    )?;
+                    if let Some(ev) = other {
+                        // A switch that could not be bracketed (grazing): continue on its end side.
+                        sides = ev.sides;
+                        rhs.set_sides(sides);
+                        rhs.eval(t_new, &y1, &mut f1)?;
+                    }
+                    y = y1;
+                    f0 = f1;
+                    g0 = g1;
+                    t = t_new;
+                    on_step(t, &state);
+                    if last {
+                        return Ok((y, stats));
+                    }
+                }
+            }
+            h_new = h_new.min(h_max);
+            if rejected_last {
+                h_new = h_new.min(h);
+            }
+            rejected_last = false;
+            h = h_new;
+        } else {
+            stats.rejected += 1;
+            rejected_last = true;
+            h /= fac_hi.min(fac11 / SAFE);
+        }
+    }
+}
