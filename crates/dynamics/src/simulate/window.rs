@@ -1,0 +1,142 @@
+//! The recorded window: samples at fixed times of the dense output feed the streamed metrics
+//! and the asked columns.
+
+use paritysim_error::{Result, bail};
+
+use crate::device::Device;
+use crate::integrate::budget::Budget;
+use crate::integrate::{Integrator, RungeKutta, State};
+use crate::metrics::{MetricsAccumulator, StrokeNeeds};
+use crate::trajectory::Trajectory;
+use crate::trajectory::{PlaneSample, Recorder, Sample, StrokeSample};
+
+use super::{Perturbation, SimulationOptions, apply_kick, validate};
+
+/// The metrics of one drive period recorded from `state` at `t = 0` (a state on the section
+/// `t ≡ 0 mod T`, e.g. a periodic orbit from continuation), with `options`' tolerances and
+/// `samples_per_cycle`; no transient, no columns.
+///
+/// # Errors
+/// [`Error::Constraint`] without a periodic drive; integration errors.
+pub fn orbit_metrics(
+    device: &Device,
+    state: &State,
+    options: &SimulationOptions,
+) -> Result<Vec<(String, f64)>> {
+    validate(options)?;
+    let _budget = Budget::new(options.max_wall_ms, options.cancel.clone()).enter();
+    let Some(period) = device.period() else {
+        bail!(Constraint "orbit metrics need a periodic drive (the device has no actuator)");
+    };
+    let integrator = RungeKutta::new(
+        options.method,
+        options.rtol,
+        options.atol,
+        options.max_steps,
+    )?;
+    let stroke = stroke_sampling(device, options.metrics.as_deref(), &[]);
+    let (_, metrics, _) = record_window(
+        device,
+        &integrator,
+        0.0,
+        &state.without_work(),
+        period,
+        options.samples_per_cycle,
+        Some(period),
+        None,
+        Vec::new(),
+        stroke,
+        None,
+    )?;
+    Ok(metrics)
+}
+
+/// How samples are taken (see [`SimulationOptions::metrics`]): `Some(needs)` for lean
+/// [`StrokeSample`]s (no column asked, drivetrain coordinates) or [`PlaneSample`]s (no column
+/// asked, the stroke-plane model), else `None` (full samples).
+pub(super) fn stroke_sampling(
+    device: &Device,
+    metrics: Option<&[String]>,
+    columns: &[crate::trajectory::Column],
+) -> Option<StrokeNeeds> {
+    let lean = columns.is_empty()
+        && (device.formulation() == crate::device::Formulation::DrivetrainCoordinates
+            || device.has_stroke_plane_model());
+    lean.then(|| StrokeNeeds::of(metrics))
+}
+
+/// A recorded window: its columns, its metrics and the state at its end.
+pub(super) type Recorded = (Trajectory, Vec<(String, f64)>, State);
+
+/// Integrates the recorded window from `(t_start, y)`, evaluating each of the `n_samples + 1`
+/// samples once: it feeds the metrics and the asked columns, nothing else is kept.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn record_window(
+    device: &Device,
+    integrator: &RungeKutta,
+    t_start: f64,
+    y: &State,
+    window: f64,
+    n_samples: usize,
+    period: Option<f64>,
+    perturbation: Option<Perturbation>,
+    columns: Vec<crate::trajectory::Column>,
+    stroke: Option<StrokeNeeds>,
+    grid: Option<&[f64]>,
+) -> Result<Recorded> {
+    // The last sample is exactly the window's end: t_start + window·k/n can round one ulp past
+    // it.
+    let t_end = t_start + window;
+    let times: Vec<f64> = (0..=n_samples)
+        .map(|k| {
+            if k == n_samples {
+                t_end
+            } else {
+                t_start + window * k as f64 / n_samples as f64
+            }
+        })
+        .collect();
+    let mut metrics = MetricsAccumulator::new(device, period);
+    let plane = device.formulation() != crate::device::Formulation::DrivetrainCoordinates;
+    let mut recorder = Recorder::new(columns, times.len());
+    let mut sink = |i: usize, t: f64, y: &State| -> Result<()> {
+        // `stroke` is only set for drivetrain-coordinate and stroke-plane devices (see
+        // `stroke_sampling`).
+        if let Some(needs) = stroke {
+            if plane {
+                if let Some(sample) = PlaneSample::new(device, t, y, needs) {
+                    metrics.add_plane(&sample?, i == n_samples);
+                    return Ok(());
+                }
+                // Outside the closed form: the general sample (which reports why).
+            } else {
+                let sample = StrokeSample::of_stroke_device(device, t, y, needs)?;
+                metrics.add_stroke(&sample, i == n_samples);
+                return Ok(());
+            }
+        }
+        let sample = Sample::new(device, t, y)?;
+        metrics.add(&sample, i == n_samples);
+        recorder.push(&sample)
+    };
+    let end = match (perturbation, grid) {
+        (None, Some(grid)) => integrator.integrate_on_grid(device, grid, y, &times, &mut sink)?,
+        (None, None) => integrator.integrate_with(device, t_start, y, t_end, &times, &mut sink)?,
+        (Some(kick), _) => {
+            let t_kick = t_start + kick.phase * period.unwrap_or(window);
+            let split = times.partition_point(|&s| s < t_kick);
+            let y_kick = if t_kick > t_start {
+                let (before, _) = times.split_at(split);
+                integrator.integrate_with(device, t_start, y, t_kick, before, &mut sink)?
+            } else {
+                *y
+            };
+            let y_kicked = apply_kick(device, t_kick, &y_kick, kick)?;
+            let after = &times[split..];
+            // Sample indices continue after the kick.
+            let mut shifted = |i: usize, t: f64, y: &State| sink(i + split, t, y);
+            integrator.integrate_with(device, t_kick, &y_kicked, t_end, after, &mut shifted)?
+        }
+    };
+    Ok((recorder.finish(), metrics.finish(), end))
+}
