@@ -32,7 +32,7 @@
 
 //!
 //! One file per subject: `hill.rs` (§2.6, eq. 2.25), `brockett.rs` (§2.6.4), `lti.rs` (§2.6.1
-//! and eq. 2.59), `shooting.rs` (periodic orbit and Floquet multipliers of the full model),
+//! and eq. 2.59), `shooting.rs` (periodic orbit of the full model), `multipliers.rs` (its Floquet multipliers),
 //! `disturbance.rs` (K2 sweeps, linearisation and disturbance response, §2.7), `rows.rs` (the
 //! parameter loops on the sweep engine). Everything is
 //! re-exported here (and as `paritysim_dynamics::floquet`, the former module name).
@@ -41,6 +41,7 @@ pub mod brockett;
 pub mod disturbance;
 pub mod hill;
 pub mod lti;
+pub mod multipliers;
 pub mod records;
 pub mod rows;
 pub mod shooting;
@@ -49,5 +50,6 @@ pub use brockett::*;
 pub use disturbance::*;
 pub use hill::*;
 pub use lti::*;
+pub use multipliers::*;
 pub use rows::Rows;
 pub use shooting::*;
