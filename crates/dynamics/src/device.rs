@@ -420,7 +420,7 @@ impl Device {
     }
 
     /// Whether the device has the closed-form stroke-plane model (§3.4 rotating wings:
-    /// `device/stroke_plane.rs`), whose lean samples are [`crate::trajectory::PlaneSample`]s.
+    /// `device/stroke_plane/`), whose lean samples are [`crate::trajectory::PlaneSample`]s.
     pub fn has_stroke_plane_model(&self) -> bool {
         self.stroke_plane_rhs.is_some()
     }

@@ -3,9 +3,10 @@
 
 use paritysim_error::Result;
 
+use super::switched::Branch;
 use super::{
-    IntegrationStats, MAX_SWITCHES, Method, Rhs, Sides, Sink, State, Stepper, Tolerances, budget,
-    dop853, dopri5, events, integration_error, sample_step,
+    IntegrationStats, MAX_SWITCHES, Method, Rhs, Sink, State, Stepper, Tolerances, budget, dop853,
+    dopri5, events, integration_error,
 };
 
 /// Safety factor of the step-size controller.
@@ -123,15 +124,8 @@ pub(super) fn drive<const M: usize, S: Stepper<M>>(
     }
     // Switching functions: their sides at the start name the branch.
     let n_switches = rhs.n_switches().min(MAX_SWITCHES);
-    let mut g0 = [0.0; MAX_SWITCHES];
-    let mut g1 = [0.0; MAX_SWITCHES];
-    let mut sides = Sides::default();
+    let mut branch = Branch::start(rhs, n_switches, t, &y)?;
     let mut redone_at = None;
-    if n_switches > 0 {
-        rhs.switches(t, &y, &mut g0)?;
-        sides = Sides::of(&g0[..n_switches]);
-        rhs.set_sides(sides);
-    }
     let mut f0 = [0.0; M];
     rhs.eval(t, &y, &mut f0)?;
     let h_max = t_end - t0;
@@ -182,96 +176,44 @@ pub(super) fn drive<const M: usize, S: Stepper<M>>(
             let t_new = if last { t_end } else { t + h };
             stepper.new_derivative(rhs, t_new, &mut f1)?;
             let y1 = *stepper.y1();
-            let mut event = None;
-            if n_switches > 0 {
-                rhs.switches(t_new, &y1, &mut g1)?;
-                if (0..n_switches).any(|i| events::crossed(sides, i, g1[i])) {
-                    stepper.prepare_dense(rhs, t, &y, &f0, &f1, h)?;
-                    stats.dense_steps += 1;
-                    let found = events::locate(
-                        stepper,
-                        rhs,
-                        n_switches,
-                        sides,
-                        t,
-                        h,
-                        &g0,
-                        &g1,
-                        events::ROOT_TOLERANCE,
-                    )?;
-                    if found.at_start && redone_at != Some(t) {
-                        // The step began on the wrong branch (a switch sitting at zero there):
-                        // take the far side and redo it.
-                        redone_at = Some(t);
-                        sides = found.sides;
-                        rhs.set_sides(sides);
-                        rhs.eval(t, &y, &mut f0)?;
-                        stats.rejected += 1;
-                        continue;
-                    }
-                    event = Some(found);
+            let event = if branch.n > 0 {
+                branch.first_switch(
+                    stepper,
+                    rhs,
+                    (t, &y, &f0),
+                    (t_new, &y1, &f1),
+                    h,
+                    true,
+                    events::ROOT_TOLERANCE,
+                    &mut stats,
+                )?
+            } else {
+                None
+            };
+            if let Some(found) = &event {
+                if found.at_start && redone_at != Some(t) {
+                    // The step began on the wrong branch (a switch sitting at zero there):
+                    // take the far side and redo it.
+                    redone_at = Some(t);
+                    branch.take(rhs, found.sides, t, &y, &mut f0)?;
+                    stats.rejected += 1;
+                    continue;
                 }
             }
             stats.accepted += 1;
-            match event {
-                Some(ev) if !ev.at_start && ev.t < t_new => {
-                    // Cut the step at the first switch and restart there on the new branch.
-                    let state = sample_step(
-                        stepper,
-                        rhs,
-                        t,
-                        &y,
-                        &f0,
-                        &f1,
-                        h,
-                        (ev.t, &ev.y),
-                        true,
-                        times,
-                        &mut next,
-                        sink,
-                        &mut stats,
-                    )?;
-                    stats.events += 1;
-                    y = ev.y;
-                    t = ev.t;
-                    g0 = ev.g;
-                    sides = ev.sides;
-                    rhs.set_sides(sides);
-                    rhs.eval(t, &y, &mut f0)?;
-                    on_step(t, &state);
-                }
-                other => {
-                    let dense_ready = other.is_some();
-                    let state = sample_step(
-                        stepper,
-                        rhs,
-                        t,
-                        &y,
-                        &f0,
-                        &f1,
-                        h,
-                        (t_new, &y1),
-                        dense_ready,
-                        times,
-                        &mut next,
-                        sink,
-                        &mut stats,
-                    )?;
-                    if let Some(ev) = other {
-                        // A switch that could not be bracketed (grazing): continue on its end side.
-                        sides = ev.sides;
-                        rhs.set_sides(sides);
-                        rhs.eval(t_new, &y1, &mut f1)?;
-                    }
-                    y = y1;
-                    f0 = f1;
-                    g0 = g1;
-                    t = t_new;
-                    on_step(t, &state);
-                    if last {
-                        return Ok((y, stats));
-                    }
-                }
+            let (state, cut) = branch.advance(
+                stepper,
+                rhs,
+                (&mut t, &mut y, &mut f0),
+                (t_new, &y1, &mut f1),
+                h,
+                event,
+                (times, &mut next, sink),
+                &mut stats,
+            )?;
+            on_step(t, &state);
+            if last && !cut {
+                return Ok((y, stats));
             }
             h_new = h_new.min(h_max);
             if rejected_last {

@@ -7,7 +7,7 @@
 //!   chained sweep point's work; docs/findings.md §7), with the error estimate counted per
 //!   lane (`over_tolerance`) and the dense output four samples at a time per lane.
 //! * **Adaptive** lanes with Hairer's initial step and step control per lane (the loop of
-//!   `drive` in integrate/mod.rs): a rejected lane retries from its own state while the others
+//!   `drive` in integrate/adaptive.rs): a rejected lane retries from its own state while the others
 //!   move on. They return the accepted step times (the grid the fixed-grid periods retrace).
 //! * The state is the compact `[q1, q2, q̇1, q̇2]`, optionally followed by uncontrolled entries
 //!   (`M = 20`: the variational equations' `Φ`, as in integrate/variational.rs).
@@ -146,7 +146,7 @@ pub(crate) struct SampleBlock {
 /// lane.
 pub(crate) type LaneSink<'a> = dyn FnMut(usize, &SampleBlock) -> bool + 'a;
 
-/// The step control of an adaptive lane (`drive` in integrate/mod.rs, per lane).
+/// The step control of an adaptive lane (`drive` in integrate/adaptive.rs, per lane).
 #[derive(Clone, Debug, Default)]
 struct Adaptive {
     t: f64,
@@ -361,7 +361,7 @@ impl<const M: usize> LaneStepper<M> {
         finished
     }
 
-    /// Hairer's initial step of adaptive lane `l` (`initial_step` of integrate/mod.rs on
+    /// Hairer's initial step of adaptive lane `l` (`initial_step` of integrate/adaptive.rs on
     /// this lane alone); `false` when its extra evaluation fails.
     fn initial_step(&mut self, rhs: &dyn LaneRhs<M>, l: usize) -> bool {
         let y0: [f64; M] = std::array::from_fn(|i| lane(self.y[i], l));

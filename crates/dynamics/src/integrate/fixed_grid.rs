@@ -3,9 +3,10 @@
 
 use paritysim_error::{Error, Result};
 
+use super::switched::Branch;
 use super::{
-    IntegrationStats, MAX_SWITCHES, Method, Rhs, Sides, Sink, Stepper, Tolerances, budget, dop853,
-    dopri5, events, integration_error, sample_step,
+    IntegrationStats, MAX_SWITCHES, Method, Rhs, Sink, Stepper, Tolerances, budget, dop853, dopri5,
+    events, integration_error, sample_step,
 };
 
 /// A step grid: at least two finite, strictly increasing times.
@@ -150,11 +151,7 @@ pub(super) fn drive_on_grid_events<const M: usize, S: Stepper<M>>(
 ) -> Result<([f64; M], IntegrationStats)> {
     let mut stats = IntegrationStats::default();
     let mut y = y0;
-    let mut g0 = [0.0; MAX_SWITCHES];
-    let mut g1 = [0.0; MAX_SWITCHES];
-    rhs.switches(grid[0], &y, &mut g0)?;
-    let mut sides = Sides::of(&g0[..n_switches]);
-    rhs.set_sides(sides);
+    let mut branch = Branch::start(rhs, n_switches, grid[0], &y)?;
     let mut f0 = [0.0; M];
     let mut f1 = [0.0; M];
     rhs.eval(grid[0], &y, &mut f0)?;
@@ -178,89 +175,44 @@ pub(super) fn drive_on_grid_events<const M: usize, S: Stepper<M>>(
             }
             stepper.new_derivative(rhs, t_new, &mut f1)?;
             let y1 = *stepper.y1();
-            rhs.switches(t_new, &y1, &mut g1)?;
-            let mut event = None;
-            if sub < MAX_EVENTS_PER_STEP
-                && (0..n_switches).any(|i| events::crossed(sides, i, g1[i]))
-            {
-                stepper.prepare_dense(rhs, t, &y, &f0, &f1, h)?;
-                stats.dense_steps += 1;
-                let found = events::locate(
-                    stepper,
-                    rhs,
-                    n_switches,
-                    sides,
-                    t,
-                    h,
-                    &g0,
-                    &g1,
-                    events::GRID_ROOT_TOLERANCE,
-                )?;
+            let event = branch.first_switch(
+                stepper,
+                rhs,
+                (t, &y, &f0),
+                (t_new, &y1, &f1),
+                h,
+                sub < MAX_EVENTS_PER_STEP,
+                events::GRID_ROOT_TOLERANCE,
+                &mut stats,
+            )?;
+            if let Some(found) = &event {
                 if found.at_start && !redone {
                     // The step began on the wrong branch (a root at its start): redo it on
                     // the far side.
                     redone = true;
-                    sides = found.sides;
-                    rhs.set_sides(sides);
-                    rhs.eval(t, &y, &mut f0)?;
+                    branch.take(rhs, found.sides, t, &y, &mut f0)?;
                     continue;
                 }
-                event = Some(found);
             }
             if err > 1.0 {
                 stats.over_tolerance += 1;
             }
             stats.accepted += 1;
-            match event {
-                Some(ev) if !ev.at_start && ev.t < t_new => {
-                    // Cut at the root; the rest of the grid step on the new branch.
-                    sample_step(
-                        stepper,
-                        rhs,
-                        t,
-                        &y,
-                        &f0,
-                        &f1,
-                        h,
-                        (ev.t, &ev.y),
-                        true,
-                        times,
-                        &mut next,
-                        sink,
-                        &mut stats,
-                    )?;
-                    stats.events += 1;
-                    (y, t, g0, sides) = (ev.y, ev.t, ev.g, ev.sides);
-                    rhs.set_sides(sides);
-                    rhs.eval(t, &y, &mut f0)?;
-                    redone = false;
-                }
-                other => {
-                    sample_step(
-                        stepper,
-                        rhs,
-                        t,
-                        &y,
-                        &f0,
-                        &f1,
-                        h,
-                        (t_new, &y1),
-                        other.is_some(),
-                        times,
-                        &mut next,
-                        sink,
-                        &mut stats,
-                    )?;
-                    if let Some(ev) = other {
-                        // Not bracketed (grazing) or at the end: go on from the end's sides.
-                        sides = ev.sides;
-                        rhs.set_sides(sides);
-                        rhs.eval(t_new, &y1, &mut f1)?;
-                    }
-                    (y, f0, g0) = (y1, f1, g1);
-                    break;
-                }
+            let (_, cut) = branch.advance(
+                stepper,
+                rhs,
+                (&mut t, &mut y, &mut f0),
+                (t_new, &y1, &mut f1),
+                h,
+                event,
+                (times, &mut next, sink),
+                &mut stats,
+            )?;
+            if !cut {
+                break;
             }
+            // Cut at a root: the rest of the grid step on the new branch.
+            redone = false;
         }
     }
     Ok((y, stats))

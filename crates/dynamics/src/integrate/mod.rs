@@ -19,6 +19,7 @@ mod fixed_grid;
 mod runge_kutta;
 mod state;
 mod stepper;
+mod switched;
 mod system;
 #[cfg(test)]
 mod tests;

@@ -9,7 +9,7 @@ use super::needs::StrokeNeeds;
 /// What the metrics read at a sample of a stroke-plane device (§3.4: two wings with θ ≡ 0,
 /// φ and ψ free, the linear map), computed as far as the asked metrics need
 /// ([`StrokeNeeds`]) from one evaluation of its closed-form equations
-/// (`device/stroke_plane.rs`): the angles, the aerodynamic roll torques (the roll component
+/// (`device/stroke_plane/`): the angles, the aerodynamic roll torques (the roll component
 /// of `R6 τ⁶ = R_x(φ) R_z(ψ) τ⁶`), `q2`, the actuator force, the body reaction torques
 /// (`R6 (τ⁶ − (I ω̇ + ω × Iω))`, `ω̇ = φ̈ a + ψ̈ ẑ + J̇6 ṗ`) and the work integrals. The same
 /// numbers as a `Sample` (tested to 1e-12) without the general wing terms, the drivetrain

@@ -8,7 +8,6 @@ use paritysim_error::{Error, Result, bail, check_positive};
 use crate::device::Device;
 use crate::integrate::{Integrator, Method, OdeSystem, RungeKutta, State, budget};
 
-
 /// Options of [`periodic_orbit`] and [`floquet`]; deserialises from a partial record (missing
 /// fields take the defaults, unknown ones are rejected).
 #[derive(Clone, Debug, PartialEq, serde::Deserialize)]
