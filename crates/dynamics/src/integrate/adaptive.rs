@@ -69,32 +69,9 @@ pub(super) fn drive_method<const M: usize>(
     sink: &mut Sink<'_>,
     on_step: &mut dyn FnMut(f64, &State),
 ) -> Result<([f64; M], IntegrationStats)> {
-    match method {
-        Method::Dop853 => drive(
-            &mut dop853::Dop853::<M>::new(),
-            rhs,
-            tol,
-            max_steps,
-            t0,
-            y0,
-            t_end,
-            times,
-            sink,
-            on_step,
-        ),
-        Method::Dopri5 => drive(
-            &mut dopri5::Dopri5::<M>::new(),
-            rhs,
-            tol,
-            max_steps,
-            t0,
-            y0,
-            t_end,
-            times,
-            sink,
-            on_step,
-        ),
-    }
+    with_stepper!(method, M, |stepper| drive(
+        stepper, rhs, tol, max_steps, t0, y0, t_end, times, sink, on_step
+    ))
 }
 
 /// The integration loop shared by both pairs (Hairer's `DP86CO` / `DOPCOR`).

@@ -34,26 +34,9 @@ pub(crate) fn drive_method_on_grid<const M: usize>(
     times: &[f64],
     sink: &mut Sink<'_>,
 ) -> Result<([f64; M], IntegrationStats)> {
-    match method {
-        Method::Dop853 => drive_on_grid(
-            &mut dop853::Dop853::<M>::new(),
-            rhs,
-            tol,
-            grid,
-            y0,
-            times,
-            sink,
-        ),
-        Method::Dopri5 => drive_on_grid(
-            &mut dopri5::Dopri5::<M>::new(),
-            rhs,
-            tol,
-            grid,
-            y0,
-            times,
-            sink,
-        ),
-    }
+    with_stepper!(method, M, |stepper| drive_on_grid(
+        stepper, rhs, tol, grid, y0, times, sink
+    ))
 }
 
 /// Fixed steps between consecutive `grid` times; the error estimate is not used.

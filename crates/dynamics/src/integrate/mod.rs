@@ -9,6 +9,23 @@
 //! * `differential-equations` 0.7.0 is kept as a dev-dependency to cross-check steps; its
 //!   DOP853 interpolant is O(h⁵) (see docs/findings.md), ours is Hairer's CONTD8.
 
+/// Evaluates `$body` with `$stepper` a new stepper of `$method` on `$m` entries: one
+/// monomorphised copy of the body per pair (the loops are generic over [`Stepper`]).
+macro_rules! with_stepper {
+    ($method:expr, $m:ident, |$stepper:ident| $body:expr) => {
+        match $method {
+            Method::Dop853 => {
+                let $stepper = &mut dop853::Dop853::<$m>::new();
+                $body
+            }
+            Method::Dopri5 => {
+                let $stepper = &mut dopri5::Dopri5::<$m>::new();
+                $body
+            }
+        }
+    };
+}
+
 mod adaptive;
 mod array;
 pub mod budget;
