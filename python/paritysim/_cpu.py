@@ -52,6 +52,6 @@ def check() -> None:
         raise ImportError(
             f"paritysim's native extension is compiled for x86-64 with {', '.join(REQUIRED_X86_64)} "
             f"(.cargo/config.toml), and this CPU lacks {', '.join(missing)}. Build it for this "
-            f'machine with `RUSTFLAGS="" maturin develop --release` (or `RUSTFLAGS="" scripts/test`), '
-            f"then set {SKIP_ENV}=1."
+            f'machine with `RUSTFLAGS="" maturin develop --release` (or `RUSTFLAGS="" '
+            f'{SKIP_ENV}=1 scripts/test`) and keep {SKIP_ENV}=1 set when you import it.'
         )
