@@ -3,7 +3,7 @@
 use super::MAX_DOF;
 
 /// Integrator state: integrated coordinates and their rates (entries past the system's
-/// [`OdeSystem::n_active`] stay zero) and the two work integrals.
+/// [`OdeSystem::n_active`](super::OdeSystem::n_active) stay zero) and the two work integrals.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct State {
     /// Integrated coordinates (null-space coordinates `x`, drivetrain coordinates `q`, or `p`).

@@ -107,7 +107,7 @@ pub struct IntegrationStats {
     /// Fixed-grid steps whose local error estimate exceeded the tolerances (always 0 for
     /// adaptive runs, which reject such steps): 0 means the grid still suits the solution.
     pub over_tolerance: usize,
-    /// Accepted steps cut short at a root of a switching function (see [`ArraySystem`]).
+    /// Accepted steps cut short at a root of a switching function (see [`ArraySystem`](super::ArraySystem)).
     pub events: usize,
 }
 
@@ -120,10 +120,10 @@ pub trait Integrator: Send + Sync {
     /// `[t0, t_end]`) in order, and returns the state at `t_end`.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] for `t_end <= t0` or times out of order or range;
-    /// [`Error::Integration`] carrying the time and state of the failure (step-size underflow,
+    /// [`Error::InvalidParameter`](paritysim_error::Error::InvalidParameter) for `t_end <= t0` or times out of order or range;
+    /// [`Error::Integration`](paritysim_error::Error::Integration) carrying the time and state of the failure (step-size underflow,
     /// step limit, non-finite state, a model error raised inside the right-hand side, or the
-    /// wall-time budget of the thread's [`budget::Budget`]); [`Error::Cancelled`] when the
+    /// wall-time budget of the thread's [`budget::Budget`](super::budget::Budget)); [`Error::Cancelled`](paritysim_error::Error::Cancelled) when the
     /// budget's cancel flag is set; whatever `sink` returns.
     fn integrate_with(
         &self,

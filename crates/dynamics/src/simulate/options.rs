@@ -51,7 +51,7 @@ pub enum SteadyState {
     Shooting,
 }
 
-/// Options of [`simulate`].
+/// Options of [`simulate`](crate::simulate()).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SimulationOptions {
     /// Runge-Kutta pair.
@@ -96,9 +96,9 @@ pub struct SimulationOptions {
     /// ([`SimulationResult::step_grid`]), reused while its steps meet the tolerances.
     pub shooting_grid: Option<Vec<f64>>,
     /// Wall-clock budget of one run (ms; None: unlimited), checked inside integration: past
-    /// it the run fails with an [`Error::Integration`] naming `options.max_wall_ms`.
+    /// it the run fails with an [`Error::Integration`](paritysim_error::Error::Integration) naming `options.max_wall_ms`.
     pub max_wall_ms: Option<f64>,
-    /// Stops the run at the next budget check with [`Error::Cancelled`] once set (not part of
+    /// Stops the run at the next budget check with [`Error::Cancelled`](paritysim_error::Error::Cancelled) once set (not part of
     /// the spec: a sweep's or a caller's flag).
     pub cancel: Option<CancelFlag>,
 }
@@ -132,7 +132,7 @@ impl Default for SimulationOptions {
     }
 }
 
-/// The outcome of [`simulate`].
+/// The outcome of [`simulate`](crate::simulate()).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SimulationResult {
     /// The recorded window (only the columns of [`SimulationOptions::columns`]; no samples

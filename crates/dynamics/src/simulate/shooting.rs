@@ -1,4 +1,4 @@
-//! [`SteadyState::Shooting`] inside [`simulate`](super::simulate): warm-up, Newton on the frozen
+//! [`SteadyState::Shooting`](super::SteadyState::Shooting) inside [`simulate`](super::simulate): warm-up, Newton on the frozen
 //! grid of the period map, the recorded window from the last Newton period.
 
 use paritysim_error::Result;
@@ -12,7 +12,7 @@ use crate::trajectory::Trajectory;
 use super::{SimulationOptions, record_window, state_change};
 
 /// Shooting results whose largest Floquet multiplier exceeds `1 + UNSTABLE_MARGIN` are
-/// unstable orbits, which a run never settles on: [`SteadyState::Shooting`] then falls back to
+/// unstable orbits, which a run never settles on: [`SteadyState::Shooting`](super::SteadyState::Shooting) then falls back to
 /// the transient (the margin covers the error of the Broyden-updated Jacobian; K2 = 0's neutral
 /// multiplier 1 stays a steady state).
 pub const UNSTABLE_MARGIN: f64 = 1e-2;
@@ -46,7 +46,7 @@ pub(crate) struct ShotSteadyState {
     pub(super) recorded: Option<(Trajectory, Vec<(String, f64)>)>,
 }
 
-/// [`SteadyState::Shooting`]: warm-up (without a neighbour's Jacobian), then Newton on the
+/// [`SteadyState::Shooting`](super::SteadyState::Shooting): warm-up (without a neighbour's Jacobian), then Newton on the
 /// frozen grid ([`crate::grid_shooting`]) of the `orbit_cycles`-period map (2: a
 /// period-doubled orbit), with a warm-up first unless `settled` (a state the caller's
 /// transient settled); the final Newton period records the window when it is one plain orbit.

@@ -17,7 +17,7 @@ use super::{Perturbation, SimulationOptions, apply_kick, validate};
 /// `samples_per_cycle`; no transient, no columns.
 ///
 /// # Errors
-/// [`Error::Constraint`] without a periodic drive; integration errors.
+/// [`Error::Constraint`](paritysim_error::Error::Constraint) without a periodic drive; integration errors.
 pub fn orbit_metrics(
     device: &Device,
     state: &State,

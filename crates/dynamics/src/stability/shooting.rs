@@ -8,7 +8,7 @@ use paritysim_error::{Error, Result, bail, check_positive};
 use crate::device::Device;
 use crate::integrate::{Integrator, Method, OdeSystem, RungeKutta, State, budget};
 
-/// Options of [`periodic_orbit`] and [`floquet`]; deserialises from a partial record (missing
+/// Options of [`periodic_orbit`] and [`floquet`](super::floquet); deserialises from a partial record (missing
 /// fields take the defaults, unknown ones are rejected).
 #[derive(Clone, Debug, PartialEq, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -35,7 +35,7 @@ pub struct ShootingOptions {
     pub tol: f64,
     /// Relative finite-difference step (scaled by the size of the coordinates or of the rates)
     /// of the independent check of the monodromy
-    /// ([`NonlinearFloquet::monodromy_uncertainty`]); Newton and the multipliers use the
+    /// ([`NonlinearFloquet::monodromy_uncertainty`](super::NonlinearFloquet::monodromy_uncertainty)); Newton and the multipliers use the
     /// variational equations.
     pub fd_step: f64,
     /// Cycles of the fallback simulation when Newton fails.
