@@ -194,6 +194,17 @@ def test_failing_points_become_error_rows_and_the_rest_is_kept(parity: ps.Simula
     assert df["left_stroke_amplitude"][4] == base.metrics["left_stroke_amplitude"]
 
 
+def test_a_non_finite_value_is_an_error_row_naming_its_path(parity: ps.Simulation) -> None:
+    # Plain rows take json's C encoder; a NaN makes it refuse and the rows go through
+    # spec._dumps, which hands the value to Rust as text so the error names the field.
+    df = sweep(parity, {"drivetrain.balance_spring": [1.0, float("nan"), 2.0]}, metrics=["left_stroke_amplitude"], progress=False)
+    assert df["status"].to_list() == ["ok", "error", "ok"]
+    assert df["error_kind"][1] == "InvalidParameter" and "drivetrain.balance_spring" in df["error"][1]
+    plain = sweep(parity, {"drivetrain.balance_spring": [1.0, 2.0]}, metrics=["left_stroke_amplitude"], progress=False)
+    assert df["left_stroke_amplitude"].to_list()[::2] == plain["left_stroke_amplitude"].to_list()
+    assert json.loads(sweep_module._rows_json([(np.float64(0.5), 3)])) == [[0.5, 3]]
+
+
 def test_option_paths_run_per_point(parity: ps.Simulation) -> None:
     df = sweep(parity, {"options.max_cycles": [1, 2], "options.min_cycles": [1]}, options={"steady_tol": 1e-30}, progress=False)
     assert df["cycles_run"].to_list() == [1, 2]

@@ -194,7 +194,17 @@ class _Chunk:
 
 def _prepare(chunk: _Chunk) -> _core.SweepRun:
     """The run of a chunk (paths resolved in Rust; points are built on the engine's pool)."""
-    return _core.SweepRun(chunk.spec, list(chunk.names), _dumps([list(r) for r in chunk.rows]), chunk.metrics, chunk.keep_cycle, chunk.threads)
+    return _core.SweepRun(chunk.spec, list(chunk.names), _rows_json(chunk.rows), chunk.metrics, chunk.keep_cycle, chunk.threads)
+
+
+def _rows_json(rows: Sequence[Sequence[Any]]) -> str:
+    """The rows as JSON. Plain Python values (what ``DataFrame.rows()`` gives) take the C
+    encoder directly; anything else (numpy scalars, NaN, dataclasses) goes through
+    ``spec._dumps``, which names non-finite values for Rust's error message."""
+    try:
+        return json.dumps(rows, allow_nan=False)
+    except (TypeError, ValueError):
+        return _dumps([list(r) for r in rows])
 
 
 _RESULT_FIELDS = ("finished", "ok", "metrics", "converged", "cycles_run", "orbit_cycles", "error", "error_kind", "cycle")
@@ -256,26 +266,25 @@ def _frame(raw: dict[str, Any], params: pl.DataFrame, points: Sequence[int], met
     ok = np.asarray(raw["ok"], dtype=bool)
     idx = np.flatnonzero(finished)
     m = np.asarray(raw["metrics"])
+    every = idx.size == finished.size  # all finished (no gathers needed)
     cols: dict[str, pl.Series] = {"point": pl.Series("point", np.asarray(points, dtype=np.int64)[idx])}
-    taken = params[idx.tolist()] if params.width else None
+    taken = (params if every else params[idx.tolist()]) if params.width else None
     if taken is not None:
         for name in taken.columns:
             cols[name] = taken[name]
     ok_f = ok[idx]
+    failed = np.flatnonzero(~ok_f)
     for k, name in enumerate(metrics):
         values = m[idx, k].astype(np.float64)
         # failed points have no metrics, and undefined metrics (NaN from the engine, e.g. the
         # phase lag of a wing that does not rotate) are null too: never a silent NaN
-        cols[name] = pl.Series(name, values, dtype=pl.Float64, nan_to_null=True).scatter(np.flatnonzero(~ok_f), None)
-    converged = np.asarray(raw["converged"], dtype=bool)[idx]
-    cycles = np.asarray(raw["cycles_run"], dtype=np.int64)[idx]
-    cols["converged"] = pl.Series("converged", [bool(c) if o else None for c, o in zip(converged, ok_f, strict=True)], dtype=pl.Boolean)
-    cols["cycles_run"] = pl.Series("cycles_run", [int(c) if o else None for c, o in zip(cycles, ok_f, strict=True)], dtype=pl.Int64)
-    orbit = np.asarray(raw["orbit_cycles"], dtype=np.int64)[idx]
-    cols["orbit_cycles"] = pl.Series("orbit_cycles", [int(c) if o else None for c, o in zip(orbit, ok_f, strict=True)], dtype=pl.Int64)
-    cols["status"] = pl.Series("status", np.where(ok_f, "ok", "error").tolist(), dtype=pl.String)
-    errors = [raw["error"][i] for i in idx]
-    kinds = [raw["error_kind"][i] for i in idx]
+        cols[name] = pl.Series(name, values, dtype=pl.Float64, nan_to_null=True).scatter(failed, None)
+    # Failed points have no convergence, cycle count or orbit length: null, not a number.
+    for name, dtype, np_dtype in (("converged", pl.Boolean, bool), ("cycles_run", pl.Int64, np.int64), ("orbit_cycles", pl.Int64, np.int64)):
+        cols[name] = pl.Series(name, np.asarray(raw[name], dtype=np_dtype)[idx], dtype=dtype).scatter(failed, None)
+    cols["status"] = pl.Series("status", np.where(ok_f, "ok", "error"), dtype=pl.String)
+    errors = list(raw["error"]) if every else [raw["error"][i] for i in idx]
+    kinds = list(raw["error_kind"]) if every else [raw["error_kind"][i] for i in idx]
     cols["error"] = pl.Series("error", errors, dtype=pl.String)
     cols["error_kind"] = pl.Series("error_kind", kinds, dtype=pl.String)
     if cycle_columns:
@@ -489,7 +498,13 @@ def sweep(
     def frame(points: list[int], raw: dict[str, Any] | BaseException) -> pl.DataFrame:
         if isinstance(raw, BaseException):
             raw = _failed_raw(len(points), len(metric_names), cycle_columns, raw)
-        return _frame(raw, table[points] if table.width else table, points, metric_names, cycle_columns)
+        if not table.width:
+            params = table
+        elif points and points == list(range(points[0], points[0] + len(points))):  # local runs: a slice
+            params = table.slice(points[0], len(points))
+        else:
+            params = table[points]
+        return _frame(raw, params, points, metric_names, cycle_columns)
 
     from tqdm.auto import tqdm  # type: ignore[import-untyped]
 
