@@ -111,6 +111,8 @@ STATUS_COLUMNS = ("converged", "cycles_run", "orbit_cycles", "status", "error", 
 
 #: Points per thread in a local chunk of a metrics-only sweep (see ``sweep``'s ``chunk_size``).
 _LOCAL_CHUNK_PER_THREAD = 1024
+#: The most points of such a chunk on a many-core machine (about 160 MB of built devices).
+_LOCAL_CHUNK_MAX = 16384
 _METADATA_KEY = "paritysim.sweep"
 _FORMAT = 1
 
@@ -420,8 +422,9 @@ def sweep(
         Any ``concurrent.futures.Executor`` (e.g. ``dask.distributed.Client.get_executor()``);
         chunks of points are submitted to it.
     chunk_size:
-        Points per chunk (default locally: 1024 per thread, 256 with ``checkpoint`` or
-        ``keep_cycle``; with an executor about 16 chunks per worker, at most 256).
+        Points per chunk (default locally: 1024 per thread up to 16384, 256 per thread with
+        ``checkpoint`` or ``keep_cycle``; with an executor about 16 chunks per worker, at
+        most 256).
     options:
         Overrides of ``spec.options`` for every point, e.g. ``{"max_cycles": 50}``.
     labels:
@@ -492,7 +495,10 @@ def sweep(
             # sweeps take few, large chunks (32 × 32 grid on 2 threads: 0.82× the time of
             # 512-point chunks; 100,000 points: +20 MB peak). Checkpoints flush per chunk and
             # kept cycles are large, so those keep smaller chunks.
+            # A chunk's points are built as devices before it runs (~10 kB each): at most
+            # _LOCAL_CHUNK_MAX points, whatever the thread count.
             chunk_size = (256 if checkpoint is not None or cycle_columns else _LOCAL_CHUNK_PER_THREAD) * n_threads
+            chunk_size = min(chunk_size, max(256 * n_threads, _LOCAL_CHUNK_MAX))
         else:
             workers = _executor_workers(executor)
             chunk_size = max(1, min(256, math.ceil(len(todo) / (16 * workers)))) if todo else 1
