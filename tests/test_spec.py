@@ -201,3 +201,23 @@ def test_old_spellings_still_load_with_a_deprecation_warning() -> None:
         d = _built_in_python().to_dict()
         d["wings"][0]["tunable_hinge"] = {"k0": 1.0, "k1": 0.5, "k2": 2.0}
         assert ps.Simulation.from_dict(d) == _built_in_python()
+
+
+def test_spec_json_equals_the_asdict_formulation() -> None:
+    """``Simulation.to_json`` walks the fields in one pass; it must write exactly what
+    ``json.dumps(_plain(_strip_none(dataclasses.asdict(spec))))`` writes (the definition it
+    replaced), for every shipped device and for Python-built values: numpy scalars, a NaN
+    (written as text so Rust can name the field), nested tuples."""
+    import numpy as np
+
+    from paritysim import spec as spec_module
+
+    def by_asdict(s: ps.Simulation) -> str:
+        return json.dumps(spec_module._plain(spec_module._strip_none(dataclasses.asdict(s))), allow_nan=False)
+
+    specs = [ps.devices.load(name) for name in ps.devices.list()]
+    base = specs[0]
+    specs.append(base.replace(options=dataclasses.replace(base.options, rtol=np.float64(1e-7), max_cycles=np.int64(7), steady_tol=float("nan"))))
+    for s in specs:
+        assert s.to_json() == by_asdict(s)
+    assert '"steady_tol": "nan"' in specs[-1].to_json()
