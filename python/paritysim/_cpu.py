@@ -1,7 +1,8 @@
 """Check the CPU before the native extension loads.
 
 On x86-64 the extension is compiled with AVX and AVX2 (``.cargo/config.toml``: the SIMD lanes
-run 4 × f64 in one register, measured 0.72× the time of a baseline build, results bit-identical).
+run 4 × f64 in one register, 0.68× the instructions of a baseline build, results bit-identical;
+docs/findings.md §18).
 A CPU without them would stop the interpreter with an illegal instruction inside the extension;
 this check turns that into an ``ImportError`` that says what is missing and how to build for
 such a machine. The same check as polars' (``POLARS_SKIP_CPU_CHECK``).

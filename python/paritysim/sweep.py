@@ -208,7 +208,7 @@ def _rows_json(rows: Sequence[Sequence[Any]]) -> str:
     try:
         return json.dumps(rows, allow_nan=False)
     except (TypeError, ValueError):
-        return _dumps([list(r) for r in rows])
+        return _dumps(rows)
 
 
 _RESULT_FIELDS = ("finished", "ok", "metrics", "converged", "cycles_run", "orbit_cycles", "error", "error_kind", "cycle")
@@ -491,14 +491,14 @@ def sweep(
 
     if chunk_size is None:
         if executor is None:
-            # Every chunk ends with lanes idling while its last chains finish: metrics-only
-            # sweeps take few, large chunks (32 × 32 grid on 2 threads: 0.82× the time of
-            # 512-point chunks; 100,000 points: +20 MB peak). Checkpoints flush per chunk and
-            # kept cycles are large, so those keep smaller chunks.
-            # A chunk's points are built as devices before it runs (~10 kB each): at most
-            # _LOCAL_CHUNK_MAX points, whatever the thread count.
-            chunk_size = (256 if checkpoint is not None or cycle_columns else _LOCAL_CHUNK_PER_THREAD) * n_threads
-            chunk_size = min(chunk_size, max(256 * n_threads, _LOCAL_CHUNK_MAX))
+            if checkpoint is not None or cycle_columns:
+                # Checkpoints flush per chunk, and kept cycles are large rows.
+                chunk_size = 256 * n_threads
+            else:
+                # Every chunk ends with lanes idling while its last chains finish, so few, large
+                # chunks (docs/findings.md §19); a chunk's points are built as devices before it
+                # runs, hence the cap.
+                chunk_size = min(_LOCAL_CHUNK_PER_THREAD * n_threads, max(256 * n_threads, _LOCAL_CHUNK_MAX))
         else:
             workers = _executor_workers(executor)
             chunk_size = max(1, min(256, math.ceil(len(todo) / (16 * workers)))) if todo else 1
