@@ -18,6 +18,7 @@ use crate::wing::{Wing, WingTerms};
 
 mod drivetrain_coordinates;
 mod drivetrain_inverse;
+mod free_deviation;
 pub(crate) mod linear_map_jacobian;
 mod null_space;
 mod ode_system;
@@ -112,6 +113,9 @@ pub struct Device {
     linear_jacobian: Option<Matrix2<f64>>,
     /// The lean right-hand side of a stroke-plane device (§3.4), when it applies.
     stroke_plane_rhs: Option<stroke_plane::StrokePlane>,
+    /// The lean right-hand side of a free-deviation device (§2.5 Lift / Dual PARITY), when it
+    /// applies.
+    free_deviation_rhs: Option<free_deviation::FreeDeviation>,
     /// Switching functions of the right-hand side (three per wing with blade elements whose
     /// `ω` has a closed form; see [`Self::blade_switching_functions`]).
     n_switches: usize,
@@ -261,9 +265,11 @@ impl Device {
             free_deviation,
             linear_jacobian,
             stroke_plane_rhs: None,
+            free_deviation_rhs: None,
             n_switches: 0,
         };
         device.stroke_plane_rhs = stroke_plane::StrokePlane::of(&device);
+        device.free_deviation_rhs = free_deviation::FreeDeviation::of(&device);
         device.n_switches = device.blade_switches();
         Ok(device)
     }
@@ -571,6 +577,9 @@ impl Device {
         }
         if let Some(lean) = &self.stroke_plane_rhs {
             return self.rhs_stroke_plane(lean, t, y, None, dydt);
+        }
+        if let Some(lean) = &self.free_deviation_rhs {
+            return self.rhs_free_deviation(lean, t, y, None, dydt);
         }
         self.rhs_null_space(t, y, dydt)
     }

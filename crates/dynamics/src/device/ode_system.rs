@@ -43,9 +43,10 @@ impl crate::integrate::OdeSystem for Device {
     ) -> Result<()> {
         match &self.stroke_plane_rhs {
             Some(lean) => self.rhs_stroke_plane(lean, t, y, Some(branches(sides)), dydt),
-            None if self.n_switches > 0 => {
-                self.rhs_null_space_on(t, y, Some(branches(sides)), dydt)
-            }
+            None if self.n_switches > 0 => match &self.free_deviation_rhs {
+                Some(lean) => self.rhs_free_deviation(lean, t, y, Some(branches(sides)), dydt),
+                None => self.rhs_null_space_on(t, y, Some(branches(sides)), dydt),
+            },
             None => Device::rhs(self, t, y, dydt),
         }
     }

@@ -5,6 +5,32 @@ use paritysim_aero::Branch;
 
 use super::{Wing, WingTerms};
 
+/// The pose and velocity terms of a free-deviation wing ([`Wing::free_deviation_kinematics`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct FreeDeviationKinematics {
+    /// `(sin φ, cos φ)` and `(sin θ, cos θ)`.
+    pub(crate) sin_cos_phi: (f64, f64),
+    pub(crate) sin_cos_theta: (f64, f64),
+    /// `J6` (A.9), `ω⁶ = J6 ṗ`, `J̇6 ṗ` and `R_6^1`.
+    pub(crate) j6: Matrix3<f64>,
+    pub(crate) omega: Vector3<f64>,
+    pub(crate) jdot_pdot: Vector3<f64>,
+    pub(crate) rotation: Matrix3<f64>,
+}
+
+/// The dynamic terms of a free-deviation wing ([`Wing::free_deviation_dynamics`]), as in
+/// [`WingTerms`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct FreeDeviationDynamics {
+    pub(crate) mass: Matrix3<f64>,
+    pub(crate) coriolis: Vector3<f64>,
+    pub(crate) spring: Vector3<f64>,
+    pub(crate) aero: Vector3<f64>,
+    pub(crate) aero_frame6: Vector3<f64>,
+    pub(crate) i_omega: Vector3<f64>,
+    pub(crate) potential: f64,
+}
+
 impl Wing {
     /// [`Self::terms`] with the deviation θ free on an α2 = 90°, α3 = 0 shoulder (the Table 3.3
     /// wings' and the §2.5 Lift / Dual PARITY devices'), in closed form: the closure
@@ -39,6 +65,34 @@ impl Wing {
         p_dot: &Vector3<f64>,
         branch: Option<Branch>,
     ) -> Option<WingTerms> {
+        let k = self.free_deviation_kinematics(p, p_dot)?;
+        let d = self.free_deviation_dynamics(p, p_dot, &k, branch);
+        let (_, cp) = k.sin_cos_phi;
+        let (st, ct) = k.sin_cos_theta;
+        Some(WingTerms {
+            mass: d.mass,
+            coriolis: d.coriolis,
+            spring: d.spring,
+            aero: d.aero,
+            aero_frame6: d.aero_frame6,
+            j6: k.j6,
+            omega: k.omega,
+            jdot_pdot: k.jdot_pdot,
+            rotation: k.rotation,
+            theta_w: (cp * st).atan2(ct),
+            potential: d.potential,
+            kinetic: 0.5 * k.omega.dot(&d.i_omega),
+        })
+    }
+
+    /// The pose and velocity terms of [`Self::free_deviation_terms`]: `J6`, `ω⁶`, `J̇6 ṗ`,
+    /// `R_6^1` (see there). `None` where the closed form does not apply.
+    #[inline(always)]
+    pub(crate) fn free_deviation_kinematics(
+        &self,
+        p: &Vector3<f64>,
+        p_dot: &Vector3<f64>,
+    ) -> Option<FreeDeviationKinematics> {
         let (phi, theta, psi) = (p.x, p.y, p.z);
         if !(phi.is_finite() && theta.is_finite() && psi.is_finite()) {
             return None;
@@ -52,7 +106,6 @@ impl Wing {
         }
         let root = d.sqrt();
         let (s5, c5) = (cp * st / root, ct / root);
-        let g5 = (cp * st).atan2(ct);
         let d_sq = d * d;
         let g5_phi = -sp * st * ct / d;
         let g5_theta = cp / d;
@@ -81,10 +134,31 @@ impl Wing {
             + Vector3::x().cross(&y3) * (g5_dot * p_dot.x)
             + omega4.cross(&z4) * p_dot.z;
         let jdot_pdot = r61.transpose() * accel_ground;
+        Some(FreeDeviationKinematics {
+            sin_cos_phi: (sp, cp),
+            sin_cos_theta: (st, ct),
+            j6,
+            omega,
+            jdot_pdot,
+            rotation: r61,
+        })
+    }
 
+    /// The dynamic terms of [`Self::free_deviation_terms`] at the pose `k` of `(p, ṗ)`: what
+    /// the lean right-hand side of the §2.5 devices (`device/free_deviation.rs`) reads.
+    #[inline(always)]
+    pub(crate) fn free_deviation_dynamics(
+        &self,
+        p: &Vector3<f64>,
+        p_dot: &Vector3<f64>,
+        k: &FreeDeviationKinematics,
+        branch: Option<Branch>,
+    ) -> FreeDeviationDynamics {
+        let (phi, theta, psi) = (p.x, p.y, p.z);
+        let (j6, omega) = (&k.j6, &k.omega);
         let i_omega = self.inertia * omega;
         let mass = j6.transpose() * self.inertia * j6;
-        let coriolis = j6.transpose() * (self.inertia * jdot_pdot + omega.cross(&i_omega));
+        let coriolis = j6.transpose() * (self.inertia * k.jdot_pdot + omega.cross(&i_omega));
 
         // A.6 with springs on joints 1, 4, 6 only.
         let s = &self.springs;
@@ -92,21 +166,16 @@ impl Wing {
         let mut potential = s[0].energy(phi) + s[3].energy(theta) + s[5].energy(psi);
         self.add_tunable_hinge(theta, psi, &mut spring, &mut potential);
 
-        let aero_frame6 = self.aero.torque(p_dot, &omega, &r61, branch);
-        Some(WingTerms {
+        let aero_frame6 = self.aero.torque(p_dot, omega, &k.rotation, branch);
+        FreeDeviationDynamics {
             mass,
             coriolis,
             spring,
             aero: j6.transpose() * aero_frame6,
             aero_frame6,
-            j6,
-            omega,
-            jdot_pdot,
-            rotation: r61,
-            theta_w: g5,
+            i_omega,
             potential,
-            kinetic: 0.5 * omega.dot(&i_omega),
-        })
+        }
     }
 
     /// `ω⁶ = J6 ṗ` of [`Self::free_deviation_terms`] alone (the same operations: the blade

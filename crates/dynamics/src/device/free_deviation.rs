@@ -1,0 +1,149 @@
+//! The lean right-hand side of the §2.5 free-deviation devices (Lift and Dual PARITY: two wings
+//! with θ free on α2 = 90°, α3 = 0 shoulders, on the linear map of eq. 2.15): eq. 3.20 in
+//! null-space coordinates with each wing's closed-form terms ([`crate::Wing`]'s
+//! `free_deviation_dynamics`), assembled directly on the `n` integrated coordinates.
+//!
+//! The general path (`null_space.rs`) computes the same equations through the 6-vector
+//! `p̈ = N (Nᵀ M N)⁻¹ Nᵀ f` and then `ẍ = Nᵀ p̈`; here `ẍ = (Nᵀ M N)⁻¹ Nᵀ f` (the two agree
+//! because `N` has orthonormal columns), the coordinates use only the basis' `n` columns, the
+//! drivetrain's inverse kinematics are the constant `J⁻¹` of the linear map (`q = J⁻¹ φ`,
+//! `τ_φ = J⁻ᵀ Q`, as `stroke_plane/` does) instead of an LU solve and a Newton correction per
+//! call, and the terms that only recordings read (the wing deviation's `atan2`, the kinetic
+//! energy, the full `Evaluation`) are not formed. Tested against the general path to 1e-12
+//! (`device/free_deviation/tests.rs`); the variational equations differentiate it.
+
+use nalgebra::{Matrix2, SMatrix, SVector, Vector2, Vector3};
+use paritysim_aero::Branch;
+use paritysim_error::{Error, Result};
+
+use super::{Device, Formulation};
+use crate::integrate::State;
+
+#[cfg(test)]
+mod tests;
+
+/// The constants of [`Device::rhs_free_deviation`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct FreeDeviation {
+    /// `J⁻¹` and `J⁻ᵀ` of the linear map.
+    inverse: Matrix2<f64>,
+    inverse_transpose: Matrix2<f64>,
+}
+
+impl FreeDeviation {
+    /// The lean model when `device` applies: null-space coordinates, two wings with the
+    /// closed-form free deviation, the 2-DOF linear map.
+    pub(super) fn of(device: &Device) -> Option<Self> {
+        let applies = device.formulation == Formulation::NullSpace
+            && device.n_wings() == 2
+            && device.free_deviation == [true, true]
+            && device.stroke_only.is_none();
+        let jacobian = device.linear_jacobian.filter(|_| applies)?;
+        let inverse = jacobian.try_inverse()?;
+        Some(Self {
+            inverse,
+            inverse_transpose: inverse.transpose(),
+        })
+    }
+}
+
+impl Device {
+    /// The right-hand side of a free-deviation device ([`FreeDeviation`]); the blade elements
+    /// on `branches` when given (event location), else on the state's own sides.
+    ///
+    /// # Errors
+    /// As the general path, which takes over (and names the cause) for a drivetrain
+    /// coordinate beyond the linkage's plausible range or a pose where the closed form does
+    /// not apply; a reduced mass matrix that is not positive definite.
+    #[inline]
+    pub(super) fn rhs_free_deviation(
+        &self,
+        lean: &FreeDeviation,
+        t: f64,
+        y: &State,
+        branches: Option<[Branch; 2]>,
+        dydt: &mut State,
+    ) -> Result<()> {
+        let done = match self.n_dof {
+            1 => self.free_deviation_step::<1>(lean, t, y, branches, dydt),
+            2 => self.free_deviation_step::<2>(lean, t, y, branches, dydt),
+            3 => self.free_deviation_step::<3>(lean, t, y, branches, dydt),
+            4 => self.free_deviation_step::<4>(lean, t, y, branches, dydt),
+            5 => self.free_deviation_step::<5>(lean, t, y, branches, dydt),
+            _ => self.free_deviation_step::<6>(lean, t, y, branches, dydt),
+        }?;
+        if done {
+            Ok(())
+        } else {
+            self.rhs_null_space_on(t, y, branches, dydt)
+        }
+    }
+
+    /// The equations of [`Self::rhs_free_deviation`] on `N` coordinates into `dydt`;
+    /// `Ok(false)` where the general path must take over (see there).
+    #[inline(always)]
+    fn free_deviation_step<const N: usize>(
+        &self,
+        lean: &FreeDeviation,
+        t: f64,
+        y: &State,
+        branches: Option<[Branch; 2]>,
+        dydt: &mut State,
+    ) -> Result<bool> {
+        // p = offset + N x, ṗ = N ẋ on the basis' first N columns.
+        let mut p = [0.0; 6];
+        let mut p_dot = [0.0; 6];
+        for i in 0..6 {
+            let (mut v, mut r) = (self.offset[i], 0.0);
+            for k in 0..N {
+                v += self.basis[(i, k)] * y.coords[k];
+                r += self.basis[(i, k)] * y.rates[k];
+            }
+            p[i] = v;
+            p_dot[i] = r;
+        }
+        let q = lean.inverse * Vector2::new(p[0], p[3]);
+        if !(q.x.abs() <= paritysim_error::plausible::OFFSET_MM
+            && q.y.abs() <= paritysim_error::plausible::ANGLE_RAD)
+        {
+            return Ok(false);
+        }
+        let q_dot = lean.inverse * Vector2::new(p_dot[0], p_dot[3]);
+        let (force, load, _) = self.drive_load(t, &q);
+        let drive_torque = lean.inverse_transpose * load;
+
+        let mut reduced_mass = SMatrix::<f64, N, N>::zeros();
+        let mut reduced_force = SVector::<f64, N>::zeros();
+        let mut aero_power = 0.0;
+        for (w, wing) in self.spec.wings.iter().enumerate() {
+            let k = 3 * w;
+            let pw = Vector3::new(p[k], p[k + 1], p[k + 2]);
+            let vw = Vector3::new(p_dot[k], p_dot[k + 1], p_dot[k + 2]);
+            let Some(kinematics) = wing.free_deviation_kinematics(&pw, &vw) else {
+                return Ok(false);
+            };
+            let terms = wing.free_deviation_dynamics(&pw, &vw, &kinematics, branches.map(|b| b[w]));
+            let mut f = terms.aero - terms.coriolis - terms.spring;
+            f.x += drive_torque[w];
+            aero_power += terms.aero.dot(&vw);
+            let basis_w: SMatrix<f64, 3, N> = self.basis.fixed_view::<3, N>(k, 0).into_owned();
+            reduced_mass += basis_w.transpose() * (terms.mass * basis_w);
+            reduced_force += basis_w.transpose() * f;
+        }
+        let Some(cholesky) = reduced_mass.cholesky() else {
+            return Err(Error::Singular(format!(
+                "reduced mass matrix is not positive definite at x = {:?}",
+                &y.coords[..N]
+            )));
+        };
+        let x_ddot = cholesky.solve(&reduced_force);
+        *dydt = State::default();
+        for i in 0..N {
+            dydt.coords[i] = y.rates[i];
+            dydt.rates[i] = x_ddot[i];
+        }
+        dydt.work_actuator = self.actuator_power(t, force, &q_dot);
+        dydt.work_aero = aero_power;
+        Ok(true)
+    }
+}
