@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import os
 import re
+import subprocess
+import sys
 import tomllib
 from pathlib import Path
 
@@ -55,3 +58,41 @@ def test_other_machines_and_unknown_features_pass():
 def test_this_machine_reports_the_features_numpy_sees():
     features = _cpu.cpu_features()
     assert features is not None and "AVX2" in features
+
+
+# A process whose CPU (as numpy reports it) lacks AVX2, then the command line started in it.
+_NO_AVX2 = """
+import sys
+from numpy._core import _multiarray_umath as umath
+umath.__cpu_features__["AVX2"] = False
+sys.argv = [{argv0!r}, "--help"]
+{start}
+"""
+
+
+@pytest.mark.skipif(_cpu.platform.machine().lower() not in ("x86_64", "amd64"), reason="x86-64 only")
+@pytest.mark.parametrize(
+    ("argv0", "start", "orig"),
+    [
+        ("/venv/bin/paritysim", "from paritysim.cli import main; raise SystemExit(main())", []),
+        ("-m", "import runpy; runpy.run_module('paritysim', run_name='__main__')", ["-m", "paritysim"]),
+    ],
+    ids=["console-script", "python-m"],
+)
+def test_the_command_line_refuses_an_unsupported_cpu_in_one_line(argv0, start, orig):
+    env = {k: v for k, v in os.environ.items() if k != _cpu.SKIP_ENV}
+    code = _NO_AVX2.format(argv0=argv0, start=start)
+    if orig:  # what ``python -m paritysim`` leaves in sys.orig_argv
+        code = f"import sys; sys.orig_argv = [sys.executable, *{orig!r}]\n" + code
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=120)
+    assert run.returncode == 1, run.stderr
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in run.stderr, run.stderr
+    assert lines[0].startswith("paritysim: error: paritysim's native extension is compiled") and "lacks avx2" in lines[0]
+
+
+def test_only_the_command_line_counts_as_the_command_line():
+    assert _cpu.running_cli(["/x/bin/paritysim", "sweep"], [])
+    assert _cpu.running_cli(["-m"], ["/usr/bin/python3", "-m", "paritysim", "trials"])
+    assert not _cpu.running_cli(["-c"], ["python", "-c", "import paritysim"])
+    assert not _cpu.running_cli(["/x/bin/pytest"], ["python", "-m", "pytest"])

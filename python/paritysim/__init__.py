@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 from . import _cpu
 
-_cpu.check()  # before the extension loads: it is compiled for AVX2 on x86-64 (.cargo/config.toml)
+_cpu.check_or_exit()  # before the extension loads: it is compiled for AVX2 on x86-64 (.cargo/config.toml)
 
 from ._core import (  # noqa: E402
     CancelledError,

@@ -12,7 +12,8 @@ from __future__ import annotations
 
 import os
 import platform
-from collections.abc import Mapping
+import sys
+from collections.abc import Mapping, Sequence
 
 #: What the default build requires on x86-64, as ``.cargo/config.toml`` enables it (a test keeps
 #: the two equal, and checks that the built extension needs nothing beyond this list).
@@ -56,3 +57,31 @@ def check() -> None:
             f'machine with `RUSTFLAGS="" maturin develop --release` (or `RUSTFLAGS="" '
             f'{SKIP_ENV}=1 scripts/test`) and keep {SKIP_ENV}=1 set when you import it.'
         )
+
+
+def running_cli(argv: Sequence[str] | None = None, orig_argv: Sequence[str] | None = None) -> bool:
+    """Whether this process is the ``paritysim`` command line (the console script, or
+    ``python -m paritysim``), whose contract is one line on stderr and never a traceback."""
+    argv = sys.argv if argv is None else argv
+    orig_argv = getattr(sys, "orig_argv", []) if orig_argv is None else orig_argv
+    if argv and os.path.basename(argv[0]) in ("paritysim", "paritysim.exe"):
+        return True
+    # ``python -m paritysim``: the package is imported while sys.argv[0] is still "-m".
+    return any(a == "-m" and b in ("paritysim", "paritysim.cli") for a, b in zip(orig_argv, orig_argv[1:]))
+
+
+def check_or_exit() -> None:
+    """:func:`check`, except that the command line prints the refusal as its one error line and
+    exits with status 1 instead of an import traceback.
+
+    Raises:
+        ImportError: as :func:`check`, outside the command line.
+        SystemExit: status 1, in the command line.
+    """
+    try:
+        check()
+    except ImportError as refusal:
+        if not running_cli():
+            raise
+        print(f"paritysim: error: {refusal}", file=sys.stderr)
+        raise SystemExit(1) from None
