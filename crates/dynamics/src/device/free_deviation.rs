@@ -64,23 +64,25 @@ impl Device {
         branches: Option<[Branch; 2]>,
         dydt: &mut State,
     ) -> Result<()> {
-        let done = match self.n_dof {
-            1 => self.free_deviation_step::<1>(lean, t, y, branches, dydt),
-            2 => self.free_deviation_step::<2>(lean, t, y, branches, dydt),
-            3 => self.free_deviation_step::<3>(lean, t, y, branches, dydt),
-            4 => self.free_deviation_step::<4>(lean, t, y, branches, dydt),
-            5 => self.free_deviation_step::<5>(lean, t, y, branches, dydt),
-            _ => self.free_deviation_step::<6>(lean, t, y, branches, dydt),
+        let lean_rhs = match self.n_dof {
+            1 => self.free_deviation_step::<1>(lean, t, y, branches),
+            2 => self.free_deviation_step::<2>(lean, t, y, branches),
+            3 => self.free_deviation_step::<3>(lean, t, y, branches),
+            4 => self.free_deviation_step::<4>(lean, t, y, branches),
+            5 => self.free_deviation_step::<5>(lean, t, y, branches),
+            _ => self.free_deviation_step::<6>(lean, t, y, branches),
         }?;
-        if done {
-            Ok(())
-        } else {
-            self.rhs_null_space_on(t, y, branches, dydt)
+        match lean_rhs {
+            Some(derivative) => {
+                *dydt = derivative;
+                Ok(())
+            }
+            None => self.rhs_null_space_on(t, y, branches, dydt),
         }
     }
 
-    /// The equations of [`Self::rhs_free_deviation`] on `N` coordinates into `dydt`;
-    /// `Ok(false)` where the general path must take over (see there).
+    /// The derivative of [`Self::rhs_free_deviation`] on `N` coordinates; `Ok(None)` where
+    /// the general path must take over (see there).
     #[inline(always)]
     fn free_deviation_step<const N: usize>(
         &self,
@@ -88,8 +90,7 @@ impl Device {
         t: f64,
         y: &State,
         branches: Option<[Branch; 2]>,
-        dydt: &mut State,
-    ) -> Result<bool> {
+    ) -> Result<Option<State>> {
         // p = offset + N x, ṗ = N ẋ on the basis' first N columns.
         let mut p = [0.0; 6];
         let mut p_dot = [0.0; 6];
@@ -106,7 +107,7 @@ impl Device {
         if !(q.x.abs() <= paritysim_error::plausible::OFFSET_MM
             && q.y.abs() <= paritysim_error::plausible::ANGLE_RAD)
         {
-            return Ok(false);
+            return Ok(None);
         }
         let q_dot = lean.inverse * Vector2::new(p_dot[0], p_dot[3]);
         let (force, load, _) = self.drive_load(t, &q);
@@ -120,7 +121,7 @@ impl Device {
             let pw = Vector3::new(p[k], p[k + 1], p[k + 2]);
             let vw = Vector3::new(p_dot[k], p_dot[k + 1], p_dot[k + 2]);
             let Some(kinematics) = wing.free_deviation_kinematics(&pw, &vw) else {
-                return Ok(false);
+                return Ok(None);
             };
             let terms = wing.free_deviation_dynamics(&pw, &vw, &kinematics, branches.map(|b| b[w]));
             let mut f = terms.aero - terms.coriolis - terms.spring;
@@ -137,13 +138,13 @@ impl Device {
             )));
         };
         let x_ddot = cholesky.solve(&reduced_force);
-        *dydt = State::default();
+        let mut dydt = State::default();
         for i in 0..N {
             dydt.coords[i] = y.rates[i];
             dydt.rates[i] = x_ddot[i];
         }
         dydt.work_actuator = self.actuator_power(t, force, &q_dot);
         dydt.work_aero = aero_power;
-        Ok(true)
+        Ok(Some(dydt))
     }
 }

@@ -235,7 +235,27 @@ pub(super) mod tests {
         }
     }
 
-    fn relative_difference(a: &State, b: &State) -> f64 {
+    /// A lean right-hand side hands a drivetrain coordinate far beyond the linkage's plausible
+    /// range to the general path, whose error names it: `d`'s right-hand side fails with the
+    /// general path's error.
+    pub(in crate::device) fn assert_implausible_coordinates_get_the_general_error(d: &Device) {
+        let y = State {
+            coords: [1e5, -1e5, 1e5, -1e5, 0.0, 0.0],
+            ..State::default()
+        };
+        let mut out = State::default();
+        let lean = d.rhs(0.0, &y, &mut out);
+        let general = d.rhs_null_space(0.0, &y, &mut out);
+        assert!(lean.is_err() && general.is_err());
+        assert_eq!(
+            format!("{:?}", lean.unwrap_err()),
+            format!("{:?}", general.unwrap_err())
+        );
+    }
+
+    /// Largest entry of `a − b` relative to `b`'s largest entry (at least 1); shared by the
+    /// device tests.
+    pub(in crate::device) fn relative_difference(a: &State, b: &State) -> f64 {
         let (a, b) = (a.to_vec(), b.to_vec());
         let scale = b.iter().fold(1.0f64, |m, v| m.max(v.abs()));
         a.iter()

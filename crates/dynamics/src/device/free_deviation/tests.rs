@@ -2,17 +2,10 @@
 
 use super::*;
 use crate::device::switches::branches;
-use crate::device::switches::tests::{device, states};
+use crate::device::switches::tests::{
+    assert_implausible_coordinates_get_the_general_error, device, relative_difference, states,
+};
 use crate::integrate::{MAX_SWITCHES, OdeSystem, Sides};
-
-/// Largest entry of `a − b` relative to `b`'s largest entry (at least 1).
-fn relative_difference(a: &State, b: &State) -> f64 {
-    let (a, b) = (a.to_vec(), b.to_vec());
-    let scale = b.iter().fold(1.0f64, |m, v| m.max(v.abs()));
-    a.iter()
-        .zip(&b)
-        .fold(0.0f64, |m, (u, v)| m.max((u - v).abs() / scale))
-}
 
 /// The lean right-hand side (closed-form wing terms on the `n` coordinates, `J⁻¹` of the
 /// linear map) equals the general one (`evaluate_on`: the Newton inverse of the drivetrain,
@@ -62,16 +55,5 @@ fn lean_path_applies_to_free_deviation_only_and_reports_implausible_coordinates(
     let d = device("drag_parity");
     assert!(d.free_deviation_rhs.is_none() && d.stroke_plane_rhs.is_some());
     let d = device("lift_parity");
-    let y = State {
-        coords: [1e5, -1e5, 1e5, -1e5, 0.0, 0.0],
-        ..State::default()
-    };
-    let mut out = State::default();
-    let lean = d.rhs(0.0, &y, &mut out);
-    let general = d.rhs_null_space(0.0, &y, &mut out);
-    assert!(lean.is_err() && general.is_err());
-    assert_eq!(
-        format!("{:?}", lean.unwrap_err()),
-        format!("{:?}", general.unwrap_err())
-    );
+    assert_implausible_coordinates_get_the_general_error(&d);
 }
