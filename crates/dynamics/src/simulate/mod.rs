@@ -107,6 +107,27 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
                     Shot::Failed => retry = Some(None),
                 }
             }
+            // Takes a shooting result found after the transient's `t`: its orbit of
+            // `$orbit_cycles` cycles, multipliers, grid and recorded window (labelled after the
+            // transient's cycles too).
+            macro_rules! take_found {
+                ($found:expr, $orbit_cycles:expr) => {{
+                    let found = $found;
+                    (y, residual, converged, orbit_cycles) =
+                        (found.state, found.residual, true, $orbit_cycles);
+                    recorded = found.recorded;
+                    if let Some((trajectory, _)) = &mut recorded {
+                        for time in &mut trajectory.time {
+                            *time += t;
+                        }
+                    }
+                    t += found.t;
+                    cycles_run += found.cycles_run;
+                    multipliers = found.multipliers;
+                    monodromy = Some(found.jacobian);
+                    step_grid = found.grid;
+                }};
+            }
             if transient_needed {
                 // Cycles before the first convergence check run in one integrator call.
                 let warm_up = options
@@ -150,7 +171,6 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
                         break;
                     }
                     if residual < PERIOD_DOUBLED_SETTLED
-                        && residual <= residual_two
                         && retry.as_ref().is_some_and(|r| {
                             r.as_ref()
                                 .is_none_or(|r| state_change(&y, r) > SHOOTING_RETRY_APART)
@@ -158,24 +178,19 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
                     {
                         // Settled, and not on the unstable orbit the shooting found from the
                         // warm-up (the §2.5 Dual PARITY has one next to its stable orbit):
-                        // Newton once more, from here.
+                        // Newton once more, from here. Also when the transient alternates in
+                        // (a multiplier in (−1, 0): the two-cycle change below the one-cycle
+                        // one): it then used to run to `steady_tol` with no monodromy, so a
+                        // sweep chain could not continue from it (docs/findings.md §22). A
+                        // period-doubled orbit keeps a macroscopic one-cycle change, far above
+                        // this gate; a small one near its flip finds the unstable period-1
+                        // orbit here (not taken) and the two-cycle shooting below.
                         retry = None;
                         if let Shot::Found(found) = shooting_steady_state(
                             device, options, &recording, &transient, period, 1, true, &y, &columns,
                             stroke,
                         )? {
-                            (y, residual, converged) = (found.state, found.residual, true);
-                            recorded = found.recorded;
-                            if let Some((trajectory, _)) = &mut recorded {
-                                for time in &mut trajectory.time {
-                                    *time += t;
-                                }
-                            }
-                            t += found.t;
-                            cycles_run += found.cycles_run;
-                            multipliers = found.multipliers;
-                            monodromy = Some(found.jacobian);
-                            step_grid = found.grid;
+                            take_found!(found, 1);
                             break;
                         }
                     }
@@ -195,25 +210,33 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
                             let half = transient.advance(device, 0.0, &found.state, period)?;
                             let apart = PERIOD_DOUBLED_SEPARATION * options.steady_tol;
                             if state_change(&half, &found.state) < apart {
-                                (y, residual, converged) = (found.state, found.residual, true);
+                                // A period-1 orbit: Newton on the one-cycle map from it gives
+                                // its one-cycle monodromy (the multipliers, and the start a
+                                // sweep chain continues from; without it the §2.5 Lift chains
+                                // ran every point cold, docs/findings.md §22).
                                 t += found.t;
                                 cycles_run += found.cycles_run;
+                                match shooting_steady_state(
+                                    device,
+                                    options,
+                                    &recording,
+                                    &transient,
+                                    period,
+                                    1,
+                                    true,
+                                    &found.state,
+                                    &columns,
+                                    stroke,
+                                )? {
+                                    Shot::Found(one) => take_found!(one, 1),
+                                    _ => {
+                                        (y, residual, converged) =
+                                            (found.state, found.residual, true);
+                                    }
+                                }
                                 break;
                             }
-                            (y, residual, converged, orbit_cycles) =
-                                (found.state, found.residual, true, 2);
-                            recorded = found.recorded;
-                            if let Some((trajectory, _)) = &mut recorded {
-                                // Labelled after the transient's cycles too.
-                                for time in &mut trajectory.time {
-                                    *time += t;
-                                }
-                            }
-                            t += found.t;
-                            cycles_run += found.cycles_run;
-                            multipliers = found.multipliers;
-                            monodromy = Some(found.jacobian);
-                            step_grid = found.grid;
+                            take_found!(found, 2);
                             break;
                         }
                     }
