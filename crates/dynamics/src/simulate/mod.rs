@@ -170,12 +170,7 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
                         (residual, converged, orbit_cycles) = (residual_two, true, 2);
                         break;
                     }
-                    if residual < PERIOD_DOUBLED_SETTLED
-                        && retry.as_ref().is_some_and(|r| {
-                            r.as_ref()
-                                .is_none_or(|r| state_change(&y, r) > SHOOTING_RETRY_APART)
-                        })
-                    {
+                    if residual < PERIOD_DOUBLED_SETTLED && retry_open(&retry, &y) {
                         // Settled, and not on the unstable orbit the shooting found from the
                         // warm-up (the §2.5 Dual PARITY has one next to its stable orbit):
                         // Newton once more, from here. Also when the transient alternates in
@@ -238,6 +233,22 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
                             }
                             take_found!(found, 2);
                             break;
+                        }
+                        // Near a flip (a multiplier μ ≈ −1) the two-cycle map is
+                        // ill-conditioned (μ² − 1 ≈ 0) where the one-cycle map is not, and the
+                        // transient's one-cycle change decays as slowly as |μ|ⁿ: Newton on the
+                        // one-cycle map from here, if the retry is still open (measured on a
+                        // §2.5 Lift point, μ ≈ −0.98: converged instead of 200 cycles and a
+                        // one-cycle change of 2.7e-3, docs/findings.md §23).
+                        if retry_open(&retry, &y) {
+                            retry = None;
+                            if let Shot::Found(found) = shooting_steady_state(
+                                device, options, &recording, &transient, period, 1, true, &y,
+                                &columns, stroke,
+                            )? {
+                                take_found!(found, 1);
+                                break;
+                            }
                         }
                     }
                 }
@@ -322,4 +333,14 @@ fn apply_kick(device: &Device, t: f64, y: &State, kick: Perturbation) -> Result<
     out.work_actuator = y.work_actuator;
     out.work_aero = y.work_aero;
     Ok(out)
+}
+
+/// Whether the transient's one retry of the one-cycle shooting is still open at `y`: the first
+/// shooting failed (`Some(None)`) or found an unstable orbit (`Some(Some(state))`) that `y` is
+/// not on (farther than [`SHOOTING_RETRY_APART`]).
+fn retry_open(retry: &Option<Option<State>>, y: &State) -> bool {
+    retry.as_ref().is_some_and(|r| {
+        r.as_ref()
+            .is_none_or(|r| state_change(y, r) > SHOOTING_RETRY_APART)
+    })
 }
