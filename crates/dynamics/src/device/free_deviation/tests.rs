@@ -58,6 +58,31 @@ fn lean_path_applies_to_free_deviation_only_and_reports_implausible_coordinates(
     assert_implausible_coordinates_get_the_general_error(&d);
 }
 
+/// The §2.5 Lift PARITY fixture with deviation springs of `stiffness` (mN·mm/rad) on both
+/// wings, driven at `amplitude_v` about `offset_v` (DC ignored).
+fn lift_variant(stiffness: f64, amplitude_v: f64, offset_v: f64) -> Device {
+    use crate::{Actuator, DcOffset, JointSpring, Waveform, Wing};
+    let mut spec = device("lift_parity").spec().clone();
+    spec.actuator = Some(
+        Actuator::new(
+            crate::actuator::THESIS_FORCE_PER_VOLT,
+            crate::actuator::THESIS_STIFFNESS,
+            Waveform::sine(amplitude_v, 110.0, offset_v, 0.0).unwrap(),
+            DcOffset::Ignore,
+        )
+        .unwrap(),
+    );
+    for w in spec.wings.iter_mut() {
+        let mut springs = *w.springs();
+        springs[3] = JointSpring::linear(stiffness, 0.0).unwrap();
+        let hinge = *w.tunable_hinge().unwrap();
+        *w = Wing::new(*w.shoulder(), *w.inertia(), springs, w.aero().clone())
+            .unwrap()
+            .with_tunable_hinge(hinge);
+    }
+    Device::new(spec).unwrap()
+}
+
 /// A sweep chain of the §2.5 Lift PARITY along the deviation stiffness (8 → 12 mN·mm/rad, drive
 /// 85 V + 85 V sin) continues from point to point. Its cold runs approach their orbits alternating (a
 /// multiplier in (−1, 0)): they used to end by the transient or by the two-cycle shooting
@@ -67,8 +92,7 @@ fn lean_path_applies_to_free_deviation_only_and_reports_implausible_coordinates(
 /// 1e-9 relative (measured: 6–9 cycles, 7e-12; docs/findings.md §22).
 #[test]
 fn a_lift_parity_chain_along_the_deviation_stiffness_continues() {
-    use crate::{Actuator, DcOffset, JointSpring, SimulationOptions, Waveform, Wing};
-    let base = device("lift_parity");
+    use crate::SimulationOptions;
     let metrics = [
         "tau_r_peak".to_string(),
         "right_rotation_amplitude".to_string(),
@@ -76,31 +100,13 @@ fn a_lift_parity_chain_along_the_deviation_stiffness_continues() {
     let points: Vec<_> = (0..8)
         .map(|k| {
             let stiffness = 8.0 + 4.0 * k as f64 / 7.0;
-            let mut spec = base.spec().clone();
-            spec.actuator = Some(
-                Actuator::new(
-                    crate::actuator::THESIS_FORCE_PER_VOLT,
-                    crate::actuator::THESIS_STIFFNESS,
-                    Waveform::sine(85.0, 110.0, 85.0, 0.0).unwrap(),
-                    DcOffset::Ignore,
-                )
-                .unwrap(),
-            );
-            for w in spec.wings.iter_mut() {
-                let mut springs = *w.springs();
-                springs[3] = JointSpring::linear(stiffness, 0.0).unwrap();
-                let hinge = *w.tunable_hinge().unwrap();
-                *w = Wing::new(*w.shoulder(), *w.inertia(), springs, w.aero().clone())
-                    .unwrap()
-                    .with_tunable_hinge(hinge);
-            }
             let options = SimulationOptions {
                 columns: Some(Vec::new()),
                 metrics: Some(metrics.to_vec()),
                 max_cycles: 200,
                 ..Default::default()
             };
-            Ok((Device::new(spec).unwrap(), options))
+            Ok((lift_variant(stiffness, 85.0, 85.0), options))
         })
         .collect();
     let control = crate::sweep::SweepControl::new();
@@ -141,28 +147,9 @@ fn a_lift_parity_chain_along_the_deviation_stiffness_continues() {
 /// circle (docs/findings.md §23).
 #[test]
 fn a_lift_point_next_to_a_flip_converges_by_shooting() {
+    use crate::SimulationOptions;
     use crate::integrate::{Method, RungeKutta};
-    use crate::{Actuator, DcOffset, JointSpring, SimulationOptions, Waveform, Wing};
-    let base = device("lift_parity");
-    let mut spec = base.spec().clone();
-    spec.actuator = Some(
-        Actuator::new(
-            crate::actuator::THESIS_FORCE_PER_VOLT,
-            crate::actuator::THESIS_STIFFNESS,
-            Waveform::sine(92.0, 110.0, 100.0, 0.0).unwrap(),
-            DcOffset::Ignore,
-        )
-        .unwrap(),
-    );
-    for w in spec.wings.iter_mut() {
-        let mut springs = *w.springs();
-        springs[3] = JointSpring::linear(9.6, 0.0).unwrap();
-        let hinge = *w.tunable_hinge().unwrap();
-        *w = Wing::new(*w.shoulder(), *w.inertia(), springs, w.aero().clone())
-            .unwrap()
-            .with_tunable_hinge(hinge);
-    }
-    let d = Device::new(spec).unwrap();
+    let d = lift_variant(9.6, 92.0, 100.0);
     let options = SimulationOptions {
         columns: Some(Vec::new()),
         metrics: Some(vec!["tau_r_peak".into()]),
