@@ -191,17 +191,8 @@ impl<'a> LanePoint<'a> {
         let times = match times_cache {
             Some((p, n, times)) if *p == period && *n == n_samples => times.clone(),
             _ => {
-                let (t_start, window) = (grid[0], period);
-                let t_end = t_start + window;
-                let times: Rc<[f64]> = (0..=n_samples)
-                    .map(|k| {
-                        if k == n_samples {
-                            t_end
-                        } else {
-                            t_start + window * k as f64 / n_samples as f64
-                        }
-                    })
-                    .collect();
+                let times: Rc<[f64]> =
+                    crate::simulate::window_times(grid[0], period, n_samples).collect();
                 *times_cache = Some((period, n_samples, times.clone()));
                 times
             }

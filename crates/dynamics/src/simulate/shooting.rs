@@ -229,11 +229,7 @@ pub(crate) fn shooting_steady_state(
         // The second grid's Newton ran on the stepping stone's Broyden-updated Jacobian
         // (taken off the orbit): the multipliers from the variational equations at the
         // orbit, on the stepping stone's coarser grid (a third of the second grid's steps).
-        match first_rk.flow_with_sensitivity_on_grid(device, &first.grid, &orbit.state) {
-            Ok((_, jacobian)) => orbit.jacobian = jacobian,
-            Err(e) if crate::grid_shooting::out_of_budget(&e) => return Err(e),
-            Err(_) => {}
-        }
+        exact_jacobian_at_orbit(device, &first_rk, &first.grid, &mut orbit)?;
     }
     let mut multipliers = crate::floquet::eigenvalues(&orbit.jacobian).unwrap_or_default();
     let largest = multipliers.first().map_or(0.0, |m| m.norm());
@@ -244,14 +240,9 @@ pub(crate) fn shooting_steady_state(
         // A marginal "unstable" from a Broyden-updated Jacobian: the variational equations
         // at the orbit decide (the free-θ devices' central differences; measured on a §2.5
         // Lift point: Broyden 1.011, exact −0.855, a stable orbit the run then missed).
-        match transient.flow_with_sensitivity_on_grid(device, &orbit.grid, &orbit.state) {
-            Ok((_, jacobian)) => {
-                orbit.jacobian = jacobian;
-                multipliers = crate::floquet::eigenvalues(&orbit.jacobian).unwrap_or_default();
-            }
-            Err(e) if crate::grid_shooting::out_of_budget(&e) => return Err(e),
-            Err(_) => {}
-        }
+        let grid = orbit.grid.clone();
+        exact_jacobian_at_orbit(device, transient, &grid, &mut orbit)?;
+        multipliers = crate::floquet::eigenvalues(&orbit.jacobian).unwrap_or_default();
     }
     if multipliers
         .first()
@@ -278,4 +269,27 @@ pub(crate) fn shooting_steady_state(
         multipliers,
         recorded,
     })))
+}
+
+/// Replaces `orbit`'s Jacobian by the variational equations' on `grid` from its state (the
+/// exact monodromy at the orbit, marked so) when they integrate; a failure other than a spent
+/// budget keeps the estimate.
+///
+/// # Errors
+/// A spent budget or a cancel.
+fn exact_jacobian_at_orbit(
+    device: &Device,
+    rk: &RungeKutta,
+    grid: &[f64],
+    orbit: &mut crate::grid_shooting::GridOrbit,
+) -> Result<()> {
+    match rk.flow_with_sensitivity_on_grid(device, grid, &orbit.state) {
+        Ok((_, jacobian)) => {
+            orbit.jacobian = jacobian;
+            orbit.jacobian_at_orbit = true;
+            Ok(())
+        }
+        Err(e) if crate::grid_shooting::out_of_budget(&e) => Err(e),
+        Err(_) => Ok(()),
+    }
 }

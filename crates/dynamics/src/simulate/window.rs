@@ -65,6 +65,23 @@ pub(super) fn stroke_sampling(
     lean.then(|| StrokeNeeds::of(metrics))
 }
 
+/// The `n_samples + 1` sample times of a recorded window from `t_start`: the last one exactly
+/// the window's end (`t_start + window·k/n` can round one ulp past it).
+pub(crate) fn window_times(
+    t_start: f64,
+    window: f64,
+    n_samples: usize,
+) -> impl Iterator<Item = f64> {
+    let t_end = t_start + window;
+    (0..=n_samples).map(move |k| {
+        if k == n_samples {
+            t_end
+        } else {
+            t_start + window * k as f64 / n_samples as f64
+        }
+    })
+}
+
 /// A recorded window: its columns, its metrics and the state at its end.
 pub(super) type Recorded = (Trajectory, Vec<(String, f64)>, State);
 
@@ -84,18 +101,8 @@ pub(super) fn record_window(
     stroke: Option<StrokeNeeds>,
     grid: Option<&[f64]>,
 ) -> Result<Recorded> {
-    // The last sample is exactly the window's end: t_start + window·k/n can round one ulp past
-    // it.
     let t_end = t_start + window;
-    let times: Vec<f64> = (0..=n_samples)
-        .map(|k| {
-            if k == n_samples {
-                t_end
-            } else {
-                t_start + window * k as f64 / n_samples as f64
-            }
-        })
-        .collect();
+    let times: Vec<f64> = window_times(t_start, window, n_samples).collect();
     let mut metrics = MetricsAccumulator::new(device, period);
     let plane = device.formulation() != crate::device::Formulation::DrivetrainCoordinates;
     let mut recorder = Recorder::new(columns, times.len());

@@ -18,6 +18,47 @@ pub(crate) struct FreeDeviationKinematics {
     pub(crate) rotation: Matrix3<f64>,
 }
 
+/// What the closed form of a free-deviation pose `(φ, θ, ψ)` starts from (module docs of
+/// [`Wing::free_deviation_terms`]): the angles' sines and cosines, eq. 2.12's determinant
+/// `D = cos²θ + cos²φ sin²θ`, `(sin γ5, cos γ5)` and `∂γ5/∂φ`, `∂γ5/∂θ`.
+struct Pose {
+    sin_cos_phi: (f64, f64),
+    sin_cos_theta: (f64, f64),
+    sin_cos_psi: (f64, f64),
+    d: f64,
+    sin_cos_gamma5: (f64, f64),
+    g5_phi: f64,
+    g5_theta: f64,
+}
+
+impl Pose {
+    /// `None` for non-finite angles or within 1e-12 of the general solve's singular poses
+    /// (eq. 2.12's and eq. 2.13's determinants).
+    #[inline(always)]
+    fn of(p: &Vector3<f64>) -> Option<Self> {
+        let (phi, theta, psi) = (p.x, p.y, p.z);
+        if !(phi.is_finite() && theta.is_finite() && psi.is_finite()) {
+            return None;
+        }
+        let (sp, cp) = phi.sin_cos();
+        let (st, ct) = theta.sin_cos();
+        let d = ct * ct + cp * cp * st * st;
+        if d < 1e-12 || cp * cp + ct * ct * sp * sp < 1e-12 {
+            return None;
+        }
+        let root = d.sqrt();
+        Some(Self {
+            sin_cos_phi: (sp, cp),
+            sin_cos_theta: (st, ct),
+            sin_cos_psi: psi.sin_cos(),
+            d,
+            sin_cos_gamma5: (cp * st / root, ct / root),
+            g5_phi: -sp * st * ct / d,
+            g5_theta: cp / d,
+        })
+    }
+}
+
 /// The dynamic terms of a free-deviation wing ([`Wing::free_deviation_dynamics`]), as in
 /// [`WingTerms`].
 #[derive(Clone, Copy, Debug)]
@@ -93,27 +134,20 @@ impl Wing {
         p: &Vector3<f64>,
         p_dot: &Vector3<f64>,
     ) -> Option<FreeDeviationKinematics> {
-        let (phi, theta, psi) = (p.x, p.y, p.z);
-        if !(phi.is_finite() && theta.is_finite() && psi.is_finite()) {
-            return None;
-        }
-        let (sp, cp) = phi.sin_cos();
-        let (st, ct) = theta.sin_cos();
-        let d = ct * ct + cp * cp * st * st;
-        // The general solve's singular poses (eq. 2.12's and eq. 2.13's determinants).
-        if d < 1e-12 || cp * cp + ct * ct * sp * sp < 1e-12 {
-            return None;
-        }
-        let root = d.sqrt();
-        let (s5, c5) = (cp * st / root, ct / root);
+        let Pose {
+            sin_cos_phi: (sp, cp),
+            sin_cos_theta: (st, ct),
+            sin_cos_psi: (ss, cs),
+            d,
+            sin_cos_gamma5: (s5, c5),
+            g5_phi,
+            g5_theta,
+        } = Pose::of(p)?;
         let d_sq = d * d;
-        let g5_phi = -sp * st * ct / d;
-        let g5_theta = cp / d;
         let h_pp = -st * ct * cp * (d + 2.0 * st * st * sp * sp) / d_sq;
         let h_pt = -sp * (d - 2.0 * cp * cp * st * st) / d_sq;
         let h_tt = 2.0 * cp * st * ct * sp * sp / d_sq;
 
-        let (ss, cs) = psi.sin_cos();
         let r3 = Matrix3::new(1.0, 0.0, 0.0, 0.0, cp, -sp, 0.0, sp, cp);
         let r4 = r3 * Matrix3::new(c5, 0.0, s5, 0.0, 1.0, 0.0, -s5, 0.0, c5);
         let r61 = r4 * Matrix3::new(cs, -ss, 0.0, ss, cs, 0.0, 0.0, 0.0, 1.0);
@@ -187,21 +221,13 @@ impl Wing {
         p: &Vector3<f64>,
         p_dot: &Vector3<f64>,
     ) -> Option<Vector3<f64>> {
-        let (phi, theta, psi) = (p.x, p.y, p.z);
-        if !(phi.is_finite() && theta.is_finite() && psi.is_finite()) {
-            return None;
-        }
-        let (sp, cp) = phi.sin_cos();
-        let (st, ct) = theta.sin_cos();
-        let d = ct * ct + cp * cp * st * st;
-        if d < 1e-12 || cp * cp + ct * ct * sp * sp < 1e-12 {
-            return None;
-        }
-        let root = d.sqrt();
-        let (s5, c5) = (cp * st / root, ct / root);
-        let g5_phi = -sp * st * ct / d;
-        let g5_theta = cp / d;
-        let (ss, cs) = psi.sin_cos();
+        let Pose {
+            sin_cos_psi: (ss, cs),
+            sin_cos_gamma5: (s5, c5),
+            g5_phi,
+            g5_theta,
+            ..
+        } = Pose::of(p)?;
         let y4 = Vector3::new(ss, cs, 0.0);
         let x3 = Vector3::new(c5 * cs, c5 * -ss, s5);
         let j6 = Matrix3::from_columns(&[y4 * g5_phi + x3, y4 * g5_theta, Vector3::z()]);
