@@ -66,6 +66,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use nalgebra::{Matrix3, Vector3};
 use paritysim_error::{Error, Result, bail, check_finite, check_non_negative};
+use paritysim_simd::f64x4;
 
 use crate::coefficients::{
     CoefficientModel, CoefficientSet, DEFAULT_ROTATIONAL_DAMPING, center_of_pressure,
@@ -625,6 +626,50 @@ impl<C: CoefficientModel> BladeElementModel<C> {
         };
         let d_cp = 0.82 / PI * alpha + 0.05; // eq. 3.7 (α in (0, π))
         AeroMoments::of_strip(o, sigma, w2, (cn, ct), d_cp, rotational_damping, alpha)
+    }
+
+    /// [`Self::moments_stroke_plane`]'s torque `(M_N, M_T, M_r + M_rd)` on held branches for
+    /// four states at once (SIMD lanes, `branches[l]` per lane): bit for bit the scalar torque
+    /// of each lane (the same operations in the same order, the coefficients'
+    /// [`CoefficientModel::lift_drag_branch_lanes`]). For the ensembles of the sweep engine.
+    /// `None` when the lanes cannot take it: coefficients without a lane form, or a lane with
+    /// `ω_x = ω_y = 0` (the scalar model's special case).
+    #[inline]
+    pub fn stroke_plane_torque_lanes(
+        &self,
+        phi_dot: f64x4,
+        psi: f64x4,
+        (sin_psi, cos_psi): (f64x4, f64x4),
+        psi_dot: f64x4,
+        branches: [Branch; 4],
+    ) -> Option<[f64x4; 3]> {
+        let o = &self.omegas;
+        let k = f64x4::splat;
+        let unit = |side: fn(&Branch) -> bool| f64x4::new(branches.map(|b| unit_sign(side(&b))));
+        let (wx, wy, wz) = (cos_psi * phi_dot, -sin_psi * phi_dot, psi_dot);
+        let w2 = wx * wx + wy * wy;
+        if w2.simd_eq(k(0.0)).any() {
+            return None;
+        }
+        let damping = unit(|b| b.spanwise_positive) * wz * wz;
+        let rotational_damping = k(-o.omega2 * self.rotational_damping) * damping; // eq. 3.10
+        let sigma = unit(|b| b.chordwise_positive);
+        let alpha = k(FRAC_PI_2) + sigma * psi;
+        let (cn, ct) = match self.law {
+            NormalForceLaw::Coefficient => {
+                let below = branches.map(|b| b.normal_positive);
+                let (cl, cd) = self.coefficients.lift_drag_branch_lanes(alpha, below)?;
+                let (sin_a, cos_a) = (cos_psi, -sigma * sin_psi);
+                (cl * cos_a + cd * sin_a, cd * cos_a - cl * sin_a)
+            }
+            NormalForceLaw::Unit => (k(1.0), k(0.0)),
+        };
+        let d_cp = k(0.82 / PI) * alpha + k(0.05); // eq. 3.7
+        // AeroMoments::of_strip, eqs. 3.8, 3.9, 3.11.
+        let normal = k(-o.omega1) * sigma * w2 * cn;
+        let tangential = k(-o.omega1) * w2 * ct;
+        let rotational = -(k(o.omega3) * d_cp - k(o.omega4)) * sigma * w2 * cn;
+        Some([normal, tangential, rotational + rotational_damping])
     }
 
     /// The torque `(M_N, M_T, M_r + M_rd)` a stroke-plane device's right-hand side takes from

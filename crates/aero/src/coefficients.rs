@@ -32,6 +32,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use std::fmt;
 
 use paritysim_error::{Error, Result, bail};
+use paritysim_simd::{Real, cos, f64x4, sin, sin_cos};
 
 /// Default rotational damping coefficient `C_rd` of eq. 3.10: 5.0, the value used by
 /// J. P. Whitney & R. J. Wood, "Aeromechanics of passive rotation in flapping flight",
@@ -101,6 +102,14 @@ pub trait CoefficientModel: Send + Sync + fmt::Debug {
         self.lift_drag(alpha)
     }
 
+    /// [`Self::lift_drag_branch`] of four angles at once (SIMD lanes, `below[l]` per lane),
+    /// bit for bit the scalar values lane by lane; `None` (the default) when the model has no
+    /// lane form (the lanes then evaluate it one at a time).
+    #[inline]
+    fn lift_drag_branch_lanes(&self, _alpha: f64x4, _below: [bool; 4]) -> Option<(f64x4, f64x4)> {
+        None
+    }
+
     /// `(C_L, C_D)` of [`Self::lift_drag_branch`] and their slopes `(dC_L/dα, dC_D/dα)`: the
     /// analytic Jacobian of the stroke-plane equations needs them. The default differentiates
     /// the branch centrally (step 1e-6 rad: slopes to ~1e-10); the built-in models override it
@@ -159,19 +168,22 @@ impl Dickinson1999 {
     const CD_OFFSET: f64 = 9.82 * PI / 180.0;
     const CL_OFFSET: f64 = 7.20 * PI / 180.0;
 
-    /// The published fits evaluated as printed at any α (rad), without the extension past 90°.
+    /// The published fits evaluated as printed at any α (rad), without the extension past 90°;
+    /// of one angle or of four in SIMD lanes (bit for bit the same per lane: the shared
+    /// polynomial `sin`/`cos` of `paritysim_simd`).
     #[inline]
-    pub fn fit(alpha: f64) -> (f64, f64) {
-        let cd = 1.92 - 1.55 * (2.04 * alpha - Self::CD_OFFSET).cos(); // eq. 3.5
-        let cl = 0.225 + 1.58 * (2.13 * alpha - Self::CL_OFFSET).sin(); // eq. 3.6
+    pub fn fit<R: Real>(alpha: R) -> (R, R) {
+        let k = R::splat;
+        let cd = k(1.92) - k(1.55) * cos(k(2.04) * alpha - k(Self::CD_OFFSET)); // eq. 3.5
+        let cl = k(0.225) + k(1.58) * sin(k(2.13) * alpha - k(Self::CL_OFFSET)); // eq. 3.6
         (cl, cd)
     }
 
     /// [`Self::fit`] and its slopes `(dC_L/dα, dC_D/dα)`.
     #[inline]
     pub fn fit_with_slope(alpha: f64) -> ((f64, f64), (f64, f64)) {
-        let (sd, cd_) = (2.04 * alpha - Self::CD_OFFSET).sin_cos();
-        let (sl, cl_) = (2.13 * alpha - Self::CL_OFFSET).sin_cos();
+        let (sd, cd_) = sin_cos(2.04 * alpha - Self::CD_OFFSET);
+        let (sl, cl_) = sin_cos(2.13 * alpha - Self::CL_OFFSET);
         (
             (0.225 + 1.58 * sl, 1.92 - 1.55 * cd_),
             (1.58 * 2.13 * cl_, 1.55 * 2.04 * sd),
@@ -206,6 +218,17 @@ impl CoefficientModel for Dickinson1999 {
             let (cl, cd) = Self::fit(PI - alpha);
             (-cl, cd)
         }
+    }
+
+    #[inline]
+    fn lift_drag_branch_lanes(&self, alpha: f64x4, below: [bool; 4]) -> Option<(f64x4, f64x4)> {
+        // `lift_drag_branch` lane by lane: the fit at α below, at π − α (C_L negated) above.
+        let a = alpha.to_array();
+        let argument = std::array::from_fn(|l| if below[l] { a[l] } else { PI - a[l] });
+        let (cl, cd) = Self::fit(f64x4::new(argument));
+        let cl = cl.to_array();
+        let cl = std::array::from_fn(|l| if below[l] { cl[l] } else { -cl[l] });
+        Some((f64x4::new(cl), cd))
     }
 
     #[inline]
@@ -264,19 +287,33 @@ impl WhitneyWood2010 {
     }
 }
 
+impl WhitneyWood2010 {
+    /// `(C_L, C_D)` of one angle or of four in SIMD lanes (bit for bit the same per lane).
+    #[inline]
+    fn harmonic<R: Real>(&self, alpha: R) -> (R, R) {
+        let k = R::splat;
+        let (s2, c2) = sin_cos(k(2.0) * alpha);
+        (
+            k(self.lift_amplitude) * s2,
+            k(self.drag_mean) - k(self.drag_amplitude) * c2,
+        )
+    }
+}
+
 impl CoefficientModel for WhitneyWood2010 {
     #[inline]
     fn lift_drag(&self, alpha: f64) -> (f64, f64) {
-        let (s2, c2) = (2.0 * alpha).sin_cos();
-        (
-            self.lift_amplitude * s2,
-            self.drag_mean - self.drag_amplitude * c2,
-        )
+        self.harmonic(alpha)
+    }
+
+    #[inline]
+    fn lift_drag_branch_lanes(&self, alpha: f64x4, _below: [bool; 4]) -> Option<(f64x4, f64x4)> {
+        Some(self.harmonic(alpha))
     }
 
     #[inline]
     fn lift_drag_slope_branch(&self, alpha: f64, _below: bool) -> ((f64, f64), (f64, f64)) {
-        let (s2, c2) = (2.0 * alpha).sin_cos();
+        let (s2, c2) = sin_cos(2.0 * alpha);
         (
             (
                 self.lift_amplitude * s2,
@@ -358,6 +395,14 @@ impl CoefficientModel for CoefficientSet {
         match self {
             CoefficientSet::Dickinson1999(m) => m.lift_drag_branch(alpha, below),
             CoefficientSet::WhitneyWood2010(m) => m.lift_drag_branch(alpha, below),
+        }
+    }
+
+    #[inline]
+    fn lift_drag_branch_lanes(&self, alpha: f64x4, below: [bool; 4]) -> Option<(f64x4, f64x4)> {
+        match self {
+            CoefficientSet::Dickinson1999(m) => m.lift_drag_branch_lanes(alpha, below),
+            CoefficientSet::WhitneyWood2010(m) => m.lift_drag_branch_lanes(alpha, below),
         }
     }
 

@@ -24,11 +24,14 @@ mod null_space;
 mod ode_system;
 mod stroke_plane;
 mod switches;
+
 use drivetrain_coordinates::{StrokeOnly, stroke_only, stroke_torque};
 use drivetrain_inverse::{
     NEWTON_MAX, NEWTON_TOL, check_plausible, invert_1dof, invert_2dof, singular_drive,
     unreachable_stroke,
 };
+pub(crate) use stroke_plane::lanes as stroke_plane_lanes;
+pub(crate) use switches::branches as blade_branches;
 
 /// A drivetrain with its balance-beam spring.
 #[derive(Clone, Debug, PartialEq)]

@@ -19,7 +19,7 @@ use crate::integrate::{MAX_SWITCHES, Sides, State};
 
 /// The blade elements' branches named by the sides of the switching functions (three per
 /// wing).
-pub(super) fn branches(sides: Sides) -> [Branch; 2] {
+pub(crate) fn branches(sides: Sides) -> [Branch; 2] {
     std::array::from_fn(|w| Branch {
         chordwise_positive: sides.positive(3 * w),
         normal_positive: sides.positive(3 * w + 1),

@@ -5,8 +5,8 @@ use paritysim_error::Result;
 
 use super::switched::Branch;
 use super::{
-    IntegrationStats, MAX_SWITCHES, Method, Rhs, Sink, State, Stepper, Tolerances, budget, dop853,
-    dopri5, events, integration_error,
+    IntegrationStats, MAX_SWITCHES, Method, Rhs, Sides, Sink, State, Stepper, Tolerances, budget,
+    dop853, dopri5, events, integration_error,
 };
 
 /// Safety factor of the step-size controller.
@@ -88,9 +88,9 @@ pub(super) fn drive<const M: usize, S: Stepper<M>>(
     sink: &mut Sink<'_>,
     on_step: &mut dyn FnMut(f64, &State),
 ) -> Result<([f64; M], IntegrationStats)> {
-    let mut stats = IntegrationStats::default();
-    let mut y = y0;
-    let mut t = t0;
+    let stats = IntegrationStats::default();
+    let y = y0;
+    let t = t0;
     let mut next = 0;
     if next < times.len() && times[next] <= t0 {
         let state = rhs.expand(&y);
@@ -101,23 +101,98 @@ pub(super) fn drive<const M: usize, S: Stepper<M>>(
     }
     // Switching functions: their sides at the start name the branch.
     let n_switches = rhs.n_switches().min(MAX_SWITCHES);
-    let mut branch = Branch::start(rhs, n_switches, t, &y)?;
-    let mut redone_at = None;
+    let branch = Branch::start(rhs, n_switches, t, &y)?;
     let mut f0 = [0.0; M];
     rhs.eval(t, &y, &mut f0)?;
     let h_max = t_end - t0;
-    let mut h = initial_step(rhs, S::ORDER, tol, t0, &y, &f0, h_max)?;
-    let fac_lo = 1.0 / S::FAC_MAX;
-    let fac_hi = 1.0 / S::FAC_MIN;
-    let mut fac_old: f64 = 1e-4;
-    let mut rejected_last = false;
-    let mut f1 = [0.0; M];
+    let h = initial_step(rhs, S::ORDER, tol, t0, &y, &f0, h_max)?;
+    let mut run = AdaptiveRun {
+        t,
+        y,
+        f0,
+        h,
+        fac_old: 1e-4,
+        rejected_last: false,
+        redone_at: None,
+        branch,
+        stats,
+    };
     loop {
+        if let Attempt::Finished = run.attempt(
+            stepper,
+            rhs,
+            tol,
+            max_steps,
+            (t_end, h_max),
+            (times, &mut next, sink),
+            on_step,
+        )? {
+            return Ok((run.y, run.stats));
+        }
+    }
+}
+
+/// What one attempt of [`AdaptiveRun::attempt`] led to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Attempt {
+    /// Rejected, or redone on the far side of a switch at its start: the next attempt retries.
+    Retry,
+    /// Accepted: the run moved to the step's end (or to a root inside it).
+    Accepted,
+    /// The last step was accepted: the run is at `t_end`.
+    Finished,
+}
+
+/// The state of [`drive`] between attempts (Hairer's `DP86CO` / `DOPCOR` loop variables).
+pub(super) struct AdaptiveRun<const M: usize> {
+    pub(super) t: f64,
+    pub(super) y: [f64; M],
+    pub(super) f0: [f64; M],
+    pub(super) h: f64,
+    pub(super) fac_old: f64,
+    pub(super) rejected_last: bool,
+    /// Where a step was last redone on the far side of a switch (once per start).
+    pub(super) redone_at: Option<f64>,
+    pub(super) branch: Branch,
+    pub(super) stats: IntegrationStats,
+}
+
+impl<const M: usize> AdaptiveRun<M> {
+    /// One attempt of the loop of [`drive`] (step-size control, event location, sampling).
+    ///
+    /// # Errors
+    /// The step limit, a step-size underflow, a spent budget, a failing model, whatever
+    /// `sink` returns.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn attempt<S: Stepper<M>>(
+        &mut self,
+        stepper: &mut S,
+        rhs: &mut dyn Rhs<M>,
+        tol: &Tolerances,
+        max_steps: usize,
+        (t_end, h_max): (f64, f64),
+        (times, next, sink): (&[f64], &mut usize, &mut Sink<'_>),
+        on_step: &mut dyn FnMut(f64, &State),
+    ) -> Result<Attempt> {
+        let fac_lo = 1.0 / S::FAC_MAX;
+        let fac_hi = 1.0 / S::FAC_MIN;
+        let Self {
+            t,
+            y,
+            f0,
+            h,
+            fac_old,
+            rejected_last,
+            redone_at,
+            branch,
+            stats,
+        } = self;
+        let mut f1 = [0.0; M];
         let attempts = stats.accepted + stats.rejected;
         if attempts >= max_steps {
             return Err(integration_error(
-                t,
-                &rhs.expand(&y),
+                *t,
+                &rhs.expand(y),
                 format!(
                     "more than {max_steps} steps in one integration (the step budget \
                      `options.max_steps`)"
@@ -126,82 +201,170 @@ pub(super) fn drive<const M: usize, S: Stepper<M>>(
         }
         if attempts % budget::CHECK_EVERY == 0 {
             if let Err(stop) = budget::check_current() {
-                return Err(budget::stop_error(stop, t, rhs.expand(&y).to_vec()));
+                return Err(budget::stop_error(stop, *t, rhs.expand(y).to_vec()));
             }
         }
         if 0.1 * h.abs() <= t.abs() * f64::EPSILON || !h.is_finite() {
-            return Err(integration_error(t, &rhs.expand(&y), "step size underflow"));
+            return Err(integration_error(*t, &rhs.expand(y), "step size underflow"));
         }
-        let last = t + 1.01 * h >= t_end;
+        let last = *t + 1.01 * *h >= t_end;
         if last {
-            h = t_end - t;
+            *h = t_end - *t;
         }
-        let err = stepper.attempt(rhs, t, &y, &f0, h, tol)?;
+        let err = stepper.attempt(rhs, *t, y, f0, *h, tol)?;
         if !err.is_finite() {
             // A non-finite trial (e.g. a state thrown out of range): shrink hard and retry.
             stats.rejected += 1;
-            rejected_last = true;
-            h *= S::FAC_MIN;
-            continue;
+            *rejected_last = true;
+            *h *= S::FAC_MIN;
+            return Ok(Attempt::Retry);
         }
         let fac11 = err.powf(S::EXPONENT);
         if err <= 1.0 {
             // Lund stabilisation (PI control): divide by the previous error's factor.
             let fac = (fac11 / fac_old.powf(S::BETA) / SAFE).clamp(fac_lo, fac_hi);
-            let mut h_new = h / fac;
-            fac_old = err.max(1e-4);
-            let t_new = if last { t_end } else { t + h };
+            let mut h_new = *h / fac;
+            *fac_old = err.max(1e-4);
+            let t_new = if last { t_end } else { *t + *h };
             stepper.new_derivative(rhs, t_new, &mut f1)?;
             let y1 = *stepper.y1();
             let event = if branch.n > 0 {
                 branch.first_switch(
                     stepper,
                     rhs,
-                    (t, &y, &f0),
+                    (*t, y, f0),
                     (t_new, &y1, &f1),
-                    h,
+                    *h,
                     true,
                     events::ROOT_TOLERANCE,
-                    &mut stats,
+                    stats,
                 )?
             } else {
                 None
             };
             if let Some(found) = &event {
-                if found.at_start && redone_at != Some(t) {
+                if found.at_start && *redone_at != Some(*t) {
                     // The step began on the wrong branch (a switch sitting at zero there):
                     // take the far side and redo it.
-                    redone_at = Some(t);
-                    branch.take(rhs, found.sides, t, &y, &mut f0)?;
+                    *redone_at = Some(*t);
+                    branch.take(rhs, found.sides, *t, y, f0)?;
                     stats.rejected += 1;
-                    continue;
+                    return Ok(Attempt::Retry);
                 }
             }
             stats.accepted += 1;
             let (state, cut) = branch.advance(
                 stepper,
                 rhs,
-                (&mut t, &mut y, &mut f0),
+                (t, y, f0),
                 (t_new, &y1, &mut f1),
-                h,
+                *h,
                 event,
-                (times, &mut next, sink),
-                &mut stats,
+                (times, next, sink),
+                stats,
             )?;
-            on_step(t, &state);
+            on_step(*t, &state);
             if last && !cut {
-                return Ok((y, stats));
+                return Ok(Attempt::Finished);
             }
             h_new = h_new.min(h_max);
-            if rejected_last {
-                h_new = h_new.min(h);
+            if *rejected_last {
+                h_new = h_new.min(*h);
             }
-            rejected_last = false;
-            h = h_new;
+            *rejected_last = false;
+            *h = h_new;
+            Ok(Attempt::Accepted)
         } else {
             stats.rejected += 1;
-            rejected_last = true;
-            h /= fac_hi.min(fac11 / SAFE);
+            *rejected_last = true;
+            *h /= fac_hi.min(fac11 / SAFE);
+            Ok(Attempt::Retry)
         }
     }
+}
+
+/// An adaptive run between attempts as a SIMD lane carries it, with the branch it holds.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct HeldRun<const M: usize> {
+    pub(crate) t: f64,
+    pub(crate) y: [f64; M],
+    pub(crate) f0: [f64; M],
+    pub(crate) h: f64,
+    pub(crate) fac_old: f64,
+    pub(crate) rejected_last: bool,
+    /// Attempts so far (accepted and rejected).
+    pub(crate) attempts: usize,
+    pub(crate) sides: Sides,
+    /// The switching functions at `t`.
+    pub(crate) g: [f64; MAX_SWITCHES],
+}
+
+/// The DOP853 attempts of [`drive`] for `system` on `M` compact entries (`[coords, rates]`,
+/// no work integrals, no samples) from `run` up to and including the next accepted step,
+/// with the same operations as the scalar run: what the SIMD lanes replay for an adaptive
+/// lane whose accepted step crosses a switch (the root located and the step cut there, or
+/// redone on the far side). `run` moves on; each accepted step's end time is pushed to
+/// `steps`. Returns whether the run reached `t_end` (`h_max`: `t_end − t0`).
+///
+/// # Errors
+/// As the scalar run: the step limit, a step-size underflow, a failing model or switching
+/// function.
+pub(crate) fn replay_adaptive_step<const M: usize>(
+    system: &dyn super::OdeSystem,
+    (rtol, atol): (f64, f64),
+    max_steps: usize,
+    (t_end, h_max): (f64, f64),
+    run: &mut HeldRun<M>,
+    steps: &mut Vec<f64>,
+) -> Result<bool> {
+    let mut rhs = super::runge_kutta::Adapter::held(system, run.sides);
+    let n_switches = Rhs::<M>::n_switches(&rhs).min(MAX_SWITCHES);
+    let mut scalar = AdaptiveRun {
+        t: run.t,
+        y: run.y,
+        f0: run.f0,
+        h: run.h,
+        fac_old: run.fac_old,
+        rejected_last: run.rejected_last,
+        // A redo is once per step start; the lane's earlier starts are behind `t`.
+        redone_at: None,
+        branch: Branch::resume(n_switches, run.sides, run.g),
+        stats: IntegrationStats {
+            accepted: run.attempts,
+            ..IntegrationStats::default()
+        },
+    };
+    let tol = Tolerances {
+        rtol,
+        atol,
+        controlled: M,
+    };
+    let mut stepper = dop853::Dop853::<M>::new();
+    let finished = loop {
+        match scalar.attempt(
+            &mut stepper,
+            &mut rhs,
+            &tol,
+            max_steps,
+            (t_end, h_max),
+            (&[], &mut 0, &mut |_, _, _| Ok(())),
+            &mut |t, _| steps.push(t),
+        )? {
+            Attempt::Retry => {}
+            Attempt::Accepted => break false,
+            Attempt::Finished => break true,
+        }
+    };
+    *run = HeldRun {
+        t: scalar.t,
+        y: scalar.y,
+        f0: scalar.f0,
+        h: scalar.h,
+        fac_old: scalar.fac_old,
+        rejected_last: scalar.rejected_last,
+        attempts: scalar.stats.accepted + scalar.stats.rejected,
+        sides: scalar.branch.sides(),
+        g: scalar.branch.g0(),
+    };
+    Ok(finished)
 }

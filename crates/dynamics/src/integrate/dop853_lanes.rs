@@ -35,10 +35,6 @@ use super::*;
 /// Problems integrated at once.
 pub(crate) const LANES: usize = 4;
 
-/// Entries in the error norm: the state `[q1, q2, q̇1, q̇2]` (a variational system's
-/// sensitivities ride along uncontrolled, as in integrate/variational.rs).
-pub(crate) const CONTROLLED: usize = 4;
-
 type V = f64x4;
 
 /// One lane's value of `v`.
@@ -62,6 +58,75 @@ pub(crate) trait LaneRhs<const M: usize> {
     /// tabulate their time dependence. Returns the bit mask of lanes whose evaluation failed
     /// (left out of the domain of the model).
     fn eval(&self, t: [f64; LANES], stage: [usize; LANES], y: &[V; M], dydt: &mut [V; M]) -> u32;
+
+    /// Whether the right-hand side has switching functions: then every fixed-grid lane holds
+    /// the branch of its own (the scalar `drive_on_grid_events`), [`Self::begin`] takes its
+    /// start's sides, [`Self::crossed`] checks every step and a step that crosses a switch is
+    /// [`Self::replay`]ed on the scalar path. Default: smooth.
+    fn switched(&self) -> bool {
+        false
+    }
+
+    /// Lane `l` starts a fixed-grid problem at `(t0, y0)`: it takes the sides of the
+    /// switching functions there (the scalar `Branch::start`); `false` when they fail.
+    fn begin(&self, _l: usize, _t0: f64, _y0: &[f64; M]) -> bool {
+        true
+    }
+
+    /// Whether lane `l`'s step ending at `(t_new, y1)` crosses a switching function from the
+    /// side it holds (the scalar `first_switch`'s test); if not, the values there start its
+    /// next step. `None` when they fail.
+    fn crossed(&self, _l: usize, _t_new: f64, _y1: &[f64; M]) -> Option<bool> {
+        Some(false)
+    }
+
+    /// Lane `l`'s grid step `[t, t_new]` from `(y, f0)` replayed on the scalar path (cut at
+    /// its roots, samples of `times[*next..]` inside to `sink`): the state and derivative at
+    /// `t_new` and the sub-steps over tolerance; the lane then holds the branch it ends on.
+    /// `None` where the scalar run fails.
+    #[allow(clippy::too_many_arguments)]
+    fn replay(
+        &self,
+        _l: usize,
+        _tol: LaneTolerances,
+        _span: (f64, f64),
+        _start: (&[f64; M], &[f64; M]),
+        _times: &[f64],
+        _next: &mut usize,
+        _sink: &mut dyn FnMut(usize, f64, &State) -> bool,
+    ) -> Option<([f64; M], [f64; M], usize)> {
+        None
+    }
+
+    /// Adaptive lane `l`'s attempts from `run` up to and including its next accepted step,
+    /// replayed on the scalar path (its accepted step crossed a switch: the root located and
+    /// the step cut there, or redone on the far side); `run` moves on and the accepted step
+    /// times go to `steps`. Returns whether the lane reached `t_end` (`h_max`: `t_end − t0`),
+    /// `None` where the scalar run fails.
+    fn replay_adaptive(
+        &self,
+        _l: usize,
+        _tol: LaneTolerances,
+        _max_steps: usize,
+        _span: (f64, f64),
+        _run: &mut LaneRun<M>,
+        _steps: &mut Vec<f64>,
+    ) -> Option<bool> {
+        None
+    }
+}
+
+/// An adaptive lane between attempts (see [`LaneRhs::replay_adaptive`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LaneRun<const M: usize> {
+    pub(crate) t: f64,
+    pub(crate) y: [f64; M],
+    pub(crate) f0: [f64; M],
+    pub(crate) h: f64,
+    pub(crate) fac_old: f64,
+    pub(crate) rejected_last: bool,
+    /// Attempts so far (accepted and rejected).
+    pub(crate) attempts: usize,
 }
 
 /// Right-hand side evaluations per step in [`stage_times`]: the step's start, stages 2–12,
@@ -131,7 +196,7 @@ pub(crate) enum LaneOutcome<const M: usize> {
 /// Up to four consecutive samples of one lane: `count` of them from `first` (index in the
 /// lane's times), their times and compact states (sample `j` in vector lane `j`; the others
 /// are padding).
-pub(crate) struct SampleBlock {
+pub(crate) struct SampleBlock<const C: usize = 4> {
     /// Index of the first sample in the lane's times.
     pub(crate) first: usize,
     /// Samples in the block (1 to 4).
@@ -139,12 +204,12 @@ pub(crate) struct SampleBlock {
     /// Their times.
     pub(crate) t: [f64; 4],
     /// Their compact states `[q1, q2, q̇1, q̇2]`, one sample per vector lane.
-    pub(crate) y: [V; 4],
+    pub(crate) y: [V; C],
 }
 
 /// Receives the samples of a lane in blocks, in order: `(lane, block)`; `false` fails the
 /// lane.
-pub(crate) type LaneSink<'a> = dyn FnMut(usize, &SampleBlock) -> bool + 'a;
+pub(crate) type LaneSink<'a, const C: usize = 4> = dyn FnMut(usize, &SampleBlock<C>) -> bool + 'a;
 
 /// The step control of an adaptive lane (`drive` in integrate/adaptive.rs, per lane).
 #[derive(Clone, Debug, Default)]
@@ -174,7 +239,12 @@ struct Progress {
 }
 
 /// [`LANES`] lanes of DOP853 on fixed grids.
-pub(crate) struct LaneStepper<const M: usize> {
+///
+/// `C` entries of the state are controlled and sampled: the compact `[coords (C/2), rates
+/// (C/2)]` (4: the two-DOF drivetrain, 8: the stroke-plane device); the rest (`M > C`: a
+/// variational system's sensitivities) ride along uncontrolled, as in
+/// integrate/variational.rs.
+pub(crate) struct LaneStepper<const M: usize, const C: usize = 4> {
     y: [V; M],
     f0: [V; M],
     k: [[V; M]; 10],
@@ -200,7 +270,7 @@ macro_rules! vstage {
     };
 }
 
-impl<const M: usize> LaneStepper<M> {
+impl<const M: usize, const C: usize> LaneStepper<M, C> {
     /// All lanes idle.
     pub(crate) fn new() -> Self {
         let z = [V::splat(0.0); M];
@@ -245,9 +315,9 @@ impl<const M: usize> LaneStepper<M> {
             };
             let t = p.adaptive.as_ref().map_or(p.grid[p.step], |a| a.t);
             let mut y = State::default();
-            for i in 0..2 {
+            for i in 0..C / 2 {
                 y.coords[i] = lane(self.y[i], l);
-                y.rates[i] = lane(self.y[2 + i], l);
+                y.rates[i] = lane(self.y[C / 2 + i], l);
             }
             p.active = false;
             self.timeouts[l] = Some(budget::stop_error(budget::Stop::Wall(ms), t, y.to_vec()));
@@ -267,14 +337,14 @@ impl<const M: usize> LaneStepper<M> {
         &mut self,
         l: usize,
         problem: LaneProblem<M>,
-        sink: &mut LaneSink<'_>,
+        sink: &mut LaneSink<'_, C>,
     ) -> bool {
         if problem.grid.len() < 2 {
             return false;
         }
         let t0 = problem.grid[0];
         let at_start = problem.times.partition_point(|&s| s <= t0);
-        let y0: [V; 4] = std::array::from_fn(|i| V::splat(problem.y0[i]));
+        let y0: [V; C] = std::array::from_fn(|i| V::splat(problem.y0[i]));
         if !emit_constant(l, &problem.times, 0, at_start, &y0, sink) {
             return false;
         }
@@ -314,7 +384,7 @@ impl<const M: usize> LaneStepper<M> {
         &mut self,
         rhs: &R,
         fresh: u32,
-        sink: &mut LaneSink<'_>,
+        sink: &mut LaneSink<'_, C>,
     ) -> Vec<(usize, LaneOutcome<M>)> {
         let mut finished = Vec::new();
         if fresh != 0 {
@@ -331,8 +401,20 @@ impl<const M: usize> LaneStepper<M> {
                     NO_STAGE
                 }
             });
+            let mut begun = 0u32;
+            if rhs.switched() {
+                for l in 0..LANES {
+                    let p = &self.lanes[l];
+                    if fresh & (1 << l) != 0 && p.active {
+                        let y0: [f64; M] = std::array::from_fn(|i| lane(self.y[i], l));
+                        if !rhs.begin(l, t0[l], &y0) {
+                            begun |= 1 << l;
+                        }
+                    }
+                }
+            }
             let mut f = [V::splat(0.0); M];
-            let failed = rhs.eval(t0, stage, &self.y, &mut f);
+            let failed = rhs.eval(t0, stage, &self.y, &mut f) | begun;
             for l in 0..LANES {
                 if fresh & (1 << l) == 0 || !self.lanes[l].active {
                     continue;
@@ -369,10 +451,10 @@ impl<const M: usize> LaneStepper<M> {
         let tol = Tolerances {
             rtol: lane(self.rtol, l),
             atol: lane(self.atol, l),
-            controlled: CONTROLLED,
+            controlled: C,
         };
         let a = self.lanes[l].adaptive.as_mut().expect("an adaptive lane");
-        let mut one = OneLane { rhs, l };
+        let mut one = OneLane::<M, C> { rhs, l };
         match super::super::initial_step(&mut one, 8, &tol, a.t, &y0, &f0, a.t_end - a.t) {
             Ok(h) => {
                 a.h = h;
@@ -387,7 +469,7 @@ impl<const M: usize> LaneStepper<M> {
     fn step<R: LaneRhs<M>>(
         &mut self,
         rhs: &R,
-        sink: &mut LaneSink<'_>,
+        sink: &mut LaneSink<'_, C>,
         finished: &mut Vec<(usize, LaneOutcome<M>)>,
     ) {
         let mut t = [0.0; LANES];
@@ -477,7 +559,7 @@ impl<const M: usize> LaneStepper<M> {
                 + V::splat(B12) * k3[i];
             let y1 = y[i] + h * inc;
             self.y1[i] = y1;
-            if i >= CONTROLLED {
+            if i >= C {
                 continue;
             }
             let sk = self.atol + self.rtol * y[i].abs().max(y1.abs());
@@ -499,17 +581,17 @@ impl<const M: usize> LaneStepper<M> {
                 *d = 1.0;
             }
         }
-        let err =
-            h.abs() * err5 * (V::splat(1.0) / (V::splat(CONTROLLED as f64) * V::new(deno))).sqrt();
+        let err = h.abs() * err5 * (V::splat(1.0) / (V::splat(C as f64) * V::new(deno))).sqrt();
         // Failures of the new derivative count only on accepted steps (the scalar evaluates
         // it after accepting).
         let mut f1 = [V::splat(0.0); M];
         let failed_f1 = rhs.eval(t_new, idx(STAGES_PER_STEP), &self.y1, &mut f1);
-        let y1_finite = (self.y1[0].is_finite()
-            & self.y1[1].is_finite()
-            & self.y1[2].is_finite()
-            & self.y1[3].is_finite())
-        .to_bitmask();
+        let y1_finite = self.y1[..C]
+            .iter()
+            .fold(V::splat(0.0).simd_eq(V::splat(0.0)), |all, v| {
+                all & v.is_finite()
+            })
+            .to_bitmask();
         let err_finite = err.is_finite().to_bitmask();
         let wants_dense = (0..LANES).any(|l| {
             let p = &self.lanes[l];
@@ -519,6 +601,7 @@ impl<const M: usize> LaneStepper<M> {
             failed |= self.prepare_dense(rhs, &t, &base, h, &f1);
         }
         let mut accepted = [true; LANES];
+        let switched = rhs.switched();
         for l in 0..LANES {
             if !self.lanes[l].active {
                 continue;
@@ -526,6 +609,23 @@ impl<const M: usize> LaneStepper<M> {
             let bit = 1 << l;
             if self.lanes[l].adaptive.is_some() {
                 let err = lane(err, l);
+                let completes = failed_f1 & bit == 0 && y1_finite & bit != 0;
+                if switched && err <= 1.0 && (given_up | failed) & bit == 0 && completes {
+                    // An accepted step that crosses a switch: replayed on the scalar path.
+                    let y1: [f64; M] = std::array::from_fn(|i| lane(self.y1[i], l));
+                    match rhs.crossed(l, t_new[l], &y1) {
+                        None => {
+                            self.lanes[l].active = false;
+                            finished.push((l, LaneOutcome::Failed));
+                            continue;
+                        }
+                        Some(true) => {
+                            self.replay_adaptive(rhs, l, &mut f1, finished);
+                            continue;
+                        }
+                        Some(false) => {}
+                    }
+                }
                 let p = &mut self.lanes[l];
                 let a = p.adaptive.as_mut().expect("an adaptive lane");
                 let outcome = a.control(err, given_up & bit != 0, failed & bit != 0, || {
@@ -556,12 +656,26 @@ impl<const M: usize> LaneStepper<M> {
                 && failed_f1 & bit == 0
                 && err_finite & bit != 0
                 && y1_finite & bit != 0;
-            if ok {
+            let mut replayed = None;
+            if ok && switched {
+                let y1: [f64; M] = std::array::from_fn(|i| lane(self.y1[i], l));
+                match rhs.crossed(l, t_new[l], &y1) {
+                    None => ok = false,
+                    Some(false) => {}
+                    Some(true) => {
+                        replayed = self.replay(rhs, l, (t[l], t_new[l]), &mut f1, sink);
+                        ok = replayed.is_some();
+                    }
+                }
+            }
+            if ok && replayed.is_none() {
                 ok = self.emit(l, t[l], hs[l], t_new[l], sink);
             }
             let p = &mut self.lanes[l];
-            if lane(err, l) > 1.0 {
-                p.over_tolerance += 1;
+            match replayed {
+                Some(over) => p.over_tolerance += over,
+                None if lane(err, l) > 1.0 => p.over_tolerance += 1,
+                None => {}
             }
             p.step += 1;
             if !ok {
@@ -597,14 +711,118 @@ impl<const M: usize> LaneStepper<M> {
         }
     }
 
+    /// Lane `l`'s step `[t, t_new]` replayed on the scalar path ([`LaneRhs::replay`]): its
+    /// end state and derivative replace the lane's (`y1`, `f1`); returns the sub-steps over
+    /// tolerance, `None` where the scalar run fails.
+    fn replay<R: LaneRhs<M>>(
+        &mut self,
+        rhs: &R,
+        l: usize,
+        span: (f64, f64),
+        f1: &mut [V; M],
+        sink: &mut LaneSink<'_, C>,
+    ) -> Option<usize> {
+        let y: [f64; M] = std::array::from_fn(|i| lane(self.y[i], l));
+        let f0: [f64; M] = std::array::from_fn(|i| lane(self.f0[i], l));
+        let tol = LaneTolerances {
+            rtol: lane(self.rtol, l),
+            atol: lane(self.atol, l),
+        };
+        let p = &mut self.lanes[l];
+        let times = p.times.clone();
+        let mut block_sink = |i: usize, t: f64, state: &State| {
+            let compact: [f64; C] = std::array::from_fn(|e| {
+                if e < C / 2 {
+                    state.coords[e]
+                } else {
+                    state.rates[e - C / 2]
+                }
+            });
+            let block = SampleBlock {
+                first: i,
+                count: 1,
+                t: [t; 4],
+                y: compact.map(V::splat),
+            };
+            sink(l, &block)
+        };
+        let (y_end, f_end, over) = rhs.replay(
+            l,
+            tol,
+            span,
+            (&y, &f0),
+            &times,
+            &mut p.next,
+            &mut block_sink,
+        )?;
+        for i in 0..M {
+            self.y1[i] = with_lane(self.y1[i], l, y_end[i]);
+            f1[i] = with_lane(f1[i], l, f_end[i]);
+        }
+        Some(over)
+    }
+
+    /// Adaptive lane `l`'s attempts replayed on the scalar path up to its next accepted step
+    /// ([`LaneRhs::replay_adaptive`]): its state and derivative there replace the lane's
+    /// (`y1`, `f1`); a lane that reached its end, or whose scalar run fails, finishes.
+    fn replay_adaptive<R: LaneRhs<M>>(
+        &mut self,
+        rhs: &R,
+        l: usize,
+        f1: &mut [V; M],
+        finished: &mut Vec<(usize, LaneOutcome<M>)>,
+    ) {
+        let tol = LaneTolerances {
+            rtol: lane(self.rtol, l),
+            atol: lane(self.atol, l),
+        };
+        let y: [f64; M] = std::array::from_fn(|i| lane(self.y[i], l));
+        let f0: [f64; M] = std::array::from_fn(|i| lane(self.f0[i], l));
+        let p = &mut self.lanes[l];
+        let a = p.adaptive.as_mut().expect("an adaptive lane");
+        let mut run = LaneRun {
+            t: a.t,
+            y,
+            f0,
+            h: a.h,
+            fac_old: a.fac_old,
+            rejected_last: a.rejected_last,
+            attempts: a.attempts,
+        };
+        let span = (a.t_end, a.t_end - a.steps[0]);
+        let Some(done) = rhs.replay_adaptive(l, tol, a.max_steps, span, &mut run, &mut a.steps)
+        else {
+            p.active = false;
+            finished.push((l, LaneOutcome::Failed));
+            return;
+        };
+        (a.t, a.h, a.fac_old, a.rejected_last, a.attempts) =
+            (run.t, run.h, run.fac_old, run.rejected_last, run.attempts);
+        for i in 0..M {
+            self.y1[i] = with_lane(self.y1[i], l, run.y[i]);
+            f1[i] = with_lane(f1[i], l, run.f0[i]);
+        }
+        if done {
+            p.active = false;
+            finished.push((
+                l,
+                LaneOutcome::Done {
+                    y: run.y,
+                    over_tolerance: 0,
+                    steps: std::mem::take(&mut a.steps),
+                },
+            ));
+        }
+    }
+
     /// The samples of lane `l` inside `[t, t_new)` (interpolated, four at a time) and at
     /// `t_new`.
-    fn emit(&mut self, l: usize, t: f64, h: f64, t_new: f64, sink: &mut LaneSink<'_>) -> bool {
+    fn emit(&mut self, l: usize, t: f64, h: f64, t_new: f64, sink: &mut LaneSink<'_, C>) -> bool {
         let p = &mut self.lanes[l];
         let inside = p.next + p.times[p.next..].partition_point(|&s| s < t_new);
         if inside > p.next {
             // This lane's interpolant, broadcast: the vector lanes now hold samples.
-            let c: [[V; 4]; 8] = std::array::from_fn(|r| {
+            let c: [[V; C]; 8] = std::array::from_fn(|r| {
                 std::array::from_fn(|i| V::splat(lane(self.cont[r][i], l)))
             });
             while p.next < inside {
@@ -613,7 +831,7 @@ impl<const M: usize> LaneStepper<M> {
                 ts[..count].copy_from_slice(&p.times[p.next..p.next + count]);
                 let s = (V::new(ts) - V::splat(t)) / V::splat(h);
                 let s1 = V::splat(1.0) - s;
-                let y: [V; 4] = std::array::from_fn(|i| {
+                let y: [V; C] = std::array::from_fn(|i| {
                     c[0][i]
                         + s * (c[1][i]
                             + s1 * (c[2][i]
@@ -621,9 +839,12 @@ impl<const M: usize> LaneStepper<M> {
                                     + s1 * (c[4][i]
                                         + s * (c[5][i] + s1 * (c[6][i] + s * c[7][i]))))))
                 });
-                let finite =
-                    (y[0].is_finite() & y[1].is_finite() & y[2].is_finite() & y[3].is_finite())
-                        .to_bitmask();
+                let finite = y
+                    .iter()
+                    .fold(V::splat(0.0).simd_eq(V::splat(0.0)), |all, v| {
+                        all & v.is_finite()
+                    })
+                    .to_bitmask();
                 let block = SampleBlock {
                     first: p.next,
                     count,
@@ -637,7 +858,7 @@ impl<const M: usize> LaneStepper<M> {
             }
         }
         let at_end = p.next + p.times[p.next..].partition_point(|&s| s <= t_new);
-        let end: [V; 4] = std::array::from_fn(|i| V::splat(lane(self.y1[i], l)));
+        let end: [V; C] = std::array::from_fn(|i| V::splat(lane(self.y1[i], l)));
         let ok = emit_constant(l, &p.times, p.next, at_end, &end, sink);
         p.next = at_end;
         ok
@@ -746,13 +967,13 @@ impl<const M: usize> LaneStepper<M> {
 }
 
 /// The samples `from..to` of lane `l` at one state `y` (broadcast), in blocks.
-fn emit_constant(
+fn emit_constant<const C: usize>(
     l: usize,
     times: &[f64],
     from: usize,
     to: usize,
-    y: &[V; 4],
-    sink: &mut LaneSink<'_>,
+    y: &[V; C],
+    sink: &mut LaneSink<'_, C>,
 ) -> bool {
     let mut first = from;
     while first < to {
@@ -841,12 +1062,12 @@ impl Adaptive {
 }
 
 /// One lane of a [`LaneRhs`] as a scalar right-hand side (for `initial_step`).
-struct OneLane<'r, const M: usize> {
+struct OneLane<'r, const M: usize, const C: usize> {
     rhs: &'r dyn LaneRhs<M>,
     l: usize,
 }
 
-impl<const M: usize> Rhs<M> for OneLane<'_, M> {
+impl<const M: usize, const C: usize> Rhs<M> for OneLane<'_, M, C> {
     fn eval(&mut self, t: f64, y: &[f64; M], dydt: &mut [f64; M]) -> paritysim_error::Result<()> {
         let mut out = [V::splat(0.0); M];
         let failed = self
@@ -866,8 +1087,8 @@ impl<const M: usize> Rhs<M> for OneLane<'_, M> {
 
     fn expand(&self, c: &[f64; M]) -> State {
         let mut y = State::default();
-        y.coords[..2].copy_from_slice(&c[..2]);
-        y.rates[..2].copy_from_slice(&c[2..]);
+        y.coords[..C / 2].copy_from_slice(&c[..C / 2]);
+        y.rates[..C / 2].copy_from_slice(&c[C / 2..C]);
         y
     }
 }

@@ -3,10 +3,11 @@
 
 use paritysim_error::{Error, Result};
 
+use super::runge_kutta::Adapter;
 use super::switched::Branch;
 use super::{
-    IntegrationStats, MAX_SWITCHES, Method, Rhs, Sink, Stepper, Tolerances, budget, dop853, dopri5,
-    events, integration_error, sample_step,
+    IntegrationStats, MAX_SWITCHES, Method, OdeSystem, Rhs, Sides, Sink, Stepper, Tolerances,
+    budget, dop853, dopri5, events, integration_error, sample_step,
 };
 
 /// A step grid: at least two finite, strictly increasing times.
@@ -136,67 +137,154 @@ pub(super) fn drive_on_grid_events<const M: usize, S: Stepper<M>>(
     let mut y = y0;
     let mut branch = Branch::start(rhs, n_switches, grid[0], &y)?;
     let mut f0 = [0.0; M];
-    let mut f1 = [0.0; M];
     rhs.eval(grid[0], &y, &mut f0)?;
     for (k, pair) in grid.windows(2).enumerate() {
-        let (mut t, t_new) = (pair[0], pair[1]);
         if k % budget::CHECK_EVERY == 0 {
             if let Err(stop) = budget::check_current() {
-                return Err(budget::stop_error(stop, t, rhs.expand(&y).to_vec()));
+                return Err(budget::stop_error(stop, pair[0], rhs.expand(&y).to_vec()));
             }
         }
-        let mut redone = false;
-        for sub in 0.. {
-            let h = t_new - t;
-            let err = stepper.attempt(rhs, t, &y, &f0, h, tol)?;
-            if !err.is_finite() {
-                return Err(integration_error(
-                    t,
-                    &rhs.expand(&y),
-                    "non-finite state on a fixed step",
-                ));
-            }
-            stepper.new_derivative(rhs, t_new, &mut f1)?;
-            let y1 = *stepper.y1();
-            let event = branch.first_switch(
-                stepper,
-                rhs,
-                (t, &y, &f0),
-                (t_new, &y1, &f1),
-                h,
-                sub < MAX_EVENTS_PER_STEP,
-                events::GRID_ROOT_TOLERANCE,
-                &mut stats,
-            )?;
-            if let Some(found) = &event {
-                if found.at_start && !redone {
-                    // The step began on the wrong branch (a root at its start): redo it on
-                    // the far side.
-                    redone = true;
-                    branch.take(rhs, found.sides, t, &y, &mut f0)?;
-                    continue;
-                }
-            }
-            if err > 1.0 {
-                stats.over_tolerance += 1;
-            }
-            stats.accepted += 1;
-            let (_, cut) = branch.advance(
-                stepper,
-                rhs,
-                (&mut t, &mut y, &mut f0),
-                (t_new, &y1, &mut f1),
-                h,
-                event,
-                (times, &mut next, sink),
-                &mut stats,
-            )?;
-            if !cut {
-                break;
-            }
-            // Cut at a root: the rest of the grid step on the new branch.
-            redone = false;
-        }
+        grid_step_with_events(
+            stepper,
+            rhs,
+            tol,
+            &mut branch,
+            (pair[0], pair[1]),
+            (&mut y, &mut f0),
+            (times, &mut next, sink),
+            &mut stats,
+        )?;
     }
     Ok((y, stats))
+}
+
+/// One grid step `[t, t_new]` of [`drive_on_grid_events`] from `(y, f0)` on `branch`, cut at
+/// the first root inside it and finished on the new branch; `(y, f0)` become the state and
+/// derivative at `t_new`.
+#[allow(clippy::too_many_arguments)]
+fn grid_step_with_events<const M: usize, S: Stepper<M>>(
+    stepper: &mut S,
+    rhs: &mut dyn Rhs<M>,
+    tol: &Tolerances,
+    branch: &mut Branch,
+    (t_start, t_new): (f64, f64),
+    (y, f0): (&mut [f64; M], &mut [f64; M]),
+    (times, next, sink): (&[f64], &mut usize, &mut Sink<'_>),
+    stats: &mut IntegrationStats,
+) -> Result<()> {
+    let mut t = t_start;
+    let mut f1 = [0.0; M];
+    let mut redone = false;
+    for sub in 0.. {
+        let h = t_new - t;
+        let err = stepper.attempt(rhs, t, y, f0, h, tol)?;
+        if !err.is_finite() {
+            return Err(integration_error(
+                t,
+                &rhs.expand(y),
+                "non-finite state on a fixed step",
+            ));
+        }
+        stepper.new_derivative(rhs, t_new, &mut f1)?;
+        let y1 = *stepper.y1();
+        let event = branch.first_switch(
+            stepper,
+            rhs,
+            (t, y, f0),
+            (t_new, &y1, &f1),
+            h,
+            sub < MAX_EVENTS_PER_STEP,
+            events::GRID_ROOT_TOLERANCE,
+            stats,
+        )?;
+        if let Some(found) = &event {
+            if found.at_start && !redone {
+                // The step began on the wrong branch (a root at its start): redo it on
+                // the far side.
+                redone = true;
+                branch.take(rhs, found.sides, t, y, f0)?;
+                continue;
+            }
+        }
+        if err > 1.0 {
+            stats.over_tolerance += 1;
+        }
+        stats.accepted += 1;
+        let (_, cut) = branch.advance(
+            stepper,
+            rhs,
+            (&mut t, y, f0),
+            (t_new, &y1, &mut f1),
+            h,
+            event,
+            (times, next, sink),
+            stats,
+        )?;
+        if !cut {
+            break;
+        }
+        // Cut at a root: the rest of the grid step on the new branch.
+        redone = false;
+    }
+    Ok(())
+}
+
+/// Where a replayed grid step ended ([`replay_grid_step`]).
+pub(crate) struct GridStepEnd<const M: usize> {
+    /// The state and derivative at the step's end.
+    pub(crate) y: [f64; M],
+    pub(crate) f: [f64; M],
+    /// The sides held there and the switching functions' values.
+    pub(crate) sides: Sides,
+    pub(crate) g: [f64; MAX_SWITCHES],
+    /// Sub-steps whose error estimate exceeded the tolerances.
+    pub(crate) over_tolerance: usize,
+}
+
+/// One DOP853 grid step of [`drive_on_grid_events`] for `system` on `M` compact entries
+/// (`[coords, rates]`, no work integrals), from `(t, y, f0)` on the held `sides` with the
+/// switching functions `g0` there: what the SIMD lanes replay for a lane whose step crosses
+/// a switch, with the same operations as the scalar run (so the same bits). Samples of
+/// `times[*next..]` inside the step go to `sink`.
+///
+/// # Errors
+/// As the scalar fixed-grid run: a failing model or switching function, a non-finite state,
+/// whatever `sink` returns.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn replay_grid_step<const M: usize>(
+    system: &dyn OdeSystem,
+    (rtol, atol): (f64, f64),
+    (t, t_new): (f64, f64),
+    (mut y, mut f0): ([f64; M], [f64; M]),
+    (sides, g0): (Sides, [f64; MAX_SWITCHES]),
+    times: &[f64],
+    next: &mut usize,
+    sink: &mut Sink<'_>,
+) -> Result<GridStepEnd<M>> {
+    let mut rhs = Adapter::held(system, sides);
+    let n_switches = Rhs::<M>::n_switches(&rhs);
+    let mut branch = Branch::resume(n_switches, sides, g0);
+    let tol = Tolerances {
+        rtol,
+        atol,
+        controlled: M,
+    };
+    let mut stats = IntegrationStats::default();
+    grid_step_with_events(
+        &mut dop853::Dop853::<M>::new(),
+        &mut rhs,
+        &tol,
+        &mut branch,
+        (t, t_new),
+        (&mut y, &mut f0),
+        (times, next, sink),
+        &mut stats,
+    )?;
+    Ok(GridStepEnd {
+        y,
+        f: f0,
+        sides: branch.sides(),
+        g: branch.g0(),
+        over_tolerance: stats.over_tolerance,
+    })
 }

@@ -10,10 +10,15 @@
 //! chain from the sweep's shared queue) while the others keep stepping: the ensemble technique
 //! of heyoka and MPGOS. One such worker runs on each thread of the sweep's rayon pool.
 //!
-//! * **Which points.** A shooting point qualifies when it reads stroke metrics only, records
-//!   one plain cycle, uses DOP853, and its device integrates drivetrain coordinates of the
-//!   linear differential map with stroke drag ([`has_lane_model`]); every other point runs the
-//!   scalar path in place, in its chain's order.
+//! * **Which points.** A shooting point qualifies when it records one plain cycle, uses DOP853
+//!   and its device has a lane model ([`has_lane_model`]): drivetrain coordinates of the linear
+//!   differential map with stroke drag (stroke metrics only; `point`), or the §3.4 stroke-plane
+//!   model with blade elements on a single drive (continued points, metrics without work
+//!   integrals; `plane_point`). Every other point runs the scalar path in place, in its
+//!   chain's order.
+//! * **Switches.** The stroke-plane lanes hold the branch of their blade elements' switching
+//!   functions and replay a step that crosses one on the scalar path (`plane_rhs`), so their
+//!   periods stay the scalar ones bit for bit.
 //! * **Same results.** The lanes perform the scalar path's floating-point operations in its
 //!   order, and the Newton logic here (`LanePoint`) is that of `grid_shooting::shoot` and
 //!   `simulate::shooting_steady_state`. The branches it does not follow (a failing period, a
@@ -30,6 +35,8 @@
 //!   sweep's cancel is checked between periods.
 
 pub(crate) mod linear_stroke;
+mod plane_point;
+mod plane_rhs;
 mod point;
 mod schedule;
 
@@ -75,9 +82,11 @@ pub fn resolve_lanes(requested: Option<usize>) -> Result<usize> {
 
 /// Whether `device` has a SIMD-lane model: its continued shooting points then run in lanes
 /// when the sweep's other conditions hold (see the module). Today: drivetrain coordinates of
-/// the two-DOF linear differential map (eq. 2.15) with stroke drag or no aerodynamics.
+/// the two-DOF linear differential map (eq. 2.15) with stroke drag or no aerodynamics, and
+/// the §3.4 stroke-plane devices (blade elements on both wings, a single drive).
 pub fn has_lane_model(device: &Device) -> bool {
     LinearStroke::of(device).is_some()
+        || crate::device::stroke_plane_lanes::StrokePlaneLanes::supports(device)
 }
 
 /// Points completed in lanes since the process started (tests and benchmarks read it to see
@@ -85,8 +94,17 @@ pub fn has_lane_model(device: &Device) -> bool {
 pub(crate) static COMPLETED_IN_LANES: std::sync::atomic::AtomicUsize =
     std::sync::atomic::AtomicUsize::new(0);
 
+/// Of [`COMPLETED_IN_LANES`], the stroke-plane (§3.4) points.
+pub(crate) static STROKE_PLANE_COMPLETED_IN_LANES: std::sync::atomic::AtomicUsize =
+    std::sync::atomic::AtomicUsize::new(0);
+
 /// How many sweep points the SIMD lanes have completed in this process (monotonic; points
 /// rerun on the scalar path are not counted).
 pub fn points_completed_in_lanes() -> usize {
     COMPLETED_IN_LANES.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// Of [`points_completed_in_lanes`], those of stroke-plane devices (§3.4).
+pub fn stroke_plane_points_completed_in_lanes() -> usize {
+    STROKE_PLANE_COMPLETED_IN_LANES.load(std::sync::atomic::Ordering::Relaxed)
 }

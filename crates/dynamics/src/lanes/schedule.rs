@@ -9,6 +9,8 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use paritysim_error::Result;
 
 use super::linear_stroke::{LinearStrokeLanes, VariationalLanes};
+use super::plane_point::PlanePoint;
+use super::plane_rhs::{self, PlaneLanes};
 use super::point::{LanePoint, Next};
 use crate::device::Device;
 use crate::integrate::lanes::{LaneOutcome, LaneStepper, SampleBlock};
@@ -55,7 +57,29 @@ struct Cursor<'a> {
     previous: Vec<Converged>,
     out: Vec<Result<PointOutput>>,
     /// The point in the lane: its index, start and state.
-    point: Option<(usize, ChainStart, LanePoint<'a>)>,
+    point: Option<(usize, ChainStart, Task<'a>)>,
+}
+
+/// A point in a lane: a drivetrain-coordinate one or a stroke-plane one.
+enum Task<'a> {
+    Linear(LanePoint<'a>),
+    Plane(PlanePoint<'a>),
+}
+
+impl Task<'_> {
+    fn deadline(&self) -> Option<(std::time::Instant, f64)> {
+        match self {
+            Task::Linear(p) => p.deadline,
+            Task::Plane(p) => p.deadline,
+        }
+    }
+}
+
+/// How a lane's period ended, by stepper.
+enum Ended {
+    State(LaneOutcome<4>),
+    Variational(LaneOutcome<20>),
+    Plane(LaneOutcome<{ plane_rhs::M }>),
 }
 
 type ChainResults = Vec<Option<Result<Vec<Result<PointOutput>>>>>;
@@ -139,33 +163,42 @@ pub(crate) fn run_chains(
         .collect())
 }
 
-/// The worker's two lane steppers (the state, and the state with its variational equations).
+/// The worker's lane steppers (the drivetrain state, with its variational equations, and
+/// the stroke-plane state).
 struct Steppers {
     state: LaneStepper<4>,
     variational: LaneStepper<20>,
+    plane: LaneStepper<{ plane_rhs::M }, { plane_rhs::M }>,
     /// Lanes started since each stepper's last run.
-    fresh: [u32; 2],
+    fresh: [u32; 3],
 }
 
-/// Starts `next` of `point` in lane `l`: `None` while it is in flight, else the point is
+/// The right-hand sides of a worker's lanes.
+struct Models<'a> {
+    linear: LinearStrokeLanes<'a>,
+    plane: PlaneLanes<'a>,
+}
+
+/// Starts `next` of `task` in lane `l`: `None` while it is in flight, else the point is
 /// complete (`Some(Some(output))` from the lanes, `Some(None)`: run it on the scalar path).
 fn launch<'a>(
     l: usize,
     next: Next,
-    point: &mut LanePoint<'a>,
+    task: &mut Task<'a>,
     steppers: &mut Steppers,
-    models: &mut LinearStrokeLanes<'a>,
+    models: &mut Models<'a>,
     forcing_cache: &mut ForcingCache,
 ) -> Option<Option<PointOutput>> {
-    match next {
-        Next::Integrate(problem) => {
+    let deadline = task.deadline();
+    match (next, task) {
+        (Next::Integrate(problem), Task::Linear(point)) => {
             // A lane reads only its own point's table (adaptive periods evaluate the drive).
             let table = problem
                 .adaptive
                 .is_none()
                 .then(|| forcing(point, forcing_cache));
-            models.load_forcing(l, table);
-            steppers.state.set_deadline(l, point.deadline);
+            models.linear.load_forcing(l, table);
+            steppers.state.set_deadline(l, deadline);
             let mut sink = |_: usize, block: &SampleBlock| point.sample(block);
             if steppers.state.start(l, problem, &mut sink) {
                 steppers.fresh[0] |= 1 << l;
@@ -174,13 +207,13 @@ fn launch<'a>(
                 Some(None)
             }
         }
-        Next::Sensitivity(problem) => {
+        (Next::Sensitivity(problem), Task::Linear(point)) => {
             let table = problem
                 .adaptive
                 .is_none()
                 .then(|| forcing(point, forcing_cache));
-            models.load_forcing(l, table);
-            steppers.variational.set_deadline(l, point.deadline);
+            models.linear.load_forcing(l, table);
+            steppers.variational.set_deadline(l, deadline);
             if steppers
                 .variational
                 .start(l, problem, &mut |_: usize, _: &SampleBlock| true)
@@ -191,8 +224,23 @@ fn launch<'a>(
                 Some(None)
             }
         }
-        Next::Done(output) => Some(Some(*output)),
-        Next::Scalar => Some(None),
+        (Next::Plane(problem), Task::Plane(point)) => {
+            models.plane.load(l, point.device);
+            if problem.adaptive.is_none() {
+                models.plane.load_forcing(l, point.forcing());
+            }
+            steppers.plane.set_deadline(l, deadline);
+            let mut sink = |_: usize, block: &SampleBlock<{ plane_rhs::M }>| point.sample(block);
+            if steppers.plane.start(l, problem, &mut sink) {
+                steppers.fresh[2] |= 1 << l;
+                None
+            } else {
+                Some(None)
+            }
+        }
+        (Next::Done(output), _) => Some(Some(*output)),
+        // `Next::Scalar`, or a period of another kind than the point's (not handed out).
+        _ => Some(None),
     }
 }
 
@@ -211,9 +259,13 @@ fn run_worker(
     let mut steppers = Steppers {
         state: LaneStepper::new(),
         variational: LaneStepper::new(),
-        fresh: [0; 2],
+        plane: LaneStepper::new(),
+        fresh: [0; 3],
     };
-    let mut models = LinearStrokeLanes::new();
+    let mut models = Models {
+        linear: LinearStrokeLanes::new(),
+        plane: PlaneLanes::new(),
+    };
     let mut times_cache = None;
     // One per lane: a lane's next point usually has its chain predecessor's grid (one cache
     // for the worker was overwritten by the other lanes' chains: 366 tables for 256 points).
@@ -257,18 +309,21 @@ fn run_worker(
                 // Continued from the neighbours, or (a chain's start) from the spec's own state.
                 let lane_point = points[i].as_ref().ok().and_then(|(device, own)| {
                     let options = continued_options(points, i, &start);
-                    LanePoint::new(
-                        device,
-                        options.as_ref().unwrap_or(own),
-                        metric_names,
-                        &mut times_cache,
-                    )
+                    let options = options.as_ref().unwrap_or(own);
+                    LanePoint::new(device, options, metric_names, &mut times_cache)
+                        .map(|(p, next)| (Task::Linear(p), next))
+                        .or_else(|| {
+                            PlanePoint::new(device, options, metric_names, &mut times_cache)
+                                .map(|(p, next)| (Task::Plane(p), next))
+                        })
                 });
                 let Some((mut point, next)) = lane_point else {
                     finish_point(points, metric_names, cursor, i, &start, None, control);
                     continue;
                 };
-                models.load(l, &point.model);
+                if let Task::Linear(p) = &point {
+                    models.linear.load(l, &p.model);
+                }
                 match launch(
                     l,
                     next,
@@ -290,36 +345,60 @@ fn run_worker(
                 }
             }
         }
-        if control.is_cancelled() || !(steppers.state.any_busy() || steppers.variational.any_busy())
-        {
+        let busy = steppers.state.any_busy()
+            || steppers.variational.any_busy()
+            || steppers.plane.any_busy();
+        if control.is_cancelled() || !busy {
             break;
         }
-        let mut finished: Vec<(usize, Result<LaneOutcome<4>, LaneOutcome<20>>)> = Vec::new();
+        let mut finished: Vec<(usize, Ended)> = Vec::new();
         if steppers.state.any_busy() {
             let mut sink = |l: usize, block: &SampleBlock| {
                 cursors[l]
                     .as_mut()
                     .and_then(|c| c.point.as_mut())
-                    .is_some_and(|(_, _, p)| p.sample(block))
+                    .is_some_and(|(_, _, task)| match task {
+                        Task::Linear(p) => p.sample(block),
+                        Task::Plane(_) => false,
+                    })
             };
             let fresh = std::mem::take(&mut steppers.fresh[0]);
             finished.extend(
                 steppers
                     .state
-                    .run(&models, fresh, &mut sink)
+                    .run(&models.linear, fresh, &mut sink)
                     .into_iter()
-                    .map(|(l, o)| (l, Ok(o))),
+                    .map(|(l, o)| (l, Ended::State(o))),
             );
         }
         if steppers.variational.any_busy() {
             let fresh = std::mem::take(&mut steppers.fresh[1]);
-            let rhs = VariationalLanes(&models);
+            let rhs = VariationalLanes(&models.linear);
             finished.extend(
                 steppers
                     .variational
                     .run(&rhs, fresh, &mut |_: usize, _: &SampleBlock| true)
                     .into_iter()
-                    .map(|(l, o)| (l, Err(o))),
+                    .map(|(l, o)| (l, Ended::Variational(o))),
+            );
+        }
+        if steppers.plane.any_busy() {
+            let mut sink = |l: usize, block: &SampleBlock<{ plane_rhs::M }>| {
+                cursors[l]
+                    .as_mut()
+                    .and_then(|c| c.point.as_mut())
+                    .is_some_and(|(_, _, task)| match task {
+                        Task::Plane(p) => p.sample(block),
+                        Task::Linear(_) => false,
+                    })
+            };
+            let fresh = std::mem::take(&mut steppers.fresh[2]);
+            finished.extend(
+                steppers
+                    .plane
+                    .run(&models.plane, fresh, &mut sink)
+                    .into_iter()
+                    .map(|(l, o)| (l, Ended::Plane(o))),
             );
         }
         for (l, outcome) in finished {
@@ -328,8 +407,9 @@ fn run_worker(
             // The point's `max_wall_ms` is spent: its row is the budget error (as the scalar
             // run's), not a scalar rerun.
             let timeout = match outcome {
-                Ok(_) => steppers.state.take_timeout(l),
-                Err(_) => steppers.variational.take_timeout(l),
+                Ended::State(_) => steppers.state.take_timeout(l),
+                Ended::Variational(_) => steppers.variational.take_timeout(l),
+                Ended::Plane(_) => steppers.plane.take_timeout(l),
             };
             if let Some(error) = timeout {
                 finish_point(
@@ -343,9 +423,11 @@ fn run_worker(
                 );
                 continue;
             }
-            let next = match outcome {
-                Ok(o) => point.resume(o),
-                Err(o) => point.resume_sensitivity(o),
+            let next = match (outcome, &mut point) {
+                (Ended::State(o), Task::Linear(p)) => p.resume(o),
+                (Ended::Variational(o), Task::Linear(p)) => p.resume_sensitivity(o),
+                (Ended::Plane(o), Task::Plane(p)) => p.resume(o),
+                _ => Next::Scalar,
             };
             match launch(
                 l,

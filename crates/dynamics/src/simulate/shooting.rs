@@ -22,7 +22,7 @@ pub const UNSTABLE_MARGIN: f64 = 1e-2;
 /// orbit is rejected: such Jacobians were measured 0.16 off in modulus near a flip (|μ| 1.011
 /// against an exact −0.855, docs/findings.md §23); the clearly unstable orbits of the §2.5
 /// devices' warm-ups (|μ| 1.86–1.99, exact within 0.004) are not rechecked.
-pub(super) const BROYDEN_VERDICT_CHECKED_BELOW: f64 = 1.5;
+pub(crate) const BROYDEN_VERDICT_CHECKED_BELOW: f64 = 1.5;
 
 /// The tolerances of the switched devices' warm-up and first grid, relative to the run's
 /// (see [`shooting_steady_state`]): the start of Newton's iteration, whose accuracy the

@@ -104,7 +104,7 @@ impl Device {
             let [row_phi, row_psi] = &lean.rows[w];
             let phi_dot = dot(row_phi, x_dot);
             let psi = lean.offset[w][1] + dot(row_psi, x);
-            let (s, c) = psi.sin_cos();
+            let (s, c) = paritysim_simd::sin_cos(psi);
             let omega = Vector3::new(c * phi_dot, -s * phi_dot, dot(row_psi, x_dot));
             let values = match wing.aero() {
                 WingAero::BladeElement(model) => model.switching_functions(&omega),
@@ -178,7 +178,7 @@ impl Device {
             let (phi, phi_dot) = (stroke[w], stroke_rate[w]);
             let psi = lean.offset[w][1] + dot(row_psi, x);
             let psi_dot = dot(row_psi, x_dot);
-            let (s, c) = psi.sin_cos();
+            let (s, c) = paritysim_simd::sin_cos(psi);
             let inertia = wing.inertia();
             let a = Vector3::new(c, -s, 0.0);
             let i_a = inertia * a;
@@ -467,6 +467,8 @@ impl Device {
         Some(Ok(()))
     }
 }
+
+pub(crate) mod lanes;
 
 #[cfg(test)]
 mod tests;

@@ -532,3 +532,102 @@ fn default_options_meet_the_accuracy_goal_against_a_tight_reference() {
     }
     assert!(checked >= 10, "{checked} metrics checked");
 }
+
+/// Four stroke-plane devices in SIMD lanes: every lane's derivative is bit for bit the scalar
+/// right-hand side's on the same held branches, lanes of different devices side by side
+/// (balance spring, tunable hinge), on their own sides (the vector path) and off them (the
+/// scalar lanes).
+#[test]
+#[allow(clippy::needless_range_loop)] // lanes and entries index several arrays
+fn stroke_plane_lanes_equal_the_scalar_right_hand_side_bit_for_bit() {
+    use super::lanes::{LANES, M, StrokePlaneLanes};
+    use paritysim_simd::f64x4;
+    let devices = [
+        device(true, false, 0.0),
+        device(true, true, 3.0),
+        device(true, false, 7.5),
+        device(true, true, 0.0),
+    ];
+    let lanes = StrokePlaneLanes::new(std::array::from_fn(|l| &devices[l])).expect("lanes");
+    let (mut vector_lanes, mut scalar_lanes) = (0usize, 0usize);
+    for k in 0..400usize {
+        let mut t = [0.0; LANES];
+        let mut force = [0.0; LANES];
+        let mut y = [[0.0; LANES]; M];
+        let mut branches = [[Branch::of(&Vector3::zeros()); 2]; LANES];
+        let mut expected = [[0.0; M]; LANES];
+        for (l, d) in devices.iter().enumerate() {
+            let h = (k * LANES + l) as f64;
+            let wave = |a: f64, b: f64| (a * h + b).sin();
+            let p = paritysim_constraints::Vec6::new(
+                0.6 * wave(0.71, 0.1),
+                0.0,
+                0.7 * wave(1.37, 0.5),
+                0.6 * wave(0.53, 1.1),
+                0.0,
+                0.7 * wave(0.97, 2.0),
+            );
+            let p_dot = paritysim_constraints::Vec6::new(
+                4.0 * wave(0.31, 0.2),
+                0.0,
+                30.0 * wave(0.43, 0.9),
+                4.0 * wave(0.29, 1.7),
+                0.0,
+                30.0 * wave(0.61, 0.4),
+            );
+            let state = d.state_from(&p, &p_dot).unwrap();
+            t[l] = 0.013 * h;
+            force[l] = d.spec.actuator.as_ref().unwrap().force(t[l]);
+            for i in 0..N {
+                y[i][l] = state.coords[i];
+                y[N + i][l] = state.rates[i];
+            }
+            let (pc, pd) = d.coordinates(&state).unwrap();
+            branches[l] = std::array::from_fn(|w| {
+                let (phi_dot, psi) = (pd[3 * w], pc[3 * w + 2]);
+                let (s, c) = psi.sin_cos();
+                let mut b = Branch::of(&Vector3::new(c * phi_dot, -s * phi_dot, pd[3 * w + 2]));
+                // One state in five on a held branch past a surface (a located switch's far
+                // side): the scalar lanes.
+                if k % 5 == 1 {
+                    b.chordwise_positive = !b.chordwise_positive;
+                }
+                b
+            });
+            let mut out = State::default();
+            let lean = d.stroke_plane_rhs.unwrap();
+            d.rhs_stroke_plane(&lean, t[l], &state, Some(branches[l]), &mut out)
+                .unwrap();
+            for i in 0..N {
+                expected[l][i] = out.coords[i];
+                expected[l][N + i] = out.rates[i];
+            }
+        }
+        let y: [f64x4; M] = y.map(f64x4::new);
+        let mut dydt = [f64x4::splat(0.0); M];
+        let eval = lanes.eval(t, force, &y, branches, &mut dydt);
+        assert_eq!(eval.failed, 0, "state {k}");
+        for l in 0..LANES {
+            if eval.scalar & (1 << l) == 0 {
+                vector_lanes += 1;
+            } else {
+                scalar_lanes += 1;
+            }
+            for i in 0..M {
+                let got = dydt[i].to_array()[l];
+                assert_eq!(
+                    got.to_bits(),
+                    expected[l][i].to_bits(),
+                    "state {k} lane {l} entry {i}: {got:e} vs {:e}",
+                    expected[l][i]
+                );
+            }
+        }
+    }
+    eprintln!("{vector_lanes} vector lanes, {scalar_lanes} scalar");
+    // Both paths were exercised.
+    assert!(
+        vector_lanes > 1000 && scalar_lanes > 200,
+        "{vector_lanes} vector, {scalar_lanes} scalar"
+    );
+}

@@ -1,0 +1,432 @@
+//! One continued shooting point of a §3.4 stroke-plane device in a lane: the state machine of
+//! `simulate::shooting_steady_state` and `grid_shooting::shoot` for a switched device that
+//! starts from a converged neighbour (see the module `lanes`).
+//!
+//! Its Newton trials and the recorded window (fixed-grid periods, most of the point's work)
+//! run in the lane. The adaptive periods that pick a grid and the variational periods (an
+//! exact Jacobian) run in place on the scalar path, with the scalar functions themselves, while
+//! the other lanes wait: they are one period in several and the lanes integrate fixed grids
+//! only (docs/findings.md §24).
+
+use std::rc::Rc;
+
+use nalgebra::{DMatrix, DVector};
+use paritysim_error::Result;
+
+use super::plane_rhs::{self, M};
+use super::point::Next;
+use super::{COMPLETED_IN_LANES, STROKE_PLANE_COMPLETED_IN_LANES};
+use crate::device::Device;
+use crate::device::stroke_plane_lanes::StrokePlaneLanes;
+use crate::grid_shooting::{GRID_TOLERANCE_FACTOR, REPICK_RESIDUAL, least_squares_step};
+use crate::integrate::budget::Budget;
+use crate::integrate::lanes::{LaneOutcome, LaneProblem, LaneTolerances, SampleBlock};
+use crate::integrate::{Method, RungeKutta, State};
+use crate::metrics::{MetricsAccumulator, StrokeNeeds};
+use crate::simulate::{
+    BROYDEN_VERDICT_CHECKED_BELOW, SimulationOptions, SimulationResult, SteadyState,
+    UNSTABLE_MARGIN,
+};
+use crate::sweep::PointOutput;
+use crate::trajectory::{PlaneSample, Sample, Trajectory};
+
+/// Newton steps of the shooting (as `simulate` gives `grid_shooting::shoot`).
+const MAX_NEWTON: usize = 20;
+
+/// Integrated coordinates.
+const N: usize = M / 2;
+
+/// The period a point waits for.
+enum Pending {
+    /// The adaptive period that picks the grid from the start (a switched device does not
+    /// reuse its neighbour's: `shooting_steady_state`).
+    Pick,
+    /// The adaptive period that picks the grid again at the converged `y_new` (the grid was
+    /// picked far from the orbit: `grid_shooting::REPICK_RESIDUAL`).
+    Repick { y_new: State },
+    /// A Newton trial from `y_new`; `last`: the recorded window.
+    Trial {
+        y_new: State,
+        delta: DVector<f64>,
+        step: f64,
+        last: bool,
+    },
+}
+
+/// One continued stroke-plane point (see the module).
+pub(super) struct PlanePoint<'a> {
+    pub(super) device: &'a Device,
+    metric_names: &'a [String],
+    samples_per_cycle: usize,
+    needs: StrokeNeeds,
+    period: f64,
+    tol: f64,
+    accept_tol: f64,
+    newton_tol: LaneTolerances,
+    /// The grid chooser's tolerances (`GRID_TOLERANCE_FACTOR` × the run's).
+    grid_tol: LaneTolerances,
+    max_steps: usize,
+    /// The run's integrator (no work integrals), for the variational periods.
+    rk: RungeKutta,
+    pub(super) grid: Rc<[f64]>,
+    /// The drive at the grid's stage times (`None` after the grid changes).
+    forcing: Option<Rc<[f64]>>,
+    times: Rc<[f64]>,
+    jac: DMatrix<f64>,
+    fresh: bool,
+    repick: bool,
+    eye: DMatrix<f64>,
+    y: State,
+    f: DVector<f64>,
+    res: f64,
+    last_step: Option<f64>,
+    iterations: usize,
+    periods: usize,
+    pending: Option<Pending>,
+    metrics: MetricsAccumulator,
+    cancel: Option<crate::integrate::budget::CancelFlag>,
+    pub(super) deadline: Option<(std::time::Instant, f64)>,
+}
+
+/// `(P(y) − y, ‖P(y) − y‖∞ / (1 + ‖y‖∞))` (as `grid_shooting`).
+fn residual(y: &State, py: &State) -> (DVector<f64>, f64) {
+    let (yv, pv) = (y.compact(N), py.compact(N));
+    let f = pv - &yv;
+    let r = f.amax() / (1.0 + yv.amax());
+    (f, r)
+}
+
+impl<'a> PlanePoint<'a> {
+    /// The point and its first lane period, or `None` when it does not qualify: a continued
+    /// shooting point of a device with stroke-plane lanes, reading metrics that need no work
+    /// integral, one plain recorded cycle, DOP853.
+    pub(super) fn new(
+        device: &'a Device,
+        options: &SimulationOptions,
+        metric_names: &'a [String],
+        times_cache: &mut Option<(f64, usize, Rc<[f64]>)>,
+    ) -> Option<(Self, Next)> {
+        if !StrokePlaneLanes::supports(device) {
+            return None;
+        }
+        let period = device.period()?;
+        let needs = StrokeNeeds::of(Some(metric_names));
+        let plain = options.steady_state == SteadyState::Shooting
+            && options.method == Method::Dop853
+            && options.record_cycles == 1
+            && options.perturbation.is_none()
+            && !needs.work;
+        if !plain || crate::simulate::validate(options).is_err() {
+            return None;
+        }
+        let (p0, pd0) = options.initial?;
+        let jac = options.shooting_jacobian.clone()?;
+        if jac.shape() != (M, M)
+            || options.samples_per_cycle > crate::simulate::MAX_RECORDED_SAMPLES
+        {
+            return None;
+        }
+        let rk = RungeKutta::new(
+            options.method,
+            options.rtol,
+            options.atol,
+            options.max_steps,
+        )
+        .ok()?
+        .with_work(false);
+        let y = device.state_from(&p0, &pd0).ok()?.without_work();
+        let n_samples = options.samples_per_cycle;
+        let times = match times_cache {
+            Some((p, n, times)) if *p == period && *n == n_samples => times.clone(),
+            _ => {
+                let times: Rc<[f64]> =
+                    crate::simulate::window_times(0.0, period, n_samples).collect();
+                *times_cache = Some((period, n_samples, times.clone()));
+                times
+            }
+        };
+        let chooser = GRID_TOLERANCE_FACTOR.clamp(f64::MIN_POSITIVE, 1.0);
+        let mut point = Self {
+            device,
+            metric_names,
+            samples_per_cycle: n_samples,
+            needs,
+            period,
+            tol: (1e-2 * options.steady_tol).min(0.1 * options.rtol),
+            accept_tol: options.steady_tol,
+            newton_tol: LaneTolerances {
+                rtol: options.rtol,
+                atol: options.atol,
+            },
+            grid_tol: LaneTolerances {
+                rtol: options.rtol * chooser,
+                atol: options.atol * chooser,
+            },
+            max_steps: options.max_steps,
+            rk,
+            grid: Rc::from([0.0, period]),
+            forcing: None,
+            times,
+            jac,
+            fresh: false,
+            repick: false,
+            eye: DMatrix::identity(M, M),
+            y,
+            f: DVector::zeros(M),
+            res: f64::NAN,
+            last_step: None,
+            iterations: 0,
+            periods: 0,
+            pending: None,
+            metrics: MetricsAccumulator::new(device, Some(period)),
+            cancel: options.cancel.clone(),
+            deadline: crate::integrate::budget::deadline(options.max_wall_ms),
+        };
+        // A switched device does not reuse its neighbour's grid: an adaptive period picks
+        // one (`chooser.advance_with_steps`, in the lane).
+        point.pending = Some(Pending::Pick);
+        let first = point.adaptive_grid_period(&point.y);
+        Some((point, first))
+    }
+
+    /// One adaptive period from `y` at the grid tolerances that picks a grid
+    /// (`chooser.advance_with_steps`, in the lane).
+    fn adaptive_grid_period(&self, y: &State) -> Next {
+        Next::Plane(LaneProblem {
+            grid: Rc::from([0.0, self.period]),
+            adaptive: Some(self.max_steps),
+            y0: plane_rhs::compact(y),
+            times: Rc::from([]),
+            tol: self.grid_tol,
+        })
+    }
+
+    /// Runs `work` on the scalar path in place, under the point's budget (what is left of its
+    /// `max_wall_ms`, and its cancel).
+    fn inline<T>(&self, work: impl FnOnce(&Self) -> Result<T>) -> Result<T> {
+        let left = self
+            .deadline
+            .map(|(end, _)| end.saturating_duration_since(std::time::Instant::now()))
+            .map(|d| (d.as_secs_f64() * 1e3).max(f64::MIN_POSITIVE));
+        let _budget = Budget::new(left, self.cancel.clone()).enter();
+        work(self)
+    }
+
+    /// The drive table of the current grid.
+    pub(super) fn forcing(&mut self) -> Rc<[f64]> {
+        if let Some(table) = &self.forcing {
+            return table.clone();
+        }
+        let table = plane_rhs::forcing(self.device, &self.grid);
+        self.forcing = Some(table.clone());
+        table
+    }
+
+    /// The exact Jacobian of the grid map at `at` (`rk.flow_with_sensitivity_on_grid`, in
+    /// place).
+    fn exact_jacobian(&self, at: &State) -> Result<DMatrix<f64>> {
+        self.inline(|p| {
+            p.rk.flow_with_sensitivity_on_grid(p.device, &p.grid, at)
+                .map(|(_, j)| j)
+        })
+    }
+
+    /// The next Newton trial from the current iterate (the head of `shoot`'s loop), or the
+    /// grid picked again first.
+    fn iterate(&mut self) -> Next {
+        if self.iterations >= MAX_NEWTON {
+            return Next::Scalar;
+        }
+        self.iterations += 1;
+        let Some(delta) = least_squares_step(&self.jac - &self.eye, &self.f) else {
+            return Next::Scalar;
+        };
+        let scale = 1.0 + self.y.compact(N).amax();
+        let step = delta.amax() / scale;
+        // The next iterate's error: the step times the contraction seen so far (Newton's
+        // quadratic model after a fresh Jacobian; unknown, so 1, after a neighbour's).
+        let contraction = match self.last_step {
+            Some(s) => step / s,
+            None if self.fresh => step,
+            None => 1.0,
+        }
+        .min(1.0);
+        let y_new = State::from_compact(N, &(self.y.compact(N) + &delta));
+        let last = contraction * step <= self.tol || step <= 1e-3 * self.tol;
+        if last && self.repick {
+            // Converged on a grid picked far from the orbit: the grid again, from here.
+            self.repick = false;
+            let next = self.adaptive_grid_period(&y_new);
+            self.pending = Some(Pending::Repick { y_new });
+            return next;
+        }
+        if last {
+            // A fresh window (a refused earlier window's samples are not kept).
+            self.metrics = MetricsAccumulator::new(self.device, Some(self.period));
+        }
+        let problem = LaneProblem {
+            grid: self.grid.clone(),
+            adaptive: None,
+            y0: plane_rhs::compact(&y_new),
+            times: if last {
+                self.times.clone()
+            } else {
+                Rc::from([])
+            },
+            tol: self.newton_tol,
+        };
+        self.pending = Some(Pending::Trial {
+            y_new,
+            delta,
+            step,
+            last,
+        });
+        Next::Plane(problem)
+    }
+
+    /// Feeds recorded samples to the metrics in order, as the scalar window's sink does
+    /// (`PlaneSample`, or the general sample outside the closed form); `false`: the scalar
+    /// path would fail here.
+    pub(super) fn sample(&mut self, block: &SampleBlock<M>) -> bool {
+        for j in 0..block.count {
+            let c: [f64; M] = std::array::from_fn(|i| block.y[i].to_array()[j]);
+            let (i, t, state) = (block.first + j, block.t[j], plane_rhs::expand(&c));
+            let closing = i == self.samples_per_cycle;
+            match PlaneSample::new(self.device, t, &state, self.needs) {
+                Some(Ok(sample)) => self.metrics.add_plane(&sample, closing),
+                Some(Err(_)) => return false,
+                None => match Sample::new(self.device, t, &state) {
+                    Ok(sample) => self.metrics.add(&sample, closing),
+                    Err(_) => return false,
+                },
+            }
+        }
+        true
+    }
+
+    /// Continues after the lane's period ended with `outcome` (the rest of `shoot`'s loop).
+    pub(super) fn resume(&mut self, outcome: LaneOutcome<M>) -> Next {
+        let (Some(pending), LaneOutcome::Done { y, steps, .. }) = (self.pending.take(), outcome)
+        else {
+            return Next::Scalar;
+        };
+        let (y_new, delta, step, last) = match pending {
+            Pending::Pick => {
+                self.grid = steps.into();
+                self.forcing = None;
+                self.periods = 1;
+                (self.f, self.res) = residual(&self.y, &plane_rhs::expand(&y));
+                self.repick = self.res > REPICK_RESIDUAL;
+                return self.iterate();
+            }
+            Pending::Repick { y_new } => {
+                self.grid = steps.into();
+                self.forcing = None;
+                self.periods += 1;
+                (self.f, self.res) = residual(&y_new, &plane_rhs::expand(&y));
+                self.y = y_new;
+                return self.iterate();
+            }
+            Pending::Trial {
+                y_new,
+                delta,
+                step,
+                last,
+            } => (y_new, delta, step, last),
+        };
+        self.periods += 1;
+        let (f_new, res_new) = residual(&y_new, &plane_rhs::expand(&y));
+        let tol = self.tol;
+        if last && res_new > tol && res_new <= self.accept_tol && !self.fresh {
+            // Re-linearise at the candidate, then decide with the exact Jacobian.
+            let Ok(jac) = self.exact_jacobian(&y_new) else {
+                return Next::Scalar;
+            };
+            self.jac = jac;
+            self.periods += 1;
+            self.fresh = true;
+            self.last_step = None;
+            (self.y, self.f, self.res) = (y_new, f_new, res_new);
+            return self.iterate();
+        }
+        let neutral = || {
+            res_new <= self.accept_tol
+                && least_squares_step(&self.jac - &self.eye, &f_new)
+                    .is_some_and(|d| d.amax() / (1.0 + y_new.compact(N).amax()) <= tol)
+        };
+        if last && (res_new <= tol || neutral()) {
+            return self.done(y_new, res_new);
+        }
+        if res_new >= self.res || res_new.is_nan() {
+            if self.fresh {
+                return Next::Scalar;
+            }
+            // A stale Jacobian that no longer descends: the exact one at the iterate.
+            let Ok(jac) = self.exact_jacobian(&self.y.clone()) else {
+                return Next::Scalar;
+            };
+            self.jac = jac;
+            self.periods += 1;
+            self.fresh = true;
+            self.last_step = None;
+            return self.iterate();
+        }
+        // Good Broyden: the secant condition on the step just taken.
+        let s_dot = delta.dot(&delta);
+        if s_dot > 0.0 {
+            let mismatch = (&f_new - &self.f) - (&self.jac - &self.eye) * &delta;
+            self.jac += mismatch * delta.transpose() / s_dot;
+        }
+        self.fresh = false;
+        (self.y, self.f, self.res) = (y_new, f_new, res_new);
+        self.last_step = Some(step);
+        self.iterate()
+    }
+
+    /// The converged point as `simulate` and `run_point` report it, after the stability
+    /// verdict of `shooting_steady_state` (a marginal one from a Broyden-updated Jacobian
+    /// checked with the variational equations at the orbit).
+    fn done(&mut self, state: State, residual: f64) -> Next {
+        let mut multipliers = crate::floquet::eigenvalues(&self.jac).unwrap_or_default();
+        let largest = multipliers.first().map_or(0.0, |m| m.norm());
+        if largest > 1.0 + UNSTABLE_MARGIN && largest < BROYDEN_VERDICT_CHECKED_BELOW {
+            match self.exact_jacobian(&state) {
+                Ok(jac) => self.jac = jac,
+                // A spent budget or a cancel: the scalar run reports it.
+                Err(e) if crate::grid_shooting::out_of_budget(&e) => return Next::Scalar,
+                Err(_) => {}
+            }
+            multipliers = crate::floquet::eigenvalues(&self.jac).unwrap_or_default();
+        }
+        if multipliers
+            .first()
+            .is_some_and(|m| m.norm() > 1.0 + UNSTABLE_MARGIN)
+        {
+            return Next::Scalar;
+        }
+        let steady_state = state.without_work();
+        let result = SimulationResult {
+            trajectory: Trajectory::default(),
+            metrics: self.metrics.finish(),
+            cycles_run: self.periods - 1,
+            converged: true,
+            period_ms: self.period,
+            residual,
+            steady_state,
+            multipliers,
+            monodromy: Some(self.jac.clone()),
+            step_grid: self.grid.to_vec(),
+            orbit_cycles: 1,
+        };
+        let coordinates = self.device.coordinates(&steady_state).ok();
+        COMPLETED_IN_LANES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        STROKE_PLANE_COMPLETED_IN_LANES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        Next::Done(Box::new(PointOutput::keep(
+            result,
+            self.metric_names,
+            false,
+            self.samples_per_cycle,
+            coordinates,
+        )))
+    }
+}

@@ -1,0 +1,243 @@
+//! The §3.4 stroke-plane devices in SIMD lanes: their right-hand side
+//! (`device::stroke_plane::lanes`) with each lane's tabulated drive and held branch, as the
+//! lane stepper drives it (`integrate::dop853_lanes`).
+//!
+//! The blade elements switch (stroke reversal, α = π/2, `ω_z = 0`), so each lane holds the
+//! branch of its own switching functions as the scalar `drive_on_grid_events` does: taken at
+//! the start of its problem, checked at the end of every step, and a step that crosses a
+//! switch is replayed on the scalar path (`integrate::replay_grid_step`, the same operations):
+//! the root located and the step finished on the new branch, samples included. A lane's step
+//! that crosses nothing is the scalar step (the same stages, error estimate and dense
+//! output), so a lane's period is bit-identical to the scalar one.
+
+use std::cell::RefCell;
+use std::rc::Rc;
+
+use wide::f64x4;
+
+use crate::device::Device;
+use crate::device::stroke_plane_lanes::{self as model, StrokePlaneLanes};
+use crate::integrate::lanes::{LANES, LaneRhs, LaneRun, LaneTolerances, NO_STAGE, stage_times};
+use crate::integrate::{
+    HeldRun, MAX_SWITCHES, OdeSystem, Sides, State, replay_adaptive_step, replay_grid_step,
+};
+
+type V = f64x4;
+
+/// Compact entries of a stroke-plane state: `x` (4) then `ẋ` (4).
+pub(crate) const M: usize = model::M;
+
+/// The branch a lane holds and its switching functions at its step's start.
+#[derive(Clone, Copy, Debug, Default)]
+struct Held {
+    sides: Sides,
+    g: [f64; MAX_SWITCHES],
+}
+
+/// [`LANES`] stroke-plane devices side by side.
+pub(crate) struct PlaneLanes<'a> {
+    devices: [Option<&'a Device>; LANES],
+    /// The lanes' constants, rebuilt when a lane takes another device.
+    model: Option<StrokePlaneLanes<'a>>,
+    /// Each lane's actuator force at the [`stage_times`] of its grid.
+    forcing: [Option<Rc<[f64]>>; LANES],
+    held: RefCell<[Held; LANES]>,
+}
+
+/// The drive at every [`stage_times`] of `grid` (the scalar `Actuator::force` of each: the
+/// drive's `sin` once per grid instead of once per evaluation).
+pub(crate) fn forcing(device: &Device, grid: &[f64]) -> Rc<[f64]> {
+    let actuator = device.spec().actuator.as_ref();
+    stage_times(grid)
+        .into_iter()
+        .map(|t| actuator.map_or(0.0, |a| a.force(t)))
+        .collect()
+}
+
+/// The state of a compact one (work integrals zero, as the shooting's states).
+pub(crate) fn expand(c: &[f64; M]) -> State {
+    let mut y = State::default();
+    y.coords[..M / 2].copy_from_slice(&c[..M / 2]);
+    y.rates[..M / 2].copy_from_slice(&c[M / 2..]);
+    y
+}
+
+/// The compact state of `y`.
+pub(crate) fn compact(y: &State) -> [f64; M] {
+    std::array::from_fn(|i| {
+        if i < M / 2 {
+            y.coords[i]
+        } else {
+            y.rates[i - M / 2]
+        }
+    })
+}
+
+impl<'a> PlaneLanes<'a> {
+    /// No lane loaded.
+    pub(crate) fn new() -> Self {
+        Self {
+            devices: [None; LANES],
+            model: None,
+            forcing: std::array::from_fn(|_| None),
+            held: RefCell::new([Held::default(); LANES]),
+        }
+    }
+
+    /// Puts `device` (one [`StrokePlaneLanes::supports`]) into lane `l`.
+    pub(crate) fn load(&mut self, l: usize, device: &'a Device) {
+        if self.devices[l].is_some_and(|d| std::ptr::eq(d, device)) {
+            return;
+        }
+        self.devices[l] = Some(device);
+        // Idle lanes compute with a loaded device's constants (their results are not read).
+        let devices = self.devices.map(|d| d.unwrap_or(device));
+        self.model = StrokePlaneLanes::new(devices);
+    }
+
+    /// The drive table lane `l` reads from its next problem on.
+    pub(crate) fn load_forcing(&mut self, l: usize, forcing: Rc<[f64]>) {
+        self.forcing[l] = Some(forcing);
+    }
+}
+
+impl LaneRhs<M> for PlaneLanes<'_> {
+    fn eval(&self, t: [f64; LANES], stage: [usize; LANES], y: &[V; M], dydt: &mut [V; M]) -> u32 {
+        let Some(model) = &self.model else {
+            return (1 << LANES) - 1;
+        };
+        let force = std::array::from_fn(|l| match (&self.forcing[l], stage[l]) {
+            (Some(table), s) if s != NO_STAGE => table[s],
+            _ => self.devices[l]
+                .and_then(|d| d.spec().actuator.as_ref())
+                .map_or(0.0, |a| a.force(t[l])),
+        });
+        let held = self.held.borrow();
+        let branches = std::array::from_fn(|l| crate::device::blade_branches(held[l].sides));
+        model.eval(t, force, y, branches, dydt).failed
+    }
+
+    fn switched(&self) -> bool {
+        true
+    }
+
+    fn begin(&self, l: usize, t0: f64, y0: &[f64; M]) -> bool {
+        let Some(device) = self.devices[l] else {
+            return false;
+        };
+        let mut g = [0.0; MAX_SWITCHES];
+        if device.switches(t0, &expand(y0), &mut g).is_err() {
+            return false;
+        }
+        let n = device.n_switches().min(MAX_SWITCHES);
+        self.held.borrow_mut()[l] = Held {
+            sides: Sides::of(&g[..n]),
+            g,
+        };
+        true
+    }
+
+    fn crossed(&self, l: usize, t_new: f64, y1: &[f64; M]) -> Option<bool> {
+        let device = self.devices[l]?;
+        let mut g = [0.0; MAX_SWITCHES];
+        device.switches(t_new, &expand(y1), &mut g).ok()?;
+        let n = device.n_switches().min(MAX_SWITCHES);
+        let mut held = self.held.borrow_mut();
+        let sides = held[l].sides;
+        if (0..n).any(|i| crate::integrate::crossed(sides, i, g[i])) {
+            return Some(true);
+        }
+        held[l].g = g;
+        Some(false)
+    }
+
+    fn replay(
+        &self,
+        l: usize,
+        tol: LaneTolerances,
+        span: (f64, f64),
+        (y, f0): (&[f64; M], &[f64; M]),
+        times: &[f64],
+        next: &mut usize,
+        sink: &mut dyn FnMut(usize, f64, &State) -> bool,
+    ) -> Option<([f64; M], [f64; M], usize)> {
+        let device = self.devices[l]?;
+        let start = {
+            let held = self.held.borrow();
+            (held[l].sides, held[l].g)
+        };
+        let mut state_sink = |i: usize, t: f64, state: &State| {
+            if sink(i, t, state) {
+                Ok(())
+            } else {
+                Err(paritysim_error::Error::OutOfDomain {
+                    what: "lane sample".into(),
+                    detail: format!("t = {t}"),
+                })
+            }
+        };
+        let end = replay_grid_step::<M>(
+            device,
+            (tol.rtol, tol.atol),
+            span,
+            (*y, *f0),
+            start,
+            times,
+            next,
+            &mut state_sink,
+        )
+        .ok()?;
+        self.held.borrow_mut()[l] = Held {
+            sides: end.sides,
+            g: end.g,
+        };
+        Some((end.y, end.f, end.over_tolerance))
+    }
+
+    fn replay_adaptive(
+        &self,
+        l: usize,
+        tol: LaneTolerances,
+        max_steps: usize,
+        span: (f64, f64),
+        run: &mut LaneRun<M>,
+        steps: &mut Vec<f64>,
+    ) -> Option<bool> {
+        let device = self.devices[l]?;
+        let held = self.held.borrow()[l];
+        let mut scalar = HeldRun {
+            t: run.t,
+            y: run.y,
+            f0: run.f0,
+            h: run.h,
+            fac_old: run.fac_old,
+            rejected_last: run.rejected_last,
+            attempts: run.attempts,
+            sides: held.sides,
+            g: held.g,
+        };
+        let done = replay_adaptive_step::<M>(
+            device,
+            (tol.rtol, tol.atol),
+            max_steps,
+            span,
+            &mut scalar,
+            steps,
+        )
+        .ok()?;
+        *run = LaneRun {
+            t: scalar.t,
+            y: scalar.y,
+            f0: scalar.f0,
+            h: scalar.h,
+            fac_old: scalar.fac_old,
+            rejected_last: scalar.rejected_last,
+            attempts: scalar.attempts,
+        };
+        self.held.borrow_mut()[l] = Held {
+            sides: scalar.sides,
+            g: scalar.g,
+        };
+        Some(done)
+    }
+}
