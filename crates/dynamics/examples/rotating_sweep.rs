@@ -3,9 +3,12 @@
 //! `GRID × GRID` grid over the hinge stiffness ∈ [1, 4] mN·mm/rad × drive amplitude V ∈
 //! [60, 100], stroke and rotation metrics of the last cycle from 200 samples (the shipped
 //! devices' default). Prints ms per point and how many points ran in SIMD lanes.
+//! `DEVICE=lift` / `dual`: the §2.5 Lift / Dual PARITY on those wings (free deviation θ,
+//! tunable hinge) over the deviation stiffness ∈ [8, 12] × `V + V sin`, V ∈ [80, 100].
 //!
-//! Environment: `GRID` (16), `THREADS` (1), `REPEAT` (3), `PARITYSIM_LANES` (lane width,
-//! 1 = scalar). Compare `PARITYSIM_LANES=1` and `=4` (issue 12 item 6; docs/findings.md §24).
+//! Environment: `DEVICE`, `GRID` (16), `THREADS` (1), `REPEAT` (3), `PARITYSIM_LANES` (lane
+//! width, 1 = scalar). Compare `PARITYSIM_LANES=1` and `=4` (issue 12 item 6;
+//! docs/findings.md §24).
 
 use std::time::Instant;
 
@@ -29,30 +32,63 @@ const METRICS: [&str; 6] = [
     "q2_amplitude",
 ];
 
-fn wing(inertia: [f64; 4], omegas: [f64; 4], hinge: f64) -> Result<Wing> {
+/// A Table 3.3 wing; `free_deviation`: the §2.5 wing (deviation spring `spring`, tunable
+/// hinge), else the §3.4 one (hinge spring `spring`).
+fn wing(inertia: [f64; 4], omegas: [f64; 4], spring: f64, free_deviation: bool) -> Result<Wing> {
     let [ixx, iyy, izz, ixz] = inertia;
     let mut springs = [JointSpring::default(); 6];
-    springs[5] = JointSpring::linear(hinge, 0.0)?;
+    springs[if free_deviation { 3 } else { 5 }] = JointSpring::linear(spring, 0.0)?;
     let blade = BladeElementModel::new(
         Omegas::new(omegas[0], omegas[1], omegas[2], omegas[3])?,
         CoefficientSet::default(),
     )?;
-    Wing::new(
+    let wing = Wing::new(
         SphericalShoulder::new(std::f64::consts::FRAC_PI_2, 0.0)?,
         Matrix3::new(ixx, 0.0, ixz, 0.0, iyy, 0.0, ixz, 0.0, izz),
         springs,
         WingAero::BladeElement(blade),
-    )
+    )?;
+    Ok(if free_deviation {
+        wing.with_tunable_hinge(paritysim_dynamics::TunableHinge::new(
+            2.533928021702924,
+            0.0,
+            20.0,
+        )?)
+    } else {
+        wing
+    })
+}
+
+/// `DEVICE`: `rotating` (§3.4, the default), `lift` or `dual` (§2.5 Lift / Dual PARITY).
+fn configuration() -> String {
+    match std::env::var("DEVICE").as_deref() {
+        Ok("lift") => "lift_parity".into(),
+        Ok("dual") => "dual_parity".into(),
+        _ => "drag_parity".into(),
+    }
 }
 
 fn device(values: &[f64]) -> Result<Device> {
-    let (hinge, amplitude_v) = (values[0], values[1]);
+    let (spring, amplitude_v) = (values[0], values[1]);
+    let configuration = configuration();
+    let free = configuration != "drag_parity";
+    let offset_v = if free { amplitude_v } else { 100.0 };
     Device::new(DeviceSpec {
         wings: vec![
-            wing([49.0, 50.5, 1.56, 4.2], [46.8, 0.587, 17.5, 0.712], hinge)?,
-            wing([40.6, 42.0, 1.43, 3.38], [28.7, 0.419, 10.6, 0.787], hinge)?,
+            wing(
+                [49.0, 50.5, 1.56, 4.2],
+                [46.8, 0.587, 17.5, 0.712],
+                spring,
+                free,
+            )?,
+            wing(
+                [40.6, 42.0, 1.43, 3.38],
+                [28.7, 0.419, 10.6, 0.787],
+                spring,
+                free,
+            )?,
         ],
-        constraints: Constraints::configuration("drag_parity")?,
+        constraints: Constraints::configuration(&configuration)?,
         transmission: Some(Transmission::new(
             Drivetrain::LinearDifferential(LinearDifferential::new(
                 35f64.to_radians() / 0.2,
@@ -64,7 +100,7 @@ fn device(values: &[f64]) -> Result<Device> {
         actuator: Some(Actuator::new(
             paritysim_dynamics::actuator::THESIS_FORCE_PER_VOLT,
             paritysim_dynamics::actuator::THESIS_STIFFNESS,
-            Waveform::sine(100.0, 110.0, amplitude_v, 0.0)?,
+            Waveform::sine(amplitude_v, 110.0, offset_v, 0.0)?,
             DcOffset::Ignore,
         )?),
         formulation: Formulation::Auto,
@@ -82,15 +118,21 @@ fn main() {
     let grid: usize = env("GRID", 16);
     let threads: usize = env("THREADS", 1);
     let repeat: usize = env("REPEAT", 3);
+    // §3.4: hinge 1–4 mN·mm/rad × 60–100 V; §2.5: deviation spring 8–12 × 80–100 V.
+    let ((s0, s1), (v0, v1)) = if configuration() == "drag_parity" {
+        ((1.0, 4.0), (60.0, 100.0))
+    } else {
+        ((8.0, 12.0), (80.0, 100.0))
+    };
     let table = Grid::new()
         .axis(
-            "hinge",
-            (0..grid).map(|i| 1.0 + 3.0 * i as f64 / (grid - 1) as f64),
+            "spring",
+            (0..grid).map(|i| s0 + (s1 - s0) * i as f64 / (grid - 1) as f64),
         )
         .and_then(|g| {
             g.axis(
                 "amplitude_v",
-                (0..grid).map(|i| 60.0 + 40.0 * i as f64 / (grid - 1) as f64),
+                (0..grid).map(|i| v0 + (v1 - v0) * i as f64 / (grid - 1) as f64),
             )
         })
         .unwrap()
@@ -110,6 +152,21 @@ fn main() {
         let r = sweep(&table, device, &options, &settings, &SweepControl::new()).unwrap();
         let ms = start.elapsed().as_secs_f64() * 1e3 / table.len() as f64;
         let in_lanes = paritysim_dynamics::lanes::points_completed_in_lanes() - before;
+        if std::env::var("VERBOSE").is_ok() {
+            for row in &r.rows {
+                match &row.outcome {
+                    Ok(o) => println!(
+                        "point {}: cycles {} residual {:.1e} converged {} monodromy {}",
+                        row.index,
+                        o.cycles_run,
+                        o.residual,
+                        o.converged,
+                        o.monodromy.is_some()
+                    ),
+                    Err(e) => println!("point {}: {e}", row.index),
+                }
+            }
+        }
         let checksum: f64 = r
             .rows
             .iter()

@@ -387,7 +387,7 @@ fn rotating_device(hinge: f64, amplitude_v: f64) -> Device {
         Actuator::new(
             paritysim_dynamics::actuator::THESIS_FORCE_PER_VOLT,
             paritysim_dynamics::actuator::THESIS_STIFFNESS,
-            Waveform::sine(100.0, 110.0, amplitude_v, 0.0).unwrap(),
+            Waveform::sine(amplitude_v, 110.0, 100.0, 0.0).unwrap(),
             paritysim_dynamics::DcOffset::Ignore,
         )
         .unwrap(),
