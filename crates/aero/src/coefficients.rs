@@ -61,6 +61,14 @@ pub fn to_normal_tangential(alpha: f64, lift: f64, drag: f64) -> (f64, f64) {
     (lift * c + drag * s, drag * c - lift * s)
 }
 
+/// [`to_normal_tangential`] of one angle or of four in SIMD lanes, with the shared polynomial
+/// `sin`/`cos` (bit for bit the same per lane).
+#[inline]
+pub fn to_normal_tangential_generic<R: Real>(alpha: R, lift: R, drag: R) -> (R, R) {
+    let (s, c) = sin_cos(alpha);
+    (lift * c + drag * s, drag * c - lift * s)
+}
+
 /// `(C_L, C_D)` from `(C_N, C_T)` at `α` (rad): the inverse rotation of
 /// [`to_normal_tangential`].
 #[inline]
@@ -347,6 +355,22 @@ impl Default for CoefficientSet {
 }
 
 impl CoefficientSet {
+    /// [`CoefficientModel::lift_drag_branch`] of one angle or of four in SIMD lanes (`below`
+    /// per lane), written once so that every lane computes the scalar bits (the shared
+    /// polynomial `sin`/`cos`).
+    #[inline]
+    pub fn lift_drag_branch_generic<R: Real>(&self, alpha: R, below: R::Mask) -> (R, R) {
+        match self {
+            CoefficientSet::Dickinson1999(_) => {
+                // The fit at α below π/2, at π − α (C_L negated) above.
+                let argument = R::select(below, alpha, R::splat(PI) - alpha);
+                let (cl, cd) = Dickinson1999::fit(argument);
+                (R::select(below, cl, -cl), cd)
+            }
+            CoefficientSet::WhitneyWood2010(m) => m.harmonic(alpha),
+        }
+    }
+
     /// Names accepted by [`Self::from_name`].
     pub const NAMES: [&'static str; 2] = ["dickinson1999", "whitney_wood2010"];
 

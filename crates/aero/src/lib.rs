@@ -37,8 +37,8 @@ pub mod planform;
 pub mod records;
 
 pub use blade::{
-    AeroLoads, AeroMoments, BladeElementModel, Branch, NormalForceLaw, Omegas, WindRelative,
-    WingState, drag_torque_eq_2_16,
+    AeroLoads, AeroMoments, BladeElementModel, Branch, HeldBranch, NormalForceLaw, Omegas,
+    WindRelative, WingState, drag_torque_eq_2_16,
 };
 pub use coefficients::{
     CoefficientModel, CoefficientSet, Coefficients, DEFAULT_ROTATIONAL_DAMPING, Dickinson1999,

@@ -30,6 +30,7 @@ use drivetrain_inverse::{
     NEWTON_MAX, NEWTON_TOL, check_plausible, invert_1dof, invert_2dof, singular_drive,
     unreachable_stroke,
 };
+pub(crate) use free_deviation::lanes as free_deviation_lanes;
 pub(crate) use stroke_plane::lanes as stroke_plane_lanes;
 pub(crate) use switches::branches as blade_branches;
 
@@ -119,6 +120,9 @@ pub struct Device {
     /// The lean right-hand side of a free-deviation device (§2.5 Lift / Dual PARITY), when it
     /// applies.
     free_deviation_rhs: Option<free_deviation::FreeDeviation>,
+    /// The free-deviation equations on a held branch written over `Real` (four coordinates,
+    /// blade elements on both wings): the scalar and SIMD-lane path's common code.
+    free_deviation_held: Option<free_deviation::HeldConstants>,
     /// Switching functions of the right-hand side (three per wing with blade elements whose
     /// `ω` has a closed form; see [`Self::blade_switching_functions`]).
     n_switches: usize,
@@ -269,10 +273,12 @@ impl Device {
             linear_jacobian,
             stroke_plane_rhs: None,
             free_deviation_rhs: None,
+            free_deviation_held: None,
             n_switches: 0,
         };
         device.stroke_plane_rhs = stroke_plane::StrokePlane::of(&device);
         device.free_deviation_rhs = free_deviation::FreeDeviation::of(&device);
+        device.free_deviation_held = free_deviation::HeldConstants::of(&device);
         device.n_switches = device.blade_switches();
         Ok(device)
     }
@@ -432,6 +438,17 @@ impl Device {
     /// `device/stroke_plane/`), whose lean samples are [`crate::trajectory::PlaneSample`]s.
     pub fn has_stroke_plane_model(&self) -> bool {
         self.stroke_plane_rhs.is_some()
+    }
+
+    /// The drive forces [`Self::drive_load`] applies at `t`: the actuator's and 0, or a dual
+    /// drivetrain's left and right sides'.
+    #[inline(always)]
+    pub(crate) fn drive_forces(&self, t: f64) -> [f64; 2] {
+        match (self.spec.actuator.as_ref(), self.is_dual()) {
+            (Some(a), true) => [a.side_force(t, 0), a.side_force(t, 1)],
+            (Some(a), false) => [a.force(t), 0.0],
+            (None, _) => [0.0, 0.0],
+        }
     }
 
     /// `∂Q/∂q` of [`Self::drive_load`] (constant: the actuator and balance springs,

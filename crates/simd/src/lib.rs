@@ -13,7 +13,7 @@
 // The polynomial coefficients as Cephes and the vector class library print them.
 #![allow(clippy::excessive_precision)]
 
-use std::ops::{Add, Mul, Neg, Sub};
+use std::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
 pub use wide::f64x4;
 
@@ -22,18 +22,42 @@ pub use wide::f64x4;
 /// Every arithmetic operation is the IEEE operation of each lane (no fused multiply-add), so
 /// a generic function gives every lane of an `f64x4` the bits it gives that lane's `f64`.
 pub trait Real:
-    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Neg<Output = Self>
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
 {
+    /// A lane-wise boolean (`bool`, or all bits of a lane set).
+    type Mask: Copy
+        + BitAnd<Output = Self::Mask>
+        + BitOr<Output = Self::Mask>
+        + Not<Output = Self::Mask>;
     /// Every lane `x`.
     fn splat(x: f64) -> Self;
     /// `|self|`.
     fn abs(self) -> Self;
+    /// The correctly rounded square root.
+    fn sqrt(self) -> Self;
+    /// `self < other`, lane by lane (false for NaN).
+    fn lt(self, other: Self) -> Self::Mask;
+    /// `self <= other`.
+    fn le(self, other: Self) -> Self::Mask;
+    /// `self == other`.
+    fn eq(self, other: Self) -> Self::Mask;
+    /// Whether the sign bit is set (also for −0 and negative NaN).
+    fn sign_negative(self) -> Self::Mask;
+    /// `mask ? a : b`, lane by lane.
+    fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
+    /// The lanes where `mask` holds, as bits (lane `l` is bit `l`; a scalar is lane 0).
+    fn bits(mask: Self::Mask) -> u32;
     /// Rounded to the nearest integer, ties to even.
     fn round_ties_even(self) -> Self;
     /// Whether some lane of `self` is above `bound` (or not a number).
     fn any_beyond(self, bound: f64) -> bool;
     /// `f` applied to every lane (the fallback for arguments outside the polynomials' range).
-    fn map(self, f: impl Fn(f64) -> f64) -> Self;
+    fn map(self, f: impl FnMut(f64) -> f64) -> Self;
     /// `(sin x, cos x)` from those of the reduced argument, `x = ±(y π/2 + r)` with the
     /// integer `y` (< 2^53): swaps and sign changes only, so exact. Each type does it its own
     /// branch-free way (integer bits, vector masks) with the same result.
@@ -41,6 +65,35 @@ pub trait Real:
 }
 
 impl Real for f64 {
+    type Mask = bool;
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> bool {
+        self < other
+    }
+    #[inline(always)]
+    fn le(self, other: Self) -> bool {
+        self <= other
+    }
+    #[inline(always)]
+    fn eq(self, other: Self) -> bool {
+        self == other
+    }
+    #[inline(always)]
+    fn sign_negative(self) -> bool {
+        self.is_sign_negative()
+    }
+    #[inline(always)]
+    fn select(mask: bool, a: Self, b: Self) -> Self {
+        if mask { a } else { b }
+    }
+    #[inline(always)]
+    fn bits(mask: bool) -> u32 {
+        u32::from(mask)
+    }
     #[inline(always)]
     fn splat(x: f64) -> Self {
         x
@@ -58,7 +111,7 @@ impl Real for f64 {
         self > bound || self.is_nan()
     }
     #[inline(always)]
-    fn map(self, f: impl Fn(f64) -> f64) -> Self {
+    fn map(self, mut f: impl FnMut(f64) -> f64) -> Self {
         f(self)
     }
     #[inline(always)]
@@ -83,6 +136,35 @@ impl Real for f64 {
 const SIGN: u64 = 1 << 63;
 
 impl Real for f64x4 {
+    type Mask = f64x4;
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f64x4::sqrt(self)
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> Self {
+        self.simd_lt(other)
+    }
+    #[inline(always)]
+    fn le(self, other: Self) -> Self {
+        self.simd_le(other)
+    }
+    #[inline(always)]
+    fn eq(self, other: Self) -> Self {
+        self.simd_eq(other)
+    }
+    #[inline(always)]
+    fn sign_negative(self) -> Self {
+        self.is_sign_negative()
+    }
+    #[inline(always)]
+    fn select(mask: Self, a: Self, b: Self) -> Self {
+        mask.select(a, b)
+    }
+    #[inline(always)]
+    fn bits(mask: Self) -> u32 {
+        mask.to_bitmask()
+    }
     #[inline(always)]
     fn splat(x: f64) -> Self {
         f64x4::splat(x)
@@ -101,8 +183,8 @@ impl Real for f64x4 {
         self.simd_gt(f64x4::splat(bound)).any() || !self.simd_eq(self).all()
     }
     #[inline(always)]
-    fn map(self, f: impl Fn(f64) -> f64) -> Self {
-        f64x4::new(self.to_array().map(f))
+    fn map(self, mut f: impl FnMut(f64) -> f64) -> Self {
+        f64x4::new(self.to_array().map(&mut f))
     }
     #[inline(always)]
     fn place_in_quadrant(x: Self, y: Self, sin_r: Self, cos_r: Self) -> (Self, Self) {
@@ -198,4 +280,120 @@ pub fn sin<R: Real>(x: R) -> R {
 #[inline]
 pub fn cos<R: Real>(x: R) -> R {
     sin_cos(x).1
+}
+
+/// `c0 + c1 x + … + c4 x⁴` (as `wide`'s `polynomial_4!`).
+#[inline(always)]
+fn polynomial_4<R: Real>(x: R, c: [f64; 5]) -> R {
+    let x2 = x * x;
+    let x4 = x2 * x2;
+    let s = R::splat;
+    mul_add(
+        mul_add(s(c[3]), x, s(c[2])),
+        x2,
+        mul_add(s(c[1]), x, s(c[0])),
+    ) + s(c[4]) * x4
+}
+
+/// `c0 + c1 x + … + c4 x⁴ + x⁵` (as `wide`'s `polynomial_5n!`).
+#[inline(always)]
+fn polynomial_5n<R: Real>(x: R, c: [f64; 5]) -> R {
+    let x2 = x * x;
+    let x4 = x2 * x2;
+    let s = R::splat;
+    mul_add(
+        x2,
+        mul_add(x, s(c[3]), s(c[2])),
+        mul_add(x4, s(c[4]) + x, mul_add(x, s(c[1]), s(c[0]))),
+    )
+}
+
+const ATAN_P: [f64; 5] = [
+    -6.485_021_904_942_025_371_773E1,
+    -1.228_866_684_490_136_173_410E2,
+    -7.500_855_792_314_704_667_340E1,
+    -1.615_753_718_733_365_076_637E1,
+    -8.750_608_600_031_904_122_785E-1,
+];
+const ATAN_Q: [f64; 5] = [
+    1.945_506_571_482_613_964_425E2,
+    4.853_903_996_359_136_964_868E2,
+    4.328_810_604_912_902_668_951E2,
+    1.650_270_098_316_988_542_046E2,
+    2.485_846_490_142_306_297_962E1,
+];
+
+/// `atan2(y, x)` of every lane (the vector class library's, as `wide`'s `f64x4::atan2`, with
+/// unfused multiply-adds); bit-identical across [`Real`] types lane by lane. Within 2 ulp of
+/// libm for finite arguments (tests/simd.rs); both infinite: libm's values.
+#[inline]
+pub fn atan2<R: Real>(y: R, x: R) -> R {
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, SQRT_2};
+    const MORE_BITS: f64 = 6.123_233_995_736_766E-17;
+    if x.abs().any_beyond(f64::MAX) || y.abs().any_beyond(f64::MAX) {
+        // An infinite or NaN argument in some lane: libm for every lane of the call.
+        return lanes2(y, x, f64::atan2);
+    }
+    let s = R::splat;
+    // Into the first octant.
+    let (x1, y1) = (x.abs(), y.abs());
+    let swap = x1.lt(y1);
+    let x2 = R::select(swap, y1, x1);
+    let y2 = R::select(swap, x1, y1);
+    // x = y = 0 gives NaN here (replaced below).
+    let t = y2 / x2;
+    let not_big = t.le(s(SQRT_2 + 1.0));
+    let not_small = !t.lt(s(0.66));
+    let zero = s(0.0);
+    let offset = R::select(
+        not_small,
+        R::select(not_big, s(FRAC_PI_4), s(FRAC_PI_2)),
+        zero,
+    );
+    let fac = R::select(
+        not_small,
+        R::select(not_big, s(MORE_BITS * 0.5), s(MORE_BITS)),
+        zero,
+    );
+    // small: z = t / 1; medium: (t − 1) / (t + 1); big: −1 / t.
+    let a = R::select(not_big, t, zero);
+    let a = R::select(not_small, a - s(1.0), a);
+    let b = R::select(not_big, s(1.0), zero);
+    let b = R::select(not_small, b + t, b);
+    let z = a / b;
+    let zz = z * z;
+    let px = polynomial_4(zz, ATAN_P);
+    let qx = polynomial_5n(zz, ATAN_Q);
+    let re = mul_add(px / qx, z * zz, z) + (offset + fac);
+    // Back in place.
+    let re = R::select(swap, s(FRAC_PI_2) - re, re);
+    let both_zero = x.eq(zero) & y.eq(zero);
+    let re = R::select(both_zero, zero, re);
+    let re = R::select(x.sign_negative(), s(PI) - re, re);
+    R::select(y.sign_negative(), -re, re)
+}
+
+/// `f(a, b)` lane by lane.
+#[inline]
+fn lanes2<R: Real>(a: R, b: R, f: fn(f64, f64) -> f64) -> R {
+    let mut lane = 0;
+    let bs = collect(b);
+    a.map(|v| {
+        let out = f(v, bs[lane]);
+        lane += 1;
+        out
+    })
+}
+
+/// The lanes of `v` (up to four).
+#[inline]
+fn collect<R: Real>(v: R) -> [f64; 4] {
+    let mut out = [0.0; 4];
+    let mut lane = 0;
+    let _ = v.map(|x| {
+        out[lane] = x;
+        lane += 1;
+        x
+    });
+    out
 }

@@ -19,8 +19,43 @@ use paritysim_error::{Error, Result};
 use super::{Device, Formulation};
 use crate::integrate::State;
 
+pub(crate) mod generic;
+pub(crate) mod lanes;
 #[cfg(test)]
 mod tests;
+
+/// Integrated coordinates of the free-deviation devices whose held-branch equations run
+/// through [`generic`] (the §2.5 Lift and Dual PARITY have four).
+pub(crate) const HELD_N: usize = 4;
+
+/// The constants of [`generic::step`] for a device: its own and its wings' blade elements.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct HeldConstants {
+    pub(crate) constants: generic::Constants<f64, HELD_N>,
+    /// The same in every lane (batches of one device's states).
+    pub(crate) splat: generic::Constants<paritysim_simd::f64x4, HELD_N>,
+    pub(crate) aero: [paritysim_aero::BladeElementModel<paritysim_aero::CoefficientSet>; 2],
+}
+
+// Derived from the spec, which `Device`'s equality compares.
+impl PartialEq for HeldConstants {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl HeldConstants {
+    /// Those of `device`, or `None` unless it has the lean free-deviation model on
+    /// [`HELD_N`] coordinates with blade elements on both wings.
+    pub(super) fn of(device: &Device) -> Option<Self> {
+        let constants = generic::Constants::of(device)?;
+        Some(Self {
+            constants,
+            splat: generic::Constants::lanes([&constants; 4]),
+            aero: generic::blade_models(device)?,
+        })
+    }
+}
 
 /// The constants of [`Device::rhs_free_deviation`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -64,6 +99,9 @@ impl Device {
         branches: Option<[Branch; 2]>,
         dydt: &mut State,
     ) -> Result<()> {
+        if let (Some(held), Some(branches)) = (&self.free_deviation_held, branches) {
+            return self.rhs_free_deviation_held(held, t, y, branches, dydt);
+        }
         let lean_rhs = match self.n_dof {
             1 => self.free_deviation_step::<1>(lean, t, y, branches),
             2 => self.free_deviation_step::<2>(lean, t, y, branches),
@@ -79,6 +117,98 @@ impl Device {
             }
             None => self.rhs_null_space_on(t, y, branches, dydt),
         }
+    }
+
+    /// [`Self::rhs_free_deviation`] on held `branches` through [`generic::step`] (the code the
+    /// SIMD lanes share).
+    ///
+    /// # Errors
+    /// As [`Self::rhs_free_deviation`].
+    #[inline]
+    fn rhs_free_deviation_held(
+        &self,
+        held: &HeldConstants,
+        t: f64,
+        y: &State,
+        branches: [Branch; 2],
+        dydt: &mut State,
+    ) -> Result<()> {
+        let forces = self.drive_forces(t);
+        let x: [f64; HELD_N] = std::array::from_fn(|i| y.coords[i]);
+        let x_dot: [f64; HELD_N] = std::array::from_fn(|i| y.rates[i]);
+        let on = branches.map(paritysim_aero::HeldBranch::of);
+        let step = generic::step(&held.constants, &held.aero, forces, (&x, &x_dot), &on);
+        if step.general {
+            // The general path names the implausible coordinate or takes the pose.
+            return self.rhs_null_space_on(t, y, Some(branches), dydt);
+        }
+        if step.singular {
+            return Err(Error::Singular(format!(
+                "reduced mass matrix is not positive definite at x = {:?}",
+                &y.coords[..HELD_N]
+            )));
+        }
+        *dydt = State::default();
+        for i in 0..HELD_N {
+            dydt.coords[i] = y.rates[i];
+            dydt.rates[i] = step.x_ddot[i];
+        }
+        let q_dot = Vector2::new(step.q_dot[0], step.q_dot[1]);
+        dydt.work_actuator = self.actuator_power(t, forces[0], &q_dot);
+        dydt.work_aero = step.aero_power;
+        Ok(())
+    }
+
+    /// [`Self::rhs_free_deviation`] of several states at `t` on held `branches`, four at a
+    /// time in SIMD lanes ([`generic::step`]: each the scalar result bit for bit; lanes off
+    /// the closed form one by one on the scalar path).
+    ///
+    /// # Errors
+    /// The first failing state's index and error.
+    #[allow(clippy::needless_range_loop)] // coordinates index the state and the lanes alike
+    pub(super) fn free_deviation_batch(
+        &self,
+        (held, lean): (&HeldConstants, &FreeDeviation),
+        t: f64,
+        branches: [Branch; 2],
+        ys: &[State],
+        out: &mut [State],
+    ) -> std::result::Result<(), (usize, Error)> {
+        use paritysim_simd::{Real, f64x4};
+        let forces = self.drive_forces(t);
+        let drive = forces.map(f64x4::splat);
+        let on = branches.map(|b| paritysim_aero::HeldBranch::lanes([b; 4]));
+        for start in (0..ys.len()).step_by(4) {
+            let count = (ys.len() - start).min(4);
+            let lane = |l: usize| &ys[start + l.min(count - 1)];
+            let x: [f64x4; HELD_N] =
+                std::array::from_fn(|i| f64x4::new(std::array::from_fn(|l| lane(l).coords[i])));
+            let x_dot: [f64x4; HELD_N] =
+                std::array::from_fn(|i| f64x4::new(std::array::from_fn(|l| lane(l).rates[i])));
+            let step = generic::step(&held.splat, &held.aero, drive, (&x, &x_dot), &on);
+            let scalar = f64x4::bits(step.general | step.singular);
+            let x_ddot = step.x_ddot.map(|v| v.to_array());
+            let (q_dot, aero_power) =
+                (step.q_dot.map(|v| v.to_array()), step.aero_power.to_array());
+            for l in 0..count {
+                let k = start + l;
+                if scalar & (1 << l) != 0 {
+                    self.rhs_free_deviation(lean, t, &ys[k], Some(branches), &mut out[k])
+                        .map_err(|e| (k, e))?;
+                    continue;
+                }
+                let mut d = State::default();
+                for i in 0..HELD_N {
+                    d.coords[i] = ys[k].rates[i];
+                    d.rates[i] = x_ddot[i][l];
+                }
+                let q_dot = Vector2::new(q_dot[0][l], q_dot[1][l]);
+                d.work_actuator = self.actuator_power(t, forces[0], &q_dot);
+                d.work_aero = aero_power[l];
+                out[k] = d;
+            }
+        }
+        Ok(())
     }
 
     /// The derivative of [`Self::rhs_free_deviation`] on `N` coordinates; `Ok(None)` where

@@ -51,6 +51,21 @@ impl crate::integrate::OdeSystem for Device {
         }
     }
 
+    fn rhs_on_batch(
+        &self,
+        t: f64,
+        sides: crate::integrate::Sides,
+        ys: &[State],
+        out: &mut [State],
+    ) -> Option<std::result::Result<(), (usize, paritysim_error::Error)>> {
+        let held = self.free_deviation_held.as_ref()?;
+        let lean = self.free_deviation_rhs.as_ref()?;
+        if self.n_switches == 0 || ys.len() < 2 {
+            return None;
+        }
+        Some(self.free_deviation_batch((held, lean), t, branches(sides), ys, out))
+    }
+
     fn variational(
         &self,
         t: f64,

@@ -42,6 +42,21 @@ pub trait OdeSystem {
         self.rhs(t, y, dydt)
     }
 
+    /// [`Self::rhs_on`] of several states at once (e.g. in SIMD lanes: the central
+    /// differences of the variational equations evaluate `2n` of them per stage); `None`
+    /// (the default) when the system has no such form, and the caller evaluates them one by
+    /// one. Each result must be [`Self::rhs_on`]'s bit for bit; a failure names the first
+    /// failing state (its index) with [`Self::rhs_on`]'s error.
+    fn rhs_on_batch(
+        &self,
+        _t: f64,
+        _sides: Sides,
+        _ys: &[State],
+        _out: &mut [State],
+    ) -> Option<std::result::Result<(), (usize, paritysim_error::Error)>> {
+        None
+    }
+
     /// The variational equations' right-hand side `dphi = J(t, y) phi` from an analytic
     /// Jacobian `J = ∂f/∂y` of the `2n` entries `[coords (n), rates (n)]`, `phi` and `dphi`
     /// `2n × 2n` by columns; `None` (the default) when the system has none for this `n`: the

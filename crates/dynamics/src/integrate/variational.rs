@@ -53,6 +53,77 @@ impl Variational<'_> {
     }
 }
 
+impl Variational<'_> {
+    /// The central differences of [`Rhs::eval`] with the `2n` perturbed right-hand sides of
+    /// each column evaluated together ([`OdeSystem::rhs_on_batch`]: the same bits, so the
+    /// same sensitivities); `false` when the system has no batch form (nothing written).
+    fn batched_differences<const M: usize>(
+        &mut self,
+        t: f64,
+        sides: Sides,
+        c: &[f64; M],
+        dc: &mut [f64; M],
+        scale: f64,
+    ) -> Result<bool> {
+        let m = 2 * self.n;
+        let mut states = [State::default(); 24];
+        let mut deltas = [0.0; 12];
+        let mut columns = [0usize; 12];
+        let mut count = 0;
+        for j in 0..m {
+            let col = m + j * m;
+            let v = &c[col..col + m];
+            let size = v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            if size == 0.0 {
+                continue;
+            }
+            let delta = DIRECTIONAL_STEP * scale / size;
+            let (mut yp, mut ym) = ([0.0; 12], [0.0; 12]);
+            for i in 0..m {
+                yp[i] = c[i] + delta * v[i];
+                ym[i] = c[i] - delta * v[i];
+            }
+            states[2 * count] = to_state(self.n, &yp[..m]);
+            states[2 * count + 1] = to_state(self.n, &ym[..m]);
+            (deltas[count], columns[count]) = (delta, j);
+            count += 1;
+        }
+        let mut out = [State::default(); 24];
+        let Some(done) =
+            self.system
+                .rhs_on_batch(t, sides, &states[..2 * count], &mut out[..2 * count])
+        else {
+            return Ok(false);
+        };
+        self.calls += 2 * count;
+        if let Err((k, e)) = done {
+            return Err(integration_error(
+                t,
+                &states[k],
+                format!("the model failed: {e}"),
+            ));
+        }
+        for j in 0..m {
+            let col = m + j * m;
+            dc[col..col + m].fill(0.0);
+        }
+        for k in 0..count {
+            let (col, delta) = (m + columns[k] * m, deltas[k]);
+            let (fp, fm) = (&out[2 * k], &out[2 * k + 1]);
+            let n = self.n;
+            for i in 0..m {
+                let (p, q) = if i < n {
+                    (fp.coords[i], fm.coords[i])
+                } else {
+                    (fp.rates[i - n], fm.rates[i - n])
+                };
+                dc[col + i] = (p - q) / (2.0 * delta);
+            }
+        }
+        Ok(true)
+    }
+}
+
 impl<const M: usize> Rhs<M> for Variational<'_> {
     fn eval(&mut self, t: f64, c: &[f64; M], dc: &mut [f64; M]) -> Result<()> {
         let m = 2 * self.n;
@@ -72,6 +143,11 @@ impl<const M: usize> Rhs<M> for Variational<'_> {
             return done.map_err(|e| integration_error(t, &y, format!("the model failed: {e}")));
         }
         let scale = 1.0 + c[..m].iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        if let Some(sides) = self.sides {
+            if self.batched_differences(t, sides, c, dc, scale)? {
+                return Ok(());
+            }
+        }
         let (mut fp, mut fm) = ([0.0; 12], [0.0; 12]);
         for j in 0..m {
             let col = m + j * m;

@@ -85,8 +85,7 @@ pub fn resolve_lanes(requested: Option<usize>) -> Result<usize> {
 /// the two-DOF linear differential map (eq. 2.15) with stroke drag or no aerodynamics, and
 /// the §3.4 stroke-plane devices (blade elements on both wings, a single drive).
 pub fn has_lane_model(device: &Device) -> bool {
-    LinearStroke::of(device).is_some()
-        || crate::device::stroke_plane_lanes::StrokePlaneLanes::supports(device)
+    LinearStroke::of(device).is_some() || plane_rhs::supports(device)
 }
 
 /// Points completed in lanes since the process started (tests and benchmarks read it to see
@@ -94,8 +93,9 @@ pub fn has_lane_model(device: &Device) -> bool {
 pub(crate) static COMPLETED_IN_LANES: std::sync::atomic::AtomicUsize =
     std::sync::atomic::AtomicUsize::new(0);
 
-/// Of [`COMPLETED_IN_LANES`], the stroke-plane (§3.4) points.
-pub(crate) static STROKE_PLANE_COMPLETED_IN_LANES: std::sync::atomic::AtomicUsize =
+/// Of [`COMPLETED_IN_LANES`], the switched devices' points (§3.4 stroke plane, §2.5 free
+/// deviation).
+pub(crate) static SWITCHED_COMPLETED_IN_LANES: std::sync::atomic::AtomicUsize =
     std::sync::atomic::AtomicUsize::new(0);
 
 /// How many sweep points the SIMD lanes have completed in this process (monotonic; points
@@ -104,7 +104,8 @@ pub fn points_completed_in_lanes() -> usize {
     COMPLETED_IN_LANES.load(std::sync::atomic::Ordering::Relaxed)
 }
 
-/// Of [`points_completed_in_lanes`], those of stroke-plane devices (§3.4).
-pub fn stroke_plane_points_completed_in_lanes() -> usize {
-    STROKE_PLANE_COMPLETED_IN_LANES.load(std::sync::atomic::Ordering::Relaxed)
+/// Of [`points_completed_in_lanes`], those of the switched devices (§3.4 stroke plane, §2.5
+/// free deviation).
+pub fn switched_points_completed_in_lanes() -> usize {
+    SWITCHED_COMPLETED_IN_LANES.load(std::sync::atomic::Ordering::Relaxed)
 }

@@ -15,9 +15,8 @@ use paritysim_error::Result;
 
 use super::plane_rhs::{self, M};
 use super::point::Next;
-use super::{COMPLETED_IN_LANES, STROKE_PLANE_COMPLETED_IN_LANES};
+use super::{COMPLETED_IN_LANES, SWITCHED_COMPLETED_IN_LANES};
 use crate::device::Device;
-use crate::device::stroke_plane_lanes::StrokePlaneLanes;
 use crate::grid_shooting::{GRID_TOLERANCE_FACTOR, REPICK_RESIDUAL, least_squares_step};
 use crate::integrate::budget::Budget;
 use crate::integrate::lanes::{LaneOutcome, LaneProblem, LaneTolerances, SampleBlock};
@@ -70,7 +69,7 @@ pub(super) struct PlanePoint<'a> {
     rk: RungeKutta,
     pub(super) grid: Rc<[f64]>,
     /// The drive at the grid's stage times (`None` after the grid changes).
-    forcing: Option<Rc<[f64]>>,
+    forcing: Option<Rc<[[f64; 2]]>>,
     times: Rc<[f64]>,
     jac: DMatrix<f64>,
     fresh: bool,
@@ -106,7 +105,7 @@ impl<'a> PlanePoint<'a> {
         metric_names: &'a [String],
         times_cache: &mut Option<(f64, usize, Rc<[f64]>)>,
     ) -> Option<(Self, Next)> {
-        if !StrokePlaneLanes::supports(device) {
+        if !plane_rhs::supports(device) {
             return None;
         }
         let period = device.period()?;
@@ -213,7 +212,7 @@ impl<'a> PlanePoint<'a> {
     }
 
     /// The drive table of the current grid.
-    pub(super) fn forcing(&mut self) -> Rc<[f64]> {
+    pub(super) fn forcing(&mut self) -> Rc<[[f64; 2]]> {
         if let Some(table) = &self.forcing {
             return table.clone();
         }
@@ -420,7 +419,7 @@ impl<'a> PlanePoint<'a> {
         };
         let coordinates = self.device.coordinates(&steady_state).ok();
         COMPLETED_IN_LANES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        STROKE_PLANE_COMPLETED_IN_LANES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        SWITCHED_COMPLETED_IN_LANES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         Next::Done(Box::new(PointOutput::keep(
             result,
             self.metric_names,

@@ -1,6 +1,7 @@
-//! The §3.4 stroke-plane devices in SIMD lanes: their right-hand side
-//! (`device::stroke_plane::lanes`) with each lane's tabulated drive and held branch, as the
-//! lane stepper drives it (`integrate::dop853_lanes`).
+//! The switched devices in SIMD lanes, the §3.4 stroke-plane ones and the §2.5 free-deviation
+//! ones: their right-hand side (`device::stroke_plane::lanes`, `device::free_deviation::lanes`)
+//! with each lane's tabulated drive and held branch, as the lane stepper drives it
+//! (`integrate::dop853_lanes`).
 //!
 //! The blade elements switch (stroke reversal, α = π/2, `ω_z = 0`), so each lane holds the
 //! branch of its own switching functions as the scalar `drive_on_grid_events` does: taken at
@@ -16,6 +17,7 @@ use std::rc::Rc;
 use wide::f64x4;
 
 use crate::device::Device;
+use crate::device::free_deviation_lanes::FreeDeviationLanes;
 use crate::device::stroke_plane_lanes::{self as model, StrokePlaneLanes};
 use crate::integrate::lanes::{LANES, LaneRhs, LaneRun, LaneTolerances, NO_STAGE, stage_times};
 use crate::integrate::{
@@ -34,23 +36,35 @@ struct Held {
     g: [f64; MAX_SWITCHES],
 }
 
-/// [`LANES`] stroke-plane devices side by side.
+/// Whether `device` has a switched lane model: the stroke-plane one or the free-deviation one.
+pub(crate) fn supports(device: &Device) -> bool {
+    StrokePlaneLanes::supports(device) || FreeDeviationLanes::supports(device)
+}
+
+/// The lanes' right-hand side.
+enum LaneModel<'a> {
+    StrokePlane(Box<StrokePlaneLanes<'a>>),
+    FreeDeviation(Box<FreeDeviationLanes<'a>>),
+    /// Lanes of different kinds: each evaluated on the scalar path.
+    Mixed,
+}
+
+/// [`LANES`] switched devices side by side.
 pub(crate) struct PlaneLanes<'a> {
     devices: [Option<&'a Device>; LANES],
     /// The lanes' constants, rebuilt when a lane takes another device.
-    model: Option<StrokePlaneLanes<'a>>,
-    /// Each lane's actuator force at the [`stage_times`] of its grid.
-    forcing: [Option<Rc<[f64]>>; LANES],
+    model: LaneModel<'a>,
+    /// Each lane's drive forces at the [`stage_times`] of its grid.
+    forcing: [Option<Rc<[[f64; 2]]>>; LANES],
     held: RefCell<[Held; LANES]>,
 }
 
-/// The drive at every [`stage_times`] of `grid` (the scalar `Actuator::force` of each: the
-/// drive's `sin` once per grid instead of once per evaluation).
-pub(crate) fn forcing(device: &Device, grid: &[f64]) -> Rc<[f64]> {
-    let actuator = device.spec().actuator.as_ref();
+/// The drive forces at every [`stage_times`] of `grid` (`Device::drive_forces`: the drive's
+/// `sin` once per grid instead of once per evaluation).
+pub(crate) fn forcing(device: &Device, grid: &[f64]) -> Rc<[[f64; 2]]> {
     stage_times(grid)
         .into_iter()
-        .map(|t| actuator.map_or(0.0, |a| a.force(t)))
+        .map(|t| device.drive_forces(t))
         .collect()
 }
 
@@ -78,7 +92,7 @@ impl<'a> PlaneLanes<'a> {
     pub(crate) fn new() -> Self {
         Self {
             devices: [None; LANES],
-            model: None,
+            model: LaneModel::Mixed,
             forcing: std::array::from_fn(|_| None),
             held: RefCell::new([Held::default(); LANES]),
         }
@@ -92,29 +106,64 @@ impl<'a> PlaneLanes<'a> {
         self.devices[l] = Some(device);
         // Idle lanes compute with a loaded device's constants (their results are not read).
         let devices = self.devices.map(|d| d.unwrap_or(device));
-        self.model = StrokePlaneLanes::new(devices);
+        self.model = if let Some(lanes) = StrokePlaneLanes::new(devices) {
+            LaneModel::StrokePlane(Box::new(lanes))
+        } else if let Some(lanes) = FreeDeviationLanes::new(devices) {
+            LaneModel::FreeDeviation(Box::new(lanes))
+        } else {
+            LaneModel::Mixed
+        };
     }
 
     /// The drive table lane `l` reads from its next problem on.
-    pub(crate) fn load_forcing(&mut self, l: usize, forcing: Rc<[f64]>) {
+    pub(crate) fn load_forcing(&mut self, l: usize, forcing: Rc<[[f64; 2]]>) {
         self.forcing[l] = Some(forcing);
+    }
+
+    /// Lane `l` on the scalar right-hand side of its device on its held sides; `None` where
+    /// it fails.
+    fn scalar_lane(&self, l: usize, t: f64, y: &[V; M], sides: Sides) -> Option<[f64; M]> {
+        let device = self.devices[l]?;
+        let c: [f64; M] = std::array::from_fn(|i| y[i].to_array()[l]);
+        let mut out = State::default();
+        device.rhs_on(t, &expand(&c), sides, &mut out).ok()?;
+        Some(compact(&out))
     }
 }
 
 impl LaneRhs<M> for PlaneLanes<'_> {
     fn eval(&self, t: [f64; LANES], stage: [usize; LANES], y: &[V; M], dydt: &mut [V; M]) -> u32 {
-        let Some(model) = &self.model else {
-            return (1 << LANES) - 1;
-        };
-        let force = std::array::from_fn(|l| match (&self.forcing[l], stage[l]) {
-            (Some(table), s) if s != NO_STAGE => table[s],
-            _ => self.devices[l]
-                .and_then(|d| d.spec().actuator.as_ref())
-                .map_or(0.0, |a| a.force(t[l])),
-        });
+        let forces: [[f64; 2]; LANES] =
+            std::array::from_fn(|l| match (&self.forcing[l], stage[l]) {
+                (Some(table), s) if s != NO_STAGE => table[s],
+                _ => self.devices[l].map_or([0.0; 2], |d| d.drive_forces(t[l])),
+            });
         let held = self.held.borrow();
         let branches = std::array::from_fn(|l| crate::device::blade_branches(held[l].sides));
-        model.eval(t, force, y, branches, dydt).failed
+        match &self.model {
+            LaneModel::StrokePlane(model) => {
+                model
+                    .eval(t, forces.map(|f| f[0]), y, branches, dydt)
+                    .failed
+            }
+            LaneModel::FreeDeviation(model) => model.eval(t, forces, y, branches, dydt).1,
+            LaneModel::Mixed => {
+                let mut failed = 0;
+                for l in 0..LANES {
+                    match self.scalar_lane(l, t[l], y, held[l].sides) {
+                        Some(f) => {
+                            for (i, value) in f.into_iter().enumerate() {
+                                let mut lanes = dydt[i].to_array();
+                                lanes[l] = value;
+                                dydt[i] = V::new(lanes);
+                            }
+                        }
+                        None => failed |= 1 << l,
+                    }
+                }
+                failed
+            }
+        }
     }
 
     fn switched(&self) -> bool {

@@ -70,9 +70,9 @@ impl JointSpring {
 /// quadratic family covers a signed (k1) and a symmetric (k2) stiffening.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TunableHinge {
-    pub(super) k0: f64,
-    pub(super) k1: f64,
-    pub(super) k2: f64,
+    pub(crate) k0: f64,
+    pub(crate) k1: f64,
+    pub(crate) k2: f64,
 }
 
 impl TunableHinge {

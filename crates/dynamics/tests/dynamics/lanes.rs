@@ -352,34 +352,43 @@ fn a_cancel_stops_the_lanes_and_keeps_the_finished_points() {
     }
 }
 
-/// The §3.4 rotating-wing device (Table 3.3 1-Cut wings, blade element, eq. 2.15 with
-/// ±200 µm → ±35°, `100 + amplitude sin(2π 110 Hz t)` V) with hinge spring `hinge`
-/// (mN·mm/rad) on both wings.
-fn rotating_device(hinge: f64, amplitude_v: f64) -> Device {
+/// A Table 3.3 1-Cut rotating-wing device (blade elements, eq. 2.15 with ±200 µm → ±35°,
+/// `offset_v + amplitude_v sin(2π 110 Hz t)`): the §3.4 Drag PARITY with hinge spring
+/// `spring` (mN·mm/rad), or (`configuration` `lift_parity`) the §2.5 Lift PARITY with free
+/// deviation θ, deviation spring `spring` and the tunable hinge.
+fn rotating_device(configuration: &str, spring: f64, amplitude_v: f64, offset_v: f64) -> Device {
     use paritysim_aero::{BladeElementModel, CoefficientSet, Omegas};
+    let free = configuration != "drag_parity";
     let wing = |inertia: [f64; 4], omegas: [f64; 4]| {
         let [ixx, iyy, izz, ixz] = inertia;
         let mut springs = [JointSpring::default(); 6];
-        springs[5] = JointSpring::linear(hinge, 0.0).unwrap();
+        springs[if free { 3 } else { 5 }] = JointSpring::linear(spring, 0.0).unwrap();
         let blade = BladeElementModel::new(
             Omegas::new(omegas[0], omegas[1], omegas[2], omegas[3]).unwrap(),
             CoefficientSet::default(),
         )
         .unwrap();
-        Wing::new(
+        let wing = Wing::new(
             shoulder(90.0, 0.0),
             Matrix3::new(ixx, 0.0, ixz, 0.0, iyy, 0.0, ixz, 0.0, izz),
             springs,
             WingAero::BladeElement(blade),
         )
-        .unwrap()
+        .unwrap();
+        if free {
+            wing.with_tunable_hinge(
+                paritysim_dynamics::TunableHinge::new(2.533928021702924, 0.0, 20.0).unwrap(),
+            )
+        } else {
+            wing
+        }
     };
     two_wing_device(
         [
             wing([49.0, 50.5, 1.56, 4.2], [46.8, 0.587, 17.5, 0.712]),
             wing([40.6, 42.0, 1.43, 3.38], [28.7, 0.419, 10.6, 0.787]),
         ],
-        "drag_parity",
+        configuration,
         Drivetrain::LinearDifferential(
             LinearDifferential::new(35f64.to_radians() / 0.2, 2.5, 1.0).unwrap(),
         ),
@@ -387,7 +396,7 @@ fn rotating_device(hinge: f64, amplitude_v: f64) -> Device {
         Actuator::new(
             paritysim_dynamics::actuator::THESIS_FORCE_PER_VOLT,
             paritysim_dynamics::actuator::THESIS_STIFFNESS,
-            Waveform::sine(amplitude_v, 110.0, 100.0, 0.0).unwrap(),
+            Waveform::sine(amplitude_v, 110.0, offset_v, 0.0).unwrap(),
             paritysim_dynamics::DcOffset::Ignore,
         )
         .unwrap(),
@@ -395,34 +404,17 @@ fn rotating_device(hinge: f64, amplitude_v: f64) -> Device {
     )
 }
 
-/// §3.4 sweeps (stroke-plane devices, whose blade elements switch) in lanes are bit for bit
-/// the scalar sweep, for lane widths 2 and 4 and two threads, and their continued points ran
-/// in the lanes (issue 12 item 6).
-#[test]
-fn stroke_plane_lane_sweeps_are_bit_identical_to_the_scalar_sweep() {
-    // Chains of 16 along the hinge stiffness, at three drive amplitudes.
-    let points: Vec<_> = [70.0, 85.0, 100.0]
-        .iter()
-        .flat_map(|&v| (0..16).map(move |k| (1.2 + 0.2 * k as f64, v)))
-        .map(|(hinge, volts)| {
-            let device = rotating_device(hinge, volts);
-            assert!(has_lane_model(&device));
-            Ok((device, shooting_options()))
-        })
-        .collect();
-    let metrics: Vec<String> = [
-        "left_stroke_amplitude",
-        "right_rotation_amplitude",
-        "left_rotation_phase_lag",
-        "imbalance_peak_pct",
-        "q2_amplitude",
-    ]
-    .map(String::from)
-    .to_vec();
+/// The sweep of `points` with every lane width and thread count equals the scalar sweep bit
+/// for bit, and at least `min_in_lanes` of its switched-device points ran in the lanes.
+fn assert_lanes_match_the_scalar_sweep(
+    points: &[paritysim_dynamics::Result<(Device, SimulationOptions)>],
+    metrics: &[String],
+    min_in_lanes: usize,
+) {
     let go = |threads: usize, lanes: usize| {
         run_points_with_lanes(
-            &points,
-            &metrics,
+            points,
+            metrics,
             false,
             Some(threads),
             Some(lanes),
@@ -436,12 +428,15 @@ fn stroke_plane_lane_sweeps_are_bit_identical_to_the_scalar_sweep() {
     let scalar = go(1, 1);
     assert!(scalar.iter().all(|o| o.converged && o.monodromy.is_some()));
     for (threads, lanes) in [(1, 2), (1, 4), (2, 4)] {
-        let before = paritysim_dynamics::lanes::stroke_plane_points_completed_in_lanes();
+        let before = paritysim_dynamics::lanes::switched_points_completed_in_lanes();
         let laned = go(threads, lanes);
-        let in_lanes = paritysim_dynamics::lanes::stroke_plane_points_completed_in_lanes() - before;
+        let in_lanes = paritysim_dynamics::lanes::switched_points_completed_in_lanes() - before;
         eprintln!("{threads} threads, {lanes} lanes: {in_lanes} points in lanes");
-        // Every continued point (all but the chain starts) can run in a lane.
-        assert!(in_lanes >= 30, "{in_lanes} of 48 points in lanes");
+        assert!(
+            in_lanes >= min_in_lanes,
+            "{in_lanes} of {} points in lanes",
+            points.len()
+        );
         for (i, (a, b)) in scalar.iter().zip(&laned).enumerate() {
             assert_eq!(
                 fingerprint(a),
@@ -450,4 +445,48 @@ fn stroke_plane_lane_sweeps_are_bit_identical_to_the_scalar_sweep() {
             );
         }
     }
+}
+
+/// Sweeps of the switched devices in lanes are bit for bit the scalar sweep, for lane widths 2
+/// and 4 and two threads, and their continued points ran in the lanes (issue 12 item 6): the
+/// §3.4 stroke-plane device (blade elements switching, θ held) and the §2.5 Lift PARITY (free
+/// deviation θ). One test, so that no other sweep moves the lane counter meanwhile.
+#[test]
+fn switched_lane_sweeps_are_bit_identical_to_the_scalar_sweep() {
+    // §3.4: chains of 16 along the hinge stiffness, at three drive amplitudes; every
+    // continued point (all but the three chain starts) can run in a lane.
+    let points: Vec<_> = [70.0, 85.0, 100.0]
+        .iter()
+        .flat_map(|&v| (0..16).map(move |k| (1.2 + 0.2 * k as f64, v)))
+        .map(|(hinge, volts)| {
+            let device = rotating_device("drag_parity", hinge, volts, 100.0);
+            assert!(has_lane_model(&device));
+            Ok((device, shooting_options()))
+        })
+        .collect();
+    let metrics: Vec<String> = [
+        "left_stroke_amplitude",
+        "right_rotation_amplitude",
+        "left_rotation_phase_lag",
+        "imbalance_peak_pct",
+        "q2_amplitude",
+    ]
+    .map(String::from)
+    .to_vec();
+    assert_lanes_match_the_scalar_sweep(&points, &metrics, 40);
+    // §2.5 Lift: two chains of 12 along the deviation stiffness (8 → 12 mN·mm/rad) at
+    // 85 V and 95 V (offset = amplitude).
+    let points: Vec<_> = [85.0, 95.0]
+        .iter()
+        .flat_map(|&v| (0..12).map(move |k| (8.0 + 4.0 * k as f64 / 11.0, v)))
+        .map(|(stiffness, volts)| {
+            let device = rotating_device("lift_parity", stiffness, volts, volts);
+            assert!(has_lane_model(&device));
+            Ok((device, shooting_options()))
+        })
+        .collect();
+    let metrics: Vec<String> = ["tau_r_peak", "right_rotation_amplitude", "left_stroke_mean"]
+        .map(String::from)
+        .to_vec();
+    assert_lanes_match_the_scalar_sweep(&points, &metrics, 16);
 }

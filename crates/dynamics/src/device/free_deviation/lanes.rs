@@ -1,0 +1,120 @@
+//! [`Device::rhs_free_deviation`] on held branches for four free-deviation devices at once, one
+//! per SIMD lane: the §2.5 Lift PARITY right-hand side the sweep ensembles need (issue 12
+//! item 6; docs/findings.md §24). Every lane runs [`generic::step`], the scalar path's own
+//! code, so its derivative is the scalar one bit for bit; a lane the closed form does not
+//! cover (an implausible drivetrain coordinate, a pose near a singular one, a reduced mass
+//! matrix that is not positive definite) is evaluated on its own by the scalar right-hand side,
+//! which also names the error of a lane that fails.
+
+use paritysim_aero::{Branch, HeldBranch};
+use paritysim_simd::{Real, f64x4};
+
+use super::generic::{self, Constants};
+use super::{HELD_N, HeldConstants};
+use crate::device::Device;
+use crate::integrate::State;
+
+type V = f64x4;
+
+/// Lanes evaluated together.
+const LANES: usize = 4;
+
+/// Compact state entries: `x` then `ẋ`.
+pub(crate) const M: usize = 2 * HELD_N;
+
+/// The constants of four free-deviation devices, gathered into vectors.
+pub(crate) struct FreeDeviationLanes<'a> {
+    devices: [&'a Device; LANES],
+    constants: Constants<V, HELD_N>,
+    /// The lanes' common blade elements (`None`: the lanes differ, every lane is scalar).
+    aero: Option<[paritysim_aero::BladeElementModel<paritysim_aero::CoefficientSet>; 2]>,
+}
+
+impl<'a> FreeDeviationLanes<'a> {
+    /// Whether `device` can take a lane: the lean free-deviation model on [`HELD_N`]
+    /// coordinates with blade elements on both wings.
+    pub(crate) fn supports(device: &Device) -> bool {
+        device.free_deviation_held.is_some()
+    }
+
+    /// The lanes of `devices`, or `None` unless every one [`Self::supports`] lanes.
+    pub(crate) fn new(devices: [&'a Device; LANES]) -> Option<Self> {
+        let held: [&HeldConstants; LANES] = {
+            let mut out = [None; LANES];
+            for (l, d) in devices.iter().enumerate() {
+                out[l] = Some(d.free_deviation_held.as_ref()?);
+            }
+            out.map(|h| h.expect("every lane checked above"))
+        };
+        let aero = (1..LANES)
+            .all(|l| held[l].aero == held[0].aero)
+            .then_some(held[0].aero);
+        Some(Self {
+            devices,
+            constants: Constants::lanes(held.map(|h| &h.constants)),
+            aero,
+        })
+    }
+
+    /// `f(t, y)` of every lane on the held `branches[l]` with the drive forces `forces[l]`
+    /// at `t[l]` ([`Device::drive_forces`], tabulated by the caller): `dydt = (ẋ, ẍ)` in the
+    /// compact layout. Returns the bit masks of the lanes evaluated on the scalar path and of
+    /// those whose scalar right-hand side fails there.
+    pub(crate) fn eval(
+        &self,
+        t: [f64; LANES],
+        forces: [[f64; 2]; LANES],
+        y: &[V; M],
+        branches: [[Branch; 2]; LANES],
+        dydt: &mut [V; M],
+    ) -> (u32, u32) {
+        let all = (1u32 << LANES) - 1;
+        let mut scalar = all;
+        if let Some(aero) = &self.aero {
+            let x: [V; HELD_N] = std::array::from_fn(|i| y[i]);
+            let x_dot: [V; HELD_N] = std::array::from_fn(|i| y[HELD_N + i]);
+            let held = [0, 1].map(|w| HeldBranch::lanes(branches.map(|b| b[w])));
+            let drive = [0, 1].map(|k| V::new(forces.map(|f| f[k])));
+            let step = generic::step(&self.constants, aero, drive, (&x, &x_dot), &held);
+            dydt[..HELD_N].copy_from_slice(&x_dot);
+            dydt[HELD_N..].copy_from_slice(&step.x_ddot);
+            scalar = V::bits(step.general | step.singular) & all;
+        }
+        let mut failed = 0u32;
+        for l in (0..LANES).filter(|l| scalar & (1 << l) != 0) {
+            match self.scalar_lane(l, t[l], y, branches[l]) {
+                Some(f) => {
+                    for (i, value) in f.into_iter().enumerate() {
+                        let mut lanes = dydt[i].to_array();
+                        lanes[l] = value;
+                        dydt[i] = V::new(lanes);
+                    }
+                }
+                None => failed |= 1 << l,
+            }
+        }
+        (scalar, failed)
+    }
+
+    /// Lane `l` on the scalar right-hand side; `None` where it fails.
+    fn scalar_lane(&self, l: usize, t: f64, y: &[V; M], branches: [Branch; 2]) -> Option<[f64; M]> {
+        let device = self.devices[l];
+        let lean = device.free_deviation_rhs.as_ref()?;
+        let mut state = State::default();
+        for i in 0..HELD_N {
+            state.coords[i] = y[i].to_array()[l];
+            state.rates[i] = y[HELD_N + i].to_array()[l];
+        }
+        let mut out = State::default();
+        device
+            .rhs_free_deviation(lean, t, &state, Some(branches), &mut out)
+            .ok()?;
+        Some(std::array::from_fn(|i| {
+            if i < HELD_N {
+                out.coords[i]
+            } else {
+                out.rates[i - HELD_N]
+            }
+        }))
+    }
+}
