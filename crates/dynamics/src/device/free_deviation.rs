@@ -24,17 +24,36 @@ pub(crate) mod lanes;
 #[cfg(test)]
 mod tests;
 
-/// Integrated coordinates of the free-deviation devices whose held-branch equations run
-/// through [`generic`] (the §2.5 Lift and Dual PARITY have four).
+/// Integrated coordinates of the free-deviation devices whose sweep lanes run
+/// [`generic::step`] (the §2.5 Lift PARITY has four; the Dual PARITY's five run it in the
+/// scalar path and its batches).
 pub(crate) const HELD_N: usize = 4;
 
-/// The constants of [`generic::step`] for a device: its own and its wings' blade elements.
+/// The constants of [`generic::step`] on `N` coordinates: the device's own, the same in every
+/// lane (batches of one device's states) and its wings' blade elements.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct HeldConstants {
-    pub(crate) constants: generic::Constants<f64, HELD_N>,
-    /// The same in every lane (batches of one device's states).
-    pub(crate) splat: generic::Constants<paritysim_simd::f64x4, HELD_N>,
+pub(crate) struct Held<const N: usize> {
+    pub(crate) constants: generic::Constants<f64, N>,
+    pub(crate) splat: generic::Constants<paritysim_simd::f64x4, N>,
     pub(crate) aero: [paritysim_aero::BladeElementModel<paritysim_aero::CoefficientSet>; 2],
+}
+
+impl<const N: usize> Held<N> {
+    fn of(device: &Device) -> Option<Self> {
+        let constants = generic::Constants::of(device)?;
+        Some(Self {
+            constants,
+            splat: generic::Constants::lanes([&constants; 4]),
+            aero: generic::blade_models(device)?,
+        })
+    }
+}
+
+/// [`Held`] for the devices' coordinate counts: four (Lift PARITY) or five (Dual PARITY).
+#[derive(Clone, Debug)]
+pub(crate) enum HeldConstants {
+    Four(Box<Held<4>>),
+    Five(Box<Held<5>>),
 }
 
 // Derived from the spec, which `Device`'s equality compares.
@@ -45,15 +64,14 @@ impl PartialEq for HeldConstants {
 }
 
 impl HeldConstants {
-    /// Those of `device`, or `None` unless it has the lean free-deviation model on
-    /// [`HELD_N`] coordinates with blade elements on both wings.
+    /// Those of `device`, or `None` unless it has the lean free-deviation model on four or
+    /// five coordinates with blade elements on both wings.
     pub(super) fn of(device: &Device) -> Option<Self> {
-        let constants = generic::Constants::of(device)?;
-        Some(Self {
-            constants,
-            splat: generic::Constants::lanes([&constants; 4]),
-            aero: generic::blade_models(device)?,
-        })
+        match device.n_dof {
+            4 => Held::of(device).map(|h| Self::Four(Box::new(h))),
+            5 => Held::of(device).map(|h| Self::Five(Box::new(h))),
+            _ => None,
+        }
     }
 }
 
@@ -99,8 +117,14 @@ impl Device {
         branches: Option<[Branch; 2]>,
         dydt: &mut State,
     ) -> Result<()> {
-        if let (Some(held), Some(branches)) = (&self.free_deviation_held, branches) {
-            return self.rhs_free_deviation_held(held, t, y, branches, dydt);
+        match (&self.free_deviation_held, branches) {
+            (Some(HeldConstants::Four(held)), Some(branches)) => {
+                return self.rhs_free_deviation_held(held, t, y, branches, dydt);
+            }
+            (Some(HeldConstants::Five(held)), Some(branches)) => {
+                return self.rhs_free_deviation_held(held, t, y, branches, dydt);
+            }
+            _ => {}
         }
         let lean_rhs = match self.n_dof {
             1 => self.free_deviation_step::<1>(lean, t, y, branches),
@@ -125,17 +149,17 @@ impl Device {
     /// # Errors
     /// As [`Self::rhs_free_deviation`].
     #[inline]
-    fn rhs_free_deviation_held(
+    fn rhs_free_deviation_held<const N: usize>(
         &self,
-        held: &HeldConstants,
+        held: &Held<N>,
         t: f64,
         y: &State,
         branches: [Branch; 2],
         dydt: &mut State,
     ) -> Result<()> {
         let forces = self.drive_forces(t);
-        let x: [f64; HELD_N] = std::array::from_fn(|i| y.coords[i]);
-        let x_dot: [f64; HELD_N] = std::array::from_fn(|i| y.rates[i]);
+        let x: [f64; N] = std::array::from_fn(|i| y.coords[i]);
+        let x_dot: [f64; N] = std::array::from_fn(|i| y.rates[i]);
         let on = branches.map(paritysim_aero::HeldBranch::of);
         let step = generic::step(&held.constants, &held.aero, forces, (&x, &x_dot), &on);
         if step.general {
@@ -145,11 +169,11 @@ impl Device {
         if step.singular {
             return Err(Error::Singular(format!(
                 "reduced mass matrix is not positive definite at x = {:?}",
-                &y.coords[..HELD_N]
+                &y.coords[..N]
             )));
         }
         *dydt = State::default();
-        for i in 0..HELD_N {
+        for i in 0..N {
             dydt.coords[i] = y.rates[i];
             dydt.rates[i] = step.x_ddot[i];
         }
@@ -166,9 +190,9 @@ impl Device {
     /// # Errors
     /// The first failing state's index and error.
     #[allow(clippy::needless_range_loop)] // coordinates index the state and the lanes alike
-    pub(super) fn free_deviation_batch(
+    pub(super) fn free_deviation_batch<const N: usize>(
         &self,
-        (held, lean): (&HeldConstants, &FreeDeviation),
+        (held, lean): (&Held<N>, &FreeDeviation),
         t: f64,
         branches: [Branch; 2],
         ys: &[State],
@@ -181,9 +205,9 @@ impl Device {
         for start in (0..ys.len()).step_by(4) {
             let count = (ys.len() - start).min(4);
             let lane = |l: usize| &ys[start + l.min(count - 1)];
-            let x: [f64x4; HELD_N] =
+            let x: [f64x4; N] =
                 std::array::from_fn(|i| f64x4::new(std::array::from_fn(|l| lane(l).coords[i])));
-            let x_dot: [f64x4; HELD_N] =
+            let x_dot: [f64x4; N] =
                 std::array::from_fn(|i| f64x4::new(std::array::from_fn(|l| lane(l).rates[i])));
             let step = generic::step(&held.splat, &held.aero, drive, (&x, &x_dot), &on);
             let scalar = f64x4::bits(step.general | step.singular);
@@ -198,7 +222,7 @@ impl Device {
                     continue;
                 }
                 let mut d = State::default();
-                for i in 0..HELD_N {
+                for i in 0..N {
                     d.coords[i] = ys[k].rates[i];
                     d.rates[i] = x_ddot[i][l];
                 }

@@ -2,6 +2,7 @@
 
 use paritysim_error::Result;
 
+use super::free_deviation::HeldConstants;
 use super::linear_map_jacobian::{self, LinearMapTerms};
 use super::switches::branches;
 use super::{Device, stroke_plane};
@@ -58,12 +59,15 @@ impl crate::integrate::OdeSystem for Device {
         ys: &[State],
         out: &mut [State],
     ) -> Option<std::result::Result<(), (usize, paritysim_error::Error)>> {
-        let held = self.free_deviation_held.as_ref()?;
         let lean = self.free_deviation_rhs.as_ref()?;
         if self.n_switches == 0 || ys.len() < 2 {
             return None;
         }
-        Some(self.free_deviation_batch((held, lean), t, branches(sides), ys, out))
+        let b = branches(sides);
+        Some(match self.free_deviation_held.as_ref()? {
+            HeldConstants::Four(held) => self.free_deviation_batch((held, lean), t, b, ys, out),
+            HeldConstants::Five(held) => self.free_deviation_batch((held, lean), t, b, ys, out),
+        })
     }
 
     fn variational(

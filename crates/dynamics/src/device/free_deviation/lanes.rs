@@ -10,7 +10,7 @@ use paritysim_aero::{Branch, HeldBranch};
 use paritysim_simd::{Real, f64x4};
 
 use super::generic::{self, Constants};
-use super::{HELD_N, HeldConstants};
+use super::{HELD_N, Held, HeldConstants};
 use crate::device::Device;
 use crate::integrate::State;
 
@@ -34,15 +34,18 @@ impl<'a> FreeDeviationLanes<'a> {
     /// Whether `device` can take a lane: the lean free-deviation model on [`HELD_N`]
     /// coordinates with blade elements on both wings.
     pub(crate) fn supports(device: &Device) -> bool {
-        device.free_deviation_held.is_some()
+        matches!(device.free_deviation_held, Some(HeldConstants::Four(_)))
     }
 
     /// The lanes of `devices`, or `None` unless every one [`Self::supports`] lanes.
     pub(crate) fn new(devices: [&'a Device; LANES]) -> Option<Self> {
-        let held: [&HeldConstants; LANES] = {
+        let held: [&Held<HELD_N>; LANES] = {
             let mut out = [None; LANES];
             for (l, d) in devices.iter().enumerate() {
-                out[l] = Some(d.free_deviation_held.as_ref()?);
+                match &d.free_deviation_held {
+                    Some(HeldConstants::Four(held)) => out[l] = Some(&**held),
+                    _ => return None,
+                }
             }
             out.map(|h| h.expect("every lane checked above"))
         };

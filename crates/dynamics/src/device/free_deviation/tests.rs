@@ -189,52 +189,18 @@ fn a_lift_point_next_to_a_flip_converges_by_shooting() {
 #[allow(clippy::needless_range_loop)] // lanes and entries index several arrays
 fn held_branch_lanes_equal_the_scalar_right_hand_side_bit_for_bit() {
     use paritysim_simd::f64x4;
+    // The Dual PARITY (five coordinates) in batches.
+    let dual = device("dual_parity");
+    assert_batches_are_scalar_bit_for_bit(&dual, &states(&dual));
     let d = device("lift_parity");
-    let lean = d.free_deviation_rhs.expect("a free-deviation device");
     let mut ys = states(&d);
     // Beyond the linkage's plausible range: the general path (and its error) in a lane.
     let mut far = ys[0];
     far.coords[0] = 50.0;
     ys.insert(3, far);
-    let bits = |s: &State| {
-        let mut v: Vec<u64> = s
-            .coords
-            .iter()
-            .chain(&s.rates)
-            .map(|x| x.to_bits())
-            .collect();
-        v.extend([s.work_actuator.to_bits(), s.work_aero.to_bits()]);
-        v
-    };
+    assert_batches_are_scalar_bit_for_bit(&d, &ys);
     for flip in [None, Some(1), Some(4)] {
-        let t = 0.61;
-        let mut g = [0.0; MAX_SWITCHES];
-        d.switches(t, &ys[1], &mut g).unwrap();
-        let own = Sides::of(&g[..6]);
-        let sides = flip.map_or(own, |i| own.with(i, !own.positive(i)));
-        // A batch of one device's states.
-        let mut out = vec![State::default(); ys.len()];
-        let batch = d
-            .rhs_on_batch(t, sides, &ys, &mut out)
-            .expect("a batch form");
-        let mut first_error = None;
-        for (k, y) in ys.iter().enumerate() {
-            let mut one = State::default();
-            match d.rhs_free_deviation(&lean, t, y, Some(branches(sides)), &mut one) {
-                Ok(()) if first_error.is_none() => {
-                    assert_eq!(bits(&out[k]), bits(&one), "state {k}")
-                }
-                Ok(()) => {}
-                Err(_) => {
-                    first_error.get_or_insert(k);
-                }
-            }
-        }
-        assert_eq!(
-            batch.err().map(|(k, _)| k),
-            first_error,
-            "the first failing state"
-        );
+        let sides = flipped_sides(&d, &ys[1], flip);
         // Four devices' lanes (deviation springs apart), the implausible state left out.
         let devices: Vec<Device> = (0..4)
             .map(|l| lift_variant(8.0 + l as f64, 85.0, 85.0))
@@ -289,5 +255,55 @@ fn held_branch_lanes_equal_the_scalar_right_hand_side_bit_for_bit() {
         }
         eprintln!("sides {flip:?}: {vector_lanes} vector lanes, {scalar_lanes} scalar");
         assert!(vector_lanes >= 12, "{vector_lanes} vector lanes");
+    }
+}
+
+/// The sides of the switching functions at `y`, with switch `flip` flipped when given.
+fn flipped_sides(d: &Device, y: &State, flip: Option<usize>) -> Sides {
+    let mut g = [0.0; MAX_SWITCHES];
+    d.switches(0.61, y, &mut g).unwrap();
+    let own = Sides::of(&g[..6]);
+    flip.map_or(own, |i| own.with(i, !own.positive(i)))
+}
+
+/// `rhs_on_batch` of `ys` equals the scalar held-branch right-hand side state by state (every
+/// entry's bits), on own and flipped sides, and fails at the scalar path's first failing state.
+fn assert_batches_are_scalar_bit_for_bit(d: &Device, ys: &[State]) {
+    let bits = |s: &State| {
+        let mut v: Vec<u64> = s
+            .coords
+            .iter()
+            .chain(&s.rates)
+            .map(|x| x.to_bits())
+            .collect();
+        v.extend([s.work_actuator.to_bits(), s.work_aero.to_bits()]);
+        v
+    };
+    let lean = d.free_deviation_rhs.expect("a free-deviation device");
+    let t = 0.61;
+    for flip in [None, Some(1), Some(4)] {
+        let sides = flipped_sides(d, &ys[1], flip);
+        let mut out = vec![State::default(); ys.len()];
+        let batch = d
+            .rhs_on_batch(t, sides, ys, &mut out)
+            .expect("a batch form");
+        let mut first_error = None;
+        for (k, y) in ys.iter().enumerate() {
+            let mut one = State::default();
+            match d.rhs_free_deviation(&lean, t, y, Some(branches(sides)), &mut one) {
+                Ok(()) if first_error.is_none() => {
+                    assert_eq!(bits(&out[k]), bits(&one), "state {k}")
+                }
+                Ok(()) => {}
+                Err(_) => {
+                    first_error.get_or_insert(k);
+                }
+            }
+        }
+        assert_eq!(
+            batch.err().map(|(k, _)| k),
+            first_error,
+            "the first failing state"
+        );
     }
 }
