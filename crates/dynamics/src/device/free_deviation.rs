@@ -24,11 +24,6 @@ pub(crate) mod lanes;
 #[cfg(test)]
 mod tests;
 
-/// Integrated coordinates of the free-deviation devices whose sweep lanes run
-/// [`generic::step`] (the §2.5 Lift PARITY has four; the Dual PARITY's five run it in the
-/// scalar path and its batches).
-pub(crate) const HELD_N: usize = 4;
-
 /// The constants of [`generic::step`] on `N` coordinates: the device's own, the same in every
 /// lane (batches of one device's states) and its wings' blade elements.
 #[derive(Clone, Copy, Debug)]

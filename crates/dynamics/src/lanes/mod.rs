@@ -12,11 +12,12 @@
 //!
 //! * **Which points.** A shooting point qualifies when it records one plain cycle, uses DOP853
 //!   and its device has a lane model ([`has_lane_model`]): drivetrain coordinates of the linear
-//!   differential map with stroke drag (stroke metrics only; `point`), or the §3.4 stroke-plane
-//!   model with blade elements on a single drive (continued points, metrics without work
-//!   integrals; `plane_point`). Every other point runs the scalar path in place, in its
-//!   chain's order.
-//! * **Switches.** The stroke-plane lanes hold the branch of their blade elements' switching
+//!   differential map with stroke drag (stroke metrics only; `point`), or a switched device
+//!   with blade elements on both wings: the §3.4 stroke-plane model on a single drive, the §2.5
+//!   free-deviation models (Lift PARITY, four coordinates; Dual PARITY, five, in a twelve-entry
+//!   layout), continued points reading metrics without work integrals (`plane_point`). Every
+//!   other point runs the scalar path in place, in its chain's order.
+//! * **Switches.** The switched lanes hold the branch of their blade elements' switching
 //!   functions and replay a step that crosses one on the scalar path (`plane_rhs`), so their
 //!   periods stay the scalar ones bit for bit.
 //! * **Same results.** The lanes perform the scalar path's floating-point operations in its
@@ -82,8 +83,9 @@ pub fn resolve_lanes(requested: Option<usize>) -> Result<usize> {
 
 /// Whether `device` has a SIMD-lane model: its continued shooting points then run in lanes
 /// when the sweep's other conditions hold (see the module). Today: drivetrain coordinates of
-/// the two-DOF linear differential map (eq. 2.15) with stroke drag or no aerodynamics, and
-/// the §3.4 stroke-plane devices (blade elements on both wings, a single drive).
+/// the two-DOF linear differential map (eq. 2.15) with stroke drag or no aerodynamics, the
+/// §3.4 stroke-plane devices (blade elements on both wings, a single drive) and the §2.5
+/// free-deviation devices (Lift and Dual PARITY with blade elements).
 pub fn has_lane_model(device: &Device) -> bool {
     LinearStroke::of(device).is_some() || plane_rhs::supports(device)
 }

@@ -13,8 +13,7 @@ use std::rc::Rc;
 use nalgebra::{DMatrix, DVector};
 use paritysim_error::Result;
 
-use super::plane_rhs::{self, M};
-use super::point::Next;
+use super::plane_rhs;
 use super::{COMPLETED_IN_LANES, SWITCHED_COMPLETED_IN_LANES};
 use crate::device::Device;
 use crate::grid_shooting::{GRID_TOLERANCE_FACTOR, REPICK_RESIDUAL, least_squares_step};
@@ -32,8 +31,15 @@ use crate::trajectory::{PlaneSample, Sample, Trajectory};
 /// Newton steps of the shooting (as `simulate` gives `grid_shooting::shoot`).
 const MAX_NEWTON: usize = 20;
 
-/// Integrated coordinates.
-const N: usize = M / 2;
+/// What a lane point does next.
+pub(super) enum PlaneStep<const M: usize> {
+    /// Integrate this period in its lane.
+    Integrate(LaneProblem<M>),
+    /// Converged: the point's output.
+    Done(Box<PointOutput>),
+    /// Leave the straight path: rerun the point on the scalar path.
+    Scalar,
+}
 
 /// The period a point waits for.
 enum Pending {
@@ -52,9 +58,12 @@ enum Pending {
     },
 }
 
-/// One continued stroke-plane point (see the module).
-pub(super) struct PlanePoint<'a> {
+/// One continued point of a switched device (see the module), its lanes' compact states of `M`
+/// entries.
+pub(super) struct PlanePoint<'a, const M: usize> {
     pub(super) device: &'a Device,
+    /// Integrated coordinates (Newton's unknowns are `2n`).
+    n: usize,
     metric_names: &'a [String],
     samples_per_cycle: usize,
     needs: StrokeNeeds,
@@ -87,15 +96,15 @@ pub(super) struct PlanePoint<'a> {
     pub(super) deadline: Option<(std::time::Instant, f64)>,
 }
 
-/// `(P(y) − y, ‖P(y) − y‖∞ / (1 + ‖y‖∞))` (as `grid_shooting`).
-fn residual(y: &State, py: &State) -> (DVector<f64>, f64) {
-    let (yv, pv) = (y.compact(N), py.compact(N));
+/// `(P(y) − y, ‖P(y) − y‖∞ / (1 + ‖y‖∞))` on `n` coordinates (as `grid_shooting`).
+fn residual(n: usize, y: &State, py: &State) -> (DVector<f64>, f64) {
+    let (yv, pv) = (y.compact(n), py.compact(n));
     let f = pv - &yv;
     let r = f.amax() / (1.0 + yv.amax());
     (f, r)
 }
 
-impl<'a> PlanePoint<'a> {
+impl<'a, const M: usize> PlanePoint<'a, M> {
     /// The point and its first lane period, or `None` when it does not qualify: a continued
     /// shooting point of a device with stroke-plane lanes, reading metrics that need no work
     /// integral, one plain recorded cycle, DOP853.
@@ -104,10 +113,11 @@ impl<'a> PlanePoint<'a> {
         options: &SimulationOptions,
         metric_names: &'a [String],
         times_cache: &mut Option<(f64, usize, Rc<[f64]>)>,
-    ) -> Option<(Self, Next)> {
-        if !plane_rhs::supports(device) {
+    ) -> Option<(Self, PlaneStep<M>)> {
+        if plane_rhs::layout(device) != Some(M) {
             return None;
         }
+        let n = device.n_dof();
         let period = device.period()?;
         let needs = StrokeNeeds::of(Some(metric_names));
         let plain = options.steady_state == SteadyState::Shooting
@@ -120,7 +130,7 @@ impl<'a> PlanePoint<'a> {
         }
         let (p0, pd0) = options.initial?;
         let jac = options.shooting_jacobian.clone()?;
-        if jac.shape() != (M, M)
+        if jac.shape() != (2 * n, 2 * n)
             || options.samples_per_cycle > crate::simulate::MAX_RECORDED_SAMPLES
         {
             return None;
@@ -147,6 +157,7 @@ impl<'a> PlanePoint<'a> {
         let chooser = GRID_TOLERANCE_FACTOR.clamp(f64::MIN_POSITIVE, 1.0);
         let mut point = Self {
             device,
+            n,
             metric_names,
             samples_per_cycle: n_samples,
             needs,
@@ -169,9 +180,9 @@ impl<'a> PlanePoint<'a> {
             jac,
             fresh: false,
             repick: false,
-            eye: DMatrix::identity(M, M),
+            eye: DMatrix::identity(2 * n, 2 * n),
             y,
-            f: DVector::zeros(M),
+            f: DVector::zeros(2 * n),
             res: f64::NAN,
             last_step: None,
             iterations: 0,
@@ -190,8 +201,8 @@ impl<'a> PlanePoint<'a> {
 
     /// One adaptive period from `y` at the grid tolerances that picks a grid
     /// (`chooser.advance_with_steps`, in the lane).
-    fn adaptive_grid_period(&self, y: &State) -> Next {
-        Next::Plane(LaneProblem {
+    fn adaptive_grid_period(&self, y: &State) -> PlaneStep<M> {
+        PlaneStep::Integrate(LaneProblem {
             grid: Rc::from([0.0, self.period]),
             adaptive: Some(self.max_steps),
             y0: plane_rhs::compact(y),
@@ -232,15 +243,15 @@ impl<'a> PlanePoint<'a> {
 
     /// The next Newton trial from the current iterate (the head of `shoot`'s loop), or the
     /// grid picked again first.
-    fn iterate(&mut self) -> Next {
+    fn iterate(&mut self) -> PlaneStep<M> {
         if self.iterations >= MAX_NEWTON {
-            return Next::Scalar;
+            return PlaneStep::Scalar;
         }
         self.iterations += 1;
         let Some(delta) = least_squares_step(&self.jac - &self.eye, &self.f) else {
-            return Next::Scalar;
+            return PlaneStep::Scalar;
         };
-        let scale = 1.0 + self.y.compact(N).amax();
+        let scale = 1.0 + self.y.compact(self.n).amax();
         let step = delta.amax() / scale;
         // The next iterate's error: the step times the contraction seen so far (Newton's
         // quadratic model after a fresh Jacobian; unknown, so 1, after a neighbour's).
@@ -250,7 +261,7 @@ impl<'a> PlanePoint<'a> {
             None => 1.0,
         }
         .min(1.0);
-        let y_new = State::from_compact(N, &(self.y.compact(N) + &delta));
+        let y_new = State::from_compact(self.n, &(self.y.compact(self.n) + &delta));
         let last = contraction * step <= self.tol || step <= 1e-3 * self.tol;
         if last && self.repick {
             // Converged on a grid picked far from the orbit: the grid again, from here.
@@ -280,7 +291,7 @@ impl<'a> PlanePoint<'a> {
             step,
             last,
         });
-        Next::Plane(problem)
+        PlaneStep::Integrate(problem)
     }
 
     /// Feeds recorded samples to the metrics in order, as the scalar window's sink does
@@ -304,17 +315,17 @@ impl<'a> PlanePoint<'a> {
     }
 
     /// Continues after the lane's period ended with `outcome` (the rest of `shoot`'s loop).
-    pub(super) fn resume(&mut self, outcome: LaneOutcome<M>) -> Next {
+    pub(super) fn resume(&mut self, outcome: LaneOutcome<M>) -> PlaneStep<M> {
         let (Some(pending), LaneOutcome::Done { y, steps, .. }) = (self.pending.take(), outcome)
         else {
-            return Next::Scalar;
+            return PlaneStep::Scalar;
         };
         let (y_new, delta, step, last) = match pending {
             Pending::Pick => {
                 self.grid = steps.into();
                 self.forcing = None;
                 self.periods = 1;
-                (self.f, self.res) = residual(&self.y, &plane_rhs::expand(&y));
+                (self.f, self.res) = residual(self.n, &self.y, &plane_rhs::expand(&y));
                 self.repick = self.res > REPICK_RESIDUAL;
                 return self.iterate();
             }
@@ -322,7 +333,7 @@ impl<'a> PlanePoint<'a> {
                 self.grid = steps.into();
                 self.forcing = None;
                 self.periods += 1;
-                (self.f, self.res) = residual(&y_new, &plane_rhs::expand(&y));
+                (self.f, self.res) = residual(self.n, &y_new, &plane_rhs::expand(&y));
                 self.y = y_new;
                 return self.iterate();
             }
@@ -334,12 +345,12 @@ impl<'a> PlanePoint<'a> {
             } => (y_new, delta, step, last),
         };
         self.periods += 1;
-        let (f_new, res_new) = residual(&y_new, &plane_rhs::expand(&y));
+        let (f_new, res_new) = residual(self.n, &y_new, &plane_rhs::expand(&y));
         let tol = self.tol;
         if last && res_new > tol && res_new <= self.accept_tol && !self.fresh {
             // Re-linearise at the candidate, then decide with the exact Jacobian.
             let Ok(jac) = self.exact_jacobian(&y_new) else {
-                return Next::Scalar;
+                return PlaneStep::Scalar;
             };
             self.jac = jac;
             self.periods += 1;
@@ -351,18 +362,18 @@ impl<'a> PlanePoint<'a> {
         let neutral = || {
             res_new <= self.accept_tol
                 && least_squares_step(&self.jac - &self.eye, &f_new)
-                    .is_some_and(|d| d.amax() / (1.0 + y_new.compact(N).amax()) <= tol)
+                    .is_some_and(|d| d.amax() / (1.0 + y_new.compact(self.n).amax()) <= tol)
         };
         if last && (res_new <= tol || neutral()) {
             return self.done(y_new, res_new);
         }
         if res_new >= self.res || res_new.is_nan() {
             if self.fresh {
-                return Next::Scalar;
+                return PlaneStep::Scalar;
             }
             // A stale Jacobian that no longer descends: the exact one at the iterate.
             let Ok(jac) = self.exact_jacobian(&self.y.clone()) else {
-                return Next::Scalar;
+                return PlaneStep::Scalar;
             };
             self.jac = jac;
             self.periods += 1;
@@ -385,14 +396,14 @@ impl<'a> PlanePoint<'a> {
     /// The converged point as `simulate` and `run_point` report it, after the stability
     /// verdict of `shooting_steady_state` (a marginal one from a Broyden-updated Jacobian
     /// checked with the variational equations at the orbit).
-    fn done(&mut self, state: State, residual: f64) -> Next {
+    fn done(&mut self, state: State, residual: f64) -> PlaneStep<M> {
         let mut multipliers = crate::floquet::eigenvalues(&self.jac).unwrap_or_default();
         let largest = multipliers.first().map_or(0.0, |m| m.norm());
         if largest > 1.0 + UNSTABLE_MARGIN && largest < BROYDEN_VERDICT_CHECKED_BELOW {
             match self.exact_jacobian(&state) {
                 Ok(jac) => self.jac = jac,
                 // A spent budget or a cancel: the scalar run reports it.
-                Err(e) if crate::grid_shooting::out_of_budget(&e) => return Next::Scalar,
+                Err(e) if crate::grid_shooting::out_of_budget(&e) => return PlaneStep::Scalar,
                 Err(_) => {}
             }
             multipliers = crate::floquet::eigenvalues(&self.jac).unwrap_or_default();
@@ -401,7 +412,7 @@ impl<'a> PlanePoint<'a> {
             .first()
             .is_some_and(|m| m.norm() > 1.0 + UNSTABLE_MARGIN)
         {
-            return Next::Scalar;
+            return PlaneStep::Scalar;
         }
         let steady_state = state.without_work();
         let result = SimulationResult {
@@ -420,7 +431,7 @@ impl<'a> PlanePoint<'a> {
         let coordinates = self.device.coordinates(&steady_state).ok();
         COMPLETED_IN_LANES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         SWITCHED_COMPLETED_IN_LANES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        Next::Done(Box::new(PointOutput::keep(
+        PlaneStep::Done(Box::new(PointOutput::keep(
             result,
             self.metric_names,
             false,

@@ -26,8 +26,13 @@ use crate::integrate::{
 
 type V = f64x4;
 
-/// Compact entries of a stroke-plane state: `x` (4) then `ẋ` (4).
+/// Compact entries of a four-coordinate state (the §3.4 stroke plane, the §2.5 Lift PARITY):
+/// `x` (4) then `ẋ` (4), as the scalar integrator holds them.
 pub(crate) const M: usize = model::M;
+
+/// Compact entries of a five-coordinate state (the §2.5 Dual PARITY): the scalar integrator
+/// holds six coordinates and six rates, the sixth of each zero.
+pub(crate) const M12: usize = 12;
 
 /// The branch a lane holds and its switching functions at its step's start.
 #[derive(Clone, Copy, Debug, Default)]
@@ -36,24 +41,89 @@ struct Held {
     g: [f64; MAX_SWITCHES],
 }
 
-/// Whether `device` has a switched lane model: the stroke-plane one or the free-deviation one.
+/// The compact size of `device`'s lanes when it has a switched lane model: [`M`] (the
+/// stroke-plane and the four-coordinate free-deviation ones) or [`M12`] (five coordinates).
+pub(crate) fn layout(device: &Device) -> Option<usize> {
+    if StrokePlaneLanes::supports(device) || FreeDeviationLanes::<4, M>::supports(device) {
+        Some(M)
+    } else if FreeDeviationLanes::<5, M12>::supports(device) {
+        Some(M12)
+    } else {
+        None
+    }
+}
+
+/// Whether `device` has a switched lane model.
 pub(crate) fn supports(device: &Device) -> bool {
-    StrokePlaneLanes::supports(device) || FreeDeviationLanes::supports(device)
+    layout(device).is_some()
 }
 
-/// The lanes' right-hand side.
-enum LaneModel<'a> {
-    StrokePlane(Box<StrokePlaneLanes<'a>>),
-    FreeDeviation(Box<FreeDeviationLanes<'a>>),
-    /// Lanes of different kinds: each evaluated on the scalar path.
-    Mixed,
+/// A right-hand side of four devices' compact states of `M` entries on held branches.
+pub(crate) trait SwitchedLanes<const M: usize> {
+    /// `f(t, y)` of every lane with the drive forces `forces[l]` at `t[l]` on `branches[l]`;
+    /// the bit mask of lanes whose scalar right-hand side fails.
+    fn eval(
+        &self,
+        t: [f64; LANES],
+        forces: [[f64; 2]; LANES],
+        y: &[V; M],
+        branches: [[paritysim_aero::Branch; 2]; LANES],
+        dydt: &mut [V; M],
+    ) -> u32;
 }
 
-/// [`LANES`] switched devices side by side.
-pub(crate) struct PlaneLanes<'a> {
+impl SwitchedLanes<M> for StrokePlaneLanes<'_> {
+    fn eval(
+        &self,
+        t: [f64; LANES],
+        forces: [[f64; 2]; LANES],
+        y: &[V; M],
+        branches: [[paritysim_aero::Branch; 2]; LANES],
+        dydt: &mut [V; M],
+    ) -> u32 {
+        StrokePlaneLanes::eval(self, t, forces.map(|f| f[0]), y, branches, dydt).failed
+    }
+}
+
+impl<const N: usize, const M: usize> SwitchedLanes<M> for FreeDeviationLanes<'_, N, M> {
+    fn eval(
+        &self,
+        t: [f64; LANES],
+        forces: [[f64; 2]; LANES],
+        y: &[V; M],
+        branches: [[paritysim_aero::Branch; 2]; LANES],
+        dydt: &mut [V; M],
+    ) -> u32 {
+        FreeDeviationLanes::eval(self, t, forces, y, branches, dydt).1
+    }
+}
+
+/// The lanes' right-hand side of four devices, or `None` for lanes of different kinds (each
+/// then evaluated on the scalar path).
+pub(crate) type Builder<'a, const M: usize> =
+    fn([&'a Device; LANES]) -> Option<Box<dyn SwitchedLanes<M> + 'a>>;
+
+/// [`Builder`] of the four-coordinate devices.
+pub(crate) fn build<'a>(devices: [&'a Device; LANES]) -> Option<Box<dyn SwitchedLanes<M> + 'a>> {
+    if let Some(lanes) = StrokePlaneLanes::new(devices) {
+        return Some(Box::new(lanes));
+    }
+    FreeDeviationLanes::<4, M>::new(devices).map(|l| Box::new(l) as Box<dyn SwitchedLanes<M>>)
+}
+
+/// [`Builder`] of the five-coordinate devices.
+pub(crate) fn build12<'a>(
+    devices: [&'a Device; LANES],
+) -> Option<Box<dyn SwitchedLanes<M12> + 'a>> {
+    FreeDeviationLanes::<5, M12>::new(devices).map(|l| Box::new(l) as Box<dyn SwitchedLanes<M12>>)
+}
+
+/// [`LANES`] switched devices side by side, on compact states of `M` entries.
+pub(crate) struct PlaneLanes<'a, const M: usize> {
     devices: [Option<&'a Device>; LANES],
-    /// The lanes' constants, rebuilt when a lane takes another device.
-    model: LaneModel<'a>,
+    build: Builder<'a, M>,
+    /// The lanes' constants, rebuilt when a lane takes another device (`None`: mixed kinds).
+    model: Option<Box<dyn SwitchedLanes<M> + 'a>>,
     /// Each lane's drive forces at the [`stage_times`] of its grid.
     forcing: [Option<Rc<[[f64; 2]]>>; LANES],
     held: RefCell<[Held; LANES]>,
@@ -69,7 +139,7 @@ pub(crate) fn forcing(device: &Device, grid: &[f64]) -> Rc<[[f64; 2]]> {
 }
 
 /// The state of a compact one (work integrals zero, as the shooting's states).
-pub(crate) fn expand(c: &[f64; M]) -> State {
+pub(crate) fn expand<const M: usize>(c: &[f64; M]) -> State {
     let mut y = State::default();
     y.coords[..M / 2].copy_from_slice(&c[..M / 2]);
     y.rates[..M / 2].copy_from_slice(&c[M / 2..]);
@@ -77,7 +147,7 @@ pub(crate) fn expand(c: &[f64; M]) -> State {
 }
 
 /// The compact state of `y`.
-pub(crate) fn compact(y: &State) -> [f64; M] {
+pub(crate) fn compact<const M: usize>(y: &State) -> [f64; M] {
     std::array::from_fn(|i| {
         if i < M / 2 {
             y.coords[i]
@@ -87,18 +157,19 @@ pub(crate) fn compact(y: &State) -> [f64; M] {
     })
 }
 
-impl<'a> PlaneLanes<'a> {
-    /// No lane loaded.
-    pub(crate) fn new() -> Self {
+impl<'a, const M: usize> PlaneLanes<'a, M> {
+    /// No lane loaded; `build` makes the lanes' right-hand side.
+    pub(crate) fn new(build: Builder<'a, M>) -> Self {
         Self {
             devices: [None; LANES],
-            model: LaneModel::Mixed,
+            build,
+            model: None,
             forcing: std::array::from_fn(|_| None),
             held: RefCell::new([Held::default(); LANES]),
         }
     }
 
-    /// Puts `device` (one [`StrokePlaneLanes::supports`]) into lane `l`.
+    /// Puts `device` (one of [`layout`] `M`) into lane `l`.
     pub(crate) fn load(&mut self, l: usize, device: &'a Device) {
         if self.devices[l].is_some_and(|d| std::ptr::eq(d, device)) {
             return;
@@ -106,13 +177,7 @@ impl<'a> PlaneLanes<'a> {
         self.devices[l] = Some(device);
         // Idle lanes compute with a loaded device's constants (their results are not read).
         let devices = self.devices.map(|d| d.unwrap_or(device));
-        self.model = if let Some(lanes) = StrokePlaneLanes::new(devices) {
-            LaneModel::StrokePlane(Box::new(lanes))
-        } else if let Some(lanes) = FreeDeviationLanes::new(devices) {
-            LaneModel::FreeDeviation(Box::new(lanes))
-        } else {
-            LaneModel::Mixed
-        };
+        self.model = (self.build)(devices);
     }
 
     /// The drive table lane `l` reads from its next problem on.
@@ -131,7 +196,7 @@ impl<'a> PlaneLanes<'a> {
     }
 }
 
-impl LaneRhs<M> for PlaneLanes<'_> {
+impl<const M: usize> LaneRhs<M> for PlaneLanes<'_, M> {
     fn eval(&self, t: [f64; LANES], stage: [usize; LANES], y: &[V; M], dydt: &mut [V; M]) -> u32 {
         let forces: [[f64; 2]; LANES] =
             std::array::from_fn(|l| match (&self.forcing[l], stage[l]) {
@@ -141,13 +206,8 @@ impl LaneRhs<M> for PlaneLanes<'_> {
         let held = self.held.borrow();
         let branches = std::array::from_fn(|l| crate::device::blade_branches(held[l].sides));
         match &self.model {
-            LaneModel::StrokePlane(model) => {
-                model
-                    .eval(t, forces.map(|f| f[0]), y, branches, dydt)
-                    .failed
-            }
-            LaneModel::FreeDeviation(model) => model.eval(t, forces, y, branches, dydt).1,
-            LaneModel::Mixed => {
+            Some(model) => model.eval(t, forces, y, branches, dydt),
+            None => {
                 let mut failed = 0;
                 for l in 0..LANES {
                     match self.scalar_lane(l, t[l], y, held[l].sides) {

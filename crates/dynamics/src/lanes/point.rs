@@ -53,8 +53,6 @@ pub(super) enum Next {
     Integrate(LaneProblem<4>),
     /// Integrate this period with the variational equations in its lane.
     Sensitivity(LaneProblem<20>),
-    /// Integrate this stroke-plane period in its lane (`plane_point`).
-    Plane(LaneProblem<{ super::plane_rhs::M }>),
     /// Converged: the point's output.
     Done(Box<PointOutput>),
     /// Leave the straight path: rerun the point on the scalar path.

@@ -9,8 +9,8 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use paritysim_error::Result;
 
 use super::linear_stroke::{LinearStrokeLanes, VariationalLanes};
-use super::plane_point::PlanePoint;
-use super::plane_rhs::{self, PlaneLanes};
+use super::plane_point::{PlanePoint, PlaneStep};
+use super::plane_rhs::{self, M, M12, PlaneLanes};
 use super::point::{LanePoint, Next};
 use crate::device::Device;
 use crate::integrate::lanes::{LaneOutcome, LaneStepper, SampleBlock};
@@ -60,26 +60,27 @@ struct Cursor<'a> {
     point: Option<(usize, ChainStart, Task<'a>)>,
 }
 
-/// A point in a lane: a drivetrain-coordinate one or a stroke-plane one.
+/// A point in a lane: a drivetrain-coordinate one, or a switched device's on four
+/// coordinates (`M` compact entries) or five (`M12`).
 enum Task<'a> {
     Linear(LanePoint<'a>),
-    Plane(PlanePoint<'a>),
+    Plane(PlanePoint<'a, M>),
+    Plane12(PlanePoint<'a, M12>),
 }
 
-impl Task<'_> {
-    fn deadline(&self) -> Option<(std::time::Instant, f64)> {
-        match self {
-            Task::Linear(p) => p.deadline,
-            Task::Plane(p) => p.deadline,
-        }
-    }
+/// What a point does next, of its kind.
+enum Step {
+    Linear(Next),
+    Plane(PlaneStep<M>),
+    Plane12(PlaneStep<M12>),
 }
 
 /// How a lane's period ended, by stepper.
 enum Ended {
     State(LaneOutcome<4>),
     Variational(LaneOutcome<20>),
-    Plane(LaneOutcome<{ plane_rhs::M }>),
+    Plane(LaneOutcome<M>),
+    Plane12(LaneOutcome<M12>),
 }
 
 type ChainResults = Vec<Option<Result<Vec<Result<PointOutput>>>>>;
@@ -164,34 +165,84 @@ pub(crate) fn run_chains(
 }
 
 /// The worker's lane steppers (the drivetrain state, with its variational equations, and
-/// the stroke-plane state).
+/// the switched devices' states).
 struct Steppers {
     state: LaneStepper<4>,
     variational: LaneStepper<20>,
-    plane: LaneStepper<{ plane_rhs::M }, { plane_rhs::M }>,
+    plane: LaneStepper<M, M>,
+    plane12: LaneStepper<M12, M12>,
     /// Lanes started since each stepper's last run.
-    fresh: [u32; 3],
+    fresh: [u32; 4],
 }
 
 /// The right-hand sides of a worker's lanes.
 struct Models<'a> {
     linear: LinearStrokeLanes<'a>,
-    plane: PlaneLanes<'a>,
+    plane: PlaneLanes<'a, M>,
+    plane12: PlaneLanes<'a, M12>,
+}
+
+/// Starts a switched point's `step` in lane `l` (see [`launch`]).
+fn launch_plane<'a, const M: usize>(
+    l: usize,
+    step: PlaneStep<M>,
+    point: &mut PlanePoint<'a, M>,
+    (stepper, fresh): (&mut LaneStepper<M, M>, &mut u32),
+    lanes: &mut PlaneLanes<'a, M>,
+) -> Option<Option<PointOutput>> {
+    match step {
+        PlaneStep::Integrate(problem) => {
+            lanes.load(l, point.device);
+            if problem.adaptive.is_none() {
+                lanes.load_forcing(l, point.forcing());
+            }
+            stepper.set_deadline(l, point.deadline);
+            let mut sink = |_: usize, block: &SampleBlock<M>| point.sample(block);
+            if stepper.start(l, problem, &mut sink) {
+                *fresh |= 1 << l;
+                None
+            } else {
+                Some(None)
+            }
+        }
+        PlaneStep::Done(output) => Some(Some(*output)),
+        PlaneStep::Scalar => Some(None),
+    }
 }
 
 /// Starts `next` of `task` in lane `l`: `None` while it is in flight, else the point is
 /// complete (`Some(Some(output))` from the lanes, `Some(None)`: run it on the scalar path).
 fn launch<'a>(
     l: usize,
-    next: Next,
+    next: Step,
     task: &mut Task<'a>,
     steppers: &mut Steppers,
     models: &mut Models<'a>,
     forcing_cache: &mut ForcingCache,
 ) -> Option<Option<PointOutput>> {
-    let deadline = task.deadline();
-    match (next, task) {
-        (Next::Integrate(problem), Task::Linear(point)) => {
+    let (next, point) = match (next, task) {
+        (Step::Linear(next), Task::Linear(point)) => (next, point),
+        (Step::Plane(step), Task::Plane(point)) => {
+            let fresh = &mut steppers.fresh[2];
+            return launch_plane(
+                l,
+                step,
+                point,
+                (&mut steppers.plane, fresh),
+                &mut models.plane,
+            );
+        }
+        (Step::Plane12(step), Task::Plane12(point)) => {
+            let fresh = &mut steppers.fresh[3];
+            let stepper = &mut steppers.plane12;
+            return launch_plane(l, step, point, (stepper, fresh), &mut models.plane12);
+        }
+        // A period of another kind than the point's (not handed out).
+        _ => return Some(None),
+    };
+    let deadline = point.deadline;
+    match next {
+        Next::Integrate(problem) => {
             // A lane reads only its own point's table (adaptive periods evaluate the drive).
             let table = problem
                 .adaptive
@@ -207,7 +258,7 @@ fn launch<'a>(
                 Some(None)
             }
         }
-        (Next::Sensitivity(problem), Task::Linear(point)) => {
+        Next::Sensitivity(problem) => {
             let table = problem
                 .adaptive
                 .is_none()
@@ -224,23 +275,8 @@ fn launch<'a>(
                 Some(None)
             }
         }
-        (Next::Plane(problem), Task::Plane(point)) => {
-            models.plane.load(l, point.device);
-            if problem.adaptive.is_none() {
-                models.plane.load_forcing(l, point.forcing());
-            }
-            steppers.plane.set_deadline(l, deadline);
-            let mut sink = |_: usize, block: &SampleBlock<{ plane_rhs::M }>| point.sample(block);
-            if steppers.plane.start(l, problem, &mut sink) {
-                steppers.fresh[2] |= 1 << l;
-                None
-            } else {
-                Some(None)
-            }
-        }
-        (Next::Done(output), _) => Some(Some(*output)),
-        // `Next::Scalar`, or a period of another kind than the point's (not handed out).
-        _ => Some(None),
+        Next::Done(output) => Some(Some(*output)),
+        Next::Scalar => Some(None),
     }
 }
 
@@ -260,11 +296,13 @@ fn run_worker(
         state: LaneStepper::new(),
         variational: LaneStepper::new(),
         plane: LaneStepper::new(),
-        fresh: [0; 3],
+        plane12: LaneStepper::new(),
+        fresh: [0; 4],
     };
     let mut models = Models {
         linear: LinearStrokeLanes::new(),
-        plane: PlaneLanes::new(),
+        plane: PlaneLanes::new(plane_rhs::build),
+        plane12: PlaneLanes::new(plane_rhs::build12),
     };
     let mut times_cache = None;
     // One per lane: a lane's next point usually has its chain predecessor's grid (one cache
@@ -311,10 +349,14 @@ fn run_worker(
                     let options = continued_options(points, i, &start);
                     let options = options.as_ref().unwrap_or(own);
                     LanePoint::new(device, options, metric_names, &mut times_cache)
-                        .map(|(p, next)| (Task::Linear(p), next))
+                        .map(|(p, next)| (Task::Linear(p), Step::Linear(next)))
                         .or_else(|| {
                             PlanePoint::new(device, options, metric_names, &mut times_cache)
-                                .map(|(p, next)| (Task::Plane(p), next))
+                                .map(|(p, step)| (Task::Plane(p), Step::Plane(step)))
+                        })
+                        .or_else(|| {
+                            PlanePoint::new(device, options, metric_names, &mut times_cache)
+                                .map(|(p, step)| (Task::Plane12(p), Step::Plane12(step)))
                         })
                 });
                 let Some((mut point, next)) = lane_point else {
@@ -347,7 +389,8 @@ fn run_worker(
         }
         let busy = steppers.state.any_busy()
             || steppers.variational.any_busy()
-            || steppers.plane.any_busy();
+            || steppers.plane.any_busy()
+            || steppers.plane12.any_busy();
         if control.is_cancelled() || !busy {
             break;
         }
@@ -359,7 +402,7 @@ fn run_worker(
                     .and_then(|c| c.point.as_mut())
                     .is_some_and(|(_, _, task)| match task {
                         Task::Linear(p) => p.sample(block),
-                        Task::Plane(_) => false,
+                        _ => false,
                     })
             };
             let fresh = std::mem::take(&mut steppers.fresh[0]);
@@ -383,13 +426,13 @@ fn run_worker(
             );
         }
         if steppers.plane.any_busy() {
-            let mut sink = |l: usize, block: &SampleBlock<{ plane_rhs::M }>| {
+            let mut sink = |l: usize, block: &SampleBlock<M>| {
                 cursors[l]
                     .as_mut()
                     .and_then(|c| c.point.as_mut())
                     .is_some_and(|(_, _, task)| match task {
                         Task::Plane(p) => p.sample(block),
-                        Task::Linear(_) => false,
+                        _ => false,
                     })
             };
             let fresh = std::mem::take(&mut steppers.fresh[2]);
@@ -401,6 +444,25 @@ fn run_worker(
                     .map(|(l, o)| (l, Ended::Plane(o))),
             );
         }
+        if steppers.plane12.any_busy() {
+            let mut sink = |l: usize, block: &SampleBlock<M12>| {
+                cursors[l]
+                    .as_mut()
+                    .and_then(|c| c.point.as_mut())
+                    .is_some_and(|(_, _, task)| match task {
+                        Task::Plane12(p) => p.sample(block),
+                        _ => false,
+                    })
+            };
+            let fresh = std::mem::take(&mut steppers.fresh[3]);
+            finished.extend(
+                steppers
+                    .plane12
+                    .run(&models.plane12, fresh, &mut sink)
+                    .into_iter()
+                    .map(|(l, o)| (l, Ended::Plane12(o))),
+            );
+        }
         for (l, outcome) in finished {
             let cursor = cursors[l].as_mut().expect("a busy lane has a chain");
             let (i, start, mut point) = cursor.point.take().expect("a busy lane has a point");
@@ -410,6 +472,7 @@ fn run_worker(
                 Ended::State(_) => steppers.state.take_timeout(l),
                 Ended::Variational(_) => steppers.variational.take_timeout(l),
                 Ended::Plane(_) => steppers.plane.take_timeout(l),
+                Ended::Plane12(_) => steppers.plane12.take_timeout(l),
             };
             if let Some(error) = timeout {
                 finish_point(
@@ -424,10 +487,11 @@ fn run_worker(
                 continue;
             }
             let next = match (outcome, &mut point) {
-                (Ended::State(o), Task::Linear(p)) => p.resume(o),
-                (Ended::Variational(o), Task::Linear(p)) => p.resume_sensitivity(o),
-                (Ended::Plane(o), Task::Plane(p)) => p.resume(o),
-                _ => Next::Scalar,
+                (Ended::State(o), Task::Linear(p)) => Step::Linear(p.resume(o)),
+                (Ended::Variational(o), Task::Linear(p)) => Step::Linear(p.resume_sensitivity(o)),
+                (Ended::Plane(o), Task::Plane(p)) => Step::Plane(p.resume(o)),
+                (Ended::Plane12(o), Task::Plane12(p)) => Step::Plane12(p.resume(o)),
+                _ => Step::Linear(Next::Scalar),
             };
             match launch(
                 l,

@@ -489,4 +489,14 @@ fn switched_lane_sweeps_are_bit_identical_to_the_scalar_sweep() {
         .map(String::from)
         .to_vec();
     assert_lanes_match_the_scalar_sweep(&points, &metrics, 16);
+    // §2.5 Dual PARITY (five coordinates, the lanes' twelve-entry layout): a chain of 10 along
+    // the deviation stiffness at 90 V.
+    let points: Vec<_> = (0..10)
+        .map(|k| {
+            let device = rotating_device("dual_parity", 8.0 + 0.4 * k as f64, 90.0, 90.0);
+            assert!(has_lane_model(&device));
+            Ok((device, shooting_options()))
+        })
+        .collect();
+    assert_lanes_match_the_scalar_sweep(&points, &metrics, 8);
 }

@@ -10,7 +10,7 @@ use paritysim_aero::{Branch, HeldBranch};
 use paritysim_simd::{Real, f64x4};
 
 use super::generic::{self, Constants};
-use super::{HELD_N, Held, HeldConstants};
+use super::{Held, HeldConstants};
 use crate::device::Device;
 use crate::integrate::State;
 
@@ -19,33 +19,41 @@ type V = f64x4;
 /// Lanes evaluated together.
 const LANES: usize = 4;
 
-/// Compact state entries: `x` then `ẋ`.
-pub(crate) const M: usize = 2 * HELD_N;
+/// The [`Held`] constants of `device` on `N` coordinates, if it has them.
+fn held<const N: usize>(device: &Device) -> Option<&Held<N>> {
+    let any: &dyn std::any::Any = match device.free_deviation_held.as_ref()? {
+        HeldConstants::Four(h) => &**h,
+        HeldConstants::Five(h) => &**h,
+    };
+    any.downcast_ref::<Held<N>>()
+}
 
-/// The constants of four free-deviation devices, gathered into vectors.
-pub(crate) struct FreeDeviationLanes<'a> {
+/// The constants of four free-deviation devices on `N` coordinates, gathered into vectors;
+/// their compact states have `M` entries (`M / 2` coordinates, then as many rates, the ones
+/// past `N` zero: the scalar integrator's layout).
+pub(crate) struct FreeDeviationLanes<'a, const N: usize, const M: usize> {
     devices: [&'a Device; LANES],
-    constants: Constants<V, HELD_N>,
+    constants: Constants<V, N>,
     /// The lanes' common blade elements (`None`: the lanes differ, every lane is scalar).
     aero: Option<[paritysim_aero::BladeElementModel<paritysim_aero::CoefficientSet>; 2]>,
 }
 
-impl<'a> FreeDeviationLanes<'a> {
-    /// Whether `device` can take a lane: the lean free-deviation model on [`HELD_N`]
-    /// coordinates with blade elements on both wings.
+impl<'a, const N: usize, const M: usize> FreeDeviationLanes<'a, N, M> {
+    /// Whether `device` can take a lane: the lean free-deviation model on `N` coordinates
+    /// with blade elements on both wings.
     pub(crate) fn supports(device: &Device) -> bool {
-        matches!(device.free_deviation_held, Some(HeldConstants::Four(_)))
+        N <= M / 2 && held::<N>(device).is_some()
     }
 
     /// The lanes of `devices`, or `None` unless every one [`Self::supports`] lanes.
     pub(crate) fn new(devices: [&'a Device; LANES]) -> Option<Self> {
-        let held: [&Held<HELD_N>; LANES] = {
+        if N > M / 2 {
+            return None;
+        }
+        let held: [&Held<N>; LANES] = {
             let mut out = [None; LANES];
             for (l, d) in devices.iter().enumerate() {
-                match &d.free_deviation_held {
-                    Some(HeldConstants::Four(held)) => out[l] = Some(&**held),
-                    _ => return None,
-                }
+                out[l] = Some(held::<N>(d)?);
             }
             out.map(|h| h.expect("every lane checked above"))
         };
@@ -74,13 +82,14 @@ impl<'a> FreeDeviationLanes<'a> {
         let all = (1u32 << LANES) - 1;
         let mut scalar = all;
         if let Some(aero) = &self.aero {
-            let x: [V; HELD_N] = std::array::from_fn(|i| y[i]);
-            let x_dot: [V; HELD_N] = std::array::from_fn(|i| y[HELD_N + i]);
+            let x: [V; N] = std::array::from_fn(|i| y[i]);
+            let x_dot: [V; N] = std::array::from_fn(|i| y[M / 2 + i]);
             let held = [0, 1].map(|w| HeldBranch::lanes(branches.map(|b| b[w])));
             let drive = [0, 1].map(|k| V::new(forces.map(|f| f[k])));
             let step = generic::step(&self.constants, aero, drive, (&x, &x_dot), &held);
-            dydt[..HELD_N].copy_from_slice(&x_dot);
-            dydt[HELD_N..].copy_from_slice(&step.x_ddot);
+            dydt.fill(V::splat(0.0));
+            dydt[..N].copy_from_slice(&x_dot);
+            dydt[M / 2..M / 2 + N].copy_from_slice(&step.x_ddot);
             scalar = V::bits(step.general | step.singular) & all;
         }
         let mut failed = 0u32;
@@ -104,19 +113,19 @@ impl<'a> FreeDeviationLanes<'a> {
         let device = self.devices[l];
         let lean = device.free_deviation_rhs.as_ref()?;
         let mut state = State::default();
-        for i in 0..HELD_N {
+        for i in 0..M / 2 {
             state.coords[i] = y[i].to_array()[l];
-            state.rates[i] = y[HELD_N + i].to_array()[l];
+            state.rates[i] = y[M / 2 + i].to_array()[l];
         }
         let mut out = State::default();
         device
             .rhs_free_deviation(lean, t, &state, Some(branches), &mut out)
             .ok()?;
         Some(std::array::from_fn(|i| {
-            if i < HELD_N {
+            if i < M / 2 {
                 out.coords[i]
             } else {
-                out.rates[i - HELD_N]
+                out.rates[i - M / 2]
             }
         }))
     }

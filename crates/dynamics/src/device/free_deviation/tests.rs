@@ -205,8 +205,9 @@ fn held_branch_lanes_equal_the_scalar_right_hand_side_bit_for_bit() {
         let devices: Vec<Device> = (0..4)
             .map(|l| lift_variant(8.0 + l as f64, 85.0, 85.0))
             .collect();
-        let lanes = super::lanes::FreeDeviationLanes::new(std::array::from_fn(|l| &devices[l]))
-            .expect("lanes");
+        let lanes =
+            super::lanes::FreeDeviationLanes::<4, 8>::new(std::array::from_fn(|l| &devices[l]))
+                .expect("lanes");
         let (mut vector_lanes, mut scalar_lanes) = (0, 0);
         for chunk in ys
             .iter()
