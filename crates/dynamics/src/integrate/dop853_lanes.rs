@@ -29,7 +29,7 @@ use paritysim_error::Error;
 use wide::f64x4;
 
 use super::super::budget::{self, CHECK_EVERY};
-use super::super::{SAFE, State};
+use super::super::{HeldRun, SAFE, State};
 use super::*;
 
 /// Problems integrated at once.
@@ -49,6 +49,13 @@ fn with_lane(v: V, l: usize, x: f64) -> V {
     let mut a = v.to_array();
     a[l] = x;
     V::new(a)
+}
+
+/// Writes `values` into lane `l` of `v`, entry by entry.
+pub(crate) fn put_lane<const M: usize>(v: &mut [V; M], l: usize, values: &[f64; M]) {
+    for (entry, &x) in v.iter_mut().zip(values) {
+        *entry = with_lane(*entry, l, x);
+    }
 }
 
 /// The right-hand side of several lanes on the compact layout `[q1, q2, q̇1, q̇2]`.
@@ -109,24 +116,11 @@ pub(crate) trait LaneRhs<const M: usize> {
         _tol: LaneTolerances,
         _max_steps: usize,
         _span: (f64, f64),
-        _run: &mut LaneRun<M>,
+        _run: &mut HeldRun<M>,
         _steps: &mut Vec<f64>,
     ) -> Option<bool> {
         None
     }
-}
-
-/// An adaptive lane between attempts (see [`LaneRhs::replay_adaptive`]).
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct LaneRun<const M: usize> {
-    pub(crate) t: f64,
-    pub(crate) y: [f64; M],
-    pub(crate) f0: [f64; M],
-    pub(crate) h: f64,
-    pub(crate) fac_old: f64,
-    pub(crate) rejected_last: bool,
-    /// Attempts so far (accepted and rejected).
-    pub(crate) attempts: usize,
 }
 
 /// Right-hand side evaluations per step in [`stage_times`]: the step's start, stages 2–12,
@@ -780,7 +774,8 @@ impl<const M: usize, const C: usize> LaneStepper<M, C> {
         let f0: [f64; M] = std::array::from_fn(|i| lane(self.f0[i], l));
         let p = &mut self.lanes[l];
         let a = p.adaptive.as_mut().expect("an adaptive lane");
-        let mut run = LaneRun {
+        // The right-hand side fills in the branch its lane holds.
+        let mut run = HeldRun {
             t: a.t,
             y,
             f0,
@@ -788,6 +783,8 @@ impl<const M: usize, const C: usize> LaneStepper<M, C> {
             fac_old: a.fac_old,
             rejected_last: a.rejected_last,
             attempts: a.attempts,
+            sides: Default::default(),
+            g: [0.0; super::super::MAX_SWITCHES],
         };
         let span = (a.t_end, a.t_end - a.steps[0]);
         let Some(done) = rhs.replay_adaptive(l, tol, a.max_steps, span, &mut run, &mut a.steps)

@@ -53,6 +53,29 @@ impl Variational<'_> {
     }
 }
 
+/// The central differences' step along column `j` of `Φ` (in `c` after the `m` state
+/// entries) and the two perturbed states `y ± δ v`; `None` for a zero column.
+fn perturbation<const M: usize>(
+    c: &[f64; M],
+    m: usize,
+    j: usize,
+    scale: f64,
+) -> Option<(f64, [f64; 12], [f64; 12])> {
+    let col = m + j * m;
+    let v = &c[col..col + m];
+    let size = v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    if size == 0.0 {
+        return None;
+    }
+    let delta = DIRECTIONAL_STEP * scale / size;
+    let (mut yp, mut ym) = ([0.0; 12], [0.0; 12]);
+    for i in 0..m {
+        yp[i] = c[i] + delta * v[i];
+        ym[i] = c[i] - delta * v[i];
+    }
+    Some((delta, yp, ym))
+}
+
 impl Variational<'_> {
     /// The central differences of [`Rhs::eval`] with the `2n` perturbed right-hand sides of
     /// each column evaluated together ([`OdeSystem::rhs_on_batch`]: the same bits, so the
@@ -71,18 +94,9 @@ impl Variational<'_> {
         let mut columns = [0usize; 12];
         let mut count = 0;
         for j in 0..m {
-            let col = m + j * m;
-            let v = &c[col..col + m];
-            let size = v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-            if size == 0.0 {
+            let Some((delta, yp, ym)) = perturbation(c, m, j, scale) else {
                 continue;
-            }
-            let delta = DIRECTIONAL_STEP * scale / size;
-            let (mut yp, mut ym) = ([0.0; 12], [0.0; 12]);
-            for i in 0..m {
-                yp[i] = c[i] + delta * v[i];
-                ym[i] = c[i] - delta * v[i];
-            }
+            };
             states[2 * count] = to_state(self.n, &yp[..m]);
             states[2 * count + 1] = to_state(self.n, &ym[..m]);
             (deltas[count], columns[count]) = (delta, j);
@@ -151,18 +165,10 @@ impl<const M: usize> Rhs<M> for Variational<'_> {
         let (mut fp, mut fm) = ([0.0; 12], [0.0; 12]);
         for j in 0..m {
             let col = m + j * m;
-            let v = &c[col..col + m];
-            let size = v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-            if size == 0.0 {
+            let Some((delta, yp, ym)) = perturbation(c, m, j, scale) else {
                 dc[col..col + m].fill(0.0);
                 continue;
-            }
-            let delta = DIRECTIONAL_STEP * scale / size;
-            let (mut yp, mut ym) = ([0.0; 12], [0.0; 12]);
-            for i in 0..m {
-                yp[i] = c[i] + delta * v[i];
-                ym[i] = c[i] - delta * v[i];
-            }
+            };
             self.f(t, &to_state(self.n, &yp[..m]), &mut fp[..m])?;
             self.f(t, &to_state(self.n, &ym[..m]), &mut fm[..m])?;
             for i in 0..m {

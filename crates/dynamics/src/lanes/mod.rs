@@ -100,6 +100,161 @@ pub(crate) static COMPLETED_IN_LANES: std::sync::atomic::AtomicUsize =
 pub(crate) static SWITCHED_COMPLETED_IN_LANES: std::sync::atomic::AtomicUsize =
     std::sync::atomic::AtomicUsize::new(0);
 
+/// A converged lane point as `simulate` and `run_point` report it (metrics only, one orbit
+/// cycle), counted in [`COMPLETED_IN_LANES`].
+pub(super) struct Converged<'a> {
+    pub(super) device: &'a Device,
+    pub(super) metric_names: &'a [String],
+    pub(super) samples_per_cycle: usize,
+    pub(super) period: f64,
+    pub(super) metrics: Vec<(String, f64)>,
+    pub(super) cycles_run: usize,
+    pub(super) residual: f64,
+    pub(super) state: crate::integrate::State,
+    pub(super) multipliers: Vec<nalgebra::Complex<f64>>,
+    pub(super) jacobian: nalgebra::DMatrix<f64>,
+    pub(super) grid: Vec<f64>,
+}
+
+impl Converged<'_> {
+    /// The point's output.
+    pub(super) fn output(self) -> Box<crate::sweep::PointOutput> {
+        let steady_state = self.state.without_work();
+        let result = crate::simulate::SimulationResult {
+            trajectory: crate::trajectory::Trajectory::default(),
+            metrics: self.metrics,
+            cycles_run: self.cycles_run,
+            converged: true,
+            period_ms: self.period,
+            residual: self.residual,
+            steady_state,
+            multipliers: self.multipliers,
+            monodromy: Some(self.jacobian),
+            step_grid: self.grid,
+            orbit_cycles: 1,
+        };
+        let coordinates = self.device.coordinates(&steady_state).ok();
+        COMPLETED_IN_LANES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        Box::new(crate::sweep::PointOutput::keep(
+            result,
+            self.metric_names,
+            false,
+            self.samples_per_cycle,
+            coordinates,
+        ))
+    }
+}
+
+/// The shooting's tolerances of a lane point, as `simulate` gives `grid_shooting::shoot`.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Limits {
+    /// Newton's convergence tolerance and the residual a neutral orbit is accepted at.
+    pub(super) tol: f64,
+    pub(super) accept_tol: f64,
+    /// The run's integration tolerances, and the grid chooser's (`GRID_TOLERANCE_FACTOR`×).
+    pub(super) newton: crate::integrate::lanes::LaneTolerances,
+    pub(super) grid: crate::integrate::lanes::LaneTolerances,
+    pub(super) max_steps: usize,
+}
+
+impl Limits {
+    pub(super) fn of(options: &crate::simulate::SimulationOptions) -> Self {
+        let chooser = crate::grid_shooting::GRID_TOLERANCE_FACTOR.clamp(f64::MIN_POSITIVE, 1.0);
+        let tolerances = |factor: f64| crate::integrate::lanes::LaneTolerances {
+            rtol: options.rtol * factor,
+            atol: options.atol * factor,
+        };
+        Self {
+            // Below the integration's own accuracy (~rtol) a tighter orbit changes nothing.
+            tol: (1e-2 * options.steady_tol).min(0.1 * options.rtol),
+            accept_tol: options.steady_tol,
+            newton: crate::integrate::lanes::LaneTolerances {
+                rtol: options.rtol,
+                atol: options.atol,
+            },
+            grid: tolerances(chooser),
+            max_steps: options.max_steps,
+        }
+    }
+}
+
+/// The recorded window's `n_samples + 1` sample times from 0 over `period`
+/// (`simulate::window_times`), from `cache` when the last point had the same.
+pub(super) fn cached_window_times(
+    cache: &mut Option<(f64, usize, std::rc::Rc<[f64]>)>,
+    period: f64,
+    n_samples: usize,
+) -> std::rc::Rc<[f64]> {
+    match cache {
+        Some((p, n, times)) if *p == period && *n == n_samples => times.clone(),
+        _ => {
+            let times: std::rc::Rc<[f64]> =
+                crate::simulate::window_times(0.0, period, n_samples).collect();
+            *cache = Some((period, n_samples, times.clone()));
+            times
+        }
+    }
+}
+
+/// `(P(y) − y, ‖P(y) − y‖∞ / (1 + ‖y‖∞))` on `n` coordinates (as `grid_shooting`).
+pub(super) fn residual(
+    n: usize,
+    y: &crate::integrate::State,
+    py: &crate::integrate::State,
+) -> (nalgebra::DVector<f64>, f64) {
+    let (yv, pv) = (y.compact(n), py.compact(n));
+    let f = pv - &yv;
+    let r = f.amax() / (1.0 + yv.amax());
+    (f, r)
+}
+
+/// A Newton trial of `grid_shooting::shoot`'s loop: its step `delta`, the step's size
+/// relative to the iterate, the next iterate, and whether it is the last (the predicted error,
+/// step × contraction, below `tol`). `None` for a singular step.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn newton_trial(
+    n: usize,
+    y: &crate::integrate::State,
+    (jac, eye, f): (
+        &nalgebra::DMatrix<f64>,
+        &nalgebra::DMatrix<f64>,
+        &nalgebra::DVector<f64>,
+    ),
+    last_step: Option<f64>,
+    fresh: bool,
+    tol: f64,
+) -> Option<(nalgebra::DVector<f64>, f64, crate::integrate::State, bool)> {
+    let delta = crate::grid_shooting::least_squares_step(jac - eye, f)?;
+    let scale = 1.0 + y.compact(n).amax();
+    let step = delta.amax() / scale;
+    // The next iterate's error: the step times the contraction seen so far (Newton's
+    // quadratic model after a fresh Jacobian; unknown, so 1, after a neighbour's).
+    let contraction = match last_step {
+        Some(s) => step / s,
+        None if fresh => step,
+        None => 1.0,
+    }
+    .min(1.0);
+    let y_new = crate::integrate::State::from_compact(n, &(y.compact(n) + &delta));
+    let last = contraction * step <= tol || step <= 1e-3 * tol;
+    Some((delta, step, y_new, last))
+}
+
+/// Good Broyden (`grid_shooting::shoot`): the secant condition on the step `delta` just taken,
+/// from the residual `f` to `f_new`.
+pub(super) fn broyden_update(
+    jac: &mut nalgebra::DMatrix<f64>,
+    eye: &nalgebra::DMatrix<f64>,
+    delta: &nalgebra::DVector<f64>,
+    (f, f_new): (&nalgebra::DVector<f64>, &nalgebra::DVector<f64>),
+) {
+    let s_dot = delta.dot(delta);
+    if s_dot > 0.0 {
+        let mismatch = (f_new - f) - (&*jac - eye) * delta;
+        *jac += mismatch * delta.transpose() / s_dot;
+    }
+}
+
 /// How many sweep points the SIMD lanes have completed in this process (monotonic; points
 /// rerun on the scalar path are not counted).
 pub fn points_completed_in_lanes() -> usize {

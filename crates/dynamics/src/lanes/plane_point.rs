@@ -13,20 +13,19 @@ use std::rc::Rc;
 use nalgebra::{DMatrix, DVector};
 use paritysim_error::Result;
 
+use super::SWITCHED_COMPLETED_IN_LANES;
 use super::plane_rhs;
-use super::{COMPLETED_IN_LANES, SWITCHED_COMPLETED_IN_LANES};
 use crate::device::Device;
-use crate::grid_shooting::{GRID_TOLERANCE_FACTOR, REPICK_RESIDUAL, least_squares_step};
+use crate::grid_shooting::{REPICK_RESIDUAL, least_squares_step};
 use crate::integrate::budget::Budget;
-use crate::integrate::lanes::{LaneOutcome, LaneProblem, LaneTolerances, SampleBlock};
+use crate::integrate::lanes::{LaneOutcome, LaneProblem, SampleBlock};
 use crate::integrate::{Method, RungeKutta, State};
 use crate::metrics::{MetricsAccumulator, StrokeNeeds};
 use crate::simulate::{
-    BROYDEN_VERDICT_CHECKED_BELOW, SimulationOptions, SimulationResult, SteadyState,
-    UNSTABLE_MARGIN,
+    BROYDEN_VERDICT_CHECKED_BELOW, SimulationOptions, SteadyState, UNSTABLE_MARGIN,
 };
 use crate::sweep::PointOutput;
-use crate::trajectory::{PlaneSample, Sample, Trajectory};
+use crate::trajectory::{PlaneSample, Sample};
 
 /// Newton steps of the shooting (as `simulate` gives `grid_shooting::shoot`).
 const MAX_NEWTON: usize = 20;
@@ -68,12 +67,7 @@ pub(super) struct PlanePoint<'a, const M: usize> {
     samples_per_cycle: usize,
     needs: StrokeNeeds,
     period: f64,
-    tol: f64,
-    accept_tol: f64,
-    newton_tol: LaneTolerances,
-    /// The grid chooser's tolerances (`GRID_TOLERANCE_FACTOR` × the run's).
-    grid_tol: LaneTolerances,
-    max_steps: usize,
+    limits: super::Limits,
     /// The run's integrator (no work integrals), for the variational periods.
     rk: RungeKutta,
     pub(super) grid: Rc<[f64]>,
@@ -94,14 +88,6 @@ pub(super) struct PlanePoint<'a, const M: usize> {
     metrics: MetricsAccumulator,
     cancel: Option<crate::integrate::budget::CancelFlag>,
     pub(super) deadline: Option<(std::time::Instant, f64)>,
-}
-
-/// `(P(y) − y, ‖P(y) − y‖∞ / (1 + ‖y‖∞))` on `n` coordinates (as `grid_shooting`).
-fn residual(n: usize, y: &State, py: &State) -> (DVector<f64>, f64) {
-    let (yv, pv) = (y.compact(n), py.compact(n));
-    let f = pv - &yv;
-    let r = f.amax() / (1.0 + yv.amax());
-    (f, r)
 }
 
 impl<'a, const M: usize> PlanePoint<'a, M> {
@@ -145,16 +131,7 @@ impl<'a, const M: usize> PlanePoint<'a, M> {
         .with_work(false);
         let y = device.state_from(&p0, &pd0).ok()?.without_work();
         let n_samples = options.samples_per_cycle;
-        let times = match times_cache {
-            Some((p, n, times)) if *p == period && *n == n_samples => times.clone(),
-            _ => {
-                let times: Rc<[f64]> =
-                    crate::simulate::window_times(0.0, period, n_samples).collect();
-                *times_cache = Some((period, n_samples, times.clone()));
-                times
-            }
-        };
-        let chooser = GRID_TOLERANCE_FACTOR.clamp(f64::MIN_POSITIVE, 1.0);
+        let times = super::cached_window_times(times_cache, period, n_samples);
         let mut point = Self {
             device,
             n,
@@ -162,17 +139,7 @@ impl<'a, const M: usize> PlanePoint<'a, M> {
             samples_per_cycle: n_samples,
             needs,
             period,
-            tol: (1e-2 * options.steady_tol).min(0.1 * options.rtol),
-            accept_tol: options.steady_tol,
-            newton_tol: LaneTolerances {
-                rtol: options.rtol,
-                atol: options.atol,
-            },
-            grid_tol: LaneTolerances {
-                rtol: options.rtol * chooser,
-                atol: options.atol * chooser,
-            },
-            max_steps: options.max_steps,
+            limits: super::Limits::of(options),
             rk,
             grid: Rc::from([0.0, period]),
             forcing: None,
@@ -204,10 +171,10 @@ impl<'a, const M: usize> PlanePoint<'a, M> {
     fn adaptive_grid_period(&self, y: &State) -> PlaneStep<M> {
         PlaneStep::Integrate(LaneProblem {
             grid: Rc::from([0.0, self.period]),
-            adaptive: Some(self.max_steps),
+            adaptive: Some(self.limits.max_steps),
             y0: plane_rhs::compact(y),
             times: Rc::from([]),
-            tol: self.grid_tol,
+            tol: self.limits.grid,
         })
     }
 
@@ -248,21 +215,12 @@ impl<'a, const M: usize> PlanePoint<'a, M> {
             return PlaneStep::Scalar;
         }
         self.iterations += 1;
-        let Some(delta) = least_squares_step(&self.jac - &self.eye, &self.f) else {
+        let model = (&self.jac, &self.eye, &self.f);
+        let (n, tol) = (self.n, self.limits.tol);
+        let trial = super::newton_trial(n, &self.y, model, self.last_step, self.fresh, tol);
+        let Some((delta, step, y_new, last)) = trial else {
             return PlaneStep::Scalar;
         };
-        let scale = 1.0 + self.y.compact(self.n).amax();
-        let step = delta.amax() / scale;
-        // The next iterate's error: the step times the contraction seen so far (Newton's
-        // quadratic model after a fresh Jacobian; unknown, so 1, after a neighbour's).
-        let contraction = match self.last_step {
-            Some(s) => step / s,
-            None if self.fresh => step,
-            None => 1.0,
-        }
-        .min(1.0);
-        let y_new = State::from_compact(self.n, &(self.y.compact(self.n) + &delta));
-        let last = contraction * step <= self.tol || step <= 1e-3 * self.tol;
         if last && self.repick {
             // Converged on a grid picked far from the orbit: the grid again, from here.
             self.repick = false;
@@ -283,7 +241,7 @@ impl<'a, const M: usize> PlanePoint<'a, M> {
             } else {
                 Rc::from([])
             },
-            tol: self.newton_tol,
+            tol: self.limits.newton,
         };
         self.pending = Some(Pending::Trial {
             y_new,
@@ -325,7 +283,7 @@ impl<'a, const M: usize> PlanePoint<'a, M> {
                 self.grid = steps.into();
                 self.forcing = None;
                 self.periods = 1;
-                (self.f, self.res) = residual(self.n, &self.y, &plane_rhs::expand(&y));
+                (self.f, self.res) = super::residual(self.n, &self.y, &plane_rhs::expand(&y));
                 self.repick = self.res > REPICK_RESIDUAL;
                 return self.iterate();
             }
@@ -333,7 +291,7 @@ impl<'a, const M: usize> PlanePoint<'a, M> {
                 self.grid = steps.into();
                 self.forcing = None;
                 self.periods += 1;
-                (self.f, self.res) = residual(self.n, &y_new, &plane_rhs::expand(&y));
+                (self.f, self.res) = super::residual(self.n, &y_new, &plane_rhs::expand(&y));
                 self.y = y_new;
                 return self.iterate();
             }
@@ -345,9 +303,9 @@ impl<'a, const M: usize> PlanePoint<'a, M> {
             } => (y_new, delta, step, last),
         };
         self.periods += 1;
-        let (f_new, res_new) = residual(self.n, &y_new, &plane_rhs::expand(&y));
-        let tol = self.tol;
-        if last && res_new > tol && res_new <= self.accept_tol && !self.fresh {
+        let (f_new, res_new) = super::residual(self.n, &y_new, &plane_rhs::expand(&y));
+        let tol = self.limits.tol;
+        if last && res_new > tol && res_new <= self.limits.accept_tol && !self.fresh {
             // Re-linearise at the candidate, then decide with the exact Jacobian.
             let Ok(jac) = self.exact_jacobian(&y_new) else {
                 return PlaneStep::Scalar;
@@ -360,7 +318,7 @@ impl<'a, const M: usize> PlanePoint<'a, M> {
             return self.iterate();
         }
         let neutral = || {
-            res_new <= self.accept_tol
+            res_new <= self.limits.accept_tol
                 && least_squares_step(&self.jac - &self.eye, &f_new)
                     .is_some_and(|d| d.amax() / (1.0 + y_new.compact(self.n).amax()) <= tol)
         };
@@ -381,12 +339,7 @@ impl<'a, const M: usize> PlanePoint<'a, M> {
             self.last_step = None;
             return self.iterate();
         }
-        // Good Broyden: the secant condition on the step just taken.
-        let s_dot = delta.dot(&delta);
-        if s_dot > 0.0 {
-            let mismatch = (&f_new - &self.f) - (&self.jac - &self.eye) * &delta;
-            self.jac += mismatch * delta.transpose() / s_dot;
-        }
+        super::broyden_update(&mut self.jac, &self.eye, &delta, (&self.f, &f_new));
         self.fresh = false;
         (self.y, self.f, self.res) = (y_new, f_new, res_new);
         self.last_step = Some(step);
@@ -414,29 +367,22 @@ impl<'a, const M: usize> PlanePoint<'a, M> {
         {
             return PlaneStep::Scalar;
         }
-        let steady_state = state.without_work();
-        let result = SimulationResult {
-            trajectory: Trajectory::default(),
-            metrics: self.metrics.finish(),
-            cycles_run: self.periods - 1,
-            converged: true,
-            period_ms: self.period,
-            residual,
-            steady_state,
-            multipliers,
-            monodromy: Some(self.jac.clone()),
-            step_grid: self.grid.to_vec(),
-            orbit_cycles: 1,
-        };
-        let coordinates = self.device.coordinates(&steady_state).ok();
-        COMPLETED_IN_LANES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         SWITCHED_COMPLETED_IN_LANES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        PlaneStep::Done(Box::new(PointOutput::keep(
-            result,
-            self.metric_names,
-            false,
-            self.samples_per_cycle,
-            coordinates,
-        )))
+        PlaneStep::Done(
+            super::Converged {
+                device: self.device,
+                metric_names: self.metric_names,
+                samples_per_cycle: self.samples_per_cycle,
+                period: self.period,
+                metrics: self.metrics.finish(),
+                cycles_run: self.periods - 1,
+                residual,
+                state,
+                multipliers,
+                jacobian: self.jac.clone(),
+                grid: self.grid.to_vec(),
+            }
+            .output(),
+        )
     }
 }

@@ -19,7 +19,7 @@ use wide::f64x4;
 use crate::device::Device;
 use crate::device::free_deviation_lanes::FreeDeviationLanes;
 use crate::device::stroke_plane_lanes::{self as model, StrokePlaneLanes};
-use crate::integrate::lanes::{LANES, LaneRhs, LaneRun, LaneTolerances, NO_STAGE, stage_times};
+use crate::integrate::lanes::{LANES, LaneRhs, LaneTolerances, NO_STAGE, put_lane, stage_times};
 use crate::integrate::{
     HeldRun, MAX_SWITCHES, OdeSystem, Sides, State, replay_adaptive_step, replay_grid_step,
 };
@@ -211,13 +211,7 @@ impl<const M: usize> LaneRhs<M> for PlaneLanes<'_, M> {
                 let mut failed = 0;
                 for l in 0..LANES {
                     match self.scalar_lane(l, t[l], y, held[l].sides) {
-                        Some(f) => {
-                            for (i, value) in f.into_iter().enumerate() {
-                                let mut lanes = dydt[i].to_array();
-                                lanes[l] = value;
-                                dydt[i] = V::new(lanes);
-                            }
-                        }
+                        Some(f) => put_lane(dydt, l, &f),
                         None => failed |= 1 << l,
                     }
                 }
@@ -309,43 +303,18 @@ impl<const M: usize> LaneRhs<M> for PlaneLanes<'_, M> {
         tol: LaneTolerances,
         max_steps: usize,
         span: (f64, f64),
-        run: &mut LaneRun<M>,
+        run: &mut HeldRun<M>,
         steps: &mut Vec<f64>,
     ) -> Option<bool> {
         let device = self.devices[l]?;
         let held = self.held.borrow()[l];
-        let mut scalar = HeldRun {
-            t: run.t,
-            y: run.y,
-            f0: run.f0,
-            h: run.h,
-            fac_old: run.fac_old,
-            rejected_last: run.rejected_last,
-            attempts: run.attempts,
-            sides: held.sides,
-            g: held.g,
-        };
-        let done = replay_adaptive_step::<M>(
-            device,
-            (tol.rtol, tol.atol),
-            max_steps,
-            span,
-            &mut scalar,
-            steps,
-        )
-        .ok()?;
-        *run = LaneRun {
-            t: scalar.t,
-            y: scalar.y,
-            f0: scalar.f0,
-            h: scalar.h,
-            fac_old: scalar.fac_old,
-            rejected_last: scalar.rejected_last,
-            attempts: scalar.attempts,
-        };
+        (run.sides, run.g) = (held.sides, held.g);
+        let done =
+            replay_adaptive_step::<M>(device, (tol.rtol, tol.atol), max_steps, span, run, steps)
+                .ok()?;
         self.held.borrow_mut()[l] = Held {
-            sides: scalar.sides,
-            g: scalar.g,
+            sides: run.sides,
+            g: run.g,
         };
         Some(done)
     }

@@ -5,16 +5,14 @@ use std::rc::Rc;
 
 use nalgebra::{DMatrix, DVector};
 
-use super::COMPLETED_IN_LANES;
 use super::linear_stroke::LinearStroke;
 use crate::device::Device;
-use crate::grid_shooting::{GRID_TOLERANCE_FACTOR, REPICK_RESIDUAL};
-use crate::integrate::lanes::{LaneOutcome, LaneProblem, LaneTolerances, SampleBlock};
+use crate::grid_shooting::REPICK_RESIDUAL;
+use crate::integrate::lanes::{LaneOutcome, LaneProblem, SampleBlock};
 use crate::integrate::{Method, RungeKutta, State};
 use crate::metrics::{MetricsAccumulator, StrokeBlock};
-use crate::simulate::{SimulationOptions, SimulationResult, SteadyState, UNSTABLE_MARGIN};
+use crate::simulate::{SimulationOptions, SteadyState, UNSTABLE_MARGIN};
 use crate::sweep::PointOutput;
-use crate::trajectory::Trajectory;
 
 /// Newton steps of the shooting (as `simulate` gives `grid_shooting::shoot`).
 const MAX_NEWTON: usize = 20;
@@ -67,11 +65,7 @@ pub(super) struct LanePoint<'a> {
     metric_names: &'a [String],
     samples_per_cycle: usize,
     period: f64,
-    tol: f64,
-    accept_tol: f64,
-    newton_tol: LaneTolerances,
-    grid_tol: LaneTolerances,
-    max_steps: usize,
+    limits: super::Limits,
     pub(super) grid: Rc<[f64]>,
     /// The actuator force at the grid's stage times (`None` until asked, and after the grid
     /// changes).
@@ -115,10 +109,7 @@ fn expand4(c: &[f64; 4]) -> State {
 
 /// `(P(y) − y, ‖P(y) − y‖∞ / (1 + ‖y‖∞))` (as `grid_shooting`).
 fn residual(y: &State, py: &State) -> (DVector<f64>, f64) {
-    let (yv, pv) = (y.compact(2), py.compact(2));
-    let f = pv - &yv;
-    let r = f.amax() / (1.0 + yv.amax());
-    (f, r)
+    super::residual(2, y, py)
 }
 
 /// Least-squares Newton step (as `grid_shooting`).
@@ -185,35 +176,16 @@ impl<'a> LanePoint<'a> {
         }
         let y = device.state_from(&p0, &pd0).ok()?.without_work();
         let min_cycles = options.min_cycles;
-        let chooser = GRID_TOLERANCE_FACTOR.clamp(f64::MIN_POSITIVE, 1.0);
         let n_samples = options.samples_per_cycle;
         // The recorded window's sample times, as `record_window` makes them.
-        let times = match times_cache {
-            Some((p, n, times)) if *p == period && *n == n_samples => times.clone(),
-            _ => {
-                let times: Rc<[f64]> =
-                    crate::simulate::window_times(grid[0], period, n_samples).collect();
-                *times_cache = Some((period, n_samples, times.clone()));
-                times
-            }
-        };
+        let times = super::cached_window_times(times_cache, period, n_samples);
         let point = Self {
             device,
             model,
             metric_names,
             samples_per_cycle: n_samples,
             period,
-            tol: (1e-2 * options.steady_tol).min(0.1 * options.rtol),
-            accept_tol: options.steady_tol,
-            newton_tol: LaneTolerances {
-                rtol: options.rtol,
-                atol: options.atol,
-            },
-            grid_tol: LaneTolerances {
-                rtol: options.rtol * chooser,
-                atol: options.atol * chooser,
-            },
-            max_steps: options.max_steps,
+            limits: super::Limits::of(options),
             grid: grid.into(),
             forcing: None,
             times,
@@ -251,10 +223,10 @@ impl<'a> LanePoint<'a> {
         self.pending = Pending::WarmUp;
         Next::Integrate(LaneProblem {
             grid: Rc::from([0.0, self.period]),
-            adaptive: Some(self.max_steps),
+            adaptive: Some(self.limits.max_steps),
             y0: compact4(&self.y),
             times: Rc::from([]),
-            tol: self.newton_tol,
+            tol: self.limits.newton,
         })
     }
 
@@ -269,10 +241,10 @@ impl<'a> LanePoint<'a> {
         }
         Next::Sensitivity(LaneProblem {
             grid: Rc::from([0.0, self.period]),
-            adaptive: Some(self.max_steps),
+            adaptive: Some(self.limits.max_steps),
             y0: c0,
             times: Rc::from([]),
-            tol: self.grid_tol,
+            tol: self.limits.grid,
         })
     }
 
@@ -317,10 +289,10 @@ impl<'a> LanePoint<'a> {
             },
             tol: match self.pending {
                 Pending::Map | Pending::Pick | Pending::Repick { .. } | Pending::Sensitivity => {
-                    self.grid_tol
+                    self.limits.grid
                 }
                 Pending::Trial { .. } | Pending::WarmUp | Pending::Relinearise { .. } => {
-                    self.newton_tol
+                    self.limits.newton
                 }
             },
         }
@@ -359,21 +331,18 @@ impl<'a> LanePoint<'a> {
             return Next::Scalar;
         }
         self.iterations += 1;
-        let Some(delta) = newton_step(&self.jac, &self.eye, &self.f) else {
+        let model = (&self.jac, &self.eye, &self.f);
+        let trial = super::newton_trial(
+            2,
+            &self.y,
+            model,
+            self.last_step,
+            self.fresh,
+            self.limits.tol,
+        );
+        let Some((delta, step, y_new, last)) = trial else {
             return Next::Scalar;
         };
-        let scale = 1.0 + self.y.compact(2).amax();
-        let step = delta.amax() / scale;
-        // The next iterate's error: the step times the contraction seen so far (Newton's
-        // quadratic model after a fresh Jacobian; unknown, so 1, after a neighbour's).
-        let contraction = match self.last_step {
-            Some(s) => step / s,
-            None if self.fresh => step,
-            None => 1.0,
-        }
-        .min(1.0);
-        let y_new = State::from_compact(2, &(self.y.compact(2) + &delta));
-        let last = contraction * step <= self.tol || step <= 1e-3 * self.tol;
         if last && self.repick {
             self.repick = false;
             self.pending = Pending::Repick { y_new };
@@ -456,13 +425,13 @@ impl<'a> LanePoint<'a> {
             ) => {
                 self.periods += 1;
                 let (f_new, res_new) = residual(&y_new, &expand4(&y));
-                let tol = self.tol;
-                if last && res_new > tol && res_new <= self.accept_tol && !self.fresh {
+                let tol = self.limits.tol;
+                if last && res_new > tol && res_new <= self.limits.accept_tol && !self.fresh {
                     // Re-linearise at the candidate, then decide with the exact Jacobian.
                     return self.relinearise(&y_new, Some((y_new, f_new, res_new)));
                 }
                 let neutral = || {
-                    res_new <= self.accept_tol
+                    res_new <= self.limits.accept_tol
                         && newton_step(&self.jac, &self.eye, &f_new)
                             .is_some_and(|d| d.amax() / (1.0 + y_new.compact(2).amax()) <= tol)
                 };
@@ -476,12 +445,7 @@ impl<'a> LanePoint<'a> {
                     }
                     return self.relinearise(&self.y.clone(), None);
                 }
-                // Good Broyden: the secant condition on the step just taken.
-                let s_dot = delta.dot(&delta);
-                if s_dot > 0.0 {
-                    let mismatch = (&f_new - &self.f) - (&self.jac - &self.eye) * &delta;
-                    self.jac += mismatch * delta.transpose() / s_dot;
-                }
+                super::broyden_update(&mut self.jac, &self.eye, &delta, (&self.f, &f_new));
                 self.fresh = false;
                 (self.y, self.f, self.res) = (y_new, f_new, res_new);
                 self.last_step = Some(step);
@@ -495,10 +459,10 @@ impl<'a> LanePoint<'a> {
     fn adaptive_grid_period(&self, y: &State) -> LaneProblem<4> {
         LaneProblem {
             grid: Rc::from([0.0, self.period]),
-            adaptive: Some(self.max_steps),
+            adaptive: Some(self.limits.max_steps),
             y0: compact4(y),
             times: Rc::from([]),
-            tol: self.grid_tol,
+            tol: self.limits.grid,
         }
     }
 
@@ -516,7 +480,7 @@ impl<'a> LanePoint<'a> {
             adaptive: None,
             y0: c0,
             times: Rc::from([]),
-            tol: self.newton_tol,
+            tol: self.limits.newton,
         })
     }
 
@@ -529,28 +493,21 @@ impl<'a> LanePoint<'a> {
         {
             return Next::Scalar;
         }
-        let steady_state = state.without_work();
-        let result = SimulationResult {
-            trajectory: Trajectory::default(),
-            metrics: self.metrics.finish(),
-            cycles_run: self.warm_cycles + self.periods - 1,
-            converged: true,
-            period_ms: self.period,
-            residual,
-            steady_state,
-            multipliers,
-            monodromy: Some(self.jac.clone()),
-            step_grid: self.grid.to_vec(),
-            orbit_cycles: 1,
-        };
-        let coordinates = self.device.coordinates(&steady_state).ok();
-        COMPLETED_IN_LANES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        Next::Done(Box::new(PointOutput::keep(
-            result,
-            self.metric_names,
-            false,
-            self.samples_per_cycle,
-            coordinates,
-        )))
+        Next::Done(
+            super::Converged {
+                device: self.device,
+                metric_names: self.metric_names,
+                samples_per_cycle: self.samples_per_cycle,
+                period: self.period,
+                metrics: self.metrics.finish(),
+                cycles_run: self.warm_cycles + self.periods - 1,
+                residual,
+                state,
+                multipliers,
+                jacobian: self.jac.clone(),
+                grid: self.grid.to_vec(),
+            }
+            .output(),
+        )
     }
 }

@@ -78,9 +78,18 @@ fn run(
     threads: usize,
     lanes: usize,
 ) -> Vec<paritysim_dynamics::Result<PointOutput>> {
+    run_with(points, &metric_list(), threads, lanes)
+}
+
+fn run_with(
+    points: &[paritysim_dynamics::Result<(Device, SimulationOptions)>],
+    metrics: &[String],
+    threads: usize,
+    lanes: usize,
+) -> Vec<paritysim_dynamics::Result<PointOutput>> {
     run_points_with_lanes(
         points,
-        &metric_list(),
+        metrics,
         false,
         Some(threads),
         Some(lanes),
@@ -412,18 +421,10 @@ fn assert_lanes_match_the_scalar_sweep(
     min_in_lanes: usize,
 ) {
     let go = |threads: usize, lanes: usize| {
-        run_points_with_lanes(
-            points,
-            metrics,
-            false,
-            Some(threads),
-            Some(lanes),
-            &SweepControl::new(),
-        )
-        .unwrap()
-        .into_iter()
-        .map(|slot| slot.expect("not cancelled").unwrap())
-        .collect::<Vec<_>>()
+        run_with(points, metrics, threads, lanes)
+            .into_iter()
+            .map(|o| o.unwrap())
+            .collect::<Vec<_>>()
     };
     let scalar = go(1, 1);
     assert!(scalar.iter().all(|o| o.converged && o.monodromy.is_some()));

@@ -13,6 +13,7 @@ use super::generic::{self, Constants};
 use super::{Held, HeldConstants};
 use crate::device::Device;
 use crate::integrate::State;
+use crate::integrate::lanes::put_lane;
 
 type V = f64x4;
 
@@ -95,13 +96,7 @@ impl<'a, const N: usize, const M: usize> FreeDeviationLanes<'a, N, M> {
         let mut failed = 0u32;
         for l in (0..LANES).filter(|l| scalar & (1 << l) != 0) {
             match self.scalar_lane(l, t[l], y, branches[l]) {
-                Some(f) => {
-                    for (i, value) in f.into_iter().enumerate() {
-                        let mut lanes = dydt[i].to_array();
-                        lanes[l] = value;
-                        dydt[i] = V::new(lanes);
-                    }
-                }
+                Some(f) => put_lane(dydt, l, &f),
                 None => failed |= 1 << l,
             }
         }

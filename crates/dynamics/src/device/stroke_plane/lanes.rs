@@ -16,6 +16,7 @@ use paritysim_simd::{f64x4, sin_cos};
 use super::{Device, N, StrokePlane};
 use crate::WingAero;
 use crate::integrate::State;
+use crate::integrate::lanes::put_lane;
 
 type V = f64x4;
 
@@ -290,13 +291,7 @@ impl<'a> StrokePlaneLanes<'a> {
         let mut failed = 0u32;
         for l in (0..LANES).filter(|l| scalar & (1 << l) != 0) {
             match self.scalar_lane(l, t[l], y, branches[l]) {
-                Some(f) => {
-                    for (i, value) in f.into_iter().enumerate() {
-                        let mut lanes = dydt[i].to_array();
-                        lanes[l] = value;
-                        dydt[i] = V::new(lanes);
-                    }
-                }
+                Some(f) => put_lane(dydt, l, &f),
                 None => failed |= 1 << l,
             }
         }
