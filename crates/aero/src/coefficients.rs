@@ -32,7 +32,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use std::fmt;
 
 use paritysim_error::{Error, Result, bail};
-use paritysim_simd::{Real, cos, f64x4, sin, sin_cos};
+use paritysim_simd::{Real, cos, sin, sin_cos};
 
 /// Default rotational damping coefficient `C_rd` of eq. 3.10: 5.0, the value used by
 /// J. P. Whitney & R. J. Wood, "Aeromechanics of passive rotation in flapping flight",
@@ -110,14 +110,6 @@ pub trait CoefficientModel: Send + Sync + fmt::Debug {
         self.lift_drag(alpha)
     }
 
-    /// [`Self::lift_drag_branch`] of four angles at once (SIMD lanes, `below[l]` per lane),
-    /// bit for bit the scalar values lane by lane; `None` (the default) when the model has no
-    /// lane form (the lanes then evaluate it one at a time).
-    #[inline]
-    fn lift_drag_branch_lanes(&self, _alpha: f64x4, _below: [bool; 4]) -> Option<(f64x4, f64x4)> {
-        None
-    }
-
     /// `(C_L, C_D)` of [`Self::lift_drag_branch`] and their slopes `(dC_L/dα, dC_D/dα)`: the
     /// analytic Jacobian of the stroke-plane equations needs them. The default differentiates
     /// the branch centrally (step 1e-6 rad: slopes to ~1e-10); the built-in models override it
@@ -187,6 +179,15 @@ impl Dickinson1999 {
         (cl, cd)
     }
 
+    /// The branch of the extended fit on one side of α = π/2 (`below`), continued past it: the
+    /// fit at α below, at π − α (C_L negated) above; of one angle or of four in SIMD lanes.
+    #[inline]
+    pub fn fit_branch<R: Real>(alpha: R, below: R::Mask) -> (R, R) {
+        let argument = R::select(below, alpha, R::splat(PI) - alpha);
+        let (cl, cd) = Self::fit(argument);
+        (R::select(below, cl, -cl), cd)
+    }
+
     /// [`Self::fit`] and its slopes `(dC_L/dα, dC_D/dα)`.
     #[inline]
     pub fn fit_with_slope(alpha: f64) -> ((f64, f64), (f64, f64)) {
@@ -220,23 +221,7 @@ impl CoefficientModel for Dickinson1999 {
 
     #[inline]
     fn lift_drag_branch(&self, alpha: f64, below: bool) -> (f64, f64) {
-        if below {
-            Self::fit(alpha)
-        } else {
-            let (cl, cd) = Self::fit(PI - alpha);
-            (-cl, cd)
-        }
-    }
-
-    #[inline]
-    fn lift_drag_branch_lanes(&self, alpha: f64x4, below: [bool; 4]) -> Option<(f64x4, f64x4)> {
-        // `lift_drag_branch` lane by lane: the fit at α below, at π − α (C_L negated) above.
-        let a = alpha.to_array();
-        let argument = std::array::from_fn(|l| if below[l] { a[l] } else { PI - a[l] });
-        let (cl, cd) = Self::fit(f64x4::new(argument));
-        let cl = cl.to_array();
-        let cl = std::array::from_fn(|l| if below[l] { cl[l] } else { -cl[l] });
-        Some((f64x4::new(cl), cd))
+        Self::fit_branch(alpha, below)
     }
 
     #[inline]
@@ -315,11 +300,6 @@ impl CoefficientModel for WhitneyWood2010 {
     }
 
     #[inline]
-    fn lift_drag_branch_lanes(&self, alpha: f64x4, _below: [bool; 4]) -> Option<(f64x4, f64x4)> {
-        Some(self.harmonic(alpha))
-    }
-
-    #[inline]
     fn lift_drag_slope_branch(&self, alpha: f64, _below: bool) -> ((f64, f64), (f64, f64)) {
         let (s2, c2) = sin_cos(2.0 * alpha);
         (
@@ -361,12 +341,7 @@ impl CoefficientSet {
     #[inline]
     pub fn lift_drag_branch_generic<R: Real>(&self, alpha: R, below: R::Mask) -> (R, R) {
         match self {
-            CoefficientSet::Dickinson1999(_) => {
-                // The fit at α below π/2, at π − α (C_L negated) above.
-                let argument = R::select(below, alpha, R::splat(PI) - alpha);
-                let (cl, cd) = Dickinson1999::fit(argument);
-                (R::select(below, cl, -cl), cd)
-            }
+            CoefficientSet::Dickinson1999(_) => Dickinson1999::fit_branch(alpha, below),
             CoefficientSet::WhitneyWood2010(m) => m.harmonic(alpha),
         }
     }
@@ -419,14 +394,6 @@ impl CoefficientModel for CoefficientSet {
         match self {
             CoefficientSet::Dickinson1999(m) => m.lift_drag_branch(alpha, below),
             CoefficientSet::WhitneyWood2010(m) => m.lift_drag_branch(alpha, below),
-        }
-    }
-
-    #[inline]
-    fn lift_drag_branch_lanes(&self, alpha: f64x4, below: [bool; 4]) -> Option<(f64x4, f64x4)> {
-        match self {
-            CoefficientSet::Dickinson1999(m) => m.lift_drag_branch_lanes(alpha, below),
-            CoefficientSet::WhitneyWood2010(m) => m.lift_drag_branch_lanes(alpha, below),
         }
     }
 

@@ -23,6 +23,7 @@ pub(crate) mod linear_map_jacobian;
 mod null_space;
 mod ode_system;
 mod stroke_plane;
+pub(crate) mod switched_lanes;
 mod switches;
 
 use drivetrain_coordinates::{StrokeOnly, stroke_only, stroke_torque};

@@ -57,7 +57,9 @@ pub trait Real:
     /// Whether some lane of `self` is above `bound` (or not a number).
     fn any_beyond(self, bound: f64) -> bool;
     /// `f` applied to every lane (the fallback for arguments outside the polynomials' range).
-    fn map(self, f: impl FnMut(f64) -> f64) -> Self;
+    fn map(self, f: impl Fn(f64) -> f64) -> Self;
+    /// `f(self, other)` lane by lane (the fallback of two-argument functions).
+    fn zip_map(self, other: Self, f: fn(f64, f64) -> f64) -> Self;
     /// `(sin x, cos x)` from those of the reduced argument, `x = ±(y π/2 + r)` with the
     /// integer `y` (< 2^53): swaps and sign changes only, so exact. Each type does it its own
     /// branch-free way (integer bits, vector masks) with the same result.
@@ -111,8 +113,12 @@ impl Real for f64 {
         self > bound || self.is_nan()
     }
     #[inline(always)]
-    fn map(self, mut f: impl FnMut(f64) -> f64) -> Self {
+    fn map(self, f: impl Fn(f64) -> f64) -> Self {
         f(self)
+    }
+    #[inline(always)]
+    fn zip_map(self, other: Self, f: fn(f64, f64) -> f64) -> Self {
+        f(self, other)
     }
     #[inline(always)]
     fn place_in_quadrant(x: f64, y: f64, sin_r: f64, cos_r: f64) -> (f64, f64) {
@@ -183,8 +189,13 @@ impl Real for f64x4 {
         self.simd_gt(f64x4::splat(bound)).any() || !self.simd_eq(self).all()
     }
     #[inline(always)]
-    fn map(self, mut f: impl FnMut(f64) -> f64) -> Self {
-        f64x4::new(self.to_array().map(&mut f))
+    fn map(self, f: impl Fn(f64) -> f64) -> Self {
+        f64x4::new(self.to_array().map(f))
+    }
+    #[inline(always)]
+    fn zip_map(self, other: Self, f: fn(f64, f64) -> f64) -> Self {
+        let (a, b) = (self.to_array(), other.to_array());
+        f64x4::new(std::array::from_fn(|l| f(a[l], b[l])))
     }
     #[inline(always)]
     fn place_in_quadrant(x: Self, y: Self, sin_r: Self, cos_r: Self) -> (Self, Self) {
@@ -332,7 +343,7 @@ pub fn atan2<R: Real>(y: R, x: R) -> R {
     const MORE_BITS: f64 = 6.123_233_995_736_766E-17;
     if x.abs().any_beyond(f64::MAX) || y.abs().any_beyond(f64::MAX) {
         // An infinite or NaN argument in some lane: libm for every lane of the call.
-        return lanes2(y, x, f64::atan2);
+        return y.zip_map(x, f64::atan2);
     }
     let s = R::splat;
     // Into the first octant.
@@ -371,29 +382,4 @@ pub fn atan2<R: Real>(y: R, x: R) -> R {
     let re = R::select(both_zero, zero, re);
     let re = R::select(x.sign_negative(), s(PI) - re, re);
     R::select(y.sign_negative(), -re, re)
-}
-
-/// `f(a, b)` lane by lane.
-#[inline]
-fn lanes2<R: Real>(a: R, b: R, f: fn(f64, f64) -> f64) -> R {
-    let mut lane = 0;
-    let bs = collect(b);
-    a.map(|v| {
-        let out = f(v, bs[lane]);
-        lane += 1;
-        out
-    })
-}
-
-/// The lanes of `v` (up to four).
-#[inline]
-fn collect<R: Real>(v: R) -> [f64; 4] {
-    let mut out = [0.0; 4];
-    let mut lane = 0;
-    let _ = v.map(|x| {
-        out[lane] = x;
-        lane += 1;
-        x
-    });
-    out
 }

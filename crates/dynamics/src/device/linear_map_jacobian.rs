@@ -14,50 +14,11 @@
 //! and the lanes (`lanes::linear_stroke`) call this one function, so a lane's monodromy is
 //! bit-identical to the scalar one with no mirrored code to keep in step.
 
-use std::ops::{Add, Div, Mul, Neg, Sub};
-
-use wide::f64x4;
+use paritysim_simd::Real;
 
 use super::DeviceSpec;
 use crate::wing::WingAero;
 use paritysim_kinematics::Drivetrain;
-
-/// The arithmetic this module needs: `f64` and `f64x4` (IEEE per lane).
-pub(crate) trait Real:
-    Copy
-    + Add<Output = Self>
-    + Sub<Output = Self>
-    + Mul<Output = Self>
-    + Div<Output = Self>
-    + Neg<Output = Self>
-{
-    /// `x` in every lane.
-    fn splat(x: f64) -> Self;
-    /// `|x|`.
-    fn magnitude(self) -> Self;
-}
-
-impl Real for f64 {
-    #[inline(always)]
-    fn splat(x: f64) -> Self {
-        x
-    }
-    #[inline(always)]
-    fn magnitude(self) -> Self {
-        self.abs()
-    }
-}
-
-impl Real for f64x4 {
-    #[inline(always)]
-    fn splat(x: f64) -> Self {
-        f64x4::splat(x)
-    }
-    #[inline(always)]
-    fn magnitude(self) -> Self {
-        self.abs()
-    }
-}
 
 /// The constants of the linear-map equations (one device, or one device per lane).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -156,7 +117,7 @@ pub(crate) fn variational<S: Real>(
         let d = stroke - terms.rest[k];
         // s'(φ) of A.7 with the cubic term; ∂(−Ω C φ̇|φ̇|)/∂φ̇ = −2 Ω C |φ̇| (eq. 2.16).
         let spring = terms.stiffness[k] + S::splat(3.0) * terms.cubic[k] * d * d;
-        let damping = S::splat(2.0) * terms.drag[k] * rate.magnitude();
+        let damping = S::splat(2.0) * terms.drag[k] * rate.abs();
         gq00 = gq00 - spring * a * a;
         gq01 = gq01 - spring * a * b;
         gq11 = gq11 - spring * b * b;

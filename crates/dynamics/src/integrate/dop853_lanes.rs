@@ -29,7 +29,8 @@ use paritysim_error::Error;
 use wide::f64x4;
 
 use super::super::budget::{self, CHECK_EVERY};
-use super::super::{HeldRun, SAFE, State};
+use super::super::lane_control::{Adaptive, Control};
+use super::super::{HeldRun, State};
 use super::*;
 
 /// Problems integrated at once.
@@ -204,21 +205,6 @@ pub(crate) struct SampleBlock<const C: usize = 4> {
 /// Receives the samples of a lane in blocks, in order: `(lane, block)`; `false` fails the
 /// lane.
 pub(crate) type LaneSink<'a, const C: usize = 4> = dyn FnMut(usize, &SampleBlock<C>) -> bool + 'a;
-
-/// The step control of an adaptive lane (`drive` in integrate/adaptive.rs, per lane).
-#[derive(Clone, Debug, Default)]
-struct Adaptive {
-    t: f64,
-    t_end: f64,
-    h: f64,
-    fac_old: f64,
-    rejected_last: bool,
-    attempts: usize,
-    max_steps: usize,
-    /// The current attempt is the last step (ends at `t_end`).
-    last: bool,
-    steps: Vec<f64>,
-}
 
 /// Per-lane progress.
 #[derive(Clone, Default)]
@@ -989,73 +975,6 @@ fn emit_constant<const C: usize>(
         first += count;
     }
     true
-}
-
-/// What an adaptive lane's attempt led to.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Control {
-    Accepted,
-    Rejected,
-    /// The last step was accepted.
-    Finished,
-    /// The scalar integration errs here (step limit, step-size underflow, a failing model).
-    Failed,
-}
-
-impl Adaptive {
-    /// `drive`'s step control after an attempt with scaled error `err` (`given_up`: the
-    /// limits were hit before it; `failed`: a stage's evaluation failed; `completes`: the new
-    /// derivative and state of an accepted step are valid).
-    fn control(
-        &mut self,
-        err: f64,
-        given_up: bool,
-        failed: bool,
-        completes: impl FnOnce() -> bool,
-    ) -> Control {
-        if given_up || failed {
-            return Control::Failed;
-        }
-        self.attempts += 1;
-        let fac_lo = 1.0 / <Dop853<4> as Stepper<4>>::FAC_MAX;
-        let fac_hi = 1.0 / <Dop853<4> as Stepper<4>>::FAC_MIN;
-        if !err.is_finite() {
-            self.rejected_last = true;
-            self.h *= <Dop853<4> as Stepper<4>>::FAC_MIN;
-            return Control::Rejected;
-        }
-        let fac11 = err.powf(<Dop853<4> as Stepper<4>>::EXPONENT);
-        if err <= 1.0 {
-            let fac = (fac11 / self.fac_old.powf(<Dop853<4> as Stepper<4>>::BETA) / SAFE)
-                .clamp(fac_lo, fac_hi);
-            let mut h_new = self.h / fac;
-            self.fac_old = err.max(1e-4);
-            if !completes() {
-                return Control::Failed;
-            }
-            let t_new = if self.last {
-                self.t_end
-            } else {
-                self.t + self.h
-            };
-            self.t = t_new;
-            self.steps.push(t_new);
-            if self.last {
-                return Control::Finished;
-            }
-            h_new = h_new.min(self.t_end - self.steps[0]);
-            if self.rejected_last {
-                h_new = h_new.min(self.h);
-            }
-            self.rejected_last = false;
-            self.h = h_new;
-            Control::Accepted
-        } else {
-            self.rejected_last = true;
-            self.h /= fac_hi.min(fac11 / SAFE);
-            Control::Rejected
-        }
-    }
 }
 
 /// One lane of a [`LaneRhs`] as a scalar right-hand side (for `initial_step`).

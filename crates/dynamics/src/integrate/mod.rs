@@ -33,6 +33,7 @@ mod dop853;
 mod dopri5;
 mod events;
 mod fixed_grid;
+mod lane_control;
 mod runge_kutta;
 mod state;
 mod stepper;

@@ -19,7 +19,9 @@ use wide::f64x4;
 use crate::device::Device;
 use crate::device::free_deviation_lanes::FreeDeviationLanes;
 use crate::device::stroke_plane_lanes::{self as model, StrokePlaneLanes};
-use crate::integrate::lanes::{LANES, LaneRhs, LaneTolerances, NO_STAGE, put_lane, stage_times};
+use crate::device::switched_lanes::{SwitchedLanes, evaluate_scalar_lanes};
+pub(crate) use crate::device::switched_lanes::{compact, expand};
+use crate::integrate::lanes::{LANES, LaneRhs, LaneTolerances, NO_STAGE, stage_times};
 use crate::integrate::{
     HeldRun, MAX_SWITCHES, OdeSystem, Sides, State, replay_adaptive_step, replay_grid_step,
 };
@@ -56,46 +58,6 @@ pub(crate) fn layout(device: &Device) -> Option<usize> {
 /// Whether `device` has a switched lane model.
 pub(crate) fn supports(device: &Device) -> bool {
     layout(device).is_some()
-}
-
-/// A right-hand side of four devices' compact states of `M` entries on held branches.
-pub(crate) trait SwitchedLanes<const M: usize> {
-    /// `f(t, y)` of every lane with the drive forces `forces[l]` at `t[l]` on `branches[l]`;
-    /// the bit mask of lanes whose scalar right-hand side fails.
-    fn eval(
-        &self,
-        t: [f64; LANES],
-        forces: [[f64; 2]; LANES],
-        y: &[V; M],
-        branches: [[paritysim_aero::Branch; 2]; LANES],
-        dydt: &mut [V; M],
-    ) -> u32;
-}
-
-impl SwitchedLanes<M> for StrokePlaneLanes<'_> {
-    fn eval(
-        &self,
-        t: [f64; LANES],
-        forces: [[f64; 2]; LANES],
-        y: &[V; M],
-        branches: [[paritysim_aero::Branch; 2]; LANES],
-        dydt: &mut [V; M],
-    ) -> u32 {
-        StrokePlaneLanes::eval(self, t, forces.map(|f| f[0]), y, branches, dydt).failed
-    }
-}
-
-impl<const N: usize, const M: usize> SwitchedLanes<M> for FreeDeviationLanes<'_, N, M> {
-    fn eval(
-        &self,
-        t: [f64; LANES],
-        forces: [[f64; 2]; LANES],
-        y: &[V; M],
-        branches: [[paritysim_aero::Branch; 2]; LANES],
-        dydt: &mut [V; M],
-    ) -> u32 {
-        FreeDeviationLanes::eval(self, t, forces, y, branches, dydt).1
-    }
 }
 
 /// The lanes' right-hand side of four devices, or `None` for lanes of different kinds (each
@@ -138,25 +100,6 @@ pub(crate) fn forcing(device: &Device, grid: &[f64]) -> Rc<[[f64; 2]]> {
         .collect()
 }
 
-/// The state of a compact one (work integrals zero, as the shooting's states).
-pub(crate) fn expand<const M: usize>(c: &[f64; M]) -> State {
-    let mut y = State::default();
-    y.coords[..M / 2].copy_from_slice(&c[..M / 2]);
-    y.rates[..M / 2].copy_from_slice(&c[M / 2..]);
-    y
-}
-
-/// The compact state of `y`.
-pub(crate) fn compact<const M: usize>(y: &State) -> [f64; M] {
-    std::array::from_fn(|i| {
-        if i < M / 2 {
-            y.coords[i]
-        } else {
-            y.rates[i - M / 2]
-        }
-    })
-}
-
 impl<'a, const M: usize> PlaneLanes<'a, M> {
     /// No lane loaded; `build` makes the lanes' right-hand side.
     pub(crate) fn new(build: Builder<'a, M>) -> Self {
@@ -184,16 +127,6 @@ impl<'a, const M: usize> PlaneLanes<'a, M> {
     pub(crate) fn load_forcing(&mut self, l: usize, forcing: Rc<[[f64; 2]]>) {
         self.forcing[l] = Some(forcing);
     }
-
-    /// Lane `l` on the scalar right-hand side of its device on its held sides; `None` where
-    /// it fails.
-    fn scalar_lane(&self, l: usize, t: f64, y: &[V; M], sides: Sides) -> Option<[f64; M]> {
-        let device = self.devices[l]?;
-        let c: [f64; M] = std::array::from_fn(|i| y[i].to_array()[l]);
-        let mut out = State::default();
-        device.rhs_on(t, &expand(&c), sides, &mut out).ok()?;
-        Some(compact(&out))
-    }
 }
 
 impl<const M: usize> LaneRhs<M> for PlaneLanes<'_, M> {
@@ -206,16 +139,14 @@ impl<const M: usize> LaneRhs<M> for PlaneLanes<'_, M> {
         let held = self.held.borrow();
         let branches = std::array::from_fn(|l| crate::device::blade_branches(held[l].sides));
         match &self.model {
-            Some(model) => model.eval(t, forces, y, branches, dydt),
+            Some(model) => model.eval(t, forces, y, branches, dydt).failed,
             None => {
-                let mut failed = 0;
-                for l in 0..LANES {
-                    match self.scalar_lane(l, t[l], y, held[l].sides) {
-                        Some(f) => put_lane(dydt, l, &f),
-                        None => failed |= 1 << l,
-                    }
-                }
-                failed
+                let all = (1 << LANES) - 1;
+                evaluate_scalar_lanes(all, y, dydt, |l, state, out| {
+                    self.devices[l]
+                        .is_some_and(|d| d.rhs_on(t[l], state, held[l].sides, out).is_ok())
+                })
+                .failed
             }
         }
     }

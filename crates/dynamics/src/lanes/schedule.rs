@@ -182,6 +182,28 @@ struct Models<'a> {
     plane12: PlaneLanes<'a, M12>,
 }
 
+/// Runs a switched-device stepper when busy (see [`LaneStepper::run`]): its samples go to the
+/// point in each lane (`point_of` picks it from the lane's task).
+fn run_plane<'a, const M: usize>(
+    stepper: &mut LaneStepper<M, M>,
+    lanes: &PlaneLanes<'a, M>,
+    fresh: &mut u32,
+    cursors: &mut [Option<Cursor<'a>>],
+    point_of: for<'t> fn(&'t mut Task<'a>) -> Option<&'t mut PlanePoint<'a, M>>,
+) -> Vec<(usize, LaneOutcome<M>)> {
+    if !stepper.any_busy() {
+        return Vec::new();
+    }
+    let mut sink = |l: usize, block: &SampleBlock<M>| {
+        cursors[l]
+            .as_mut()
+            .and_then(|c| c.point.as_mut())
+            .and_then(|(_, _, task)| point_of(task))
+            .is_some_and(|p| p.sample(block))
+    };
+    stepper.run(lanes, std::mem::take(fresh), &mut sink)
+}
+
 /// Starts a switched point's `step` in lane `l` (see [`launch`]).
 fn launch_plane<'a, const M: usize>(
     l: usize,
@@ -425,44 +447,34 @@ fn run_worker(
                     .map(|(l, o)| (l, Ended::Variational(o))),
             );
         }
-        if steppers.plane.any_busy() {
-            let mut sink = |l: usize, block: &SampleBlock<M>| {
-                cursors[l]
-                    .as_mut()
-                    .and_then(|c| c.point.as_mut())
-                    .is_some_and(|(_, _, task)| match task {
-                        Task::Plane(p) => p.sample(block),
-                        _ => false,
-                    })
-            };
-            let fresh = std::mem::take(&mut steppers.fresh[2]);
-            finished.extend(
-                steppers
-                    .plane
-                    .run(&models.plane, fresh, &mut sink)
-                    .into_iter()
-                    .map(|(l, o)| (l, Ended::Plane(o))),
-            );
-        }
-        if steppers.plane12.any_busy() {
-            let mut sink = |l: usize, block: &SampleBlock<M12>| {
-                cursors[l]
-                    .as_mut()
-                    .and_then(|c| c.point.as_mut())
-                    .is_some_and(|(_, _, task)| match task {
-                        Task::Plane12(p) => p.sample(block),
-                        _ => false,
-                    })
-            };
-            let fresh = std::mem::take(&mut steppers.fresh[3]);
-            finished.extend(
-                steppers
-                    .plane12
-                    .run(&models.plane12, fresh, &mut sink)
-                    .into_iter()
-                    .map(|(l, o)| (l, Ended::Plane12(o))),
-            );
-        }
+        finished.extend(
+            run_plane(
+                &mut steppers.plane,
+                &models.plane,
+                &mut steppers.fresh[2],
+                &mut cursors,
+                |t| match t {
+                    Task::Plane(p) => Some(p),
+                    _ => None,
+                },
+            )
+            .into_iter()
+            .map(|(l, o)| (l, Ended::Plane(o))),
+        );
+        finished.extend(
+            run_plane(
+                &mut steppers.plane12,
+                &models.plane12,
+                &mut steppers.fresh[3],
+                &mut cursors,
+                |t| match t {
+                    Task::Plane12(p) => Some(p),
+                    _ => None,
+                },
+            )
+            .into_iter()
+            .map(|(l, o)| (l, Ended::Plane12(o))),
+        );
         for (l, outcome) in finished {
             let cursor = cursors[l].as_mut().expect("a busy lane has a chain");
             let (i, start, mut point) = cursor.point.take().expect("a busy lane has a point");

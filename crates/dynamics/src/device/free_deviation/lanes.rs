@@ -12,8 +12,7 @@ use paritysim_simd::{Real, f64x4};
 use super::generic::{self, Constants};
 use super::{Held, HeldConstants};
 use crate::device::Device;
-use crate::integrate::State;
-use crate::integrate::lanes::put_lane;
+use crate::device::switched_lanes::{LaneEval, SwitchedLanes, evaluate_scalar_lanes};
 
 type V = f64x4;
 
@@ -67,19 +66,17 @@ impl<'a, const N: usize, const M: usize> FreeDeviationLanes<'a, N, M> {
             aero,
         })
     }
+}
 
-    /// `f(t, y)` of every lane on the held `branches[l]` with the drive forces `forces[l]`
-    /// at `t[l]` ([`Device::drive_forces`], tabulated by the caller): `dydt = (ẋ, ẍ)` in the
-    /// compact layout. Returns the bit masks of the lanes evaluated on the scalar path and of
-    /// those whose scalar right-hand side fails there.
-    pub(crate) fn eval(
+impl<const N: usize, const M: usize> SwitchedLanes<M> for FreeDeviationLanes<'_, N, M> {
+    fn eval(
         &self,
         t: [f64; LANES],
         forces: [[f64; 2]; LANES],
         y: &[V; M],
         branches: [[Branch; 2]; LANES],
         dydt: &mut [V; M],
-    ) -> (u32, u32) {
+    ) -> LaneEval {
         let all = (1u32 << LANES) - 1;
         let mut scalar = all;
         if let Some(aero) = &self.aero {
@@ -93,35 +90,13 @@ impl<'a, const N: usize, const M: usize> FreeDeviationLanes<'a, N, M> {
             dydt[M / 2..M / 2 + N].copy_from_slice(&step.x_ddot);
             scalar = V::bits(step.general | step.singular) & all;
         }
-        let mut failed = 0u32;
-        for l in (0..LANES).filter(|l| scalar & (1 << l) != 0) {
-            match self.scalar_lane(l, t[l], y, branches[l]) {
-                Some(f) => put_lane(dydt, l, &f),
-                None => failed |= 1 << l,
-            }
-        }
-        (scalar, failed)
-    }
-
-    /// Lane `l` on the scalar right-hand side; `None` where it fails.
-    fn scalar_lane(&self, l: usize, t: f64, y: &[V; M], branches: [Branch; 2]) -> Option<[f64; M]> {
-        let device = self.devices[l];
-        let lean = device.free_deviation_rhs.as_ref()?;
-        let mut state = State::default();
-        for i in 0..M / 2 {
-            state.coords[i] = y[i].to_array()[l];
-            state.rates[i] = y[M / 2 + i].to_array()[l];
-        }
-        let mut out = State::default();
-        device
-            .rhs_free_deviation(lean, t, &state, Some(branches), &mut out)
-            .ok()?;
-        Some(std::array::from_fn(|i| {
-            if i < M / 2 {
-                out.coords[i]
-            } else {
-                out.rates[i - M / 2]
-            }
-        }))
+        evaluate_scalar_lanes(scalar, y, dydt, |l, state, out| {
+            let device = self.devices[l];
+            device.free_deviation_rhs.as_ref().is_some_and(|lean| {
+                device
+                    .rhs_free_deviation(lean, t[l], state, Some(branches[l]), out)
+                    .is_ok()
+            })
+        })
     }
 }

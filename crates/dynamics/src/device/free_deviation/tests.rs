@@ -188,6 +188,7 @@ fn a_lift_point_next_to_a_flip_converges_by_shooting() {
 #[test]
 #[allow(clippy::needless_range_loop)] // lanes and entries index several arrays
 fn held_branch_lanes_equal_the_scalar_right_hand_side_bit_for_bit() {
+    use crate::device::switched_lanes::SwitchedLanes;
     use paritysim_simd::f64x4;
     // The Dual PARITY (five coordinates) in batches.
     let dual = device("dual_parity");
@@ -227,7 +228,8 @@ fn held_branch_lanes_equal_the_scalar_right_hand_side_bit_for_bit() {
             let ts = [0.1, 0.2, 0.3, 0.4];
             let forces = std::array::from_fn(|l| devices[l].drive_forces(ts[l]));
             let mut dydt = [f64x4::splat(0.0); 8];
-            let (scalar, failed) = lanes.eval(ts, forces, &y, [branches(sides); 4], &mut dydt);
+            let super::super::switched_lanes::LaneEval { scalar, failed } =
+                lanes.eval(ts, forces, &y, [branches(sides); 4], &mut dydt);
             assert_eq!(failed, 0);
             for l in 0..4 {
                 if scalar & (1 << l) == 0 {

@@ -10,13 +10,12 @@
 //! reduced mass matrix that is not positive definite) is evaluated on its own by the scalar
 //! right-hand side, which also names the error of a lane that fails.
 
-use paritysim_aero::{BladeElementModel, Branch, CoefficientSet};
+use paritysim_aero::{BladeElementModel, Branch, CoefficientSet, HeldBranch};
 use paritysim_simd::{f64x4, sin_cos};
 
 use super::{Device, N, StrokePlane};
 use crate::WingAero;
-use crate::integrate::State;
-use crate::integrate::lanes::put_lane;
+use crate::device::switched_lanes::{LaneEval, SwitchedLanes, evaluate_scalar_lanes};
 
 type V = f64x4;
 
@@ -48,15 +47,6 @@ pub(crate) struct StrokePlaneLanes<'a> {
     springs: [[[V; 3]; 2]; 2],
     /// Each wing's tunable hinge `k(θ = 0)` and the lanes that have one (a mask).
     hinge: [(V, V); 2],
-}
-
-/// Which lanes of a [`StrokePlaneLanes::eval`] left the vector path (bit masks).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct LaneEval {
-    /// Lanes evaluated by the scalar right-hand side.
-    pub(crate) scalar: u32,
-    /// Lanes whose scalar right-hand side failed.
-    pub(crate) failed: u32,
 }
 
 /// `a · x` of the scalar `dot`, lane by lane.
@@ -182,16 +172,14 @@ impl<'a> StrokePlaneLanes<'a> {
             aero,
         })
     }
+}
 
-    /// `f(t, y)` of every lane on the held `branches[l]` (per wing), the actuator force
-    /// `force[l]` at `t[l]` given (the scalar `Actuator::force`, tabulated by the caller):
-    /// `dydt = (ẋ, ẍ)` in the compact layout `(x, ẋ)`. Returns the bit masks of the lanes
-    /// evaluated on the scalar path and of those whose scalar right-hand side fails there
-    /// (their `dydt` is then unspecified).
-    pub(crate) fn eval(
+impl SwitchedLanes<M> for StrokePlaneLanes<'_> {
+    /// The actuator force is `forces[l][0]` (a single drive).
+    fn eval(
         &self,
         t: [f64; LANES],
-        force: [f64; LANES],
+        forces: [[f64; 2]; LANES],
         y: &[V; M],
         branches: [[Branch; 2]; LANES],
         dydt: &mut [V; M],
@@ -216,7 +204,7 @@ impl<'a> StrokePlaneLanes<'a> {
         let plausible = q[0].abs().simd_le(k(paritysim_error::plausible::OFFSET_MM))
             & q[1].abs().simd_le(k(paritysim_error::plausible::ANGLE_RAD));
         scalar |= !plausible.to_bitmask() & ALL;
-        let drive = V::new(force);
+        let drive = V::new(forces.map(|f| f[0]));
         let load = [drive - self.k1 * q[0], -self.k2 * q[1]];
         let drive_torque = mat2(&self.inverse_transpose, load);
         let mut x_ddot = [k(0.0); N];
@@ -247,14 +235,9 @@ impl<'a> StrokePlaneLanes<'a> {
             let own_side = !(chordwise ^ side(|b| b.chordwise_positive))
                 & !(normal ^ side(|b| b.normal_positive));
             scalar |= !(c.simd_gt(zero).to_bitmask() & own_side) & ALL;
+            let held = HeldBranch::lanes(branches.map(|b| b[w]));
             let tau = self.aero[w].and_then(|model| {
-                model.stroke_plane_torque_lanes(
-                    phi_dot,
-                    psi,
-                    (s, c),
-                    psi_dot,
-                    branches.map(|b| b[w]),
-                )
+                model.stroke_plane_torque_lanes(phi_dot, psi, (s, c), psi_dot, &held)
             });
             let Some(tau) = tau else {
                 scalar = (1 << LANES) - 1;
@@ -288,35 +271,13 @@ impl<'a> StrokePlaneLanes<'a> {
         }
         dydt[..N].copy_from_slice(x_dot);
         dydt[N..].copy_from_slice(&x_ddot);
-        let mut failed = 0u32;
-        for l in (0..LANES).filter(|l| scalar & (1 << l) != 0) {
-            match self.scalar_lane(l, t[l], y, branches[l]) {
-                Some(f) => put_lane(dydt, l, &f),
-                None => failed |= 1 << l,
-            }
-        }
-        LaneEval { scalar, failed }
-    }
-
-    /// Lane `l` on the scalar right-hand side; `None` where it fails.
-    fn scalar_lane(&self, l: usize, t: f64, y: &[V; M], branches: [Branch; 2]) -> Option<[f64; M]> {
-        let device = self.devices[l];
-        let lean = device.stroke_plane_rhs.as_ref()?;
-        let mut state = State::default();
-        for i in 0..N {
-            state.coords[i] = y[i].to_array()[l];
-            state.rates[i] = y[N + i].to_array()[l];
-        }
-        let mut out = State::default();
-        device
-            .rhs_stroke_plane(lean, t, &state, Some(branches), &mut out)
-            .ok()?;
-        Some(std::array::from_fn(|i| {
-            if i < N {
-                out.coords[i]
-            } else {
-                out.rates[i - N]
-            }
-        }))
+        evaluate_scalar_lanes(scalar, y, dydt, |l, state, out| {
+            let device = self.devices[l];
+            device.stroke_plane_rhs.as_ref().is_some_and(|lean| {
+                device
+                    .rhs_stroke_plane(lean, t[l], state, Some(branches[l]), out)
+                    .is_ok()
+            })
+        })
     }
 }

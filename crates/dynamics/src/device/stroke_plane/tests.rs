@@ -541,6 +541,7 @@ fn default_options_meet_the_accuracy_goal_against_a_tight_reference() {
 #[allow(clippy::needless_range_loop)] // lanes and entries index several arrays
 fn stroke_plane_lanes_equal_the_scalar_right_hand_side_bit_for_bit() {
     use super::lanes::{LANES, M, StrokePlaneLanes};
+    use crate::device::switched_lanes::SwitchedLanes;
     use paritysim_simd::f64x4;
     let devices = [
         device(true, false, 0.0),
@@ -605,7 +606,7 @@ fn stroke_plane_lanes_equal_the_scalar_right_hand_side_bit_for_bit() {
         }
         let y: [f64x4; M] = y.map(f64x4::new);
         let mut dydt = [f64x4::splat(0.0); M];
-        let eval = lanes.eval(t, force, &y, branches, &mut dydt);
+        let eval = lanes.eval(t, force.map(|f| [f, 0.0]), &y, branches, &mut dydt);
         assert_eq!(eval.failed, 0, "state {k}");
         for l in 0..LANES {
             if eval.scalar & (1 << l) == 0 {
