@@ -111,3 +111,17 @@ def test_calibrate_spec_paths_and_errors() -> None:
         ps.calibrate(spec, {"left_stroke_amplitude": 0.5}, {"actuator.nonsense": (0.0, 1.0)})
     with pytest.raises(ps.InvalidParameterError, match="free"):
         ps.calibrate(spec, {"left_stroke_amplitude": 0.5}, {"actuator.force_per_volt": (2.0, 1.0)})
+
+
+def test_calibrate_a_fixed_wing_device_with_undefined_metrics() -> None:
+    """Issue 33: a fixed wing's `*_rotation_phase_lag` is None; the fit must not crash on it."""
+    spec = ps.devices.load("sreetharan2012_3_3_parity")
+    fit = ps.calibrate(spec, {"left_stroke_amplitude": 0.6}, {"actuator.force_per_volt": (0.5, 2.0)})
+    assert fit.model_outputs["left_rotation_phase_lag"] is None
+    assert fit.model_outputs["left_stroke_amplitude"] == pytest.approx(0.6, abs=1e-4)
+    assert repr(fit).startswith("CalibrationResult(actuator.force_per_volt=0.96") and "\n" not in repr(fit)
+    with pytest.raises(ps.InvalidParameterError, match=r"targets\.left_rotation_phase_lag.*undefined"):
+        ps.calibrate(spec, {"left_rotation_phase_lag": 0.1}, {"actuator.force_per_volt": (0.5, 2.0)})
+    with pytest.raises(ps.InvalidParameterError, match="did you mean `left_stroke_amplitude`") as caught:
+        ps.calibrate(spec, {"left_stroke_amplitud": 0.6}, {"actuator.force_per_volt": (0.5, 2.0)})
+    assert str(caught.value).count("`") <= 12  # a handful of close names, not all 50 metrics

@@ -18,8 +18,7 @@ import numpy as np
 import polars as pl
 from scipy.optimize import least_squares
 
-from . import _core
-from ._errors import invalid
+from ._errors import invalid, suggest
 from .simulation import simulate
 from .spec import Simulation
 
@@ -28,7 +27,9 @@ __all__ = ["CalibrationResult", "calibrate"]
 @dataclass(frozen=True)
 class CalibrationResult:
     """Fitted ``values``, final ``residuals`` (model − target, scaled), ``cost`` (½Σr²),
-    optimiser ``success``/``message``, and every evaluation in ``iterations``."""
+    optimiser ``success``/``message``, every evaluation in ``iterations`` and the model's outputs
+    at the fit (``None`` for a metric the device does not define, e.g. a fixed wing's rotation
+    phase lag). ``repr`` is one summary line; :meth:`summary` a short table."""
 
     values: dict[str, float]
     residuals: np.ndarray
@@ -36,7 +37,19 @@ class CalibrationResult:
     success: bool
     message: str
     iterations: pl.DataFrame
-    model_outputs: dict[str, float]
+    model_outputs: dict[str, float | None]
+
+    def __repr__(self) -> str:
+        fitted = ", ".join(f"{k}={v:.6g}" for k, v in self.values.items())
+        state = "converged" if self.success else "not converged"
+        return f"CalibrationResult({fitted}; cost={self.cost:.3g}, {state}, {len(self.iterations)} evaluations)"
+
+    def summary(self) -> str:
+        """The fitted values, the scaled residuals and the optimiser's message, one per line."""
+        lines = [repr(self), f"  message: {self.message}"]
+        lines += [f"  {k:<40} {v:.9g}" for k, v in self.values.items()]
+        lines.append("  scaled residuals: " + ", ".join(f"{r:.3g}" for r in np.atleast_1d(self.residuals)[:8]))
+        return "\n".join(lines)
 
 
 def calibrate(
@@ -112,10 +125,13 @@ def calibrate(
         goal = np.array([float(targets[k]) for k in keys])
 
         def residual_of(out: dict[str, Any]) -> np.ndarray:
+            available = sorted(k for k in out if not k.startswith("__") and out[k] is not None)
             missing = [k for k in keys if k not in out]
             if missing:
-                available = sorted(k for k in out if not k.startswith("__"))
-                raise invalid(f"targets.{missing[0]}", "<unknown output>", _core.spec_suggestion(missing[0], available))
+                raise invalid(f"targets.{missing[0]}", "<unknown output>", suggest(missing[0], available, listed_by="simulate(spec).metrics"))
+            undefined = [k for k in keys if out[k] is None]
+            if undefined:  # e.g. a fixed wing's rotation phase lag: no number to fit to
+                raise invalid(f"targets.{undefined[0]}", "None (undefined for this device)", "an output this device computes (`simulate(spec).metrics` has a number for it)")
             return (np.array([float(out[k]) for k in keys]) - goal) / scales
 
     log: list[dict[str, float]] = []
@@ -151,5 +167,5 @@ def calibrate(
         success=bool(fit.success),
         message=str(fit.message),
         iterations=pl.DataFrame(log),
-        model_outputs={k: float(v) for k, v in final.items() if not k.startswith("__")},
+        model_outputs={k: None if v is None else float(v) for k, v in final.items() if not k.startswith("__")},
     )
