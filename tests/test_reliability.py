@@ -213,3 +213,88 @@ def test_eq_2_59_at_zero_frequency_names_the_frequency() -> None:
     with pytest.raises(ps.SingularError) as info:
         ps.stability.lti_transfer(1.0, 0.0, [50.0, 0.0])
     assert info.value.field == "frequency_hz[1]"
+
+
+# ----------------------------------------------------------------------------- issue 34
+
+HMF_FAST = {"max_cycles": 5, "samples_per_cycle": 40}
+
+
+def _shared_sweep(checkpoint: Any, values: list[float]) -> Any:
+    spec = ps.load_spec(EXAMPLES / "hmf.toml")
+    return ps.sweep(spec, {"actuator.frequency_hz": values}, metrics=["left_stroke_amplitude"], options=HMF_FAST, threads=1, chunk_size=1, checkpoint=checkpoint, progress=False)
+
+
+def test_two_threads_sharing_a_checkpoint_both_return_their_tables(tmp_path: Any) -> None:
+    """Issue 34's lost table: two sweeps on one checkpoint at once; one raised FileNotFoundError
+    from `finish()` (it unlinked parts the other had removed). Both return every row, and the
+    final table holds the rows of both (neither replaced the other's)."""
+    import polars as pl
+    import threading
+
+    for attempt in range(3):
+        path = tmp_path / f"shared{attempt}.parquet"
+        grids = [[100.0, 105.0, 110.0, 115.0], [112.5, 117.5, 122.5, 127.5]]
+        out: dict[int, Any] = {}
+        barrier = threading.Barrier(2)
+
+        def run(i: int, path: Any = path, grids: Any = grids, out: Any = out, barrier: Any = barrier) -> None:
+            barrier.wait()
+            try:
+                out[i] = _shared_sweep(path, grids[i])
+            except BaseException as exc:  # noqa: BLE001 - reported below
+                out[i] = exc
+
+        threads = [threading.Thread(target=run, args=(i,)) for i in range(2)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        for i in range(2):
+            assert isinstance(out[i], pl.DataFrame), out[i]
+            assert out[i]["actuator.frequency_hz"].to_list() == grids[i] and (out[i]["status"] == "ok").all()
+        saved = pl.read_parquet(path)
+        assert sorted(saved["actuator.frequency_hz"].to_list()) == sorted(grids[0] + grids[1])
+        assert not path.with_name(path.name + ".parts").exists()
+
+
+def test_two_processes_sharing_a_checkpoint_both_finish(tmp_path: Any) -> None:
+    import os
+    import subprocess
+    import sys
+
+    import polars as pl
+
+    path = tmp_path / "shared.parquet"
+    script = (
+        "import sys, paritysim as ps\n"
+        f"spec = ps.load_spec({str(EXAMPLES / 'hmf.toml')!r})\n"
+        "values = [float(v) for v in sys.argv[2].split(',')]\n"
+        f"df = ps.sweep(spec, {{'actuator.frequency_hz': values}}, metrics=['left_stroke_amplitude'], options={HMF_FAST!r}, threads=1, chunk_size=1, checkpoint=sys.argv[1], progress=False)\n"
+        "assert df.height == len(values) and (df['status'] == 'ok').all()\n"
+        "print('ok', df.height)\n"
+    )
+    grids = ["100,105,110,115,120", "102.5,107.5,112.5,117.5,122.5"]
+    procs = [subprocess.Popen([sys.executable, "-c", script, str(path), g], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env={**os.environ}) for g in grids]
+    for p in procs:
+        out, err = p.communicate(timeout=240)
+        assert p.returncode == 0, err[-2000:]
+        assert out.strip() == "ok 5"
+    saved = pl.read_parquet(path)
+    assert saved.height == 10 and saved["actuator.frequency_hz"].n_unique() == 10
+
+
+def test_checkpoint_paths_that_cannot_hold_a_table_name_checkpoint(tmp_path: Any) -> None:
+    spec = ps.load_spec(EXAMPLES / "hmf.toml")
+    a_file = tmp_path / "file.txt"
+    a_file.write_text("x")
+    garbage = tmp_path / "garbage.parquet"
+    garbage.write_text("not parquet")
+    for bad in [tmp_path, a_file / "study.parquet", garbage, 42, b"x.parquet"]:
+        with pytest.raises(ps.InvalidParameterError) as info:
+            ps.sweep(spec, {"actuator.frequency_hz": [100.0]}, options=HMF_FAST, checkpoint=bad, progress=False)
+        assert info.value.field == "checkpoint", (bad, info.value)
+    # A missing directory is created (documented behaviour), and the table lands there.
+    deep = tmp_path / "new" / "dir" / "study.parquet"
+    ps.sweep(spec, {"actuator.frequency_hz": [100.0]}, options=HMF_FAST, checkpoint=deep, progress=False)
+    assert deep.exists()

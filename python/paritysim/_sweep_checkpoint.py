@@ -1,6 +1,15 @@
 """Sweep checkpoints: finished chunks flushed to ``path.parts/`` as they complete, the final
 table at ``path``, each file stamped with the sweep's fingerprint so a re-run resumes only the
-same sweep (``paritysim.sweep``'s ``checkpoint``)."""
+same sweep (``paritysim.sweep``'s ``checkpoint``).
+
+Several writers may share one checkpoint (two sweeps in threads or processes, issue 34): part
+names are unique per writer, every file is written to a temporary name and renamed, and the
+loads, flushes and finishes of every writer in the checkpoint's directory take turns under an
+``flock`` of that directory. A writer's finish deletes only the parts whose rows its table holds
+(the ones it wrote or loaded), and when another writer finished since this one loaded, its rows
+that this sweep does not have are kept in the final table: no writer deletes or replaces rows it
+does not hold.
+"""
 
 from __future__ import annotations
 
@@ -10,7 +19,8 @@ import json
 import math
 import os
 import uuid
-from collections.abc import Sequence
+import warnings
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -22,57 +32,169 @@ from ._errors import invalid
 _METADATA_KEY = "paritysim.sweep"
 _FORMAT = 1
 
+try:  # POSIX: writers of one directory take turns; elsewhere only the atomic renames protect
+    import fcntl
+except ImportError:  # pragma: no cover - Windows
+    fcntl = None  # type: ignore[assignment]
+
+
+def _refuse(path: Any, why: str) -> Exception:
+    return invalid("checkpoint", str(path), f"a writable .parquet file path ({why})")
+
+
+def _checked_path(path: Any) -> Path:
+    """``path`` as a checkpoint file, its directory created: a typed error naming
+    ``checkpoint`` for a path that is not text, is a directory, or cannot be written."""
+    if isinstance(path, bytes) or not isinstance(path, (str, os.PathLike)):
+        raise invalid("checkpoint", repr(path)[:60], "a file path (str or os.PathLike) ending in .parquet")
+    try:
+        file = Path(os.fspath(path))
+    except TypeError as exc:
+        raise invalid("checkpoint", repr(path)[:60], "a file path (str or os.PathLike) ending in .parquet") from exc
+    if not str(file) or str(file).endswith(os.sep) or file.name in ("", ".", ".."):
+        raise _refuse(path, "a file name, not a directory")
+    if file.is_dir():
+        raise _refuse(path, "it is a directory")
+    parts = file.with_name(file.name + ".parts")
+    if parts.exists() and not parts.is_dir():
+        raise _refuse(path, f"{parts} is not a directory")
+    try:
+        file.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise _refuse(path, f"its directory cannot be created: {exc.strerror or exc}") from exc
+    if not os.access(file.parent, os.W_OK | os.X_OK):
+        raise _refuse(path, f"{file.parent} is not writable")
+    return file
+
 
 class _Checkpoint:
     """``path`` (the final table) plus ``path.parts/`` (chunks flushed while running)."""
 
-    def __init__(self, path: str | os.PathLike[str], fingerprint: str) -> None:
-        self.path = Path(path)
+    def __init__(self, path: str | os.PathLike[str], fingerprint: str, names: Sequence[str] = ()) -> None:
+        self.path = _checked_path(path)
         self.parts = self.path.with_name(self.path.name + ".parts")
         self.fingerprint = fingerprint
+        self.names = list(names)  # the grid's columns: a row's key
+        self._writer = uuid.uuid4().hex[:12]
+        self._held: set[Path] = set()  # parts whose rows this writer's final table holds
+        self._seen: tuple[int, int, int] | None = None  # the final table as loaded
 
-    def _check(self, file: Path) -> None:
-        meta = pl.read_parquet_metadata(file)
-        found = meta.get(_METADATA_KEY)
-        if found != self.fingerprint:
+    @contextlib.contextmanager
+    def _turn(self) -> Iterator[None]:
+        """Exclusive use of the checkpoint's directory among writers (threads and processes)."""
+        if fcntl is None:
+            yield
+            return
+        try:
+            fd = os.open(self.path.parent, os.O_RDONLY)
+        except OSError as exc:
+            raise _refuse(self.path, f"its directory cannot be opened: {exc.strerror or exc}") from exc
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX)
+            yield
+        finally:
+            os.close(fd)  # releases the lock
+
+    @staticmethod
+    def _stamp(file: Path) -> tuple[int, int, int] | None:
+        try:
+            st = file.stat()
+        except FileNotFoundError:
+            return None
+        return (st.st_ino, st.st_mtime_ns, st.st_size)
+
+    def _read(self, file: Path) -> pl.DataFrame | None:
+        """One stored table after checking its fingerprint (None: removed meanwhile)."""
+        try:
+            meta = pl.read_parquet_metadata(file)
+        except FileNotFoundError:
+            return None
+        except (OSError, pl.exceptions.PolarsError) as exc:
+            raise invalid("checkpoint", str(file), f"a checkpoint written by paritysim.sweep (it cannot be read: {str(exc)[:80]}); delete it or choose another path") from exc
+        if meta.get(_METADATA_KEY) != self.fingerprint:
             raise invalid(
                 "checkpoint",
                 str(file),
                 "a checkpoint written by the same sweep (same spec, options, parameter names, metrics and keep_cycle); "
                 "delete it or choose another path",
             )
+        try:
+            return pl.read_parquet(file)
+        except FileNotFoundError:
+            return None
+        except (OSError, pl.exceptions.PolarsError) as exc:
+            raise invalid("checkpoint", str(file), f"a readable checkpoint ({str(exc)[:80]}); delete it or choose another path") from exc
 
     def load(self) -> pl.DataFrame | None:
         """Every finished row stored so far (final table and parts), or None."""
         frames = []
-        if self.path.exists():
-            self._check(self.path)
-            frames.append(pl.read_parquet(self.path))
-        if self.parts.is_dir():
-            for part in sorted(self.parts.glob("part-*.parquet")):
-                self._check(part)
-                frames.append(pl.read_parquet(part))
+        with self._turn():
+            self._seen = self._stamp(self.path)
+            if self._seen is not None:
+                df = self._read(self.path)
+                if df is not None:
+                    frames.append(df)
+            if self.parts.is_dir():
+                for part in sorted(self.parts.glob("part-*.parquet")):
+                    df = self._read(part)
+                    if df is not None:
+                        frames.append(df)
+                        self._held.add(part)
         if not frames:
             return None
         return pl.concat(frames, how="vertical_relaxed")
 
     def _write(self, df: pl.DataFrame, file: Path) -> None:
-        file.parent.mkdir(parents=True, exist_ok=True)
         tmp = file.with_name(f".{file.name}.{uuid.uuid4().hex}.tmp")
-        df.write_parquet(tmp, metadata={_METADATA_KEY: self.fingerprint})
-        os.replace(tmp, file)  # atomic: a killed run never leaves half a part
+        try:
+            file.parent.mkdir(parents=True, exist_ok=True)
+            df.write_parquet(tmp, metadata={_METADATA_KEY: self.fingerprint})
+            os.replace(tmp, file)  # atomic: a killed run never leaves half a part
+        except OSError as exc:
+            with contextlib.suppress(OSError):
+                tmp.unlink()
+            raise _refuse(self.path, f"writing {file.name} failed: {exc.strerror or exc}") from exc
 
     def flush(self, df: pl.DataFrame) -> None:
         if df.height:
-            self._write(df, self.parts / f"part-{int(df['point'][0]):09d}-{uuid.uuid4().hex[:8]}.parquet")
+            part = self.parts / f"part-{int(df['point'][0]):09d}-{self._writer}-{uuid.uuid4().hex[:8]}.parquet"
+            with self._turn():
+                self._write(df, part)
+            self._held.add(part)
 
     def finish(self, df: pl.DataFrame) -> None:
-        self._write(df, self.path)
-        if self.parts.is_dir():
-            for part in self.parts.glob("part-*.parquet"):
-                part.unlink()
+        with self._turn():
+            if self._stamp(self.path) not in (None, self._seen):
+                df = self._with_rows_of_another_writer(df)
+                if df is None:
+                    return
+            self._write(df, self.path)
+            for part in self._held:
+                with contextlib.suppress(FileNotFoundError):
+                    part.unlink()
             with contextlib.suppress(OSError):
-                self.parts.rmdir()
+                self.parts.rmdir()  # only when no other writer still has parts there
+
+    def _with_rows_of_another_writer(self, df: pl.DataFrame) -> pl.DataFrame | None:
+        """``df`` plus the rows of the final table another writer finished since this one
+        loaded that ``df`` lacks (None, with a warning, when that table is another sweep's)."""
+        try:
+            other = self._read(self.path)
+        except _core.InvalidParameterError:
+            warnings.warn(
+                f"checkpoint {self.path} was finished meanwhile by a different sweep; this sweep's rows stay in {self.parts}",
+                RuntimeWarning,
+                stacklevel=4,
+            )
+            return None
+        if other is None or not other.height:
+            return df
+        keys = {_key(r) for r in df.select(self.names).rows()} if self.names else {()}
+        rows = other.select(self.names).rows() if self.names else [()] * other.height
+        extra = [i for i, r in enumerate(rows) if _key(r) not in keys]
+        if not extra:
+            return df
+        return pl.concat([df, other[extra]], how="vertical_relaxed")
 
 
 def _fingerprint(spec: str, names: Sequence[str], metrics: Sequence[str], cycle: Sequence[str]) -> str:

@@ -405,7 +405,7 @@ def sweep(
 
     rows = param_table.rows() if param_table.width else [()] * max(table.height, 1)
     n = len(rows)
-    store = _Checkpoint(checkpoint, _fingerprint(spec_json, table.columns, metric_names, cycle_columns)) if checkpoint is not None else None
+    store = _Checkpoint(checkpoint, _fingerprint(spec_json, table.columns, metric_names, cycle_columns), table.columns) if checkpoint is not None else None
     done: list[pl.DataFrame] = []
     todo = list(range(n))
     if store is not None:
