@@ -54,6 +54,80 @@ def reals(field: str, value: Any) -> Any:
         raise invalid(field, shown if len(shown) <= 60 else shown[:57] + "...", "a real number or an array of real numbers") from exc
 
 
+def finite_reals(field: str, value: Any) -> Any:
+    """`reals`, and every element finite: a NaN, an infinity or ``None`` (which numpy reads as
+    NaN) is an ``InvalidParameterError`` naming ``field`` (``field[i]`` for an array element)."""
+    import numpy as np
+
+    a = reals(field, value)
+    bad = ~np.isfinite(a)
+    if bad.any():
+        where = tuple(int(i) for i in np.argwhere(bad)[0])
+        name = field + "".join(f"[{i}]" for i in where)
+        raise invalid(name, repr(value) if a.ndim == 0 else a[where], "a finite real number")
+    return a
+
+
+#: Environment variable bounding the bytes one call may allocate (see `memory_limit`).
+MAX_BYTES_ENV = "PARITYSIM_MAX_BYTES"
+
+
+def _proc_kib(path: str, key: str) -> int | None:
+    try:
+        with open(path, encoding="ascii") as f:
+            for line in f:
+                if line.startswith(key + ":"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None
+
+
+def memory_limit() -> int:
+    """Bytes one call may allocate for its arrays: ``$PARITYSIM_MAX_BYTES`` when set, else half
+    of the memory available now (``MemAvailable``, and what an address-space limit
+    ``RLIMIT_AS`` leaves to this process), at least 64 MB."""
+    import os
+
+    given = os.environ.get(MAX_BYTES_ENV)
+    if given:
+        try:
+            return max(int(float(given)), 1)
+        except (ValueError, OverflowError):
+            raise invalid(MAX_BYTES_ENV, repr(given), "a number of bytes") from None
+    available = _proc_kib("/proc/meminfo", "MemAvailable")
+    if available is None:
+        try:
+            available = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+        except (ValueError, OSError, AttributeError):
+            available = 8 << 30
+    try:
+        import resource
+
+        soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+        if soft != resource.RLIM_INFINITY:
+            used = _proc_kib("/proc/self/status", "VmSize") or 0
+            available = min(available, max(soft - used, 0))
+    except (ImportError, OSError, ValueError):
+        pass
+    return max(available // 2, 64 << 20)
+
+
+def sized(field: str, value: Any, count: int, bytes_each: float, what: str) -> None:
+    """Refuses, before anything is allocated, a call whose ``count`` items of about
+    ``bytes_each`` bytes (``what``) exceed `memory_limit`: an ``InvalidParameterError`` naming
+    ``field`` with the bytes needed and allowed."""
+    need = int(count) * float(bytes_each)
+    limit = memory_limit()
+    if need > limit:
+        raise invalid(
+            field,
+            value,
+            f"small enough for {what} to fit in memory (~{need / 1e9:.3g} GB needed, {limit / 1e9:.3g} GB allowed: "
+            f"half the available memory, or ${MAX_BYTES_ENV})",
+        )
+
+
 def _edit_distance(a: str, b: str) -> int:
     """Levenshtein distance (the Rust core's `schema::nearest` uses the same measure)."""
     if len(a) < len(b):
