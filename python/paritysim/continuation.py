@@ -167,7 +167,12 @@ def _current(spec: Simulation, path: str) -> float:
     return float(value)
 
 
-def continuation(spec: Simulation, path: str, stop: float, *, start: float | None = None, **settings: Any) -> ContinuationResult:
+#: Wall budget of a whole `continuation` by default (ms); each orbit also has the spec's
+#: ``options.max_wall_ms``.
+MAX_WALL_MS = 600_000.0
+
+
+def continuation(spec: Simulation, path: str, stop: float, *, start: float | None = None, max_wall_ms: float = MAX_WALL_MS, **settings: Any) -> ContinuationResult:
     """Follows the periodic orbit of ``spec`` as ``path`` goes from ``start`` (default: the
     spec's value) to ``stop``.
 
@@ -177,7 +182,8 @@ def continuation(spec: Simulation, path: str, stop: float, *, start: float | Non
     default |stop − start| / 10), ``multiplier_tolerance``, ``cyclic`` (index of a cyclic
     integrated coordinate, e.g. 1 for ``q2`` of a K2 = 0 linear whippletree), ``locate``,
     ``metrics`` (orbit metrics per point, default True). The spec's ``options`` set the
-    integration (rtol capped at 1e-10 for shooting).
+    integration (rtol capped at 1e-10 for shooting). ``max_wall_ms`` (default 600 000, 10
+    min) bounds the whole branch; Ctrl-C stops it within tens of milliseconds.
 
     Raises
     ------
@@ -197,7 +203,8 @@ def continuation(spec: Simulation, path: str, stop: float, *, start: float | Non
     if unknown:
         raise invalid(unknown[0], "<unknown setting>", _core.spec_suggestion(unknown[0], list(SETTINGS)) or "one of: " + ", ".join(SETTINGS))
     first = _current(spec, path) if start is None else real("start", start)
-    native = _core.continuation(spec.to_json(), path, first, real("stop", stop), json.dumps(settings))
+    settings_json = json.dumps(settings, default=lambda o: o.item() if hasattr(o, "item") else repr(o))  # Rust names a bad value
+    native = _core.continuation(spec.to_json(), path, first, real("stop", stop), settings_json, real("max_wall_ms", max_wall_ms))
     record = native.record  # paritysim_spec::continuation::BranchRecord
     mus = record["multipliers"]
     states = record["states"]

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -32,7 +33,7 @@ import polars as pl
 from matplotlib.figure import Figure
 
 from . import _core
-from ._errors import invalid, real, reals, whole
+from ._errors import invalid, real, reals, sized, whole
 from .spec import Simulation
 
 __all__ = [
@@ -83,9 +84,20 @@ def hill_monodromy(beta0: float, kappa: float, t0: float = -math.pi / 2) -> np.n
     return _core.stability_hill_monodromy(real("beta0", beta0), real("kappa", kappa), real("t0", t0))
 
 
-def hill_solution(beta0: float, kappa: float, t: Any, t0: float = -math.pi / 2) -> np.ndarray:
-    """Solution matrices ``Π(t_i, t0)`` (eq. 2.33) at each ``t_i >= t0``, shape ``(n, 2, 2)``."""
-    return _core.stability_hill_solution(real("beta0", beta0), real("kappa", kappa), real("t0", t0), _f64(t, "t"))
+#: Wall budget of `hill_solution` by default (ms).
+HILL_SOLUTION_MAX_WALL_MS = 60_000.0
+
+
+def hill_solution(beta0: float, kappa: float, t: Any, t0: float = -math.pi / 2, *, max_wall_ms: float = HILL_SOLUTION_MAX_WALL_MS) -> np.ndarray:
+    """Solution matrices ``Π(t_i, t0)`` (eq. 2.33) at each ``t_i >= t0``, shape ``(n, 2, 2)``.
+
+    Each ``t_i`` is integrated from ``t0`` (within 1e4 of it), so many late times take a while:
+    Ctrl-C stops the call between two of them and ``max_wall_ms`` (default 60 s) bounds it
+    (``IntegrationError`` naming ``max_wall_ms``).
+    """
+    times = _f64(t, "t")
+    sized("t", f"{times.size} times", times.size, 32, "the solution matrices")
+    return _core.stability_hill_solution(real("beta0", beta0), real("kappa", kappa), real("t0", t0), times, real("max_wall_ms", max_wall_ms))
 
 
 def hill_floquet(beta0: float, kappa: float) -> dict[str, Any]:
@@ -344,6 +356,12 @@ def k2_sweep(spec: Simulation | dict[str, Any], k2: Any, **options: Any) -> pl.D
 
 #: Orbit samples of `linearise` (its cycle averages), also used by `disturbance_response`.
 _LINEARISE_SAMPLES = 2000
+#: Bytes `linearise` holds per orbit sample (a state, its time and the averaged terms; the
+#: issue 34 reproducer allocated 112 GB for 1e9 samples), with a margin.
+_BYTES_PER_ORBIT_SAMPLE = 256
+#: Bytes `disturbance_response` holds per sample of a measurement window (two windows, two
+#: signs of the disturbance, a state and its time each), with a margin.
+_BYTES_PER_WINDOW_SAMPLE = 512
 
 
 def linearise(spec: Simulation | dict[str, Any], samples: int = _LINEARISE_SAMPLES, **options: Any) -> dict[str, Any]:
@@ -356,7 +374,9 @@ def linearise(spec: Simulation | dict[str, Any], samples: int = _LINEARISE_SAMPL
     flapping) and ``lti_averaged`` (cycle average of the full model's variational equation,
     which adds the linkage's ``geometric_stiffness`` in mN·mm/rad).
     """
-    return _core.stability_linearise(_device(spec), _shooting(options), whole("samples", samples))
+    n = whole("samples", samples, 8, 10**9)
+    sized("samples", n, n, _BYTES_PER_ORBIT_SAMPLE, "the orbit samples")
+    return _core.stability_linearise(_device(spec), _shooting(options), n)
 
 
 def disturbance_response(
@@ -384,6 +404,15 @@ def disturbance_response(
     nulls elsewhere; the others are kept).
     """
     freqs = _f64(frequency_hz, "frequency_hz")
+    if settle_cycles is not None:
+        settle_cycles = whole("settle_cycles", settle_cycles, 0, 100_000)
+    if max_window_cycles is not None:
+        max_window_cycles = whole("max_window_cycles", max_window_cycles, 1, 10_000)
+    if samples_per_cycle is not None:
+        samples_per_cycle = whole("samples_per_cycle", samples_per_cycle, 16, 10**9)
+    per_window = (samples_per_cycle or 400) * (max_window_cycles or 12)
+    parallel = max(1, min(freqs.size, os.cpu_count() or 1))
+    sized("samples_per_cycle" if samples_per_cycle is not None else "max_window_cycles", samples_per_cycle or max_window_cycles, per_window * parallel, _BYTES_PER_WINDOW_SAMPLE, "the measurement windows")
     dist = {"settle_cycles": settle_cycles, "max_window_cycles": max_window_cycles, "samples_per_cycle": samples_per_cycle}
     device = _device(spec)
     raw = _core.stability_disturbance_response(device, freqs, real("amplitude", amplitude), _shooting(options), _shooting(dist))

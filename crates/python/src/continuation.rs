@@ -5,7 +5,7 @@ use paritysim_spec::continuation::{ContinuationRun, ContinuationSettings};
 use pyo3::prelude::*;
 
 use crate::convert::{bindings, from_json, to_py};
-use crate::spec::{cancellable, parse};
+use crate::spec::{cancellable, parse, within};
 
 /// A continued branch, kept so that its bifurcations can be followed.
 #[pyclass(module = "paritysim._core", frozen)]
@@ -44,16 +44,21 @@ bindings! {
     run cancellable;
     class ContinuationOutput;
 
-    /// Continues the periodic orbit of a JSON spec in `path` from `start` to `stop`.
+    /// Continues the periodic orbit of a JSON spec in `path` from `start` to `stop`, within
+    /// `max_wall_ms` for the whole branch (None: only each orbit's `options.max_wall_ms`).
+    #[pyo3(signature = (json, path, start, stop, settings_json, max_wall_ms = None))]
     fn continuation(
         json: &str,
         path: &str,
         start: f64,
         stop: f64,
         settings_json: &str,
+        max_wall_ms: Option<f64>,
     ) -> ContinuationOutput {
         let settings: ContinuationSettings = from_json("settings", settings_json)?;
-        let run = ContinuationRun::new(parse(json)?, path, start, stop, settings)?;
+        let run = within(max_wall_ms, || {
+            ContinuationRun::new(parse(json)?, path, start, stop, settings)
+        })?;
         Ok(ContinuationOutput { run })
     }
 }

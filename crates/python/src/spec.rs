@@ -145,6 +145,49 @@ pub(crate) fn cancellable<T: Send>(
     interruptible(py, &cancel, move || budget::cancellable(&flag, work))
 }
 
+/// Runs `work` with a wall-clock budget of `max_wall_ms` (None: none of its own) installed on
+/// this thread (`budget::Budget`; the call's cancel flag and any outer deadline still apply):
+/// every integration and `budget::check` it makes stops once the budget is spent, and the call
+/// then fails with an `IntegrationError` naming `max_wall_ms` (a whole continuation, a long
+/// list of Hill solutions: issue 34).
+///
+/// # Errors
+/// `max_wall_ms` outside (0, 1e9] ms; the spent budget; those of `work`.
+pub(crate) fn within<T>(max_wall_ms: Option<f64>, work: impl FnOnce() -> Result<T>) -> Result<T> {
+    let Some(ms) = max_wall_ms else {
+        return work();
+    };
+    if !(ms.is_finite() && ms > 0.0 && ms <= 1e9) {
+        return Err(paritysim_error::Error::invalid(
+            "max_wall_ms",
+            ms.to_string(),
+            "a wall-time budget in (0, 1e9] ms",
+        ));
+    }
+    let start = std::time::Instant::now();
+    let out = {
+        let _guard = budget::Budget::new(Some(ms), None).enter();
+        work()
+    };
+    match out {
+        Err(paritysim_error::Error::Cancelled) => Err(paritysim_error::Error::Cancelled),
+        out if start.elapsed().as_secs_f64() * 1e3 >= ms => {
+            Err(paritysim_error::Error::Integration {
+                time: f64::NAN,
+                state: Vec::new(),
+                reason: format!(
+                    "exceeded the wall-time budget `max_wall_ms` = {ms} ms{}",
+                    out.err()
+                        .filter(|e| !e.to_string().contains("wall-time budget"))
+                        .map_or(String::new(), |e| format!(" (stopped: {e})"))
+                ),
+            }
+            .attributed("max_wall_ms", ms, "a larger budget (ms), or less work"))
+        }
+        out => out,
+    }
+}
+
 /// Simulates a JSON spec on a worker thread (GIL released); Ctrl-C stops it within a few
 /// tens of milliseconds and raises `KeyboardInterrupt`.
 /// `columns` / `metrics` select what is built (`None`: everything).
@@ -186,9 +229,13 @@ fn simulate_controlled(
 ) -> PyResult<SimulationOutput> {
     let spec = parse(json).py_err()?;
     let (device, options) = spec.model().py_err()?;
-    let options = spec
+    let mut options = spec
         .with_outputs(&device, &options, columns.as_deref(), metrics.as_deref())
         .py_err()?;
+    // Ctrl-C is polled from the integrator's budget checks as in `simulate` (the controller's
+    // own Python calls did not see it: issue 34).
+    let cancel = CancelFlag::new();
+    options.cancel = Some(cancel.clone());
     let mut raised: Option<PyErr> = None;
     let mut call = |t: f64, s: &paritysim_flight::FlightSample| {
         Python::attach(|py| {
@@ -205,13 +252,13 @@ fn simulate_controlled(
             paritysim_error::Error::Cancelled
         })
     };
-    let r = py.detach(|| {
+    let r = interruptible_here(py, &cancel, || {
         spec.run_controlled(&device, &options, rate_hz, &mut call)
             .map_err(|e| spec.attribute(e))
     });
     match (raised, r) {
         (Some(e), _) => Err(e),
-        (None, r) => output(py, Simulation::asked_metrics(&options, r.py_err()?)),
+        (None, r) => output(py, Simulation::asked_metrics(&options, r?)),
     }
 }
 

@@ -8,7 +8,7 @@ use nalgebra::Complex;
 use numpy::{Complex64, PyArray1, PyReadonlyArray1};
 use paritysim_dynamics::floquet::records::{
     BalanceSweepRecord, DisturbanceRecord, FloquetRecord, HillFloquetRecord, HillParametersRecord,
-    hill_solutions, regions, rows2,
+    regions, rows2,
 };
 use paritysim_dynamics::floquet::{self, DisturbanceOptions, PhysicalParameters, ShootingOptions};
 use paritysim_error::Result;
@@ -17,7 +17,8 @@ use pyo3::types::PyDict;
 
 use crate::convert::{Floats, bindings, from_json, to_vec};
 use crate::errors::IntoPyResult;
-use crate::spec::{cancellable, device as parse_device};
+use crate::spec::{cancellable, device as parse_device, within};
+use paritysim_dynamics::integrate::budget;
 
 fn c64(z: Complex<f64>) -> Complex64 {
     Complex64::new(z.re, z.im)
@@ -40,8 +41,20 @@ bindings! {
     }
 
     /// Solution matrices `Π(t_i, t0)` of eq. 2.25 at each `t_i >= t0`, shape `(n, 2, 2)`.
-    fn stability_hill_solution(beta0: f64, kappa: f64, t0: f64, t: Floats) {
-        hill_solutions(beta0, kappa, t0, &t)
+    /// The budget (Ctrl-C, `max_wall_ms`) is checked between the `t_i`: each is an
+    /// integration of up to 1e4 time units.
+    #[pyo3(signature = (beta0, kappa, t0, t, max_wall_ms = None))]
+    fn stability_hill_solution(beta0: f64, kappa: f64, t0: f64, t: Floats, max_wall_ms: Option<f64>) {
+        within(max_wall_ms, || {
+            let mut out = Vec::with_capacity(t.len());
+            for (i, ti) in t.iter().enumerate() {
+                budget::check(0.0)?;
+                let m = floquet::hill_solution_matrix(beta0, kappa, t0, *ti)
+                    .map_err(|e| e.at_index(i, Some("t")))?;
+                out.push(rows2(&m));
+            }
+            Ok(out)
+        })
     }
 
     /// Floquet analysis of eq. 2.25 (`floquet::records::HillFloquetRecord`).
