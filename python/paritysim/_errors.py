@@ -190,3 +190,52 @@ def suggest(name: str, valid: Iterable[str], limit: int = 5, listed_by: str | No
         others = f"also close: {', '.join(f'`{c}`' for c in close[1:])}; " if len(close) > 1 else ""
         return f"a known name: did you mean `{close[0]}`? ({others}{where})"
     return f"a known name (none close to `{name}`; {where})"
+
+
+#: Points per call of an array path that is evaluated in chunks (`chunked`): the native call
+#: holds several times its output while it runs (issue 34 measured ~20x), so a chunk of 16384
+#: points peaks at tens of MB whatever the length of the arrays.
+CHUNK_POINTS = 1 << 14
+
+
+def _shifted(exc: BaseException, start: int, names: Iterable[str]) -> BaseException:
+    """``exc`` of a chunk starting at element ``start``, its ``name[i]`` indices (message,
+    ``.field``, ``.problems``) shifted to the whole array's."""
+    pattern = re.compile(r"\b(" + "|".join(re.escape(n) for n in names) + r")\[(\d+)\]")
+
+    def shift(text: Any) -> Any:
+        return pattern.sub(lambda m: f"{m.group(1)}[{int(m.group(2)) + start}]", text) if isinstance(text, str) else text
+
+    new = type(exc)(shift(str(exc)))
+    for attr, value in vars(exc).items():
+        if attr == "problems" and isinstance(value, list):
+            value = [tuple(shift(v) for v in p) for p in value]
+        setattr(new, attr, shift(value))
+    return new
+
+
+def chunked(call: Any, inputs: list[Any], names: Iterable[str]) -> dict[str, Any]:
+    """``call(*inputs)`` (1-D arrays of equal length, every output's first axis per point)
+    evaluated `CHUNK_POINTS` points at a time into outputs allocated once; an error's element
+    index is the whole array's. Ctrl-C is seen between chunks."""
+    import numpy as np
+
+    from ._exceptions import ParitysimError
+
+    n = int(inputs[0].size)
+    if n <= CHUNK_POINTS:
+        out: dict[str, Any] = call(*inputs)
+        return out
+    names = list(names)
+    whole_out: dict[str, Any] = {}
+    for start in range(0, n, CHUNK_POINTS):
+        try:
+            part = call(*(x[start : start + CHUNK_POINTS] for x in inputs))
+        except ParitysimError as exc:
+            raise _shifted(exc, start, names) from None
+        for key, value in part.items():
+            value = np.asarray(value)
+            if key not in whole_out:
+                whole_out[key] = np.empty((n, *value.shape[1:]), dtype=value.dtype)
+            whole_out[key][start : start + value.shape[0]] = value
+    return whole_out

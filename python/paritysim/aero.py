@@ -22,7 +22,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _core
-from ._errors import real, whole
+from ._errors import chunked, finite_reals, invalid, real, reals, sized, whole
 
 __all__ = [
     "AIR_DENSITY",
@@ -56,9 +56,27 @@ TABLE_3_3: dict[str, dict[str, float]] = {
 }  # fmt: skip
 
 
-def _flat(a: npt.ArrayLike) -> tuple[FloatArray, tuple[int, ...]]:
-    x = np.asarray(a, dtype=np.float64)
+def _flat(a: npt.ArrayLike, name: str = "alpha") -> tuple[FloatArray, tuple[int, ...]]:
+    x = reals(name, a)
     return np.ascontiguousarray(x).ravel(), x.shape
+
+
+def _model(name: str, value: Any) -> str:
+    if not isinstance(value, str):
+        raise invalid(name, repr(value)[:60], "a name (str)")
+    return value
+
+
+def _finite_out(out: dict[str, FloatArray], inputs: dict[str, FloatArray]) -> None:
+    """An overflow (a non-finite output of finite inputs) is an error naming the input with the
+    largest magnitude at the first such point (issue 34: huge finite rates gave inf/NaN)."""
+    for values in out.values():
+        values = np.asarray(values)
+        if values.dtype.kind == "f" and not np.isfinite(values).all():
+            i = int(np.argwhere(~np.isfinite(values.reshape(values.shape[0], -1)))[0][0])
+            name = max(inputs, key=lambda k: abs(float(inputs[k][i if inputs[k].size > 1 else 0])))
+            v = float(inputs[name][i if inputs[name].size > 1 else 0])
+            raise invalid(f"{name}[{i}]" if inputs[name].size > 1 else name, v, "small enough that the blade-element terms stay finite (they overflow here)")
 
 
 def coefficients(alpha: npt.ArrayLike, model: str = _core.AERO_DEFAULT_MODEL) -> dict[str, FloatArray]:
@@ -73,14 +91,19 @@ def coefficients(alpha: npt.ArrayLike, model: str = _core.AERO_DEFAULT_MODEL) ->
     Raises ``InvalidParameterError`` for an unknown model or an angle outside [0, pi].
     """
     a, shape = _flat(alpha)
-    out = _core.aero_coefficients(a, str(model))
+    name = _model("model", model)
+    sized("alpha", f"{a.size} angles", a.size, 6 * 8, "the coefficients")
+    out = chunked(lambda x: _core.aero_coefficients(x, name), [a], ("alpha",))
     return {k: v.reshape(shape) for k, v in out.items()}
 
 
 def center_of_pressure(alpha: npt.ArrayLike) -> FloatArray:
     """Eq. 3.7: ``0.82 |alpha| / pi + 0.05`` (fraction of the chord behind the leading edge)."""
-    a = np.asarray(alpha, dtype=np.float64)
+    a = finite_reals("alpha", alpha)
     out: FloatArray = 0.82 / np.pi * np.abs(a) + 0.05
+    if not np.isfinite(out).all():  # |alpha| near 1.8e308
+        i = tuple(int(j) for j in np.argwhere(~np.isfinite(out))[0])
+        raise invalid("alpha" + "".join(f"[{j}]" for j in i), float(a[i]), "an angle in [0, pi] rad")
     return out
 
 
@@ -120,27 +143,37 @@ def moments(
     """
     force: float | None = None
     if isinstance(omegas, dict):
-        values = [float(omegas[f"omega{k}"]) for k in range(1, 5)]
+        missing = [f"omega{k}" for k in range(1, 5) if f"omega{k}" not in omegas]
+        if missing:
+            raise invalid("omegas", f"keys {sorted(map(str, omegas))}", "a dict with omega1..omega4 (and optionally force), e.g. Planform.omegas()")
+        values = [real(f"omegas['omega{k}']", omegas[f"omega{k}"]) for k in range(1, 5)]
         if omegas.get("force") is not None:
-            force = float(omegas["force"])
+            force = real("omegas['force']", omegas["force"])
     else:
-        values = [float(v) for v in omegas]
+        if isinstance(omegas, (str, bytes)) or not hasattr(omegas, "__len__"):
+            raise invalid("omegas", repr(omegas)[:60], "a dict with omega1..omega4 or a sequence [Ω1, Ω2, Ω3, Ω4]")
+        values = [real(f"omegas[{i}]", v) for i, v in enumerate(omegas)]
         if len(values) != 4:
             raise _core.ShapeError(f"`omegas` must have 4 values [Ω1, Ω2, Ω3, Ω4], got {len(values)}")
-    arrays = np.broadcast_arrays(*(np.asarray(v, dtype=np.float64) for v in (phi, theta, psi, phi_dot, theta_dot, psi_dot)))
+    names = ("phi", "theta", "psi", "phi_dot", "theta_dot", "psi_dot")
+    given = [reals(n, v) for n, v in zip(names, (phi, theta, psi, phi_dot, theta_dot, psi_dot), strict=True)]
+    try:
+        arrays = np.broadcast_arrays(*given)
+    except ValueError as exc:
+        raise invalid(", ".join(names), "shapes " + ", ".join(str(g.shape) for g in given), "arrays that broadcast together") from exc
     shape = arrays[0].shape
     flat = [np.ascontiguousarray(a).ravel() for a in arrays]
-    out = _core.aero_moments(
-        values,
-        flat[0],
-        flat[1],
-        flat[2],
-        flat[3],
-        flat[4],
-        flat[5],
-        str(model),
-        real("rotational_damping", rotational_damping),
-        str(normal_force_law),
-        force,
-    )
+    damping = real("rotational_damping", rotational_damping)
+    model_name, law = _model("model", model), _model("normal_force_law", normal_force_law)
+    # 26 floats per point out (with force), six in: chunked (the native call peaked at ~20x).
+    sized("phi_dot", f"{flat[0].size} points", flat[0].size, 32 * 8, "the moments")
+
+    def call(*x: FloatArray) -> dict[str, FloatArray]:
+        return _core.aero_moments(values, *x, model_name, damping, law, force)
+
+    out = chunked(call, flat, names)
+    scales = {f"omegas[{i}]": np.array([v]) for i, v in enumerate(values)}
+    if force is not None:
+        scales["omegas['force']"] = np.array([force])
+    _finite_out(out, {**dict(zip(names, flat, strict=True)), **scales})
     return {k: (v.reshape((*shape, 3)) if v.ndim == 2 else v.reshape(shape)) for k, v in out.items()}

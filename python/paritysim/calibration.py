@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import threading
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
@@ -18,7 +18,8 @@ import numpy as np
 import polars as pl
 from scipy.optimize import least_squares
 
-from ._errors import invalid, suggest
+from ._errors import invalid, real, suggest, whole
+from ._exceptions import ParitysimError
 from .simulation import simulate
 from .spec import Simulation
 
@@ -78,18 +79,42 @@ def calibrate(
     ``max(|target|, 1e-12)``), or a DataFrame with ``time_ms`` and columns of the trajectory to
     match (e.g. ``right_phi``), compared on the recorded window after aligning time origins.
     """
+    diff_step = real("diff_step", diff_step)
     if not (math.isfinite(diff_step) and 0 < diff_step < 0.5):
         raise invalid("diff_step", diff_step, "in (0, 0.5)")
+    xtol = real("xtol", xtol)
+    if not (math.isfinite(xtol) and 0 < xtol < 1):
+        raise invalid("xtol", xtol, "in (0, 1)")
+    max_nfev = whole("max_nfev", max_nfev, 1, 1_000_000)
+    workers = whole("workers", workers, 1, 1024)
+    if not isinstance(model, Simulation) and not callable(model):
+        raise invalid("model", type(model).__name__, "a paritysim.Simulation or a callable f(**values) -> outputs")
+    if not isinstance(free, Mapping):
+        raise invalid("free", type(free).__name__, "a mapping {name: (low, high)}")
+    for field_name, given in (("x0", x0), ("scale", scale)):
+        if given is not None and not isinstance(given, Mapping):
+            raise invalid(field_name, type(given).__name__, "a mapping {name: value}")
     names = list(free)
     if not names:
         raise invalid("free", "{}", "at least one parameter with (low, high) bounds")
-    lo = np.array([float(free[n][0]) for n in names])
-    hi = np.array([float(free[n][1]) for n in names])
+    bounds = []
+    for n in names:
+        pair = free[n]
+        if isinstance(pair, str | bytes) or not isinstance(pair, Sequence | np.ndarray) or len(pair) != 2:
+            raise invalid(f"free.{n}", repr(pair)[:60], "a (low, high) pair of finite bounds")
+        bounds.append((real(f"free.{n}", pair[0]), real(f"free.{n}", pair[1])))
+    lo = np.array([b[0] for b in bounds])
+    hi = np.array([b[1] for b in bounds])
     for n, a, b in zip(names, lo, hi, strict=True):
         if not (math.isfinite(a) and math.isfinite(b) and a < b):
-            raise invalid(f"free.{n}", (a, b), "finite bounds with low < high")
-    start = np.array([float((x0 or {}).get(n, 0.5 * (a + b))) for n, a, b in zip(names, lo, hi, strict=True)])
+            raise invalid(f"free.{n}", (float(a), float(b)), "finite bounds with low < high")
+    start = np.array([real(f"x0.{n}", (x0 or {}).get(n, 0.5 * (a + b))) for n, a, b in zip(names, lo, hi, strict=True)])
+    for n, v, a, b in zip(names, start, lo, hi, strict=True):
+        if not (math.isfinite(v) and a <= v <= b):
+            raise invalid(f"x0.{n}", float(v), f"within the bounds [{a}, {b}]")
     trajectory_target = isinstance(targets, pl.DataFrame)
+    if not trajectory_target and not isinstance(targets, Mapping):
+        raise invalid("targets", type(targets).__name__, "a mapping {output: value} or a DataFrame with time_ms and trajectory columns")
 
     if isinstance(model, Simulation):
         base = model
@@ -121,8 +146,15 @@ def calibrate(
             return np.concatenate(res)
     else:
         keys = list(targets)
-        scales = np.array([float((scale or {}).get(k, max(abs(float(targets[k])), 1e-12))) for k in keys])
-        goal = np.array([float(targets[k]) for k in keys])
+        if not keys:
+            raise invalid("targets", "{}", "at least one output to fit")
+        goal = np.array([real(f"targets.{k}", targets[k]) for k in keys])
+        scales = np.array([real(f"scale.{k}", (scale or {}).get(k, max(abs(g), 1e-12))) for k, g in zip(keys, goal, strict=True)])
+        for k, g, sc in zip(keys, goal, scales, strict=True):
+            if not math.isfinite(g):
+                raise invalid(f"targets.{k}", float(g), "a finite number")
+            if not (math.isfinite(sc) and sc > 0):
+                raise invalid(f"scale.{k}", float(sc), "finite and > 0")
 
         def residual_of(out: dict[str, Any]) -> np.ndarray:
             available = sorted(k for k in out if not k.startswith("__") and out[k] is not None)
@@ -156,6 +188,12 @@ def calibrate(
 
     try:
         fit = least_squares(evaluate, start, jac=jacobian, bounds=(lo, hi), x_scale="jac", max_nfev=max_nfev, xtol=xtol)
+    except ValueError as exc:
+        if isinstance(exc, ParitysimError):
+            raise
+        # scipy's own checks (e.g. residuals not finite at the start: an output the model
+        # returned as NaN): a typed error naming what the fit started from (issue 34).
+        raise invalid("x0", {n: float(v) for n, v in zip(names, start, strict=True)}, f"a start where the model's outputs are finite numbers ({exc})") from exc
     finally:
         pool.shutdown()
     values = dict(zip(names, (float(v) for v in fit.x), strict=True))

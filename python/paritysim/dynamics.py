@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from . import _core
-from ._errors import invalid
+from ._errors import finite_reals, invalid, whole
 from .spec import Configuration, Simulation, Wing
 
 __all__ = ["WingTerms", "wing_terms"]
@@ -39,7 +39,7 @@ class WingTerms:
 
 
 def _vec3(x: Any, name: str) -> list[float]:
-    a = np.asarray(x, dtype=float)
+    a = finite_reals(name, x)
     if a.shape != (3,):
         raise invalid(name, f"shape {a.shape}", "3 values (phi, theta, psi)")
     return [float(v) for v in a]
@@ -59,6 +59,15 @@ def wing_terms(wing: Wing | Simulation, p: Any, p_dot: Any, *, index: int = 0) -
     OutOfDomainError, SingularError
         Outside the shoulder's joint limit or at a singular pose.
     """
+    if not isinstance(wing, Simulation | Wing):
+        raise invalid("wing", type(wing).__name__, "a paritysim.Wing or a paritysim.Simulation")
     spec = wing if isinstance(wing, Simulation) else Simulation(wings=(wing,), configuration=Configuration(name=None))
-    raw = _core.dynamics_wing_terms(spec.to_json(), int(index), _vec3(p, "p"), _vec3(p_dot, "p_dot"))
+    p3, v3 = _vec3(p, "p"), _vec3(p_dot, "p_dot")
+    raw = _core.dynamics_wing_terms(spec.to_json(), whole("index", index, 0, 2**31), p3, v3)
+    bad = [k for k, v in raw.items() if not np.isfinite(np.asarray(v, dtype=float)).all()]
+    if bad:
+        # Huge finite rates overflow the quadratic terms (issue 34): name the input.
+        name, values = ("p_dot", v3) if max(map(abs, v3)) > 0 else ("p", p3)
+        i = max(range(3), key=lambda k: abs(values[k]))
+        raise invalid(f"{name}[{i}]", values[i], f"small enough that the terms ({', '.join(bad)}) are finite (they overflow here)")
     return WingTerms(**raw)

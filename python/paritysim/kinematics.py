@@ -11,7 +11,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _core
-from ._errors import invalid, real, reals
+from ._errors import chunked, invalid, real, reals, sized
 from ._core import Drivetrain
 
 __all__ = ["Drivetrain", "drivetrain_map", "shoulder_map", "shoulder_partials", "shoulder_pose"]
@@ -52,7 +52,9 @@ def shoulder_map(alpha2: float, alpha3: float, phi: ArrayLike, theta: ArrayLike)
         For ``alpha2``/``alpha3`` out of range or non-finite inputs.
     """
     p, t, shape = _paired(phi, theta, ("phi", "theta"))
-    out = _core.shoulder_map(real("alpha2", alpha2), real("alpha3", alpha3), p, t)
+    a2, a3 = real("alpha2", alpha2), real("alpha3", alpha3)
+    sized("phi", f"{p.size} points", p.size, 8 * 8, "the shoulder map")
+    out = chunked(lambda x, y: _core.shoulder_map(a2, a3, x, y), [p, t], ("phi", "theta"))
     return {k: v.reshape(shape) for k, v in out.items()}
 
 
@@ -77,8 +79,13 @@ def drivetrain_map(drivetrain: Any, q1: ArrayLike, q2: ArrayLike = 0.0) -> dict[
     Returns ``stroke_left``, ``stroke_right`` (rad), ``jacobian`` (..., 2, 2) and
     ``hessian`` (..., 2, 2, 2).
     """
+    if not callable(getattr(drivetrain, "evaluate", None)):
+        raise invalid("drivetrain", type(drivetrain).__name__, "a paritysim.Drivetrain (e.g. Drivetrain.linkage_differential())")
     a, b, shape = _paired(q1, q2, ("q1", "q2"))
-    out = drivetrain.evaluate(a, b)
+    # Outputs: 14 floats per point, plus the inputs; evaluated in chunks (the native call holds
+    # several times its output while it runs).
+    sized("q1", f"{a.size} points", a.size, 16 * 8, "the drivetrain map")
+    out = chunked(drivetrain.evaluate, [a, b], ("q1", "q2"))
     return {
         "stroke_left": out["stroke_left"].reshape(shape),
         "stroke_right": out["stroke_right"].reshape(shape),

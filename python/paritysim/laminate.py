@@ -107,6 +107,15 @@ def _f(x: Any, field: str) -> float:
     return real(field, x)
 
 
+def _finite_result(data: dict[str, Any], inputs: dict[str, Any]) -> None:
+    """An overflow (a result that came back NaN/None for finite inputs, issue 34) is an
+    ``InvalidParameterError`` naming the input of largest magnitude (relative to 1)."""
+    bad = [k for k, v in data.items() if v is None or (np.asarray(v).dtype.kind == "f" and not np.isfinite(np.asarray(v, dtype=float)).all())]
+    if bad:
+        name = max(inputs, key=lambda k: abs(math.log(abs(float(inputs[k])))) if float(inputs[k]) else 0.0)
+        raise invalid(name, inputs[name], f"a value for which {', '.join(bad)} stay finite (they overflow here)")
+
+
 def _num(x: Any) -> Any:
     """numpy scalars unwrapped; anything else passed on unchanged."""
     return x.item() if isinstance(x, np.generic) else x
@@ -537,6 +546,7 @@ class Bimorph:
             _f(self.width_ratio, "width_ratio"),
             np.zeros(0),
         )
+        _finite_result(d, {"length": self.length, "extension": self.extension, "base_width": self.base_width, "width_ratio": self.width_ratio})
         object.__setattr__(self, "_data", d)
 
     @classmethod

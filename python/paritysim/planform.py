@@ -21,7 +21,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _core
-from ._errors import invalid, real, whole
+from ._errors import invalid, real, reals, whole
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -34,21 +34,28 @@ AIR_DENSITY: float = _core.AERO_AIR_DENSITY
 FloatArray = npt.NDArray[np.float64]
 
 
+def _shape_error(name: str, message: str) -> Exception:
+    err = _core.ShapeError(message)
+    err.field = name  # type: ignore[attr-defined]
+    err.kind = "Shape"  # type: ignore[attr-defined]
+    return err
+
+
 def _as_points(points: npt.ArrayLike, name: str = "points") -> FloatArray:
-    a = np.ascontiguousarray(np.asarray(points, dtype=np.float64))
+    a = np.ascontiguousarray(reals(name, points))
     if a.ndim != 2 or a.shape[1] != 2:
-        raise _core.ShapeError(f"`{name}` must have shape (n, 2) of [z, x] in mm, got {a.shape}")
+        raise _shape_error(name, f"`{name}` must have shape (n, 2) of [z, x] in mm, got {a.shape}")
     return a
 
 
 def _rows(values: Iterable[Sequence[float]] | npt.ArrayLike, cols: int, name: str) -> FloatArray:
-    a = np.asarray(values, dtype=np.float64)
+    a = reals(name, values)
     if a.size == 0:
         return np.zeros((0, cols))
     if a.ndim == 1:
         a = a.reshape(1, -1)
     if a.ndim != 2 or a.shape[1] != cols:
-        raise _core.ShapeError(f"`{name}` must have shape (n, {cols}), got {a.shape}")
+        raise _shape_error(name, f"`{name}` must have shape (n, {cols}), got {a.shape}")
     return np.ascontiguousarray(a)
 
 
@@ -158,27 +165,35 @@ class Planform:
 
     def chord(self, z: npt.ArrayLike) -> FloatArray:
         """Chord ``c(z)`` (mm); 0 outside the span."""
-        zz = np.asarray(z, dtype=np.float64)
+        zz = reals("z", z)
         out = _core.aero_planform_chord(self.points, np.ascontiguousarray(zz).ravel())
         c: FloatArray = out["chord"].reshape(zz.shape)
         return c
 
     def leading_edge(self, z: npt.ArrayLike) -> FloatArray:
         """Leading edge ``l(z)`` (mm, signed distance ahead of the hinge line); NaN outside the span."""
-        zz = np.asarray(z, dtype=np.float64)
+        zz = reals("z", z)
         out = _core.aero_planform_chord(self.points, np.ascontiguousarray(zz).ravel())
         l_: FloatArray = out["leading_edge"].reshape(zz.shape)
         return l_
 
     def scaled(self, factor: float) -> Planform:
         """Uniformly scaled about the spherical centre (Ω scale as ``factor**5``)."""
-        if not (np.isfinite(factor) and factor > 0):
+        f = real("factor", factor)
+        if not (math.isfinite(f) and f > 0):
             raise invalid("factor", factor, "finite and > 0")
-        return Planform(self.points * real("factor", factor))
+        scaled = self.points * f
+        if not np.isfinite(scaled).all():
+            raise invalid("factor", factor, f"small enough that the outline stays finite (<= {np.finfo(float).max / np.abs(self.points).max():.3g})")
+        return Planform(scaled)
 
     def translated(self, dz: float = 0.0, dx: float = 0.0) -> Planform:
         """Shifted by ``dz`` (spanwise) and ``dx`` (toward the leading edge; moves the hinge line by ``-dx``)."""
-        return Planform(self.points + np.array([real("dz", dz), real("dx", dx)]))
+        shift = np.array([real("dz", dz), real("dx", dx)])
+        moved = self.points + shift
+        if not np.isfinite(moved).all():
+            raise invalid("dz" if not np.isfinite(moved[:, 0]).all() else "dx", shift.tolist(), "a finite shift")
+        return Planform(moved)
 
     def cut(self, fraction: float, where: str = "tip", *, measure: str = "span") -> Planform:
         """The membrane left after cutting part of it away along a straight line.
@@ -197,8 +212,10 @@ class Planform:
         ``measure``) and ``GeometryError`` if the line would split the membrane in pieces.
         """
         if measure not in ("span", "area"):
-            raise invalid("measure", measure, '"span" or "area"')
-        f = float(fraction)
+            raise invalid("measure", repr(measure), '"span" or "area"')
+        if where not in ("tip", "trailing"):
+            raise invalid("where", repr(where), '"tip" or "trailing"')
+        f = real("fraction", fraction)
         if not (math.isfinite(f) and 0.0 <= f < 1.0):
             raise invalid("fraction", fraction, "in [0, 1)")
         if measure == "span" or f == 0.0:
@@ -222,9 +239,13 @@ class Planform:
         ``rho`` in mg/mm³ (1.2e-3 for air). No force coefficient is folded in.
         Raises ``InvalidParameterError`` (``rho``) unless ``rho`` is finite and > 0.
         """
-        if not (math.isfinite(rho) and rho > 0):
+        r = real("rho", rho)
+        if not (math.isfinite(r) and r > 0):
             raise invalid("rho", rho, "finite and > 0 (mg/mm^3; air is 1.2e-3)")
-        p = _core.aero_planform_properties(self.points, real("rho", rho), None)
+        p = _core.aero_planform_properties(self.points, r, None)
+        for k in ("omega1", "omega2", "omega3", "omega4", "force"):
+            if not math.isfinite(float(p[k])):
+                raise invalid("rho", rho, f"small enough that {k} is finite")
         return {k: float(p[k]) for k in ("omega1", "omega2", "omega3", "omega4", "force")}
 
     def inertia(
@@ -251,12 +272,16 @@ class Planform:
             ``iyy = ixx + izz``, ``ixz = -∫xz dm`` (tensor element; positive for a wing behind
             its hinge, as in Table 3.3) and ``tensor`` (3, 3).
         """
-        out: dict[str, Any] = _core.aero_planform_inertia(
-            self.points,
-            real("areal_density", areal_density),
-            _rows(line_masses, 5, "line_masses"),
-            _rows(point_masses, 3, "point_masses"),
-        )
+        inputs = {
+            "areal_density": np.array([[real("areal_density", areal_density)]]),
+            "line_masses": _rows(line_masses, 5, "line_masses"),
+            "point_masses": _rows(point_masses, 3, "point_masses"),
+        }
+        out: dict[str, Any] = _core.aero_planform_inertia(self.points, float(inputs["areal_density"][0, 0]), inputs["line_masses"], inputs["point_masses"])
+        if not all(np.isfinite(np.asarray(v, dtype=float)).all() for v in out.values()):
+            # An overflow of huge finite inputs (issue 34): name the largest one.
+            name = max((k for k in inputs if inputs[k].size), key=lambda k: float(np.abs(inputs[k]).max()))
+            raise invalid(name, float(np.abs(inputs[name]).max()), "small enough that the mass properties are finite (they overflow here)")
         return out
 
     # ------------------------------------------------------------------ display

@@ -25,6 +25,8 @@ import dataclasses
 import functools
 import json
 import math
+import numbers
+import os
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -435,12 +437,20 @@ class Simulation(_Node):
     @classmethod
     def from_json(cls, text: str) -> Simulation:
         """From JSON text (validated in Rust)."""
+        if not isinstance(text, str):
+            from ._errors import invalid
+
+            raise invalid("text", type(text).__name__, "JSON text (str)")
         canonical, notes = _core.spec_normalize(text)
         return _canonical(canonical, notes)
 
     def with_paths(self, values: Mapping[str, Any]) -> Simulation:
         """A copy with ``{path: value}`` applied; paths as listed by :func:`spec_paths` (aliases
         such as ``wings.left.omega_ratio`` included)."""
+        if not isinstance(values, Mapping):
+            from ._errors import invalid
+
+            raise invalid("values", type(values).__name__, "a mapping {path: value}")
         canonical, notes = _core.spec_apply(self.to_json(), _dumps(dict(values)))
         return _canonical(canonical, notes)
 
@@ -450,9 +460,16 @@ class Simulation(_Node):
 
     def save(self, path: str | Path) -> Path:
         """Writes the spec as TOML."""
+        from ._errors import invalid
+
+        if isinstance(path, bytes) or not isinstance(path, str | os.PathLike):
+            raise invalid("path", repr(path)[:60], "a file path (str or os.PathLike)")
         path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(self.to_toml())
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(self.to_toml(), encoding="utf-8")
+        except OSError as exc:
+            raise invalid("path", str(path), f"a writable file path ({exc.strerror or exc})") from exc
         return path
 
 
@@ -463,8 +480,22 @@ def _canonical(text: str, notes: list[str]) -> Simulation:
 
 
 def load_spec(path: str | Path) -> Simulation:
-    """Loads a :class:`Simulation` from a TOML file (parsed and validated in Rust)."""
-    canonical, notes = _core.spec_from_toml(Path(path).read_text())
+    """Loads a :class:`Simulation` from a UTF-8 TOML file (parsed and validated in Rust).
+
+    A file that cannot be read (missing, a directory, not UTF-8) raises
+    ``InvalidParameterError`` naming ``path``."""
+    from ._errors import invalid
+
+    if isinstance(path, bytes) or not isinstance(path, str | os.PathLike):
+        raise invalid("path", repr(path)[:60], "a TOML file path (str or os.PathLike)")
+    file = Path(path)
+    try:
+        text = file.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise invalid("path", str(file), f"a UTF-8 text file ({exc.reason} at byte {exc.start})") from exc
+    except OSError as exc:
+        raise invalid("path", str(file), f"a readable TOML file ({exc.strerror or exc})") from exc
+    canonical, notes = _core.spec_from_toml(text)
     return _canonical(canonical, notes)
 
 
@@ -498,7 +529,16 @@ def _plain(x: Any) -> Any:
         return [_plain(v) for v in x]
     if isinstance(x, np.generic):
         return _plain(x.item())
-    return x
+    if x is None:
+        return x
+    if isinstance(x, numbers.Integral):
+        return int(x)
+    if isinstance(x, numbers.Real):
+        return _plain(float(x))
+    # Not plain data (an object, a complex, a set, bytes): its text, so that Rust names the field
+    # holding it and what it allows (a TypeError of the JSON encoder named nothing; issue 34).
+    shown = repr(x)
+    return f"<{type(x).__name__}> " + (shown if len(shown) <= 60 else shown[:57] + "...")
 
 
 @functools.cache
@@ -507,7 +547,12 @@ def _field_names(cls: type) -> tuple[str, ...]:
 
 
 def _dumps(data: Any) -> str:
-    return json.dumps(_plain(data), allow_nan=False)
+    try:
+        return json.dumps(_plain(data), allow_nan=False)
+    except RecursionError:
+        from ._errors import invalid
+
+        raise invalid("spec", "<data nested too deeply>", "a spec: plain data nested a few levels deep (see paritysim.schema())") from None
 
 
 def _strip_none(x: Any) -> Any:

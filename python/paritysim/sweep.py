@@ -91,7 +91,7 @@ import numpy as np
 import polars as pl
 
 from . import _core
-from ._errors import invalid
+from ._errors import invalid, whole
 from ._sweep_checkpoint import _Checkpoint, _fingerprint, _reuse
 from .spec import Simulation, _dumps
 
@@ -377,10 +377,18 @@ def sweep(
     """
     if not isinstance(spec, Simulation):
         raise invalid("spec", type(spec).__name__, "a paritysim.Simulation")
+    if options is not None and not isinstance(options, Mapping):
+        raise invalid("options", type(options).__name__, "a mapping of spec options, e.g. {\"max_cycles\": 50}")
     if options:
-        spec = spec.replace(options=spec.options.with_fields("options", **dict(options)))
+        spec = spec.replace(options=spec.options.with_fields("options", **{str(k): v for k, v in options.items()}))
     table = _table(grid)
-    label_names = [labels] if isinstance(labels, str) else list(labels)
+    label_names = _names("labels", labels)
+    if metrics is not None:
+        metrics = _names("metrics", metrics)
+    if not isinstance(keep_cycle, bool) and keep_cycle is not None:
+        keep_cycle = _names("keep_cycle", keep_cycle)
+    if threads is not None:
+        threads = whole("threads", threads, 1, 4096)
     for name in label_names:
         if name not in table.columns:
             raise invalid("labels", repr(name), "columns of the grid: " + ", ".join(table.columns))
@@ -518,6 +526,19 @@ def _caller_stacklevel() -> int:
     while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package):
         frame, level = frame.f_back, level + 1  # type: ignore[assignment]
     return level
+
+
+def _names(field: str, value: Any) -> list[str]:
+    """A name or a sequence of names, or an error naming ``field``."""
+    if isinstance(value, str):
+        return [value]
+    if isinstance(value, Iterable) and not isinstance(value, bytes | Mapping):
+        names = list(value)
+        for name in names:
+            if not isinstance(name, str):
+                raise invalid(field, repr(name)[:60], "names (str)")
+        return names
+    raise invalid(field, repr(value)[:60], "a name or a list of names (str)")
 
 
 def _cycle_columns(spec_json: str, keep_cycle: bool | Sequence[str]) -> list[str]:

@@ -145,8 +145,18 @@ def trim(
         Unknown knob path or equation name, a spec without an actuator, or a drive the model
         rejects (the message names the field).
     """
-    from .._errors import invalid
+    from .._errors import finite_reals, invalid, real, whole
 
+    if not isinstance(spec, Simulation):
+        raise invalid("spec", type(spec).__name__, "a paritysim.Simulation")
+    tol = real("tol", tol)
+    if not (math.isfinite(tol) and 0.0 < tol <= 1.0):
+        raise invalid("tol", tol, "in (0, 1] (a residual over its scale)")
+    max_evaluations = whole("max_evaluations", max_evaluations, 1, 100_000)
+    if knobs is not None:
+        knobs = _trim_names("knobs", knobs)
+    if equations is not None:
+        equations = _trim_names("equations", equations)
     if spec.actuator is None:
         raise invalid("actuator", "None", "an actuator to trim (the drive is what trim solves for)")
     if spec.actuator.waveform.kind != "sine" and knobs is None:
@@ -168,7 +178,12 @@ def trim(
     for k in knobs:
         if k not in paths:
             raise invalid("knobs", k, "a spec path (paritysim.spec_paths)")
-    x0 = np.array(initial if initial is not None else [float(paths[k]) for k in knobs], dtype=float)
+    if initial is not None:
+        x0 = np.atleast_1d(finite_reals("initial", initial))
+        if x0.shape != (len(knobs),):
+            raise invalid("initial", list(x0.ravel())[:8], f"{len(knobs)} values, one per knob")
+    else:
+        x0 = np.array([float(paths[k]) for k in knobs], dtype=float)
     lo = np.array([_BOUNDS.get(k, (-np.inf, np.inf))[0] for k in knobs])
     hi = np.array([_BOUNDS.get(k, (-np.inf, np.inf))[1] for k in knobs])
     x0 = np.clip(x0, lo + 1e-12, hi - 1e-12)
@@ -197,7 +212,10 @@ def trim(
         fit = root(lambda v: scaled(np.clip(v, lo, hi)), x0, method="hybr", options={"xtol": 1e-10, "maxfev": max_evaluations, "eps": 1e-6})
         x = np.clip(fit.x, lo, hi)
     if len(equations) != len(knobs) or not np.all(np.abs(scaled(x)) < tol):
-        fit = least_squares(scaled, x, bounds=(lo, hi), x_scale=np.maximum(np.abs(x0), 1.0), diff_step=1e-5, xtol=1e-10, ftol=1e-12, max_nfev=max_evaluations)
+        try:
+            fit = least_squares(scaled, x, bounds=(lo, hi), x_scale=np.maximum(np.abs(x0), 1.0), diff_step=1e-5, xtol=1e-10, ftol=1e-12, max_nfev=max_evaluations)
+        except ValueError as exc:  # scipy's: residuals not finite at the start (an undefined metric)
+            raise invalid("initial", [float(v) for v in x], f"a drive where every residual ({', '.join(equations)}) is defined ({exc})") from exc
         x = fit.x
     r = evaluate(x)
     values = dict(zip(knobs, (float(v) for v in x), strict=True))
@@ -215,6 +233,15 @@ def trim(
         evaluations=len(cache),
         tol=tol,
     )
+
+
+def _trim_names(field: str, value: Any) -> tuple[str, ...]:
+    from .._errors import invalid
+
+    names = (value,) if isinstance(value, str) else tuple(value) if isinstance(value, Sequence) else None
+    if names is None or not all(isinstance(n, str) for n in names):
+        raise invalid(field, repr(value)[:60], "a sequence of names (str)")
+    return names
 
 
 def _path_values(spec: Simulation) -> list[tuple[str, str, str, Any]]:
