@@ -34,6 +34,10 @@ AIR_DENSITY: float = _core.AERO_AIR_DENSITY
 FloatArray = npt.NDArray[np.float64]
 
 
+#: Largest |z|, |x| of an outline vertex (mm), as the Rust outline check allows.
+_MAX_COORDINATE = 1e3
+
+
 def _shape_error(name: str, message: str) -> Exception:
     err = _core.ShapeError(message)
     err.field = name  # type: ignore[attr-defined]
@@ -182,17 +186,18 @@ class Planform:
         f = real("factor", factor)
         if not (math.isfinite(f) and f > 0):
             raise invalid("factor", factor, "finite and > 0")
-        scaled = self.points * f
-        if not np.isfinite(scaled).all():
-            raise invalid("factor", factor, f"small enough that the outline stays finite (<= {np.finfo(float).max / np.abs(self.points).max():.3g})")
-        return Planform(scaled)
+        reach = float(np.abs(self.points).max())
+        if reach * f > _MAX_COORDINATE:  # the outline's bound (|z|, |x| <= 1e3 mm), named here
+            raise invalid("factor", factor, f"in (0, {_MAX_COORDINATE / reach:.6g}] (the outline must stay within {_MAX_COORDINATE:g} mm)")
+        return Planform(self.points * f)
 
     def translated(self, dz: float = 0.0, dx: float = 0.0) -> Planform:
         """Shifted by ``dz`` (spanwise) and ``dx`` (toward the leading edge; moves the hinge line by ``-dx``)."""
         shift = np.array([real("dz", dz), real("dx", dx)])
         moved = self.points + shift
-        if not np.isfinite(moved).all():
-            raise invalid("dz" if not np.isfinite(moved[:, 0]).all() else "dx", shift.tolist(), "a finite shift")
+        for axis, name in enumerate(("dz", "dx")):
+            if not (np.isfinite(moved[:, axis]).all() and np.abs(moved[:, axis]).max() <= _MAX_COORDINATE):
+                raise invalid(name, float(shift[axis]), f"a shift keeping the outline within {_MAX_COORDINATE:g} mm")
         return Planform(moved)
 
     def cut(self, fraction: float, where: str = "tip", *, measure: str = "span") -> Planform:
