@@ -36,7 +36,8 @@ def test_a_pathological_point_becomes_an_error_row_naming_the_budget(hmf: ps.Sim
 
 def test_simulate_names_the_wall_budget(hmf: ps.Simulation) -> None:
     with pytest.raises(ps.IntegrationError, match=r"options\.max_wall_ms") as info:
-        ps.simulate(hmf.with_paths({"actuator.frequency_hz": 1e-3}), max_wall_ms=100.0)
+        # duration_ms: a slow drive on purpose (without it the frequency is blamed, test_slow_drive.py)
+        ps.simulate(hmf.with_paths({"actuator.frequency_hz": 1e-3}), max_wall_ms=100.0, duration_ms=1e7)
     assert 0.0 < info.value.time < 1e6 * 300  # stopped partway through the transient
     assert info.value.field == "options.max_wall_ms"
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 import time
 import tomllib
@@ -126,10 +127,18 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+_STATE = re.compile(r" \(state = \[[^\]]*\]\)")
+
+
 def describe_error(exc: BaseException) -> str:
     """One line for a user: what failed and on which file or field, without a traceback."""
     if isinstance(exc, ParitysimError):
-        return f"{type(exc).__name__}: {exc}"
+        # The state vector is for `--debug` (the traceback, `.state`); the responsible field first.
+        text = _STATE.sub("", str(exc))
+        cause, sep, responsible = text.partition("; most responsible: ")
+        if sep:
+            text = f"{responsible} (because: {cause})"
+        return f"{type(exc).__name__}: {text}"
     if isinstance(exc, FileNotFoundError):
         return f"no such file or directory: {exc.filename}"
     if isinstance(exc, IsADirectoryError):

@@ -13,7 +13,7 @@ import numpy as np
 import polars as pl
 from matplotlib.figure import Figure
 
-from . import _core
+from . import _core, _slow_drive
 from ._errors import invalid, real
 from .spec import Simulation
 
@@ -175,7 +175,11 @@ def simulate(
         field most responsible with ``.problems`` giving its allowed range (e.g. a drive
         amplitude that moves the rod-crank past its reach). Also when one integration needs
         more than ``options.max_steps`` steps or the run takes longer than
-        ``options.max_wall_ms`` (default 60 000 ms); ``.field`` names the option.
+        ``options.max_wall_ms`` (default 60 000 ms); ``.field`` names the option. A sine drive
+        slower than 1 Hz (``frequency_hz = 0.12`` meaning 120 Hz) that does not finish within
+        3 s raises ``InvalidParameterError`` naming ``actuator.waveform.frequency_hz`` with the
+        likely value; one that finishes warns that its result is quasi-static (set
+        ``options.duration_ms`` to simulate a slow drive on purpose).
     KeyboardInterrupt
         On Ctrl-C: the run stops inside the integration (within about 20 ms).
     """
@@ -188,7 +192,8 @@ def simulate(
     if controller is None:
         if control_rate_hz is not None:
             raise invalid("control_rate_hz", control_rate_hz, "given only with a controller")
-        raw = _core.simulate(spec.to_json(), _names(columns), _names(metrics))
+        # A drive typed in kHz runs for its whole wall budget: probed first, refused by field.
+        raw = _slow_drive.guarded(spec, lambda s: _core.simulate(s.to_json(), _names(columns), _names(metrics)))
     else:
         if not callable(controller):
             raise invalid("controller", type(controller).__name__, "a callable (t_ms, body) -> dict")
