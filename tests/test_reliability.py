@@ -505,3 +505,24 @@ def test_chunked_array_errors_name_the_element_of_the_whole_array() -> None:
     phi = np.zeros(40_000)
     phi[20_000] = math.nan
     _named(lambda: ps.aero.moments(ps.aero.TABLE_3_3["left"], phi=phi), "phi[20000]")
+
+
+def test_trim_and_calibrate_have_a_wall_budget_naming_max_wall_ms() -> None:
+    """One budget for the Python loops of runs: what is left goes to each run's
+    ``options.max_wall_ms`` (the engine's budget), and the loop stops naming ``max_wall_ms``."""
+    flight = ps.load_spec(EXAMPLES / "free_flight.toml")
+    start = time.monotonic()
+    with pytest.raises(ps.IntegrationError) as info:
+        ps.flight.trim(flight, max_wall_ms=200.0)
+    assert info.value.field == "max_wall_ms" and time.monotonic() - start < 10.0
+    calls = []
+
+    def slow_model(**values: float) -> dict[str, float]:
+        calls.append(values)
+        time.sleep(0.05)
+        return {"y": values["x"] ** 2}
+
+    with pytest.raises(ps.IntegrationError) as info:
+        ps.calibrate(slow_model, {"y": 2.0}, {"x": (0.0, 3.0)}, max_wall_ms=120.0)
+    assert info.value.field == "max_wall_ms" and 1 <= len(calls) <= 5
+    _named(lambda: ps.calibrate(slow_model, {"y": 2.0}, {"x": (0.0, 3.0)}, max_wall_ms=math.nan), "max_wall_ms")

@@ -18,6 +18,7 @@ import numpy as np
 import polars as pl
 from scipy.optimize import least_squares
 
+from ._budget import Deadline
 from ._errors import invalid, real, suggest, whole
 from ._exceptions import ParitysimError
 from .simulation import simulate
@@ -64,6 +65,7 @@ def calibrate(
     max_nfev: int = 100,
     xtol: float = 1e-10,
     diff_step: float = 1e-4,
+    max_wall_ms: float = 600_000.0,
 ) -> CalibrationResult:
     """Least-squares fit of the ``free`` parameters (name -> (low, high)).
 
@@ -78,6 +80,10 @@ def calibrate(
     ``targets``: ``{output: value}`` (residual ``(model − target)/scale``, scale defaults to
     ``max(|target|, 1e-12)``), or a DataFrame with ``time_ms`` and columns of the trajectory to
     match (e.g. ``right_phi``), compared on the recorded window after aligning time origins.
+
+    ``max_wall_ms`` (default 10 min) bounds the whole fit: each simulation gets what is left as
+    its ``options.max_wall_ms`` (a callable model is checked between evaluations); when it is
+    spent, ``IntegrationError`` naming ``max_wall_ms``.
     """
     diff_step = real("diff_step", diff_step)
     if not (math.isfinite(diff_step) and 0 < diff_step < 0.5):
@@ -87,6 +93,7 @@ def calibrate(
         raise invalid("xtol", xtol, "in (0, 1)")
     max_nfev = whole("max_nfev", max_nfev, 1, 1_000_000)
     workers = whole("workers", workers, 1, 1024)
+    deadline = Deadline("max_wall_ms", max_wall_ms)
     if not isinstance(model, Simulation) and not callable(model):
         raise invalid("model", type(model).__name__, "a paritysim.Simulation or a callable f(**values) -> outputs")
     if not isinstance(free, Mapping):
@@ -122,7 +129,7 @@ def calibrate(
         base.with_paths({n: float(v) for n, v in zip(names, start, strict=True)})
 
         def outputs(values: dict[str, float]) -> dict[str, Any]:
-            result = simulate(base.with_paths(values))
+            result = deadline.run(simulate, base.with_paths(values))
             out: dict[str, Any] = dict(result.metrics)
             if trajectory_target:
                 out["__trajectory__"] = result.trajectory
@@ -130,7 +137,11 @@ def calibrate(
     else:
 
         def outputs(values: dict[str, float]) -> dict[str, Any]:
-            return dict(model(**values))
+            deadline.remaining_ms()
+            out = model(**values)
+            if not isinstance(out, Mapping):
+                raise invalid("model", type(out).__name__, "a callable returning a mapping {output: value}")
+            return dict(out)
 
     if trajectory_target:
         columns = [c for c in targets.columns if c != "time_ms"]

@@ -98,14 +98,17 @@ def _clamped(spec: Simulation) -> tuple[Simulation, dict[str, Any]]:
     return clamped, body_of(clamped)
 
 
-def _metrics(spec: Simulation) -> dict[str, float]:
+def _metrics(spec: Simulation, deadline: Any = None) -> dict[str, float]:
     from ..simulation import simulate
 
     # The transient, not the default shooting: the root finder differences these metrics in
     # the knobs (eps 1e-6), and with shooting it stalled (pitch residual 3.9e-3 mN·mm instead
     # of 5.6e-10 on the §3.4 PARITY trim; each run re-picks its frozen step grid, so the
     # metrics are not smooth at that scale). Measured when shooting became the default.
-    m = simulate(spec, record_cycles=1, steady_state="transient").metrics
+    if deadline is not None:
+        m = deadline.run(simulate, spec, record_cycles=1, steady_state="transient").metrics
+    else:
+        m = simulate(spec, record_cycles=1, steady_state="transient").metrics
     return {name: float(m[metric]) if m[metric] is not None else math.nan for name, metric in EQUATIONS.items()}
 
 
@@ -117,6 +120,7 @@ def trim(
     initial: Sequence[float] | None = None,
     tol: float = 1e-4,
     max_evaluations: int = 80,
+    max_wall_ms: float = 600_000.0,
 ) -> Trim:
     """Finds the drive of ``spec`` for which cycle-averaged lift equals weight and the
     cycle-averaged body torques ``equations`` vanish (the spec's ``body`` section gives mass,
@@ -138,6 +142,9 @@ def trim(
     max_evaluations:
         Cap on residual evaluations per solver stage (each a clamped steady state; the
         finite-difference Jacobian's runs come on top).
+    max_wall_ms:
+        Wall-time budget of the whole trim (default 10 min): each run gets what is left as its
+        ``options.max_wall_ms``; when it is spent, ``IntegrationError`` naming ``max_wall_ms``.
 
     Raises
     ------
@@ -153,6 +160,9 @@ def trim(
     if not (math.isfinite(tol) and 0.0 < tol <= 1.0):
         raise invalid("tol", tol, "in (0, 1] (a residual over its scale)")
     max_evaluations = whole("max_evaluations", max_evaluations, 1, 100_000)
+    from .._budget import Deadline
+
+    deadline = Deadline("max_wall_ms", max_wall_ms)
     if knobs is not None:
         knobs = _trim_names("knobs", knobs)
     if equations is not None:
@@ -192,7 +202,7 @@ def trim(
     def evaluate(x: np.ndarray) -> dict[str, float]:
         key = tuple(float(v) for v in x)
         if key not in cache:
-            r = _metrics(clamped.with_paths(dict(zip(knobs, key, strict=True))))
+            r = _metrics(clamped.with_paths(dict(zip(knobs, key, strict=True))), deadline)
             r["lift"] -= weight
             cache[key] = r
         return cache[key]
