@@ -71,3 +71,15 @@ def test_trial_functions_are_exported() -> None:
         assert callable(getattr(ps.trials, name)), name
     expected = {"fig2.9", "table3.2", "fig3.2", "fig3.3", "fig3.4", "fig2.12", "calibration3.2", "table3.3", "fig3.11", "fig3.12", "fig3.13", "lift-dual", "laminate", "fig2.13", "sec2.7", "floquet"}
     assert expected <= set(ps.trials.REGISTRY)
+
+
+def test_run_names_its_outputs_after_the_spec_name(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 33: `paritysim run lift_wide.toml` writes `<spec name>_*`, not `<file stem>_*`."""
+    source = Path(__file__).resolve().parents[1] / "examples" / "hmf.toml"
+    toml = tmp_path / "lift_wide.toml"
+    toml.write_text(source.read_text(encoding="utf-8").replace('name = "hmf"', 'name = "hmf wide/v2"', 1), encoding="utf-8")
+    assert main(["run", str(toml), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    written = sorted(p.name for p in (tmp_path / "out").iterdir())
+    assert written == ["hmf_wide_v2.png", "hmf_wide_v2_metrics.csv", "hmf_wide_v2_trajectory.parquet"]
+    metrics = pl.read_csv(tmp_path / "out" / "hmf_wide_v2_metrics.csv")
+    assert metrics["left_stroke_amplitude"][0] > 0.1

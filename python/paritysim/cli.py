@@ -64,6 +64,13 @@ def _devices(args: argparse.Namespace) -> int:
     return 0
 
 
+def output_stem(name: str, fallback: str) -> str:
+    """The file stem of a run's outputs: the spec's ``name`` (what the user called the device),
+    made safe as a file name, or ``fallback`` (the TOML file's stem) when the name is empty."""
+    safe = re.sub(r"[^\w.-]+", "_", name.strip()).strip("._")
+    return safe or fallback
+
+
 def _run(args: argparse.Namespace) -> int:
     from . import devices, load_spec, simulate
 
@@ -71,7 +78,7 @@ def _run(args: argparse.Namespace) -> int:
     spec = devices.load(args.spec) if args.spec in devices.list() and not Path(args.spec).exists() else load_spec(args.spec)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    stem = Path(args.spec).stem
+    stem = output_stem(spec.name, Path(args.spec).stem)
     start = time.perf_counter()
     result = simulate(spec)
     result.trajectory.write_parquet(out / f"{stem}_trajectory.parquet")
