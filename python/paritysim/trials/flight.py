@@ -697,17 +697,25 @@ def _fig_eq_5_1(traces: pl.DataFrame, df: pl.DataFrame):  # type: ignore[no-unty
     return fig
 
 
-def _cli_trim(out: Path) -> list[Path]:
+def _fig_trim(df: pl.DataFrame, tol: float):  # type: ignore[no-untyped-def]
     import matplotlib.pyplot as plt
 
-    df = hover_trim()
-    tol = _trim("HMF").tol
     fig, ax = plt.subplots(1, 2, figsize=(11, 3.8), constrained_layout=True)
     labels = df["trim"].to_list()
     x = np.arange(len(labels))
-    ax[0].bar(x, df["amplitude_v"].to_numpy(), 0.5, color="C0")
+    # Every solved knob: the drive amplitude as bars, the DC offset (hundredths of a volt,
+    # invisible as a bar) and a solved arm ratio written on each.
+    amplitude, offset = df["amplitude_v"].to_numpy(), df["offset_v"].to_numpy()
+    bars = ax[0].bar(x, amplitude, 0.5, color="C0")
+    arm = df["arm_ratio"].to_numpy()
+    notes = [
+        f"{a:.2f} V\nDC offset {round(o, 3) + 0.0:+.3f} V" + (f"\narm ratio {r:.4f}" if r != 1.0 else "")
+        for a, o, r in zip(amplitude, offset, arm, strict=True)
+    ]
+    ax[0].bar_label(bars, notes, fontsize=8)
+    ax[0].set_ylim(0.0, 1.3 * float(amplitude.max()))
     ax[0].set_xticks(x, labels)
-    ax[0].set_ylabel("trim amplitude (V)")
+    ax[0].set_ylabel("trim drive amplitude (V)")
     ax[0].set_title(f"hover trim of the §3.4 device (weight {df['weight_mn'][0]:.3f} mN)")
     for k, e in enumerate(("lift", "roll", "yaw", "pitch")):
         ax[1].bar(x + (k - 1.5) * 0.2, np.abs(df[f"scaled_{e}"].to_numpy()) + 1e-16, 0.2, label=e)
@@ -717,7 +725,13 @@ def _cli_trim(out: Path) -> list[Path]:
     ax[1].set_ylabel("|residual| / scale")
     ax[1].set_title("residuals at the trim (unsolved ones included)")
     ax[1].legend(fontsize=7, ncol=2)
-    written = write_trial(df, out, "flight_trim", fig)
+    return fig
+
+
+def _cli_trim(out: Path) -> list[Path]:
+    df = hover_trim()
+    tol = _trim("HMF").tol
+    written = write_trial(df, out, "flight_trim", _fig_trim(df, tol))
     return [*written, write_claims(out, "flight.trim", trim_claims(df, tol), {"tol": tol})]
 
 

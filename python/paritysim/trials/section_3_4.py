@@ -202,15 +202,19 @@ def _fig(df: pl.DataFrame, quantity: str, trials: tuple[str, ...], title: str, y
 
     from ..plots import pair
 
-    fig, axes = plt.subplots(1, len(trials), figsize=(5 * len(trials), 4.2), sharey=True, constrained_layout=True, squeeze=False)
+    fig, axes = plt.subplots(1, len(trials), figsize=(5 * len(trials), 4.6), sharey=True, constrained_layout=True, squeeze=False)
     for ax, trial in zip(axes[0], trials, strict=True):
         for d, colors in (("HMF", ("C0", "C1")), ("PARITY", ("C2", "C3"))):
             sub = df.filter((pl.col("trial") == trial) & (pl.col("drivetrain") == d))
             pair(ax, sub["time_ms"], -sub[f"left_{quantity}"].to_numpy(), sub[f"right_{quantity}"].to_numpy(), (f"{d} left (−)", f"{d} right"), colors)
-        ax.set_title(trial)
         ax.set_xlabel("time (ms)")
-        ax.legend(fontsize=7)
+        if len(trials) > 1:  # each panel's legend says which of its curves coincide
+            ax.set_title(trial)
+            ax.legend(fontsize=7)
     axes[0][0].set_ylabel(ylabel)
+    if len(trials) == 1:  # the title names the trial; the legend goes below, over no peak
+        handles, names = axes[0][0].get_legend_handles_labels()
+        fig.legend(handles, names, loc="outside lower center", ncol=4, fontsize=7)
     fig.suptitle(title)
     return fig
 
