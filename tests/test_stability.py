@@ -168,7 +168,7 @@ def test_whippletree_mode_of_the_example_is_unstable_and_k2_stabilises_it() -> N
     assert unstable.coordinates == ["q1", "q2", "q1_dot", "q2_dot"]
     assert np.abs(unstable.whippletree_multipliers).max() == pytest.approx(unstable.spectral_radius, rel=1e-9)
     frame = stable.frame
-    assert frame.columns == ["re", "im", "modulus", "exponent_per_ms"] and frame.height == 4
+    assert frame.columns == ["re", "im", "modulus", "exponent_per_ms", "kind", "mode", "mode_share"] and frame.height == 4
     # Liouville for the whippletree block of a symmetric orbit: det = e^{-4 β0} per drive period
     # (two periods of eq. 2.25) with β0 = 2ΩΦ/I (docs/errata.md#7). With eq. 2.16 drag at 50 V the
     # determinant (~1e-2) is well above the finite-difference resolution (~1e-7).

@@ -236,7 +236,16 @@ class FloquetResult:
         ``T / ln|ρ|max`` of an unstable orbit (None otherwise).
     whippletree_multipliers:
         Multipliers of the (q2, q2_dot) block for a Drag PARITY device in drivetrain
-        coordinates (exact for a symmetric orbit, see ``whippletree_coupling``), else None.
+        coordinates (exact for a symmetric orbit, see ``whippletree_coupling``), else None:
+        the rotating-wing devices (§3.4, §2.5) integrate null-space coordinates ``x0, x1, ...``
+        (``p = N x``, orthonormal ``N``), which have no (q2, q2_dot) block.
+    coordinates:
+        Names of the monodromy's rows: ``q1`` (actuator, mm), ``q2`` (whippletree angle, rad)
+        and their rates ``q1_dot, q2_dot`` in drivetrain coordinates, else ``x<i>`` and
+        ``x<i>_dot``. :attr:`frame` names the coordinate that carries each mode;
+        :attr:`dominant_mode` and :attr:`neutral_modes` the ones the verdict turns on.
+
+    ``repr`` is one line; :attr:`frame` has every multiplier.
     """
 
     multipliers: np.ndarray
@@ -264,12 +273,62 @@ class FloquetResult:
 
     @property
     def frame(self) -> pl.DataFrame:
-        """The multipliers as a DataFrame: ``re, im, modulus, exponent_per_ms`` (Re ln ρ / T)."""
-        m = self.multipliers
-        modulus = np.abs(m)
+        """The multipliers as a DataFrame, largest modulus first: ``re, im, modulus,
+        exponent_per_ms`` (Re ln ρ / T), ``kind`` (``neutral`` within the marginal tolerance of
+        |ρ| = 1, ``growing`` or ``decaying``) and ``mode``/``mode_share``: the coordinate that
+        carries most of the mode's eigenvector of ``monodromy`` and its share of the squared norm
+        (coordinates in their own units: mm for ``q1``, rad for angles)."""
+        values, vectors = np.linalg.eig(self.monodromy)
+        order = np.argsort(-np.abs(values), kind="stable")
+        values, vectors = values[order], vectors[:, order]
+        modulus = np.abs(values)
         with np.errstate(divide="ignore"):
             exponent = np.where(modulus > 0, np.log(np.where(modulus > 0, modulus, 1.0)) / self.period_ms, -np.inf)
-        return pl.DataFrame({"re": m.real, "im": m.imag, "modulus": modulus, "exponent_per_ms": exponent})
+        tol = self._neutral_tolerance
+        kind = np.where(np.abs(modulus - 1.0) <= tol, "neutral", np.where(modulus > 1.0, "growing", "decaying"))
+        weights = np.abs(vectors) ** 2
+        weights /= np.maximum(weights.sum(axis=0), 1e-300)
+        dominant = np.argmax(weights, axis=0)
+        return pl.DataFrame(
+            {
+                "re": values.real,
+                "im": values.imag,
+                "modulus": modulus,
+                "exponent_per_ms": exponent,
+                "kind": kind.tolist(),
+                "mode": [self.coordinates[i] for i in dominant],
+                "mode_share": weights[dominant, np.arange(len(dominant))],
+            }
+        )
+
+    @property
+    def _neutral_tolerance(self) -> float:
+        # The `stability` verdict's marginal band (see the class docstring).
+        return max(1e-5, self.monodromy_uncertainty)
+
+    @property
+    def dominant_mode(self) -> str:
+        """The coordinate carrying the largest multiplier's mode (e.g. ``q2``: the whippletree)."""
+        return str(self.frame["mode"][0])
+
+    @property
+    def neutral_modes(self) -> list[str]:
+        """The coordinates carrying the neutral multipliers (|ρ| = 1 within the tolerance): a
+        free direction of the orbit, such as the whippletree angle ``q2`` without a balance spring."""
+        frame = self.frame
+        return frame.filter(pl.col("kind") == "neutral")["mode"].to_list()
+
+    def __repr__(self) -> str:
+        radius = f"|ρ|max = {self.spectral_radius:.6g} ({self.dominant_mode})"
+        neutral = self.neutral_modes
+        extra = f", neutral: {', '.join(neutral)}" if neutral else ""
+        whippletree = ""
+        if self.whippletree_multipliers is not None:
+            whippletree = ", whippletree |ρ| = " + ", ".join(f"{abs(m):.4g}" for m in self.whippletree_multipliers)
+        return (
+            f"FloquetResult({self.stability}: {radius}{extra}{whippletree}; period {self.period_ms:.4g} ms, "
+            f"{len(self.multipliers)} multipliers over {', '.join(self.coordinates)}; .frame for every mode)"
+        )
 
 
 def _shooting(options: dict[str, Any]) -> str | None:
