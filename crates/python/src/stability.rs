@@ -11,6 +11,7 @@ use paritysim_dynamics::floquet::records::{
     regions, rows2,
 };
 use paritysim_dynamics::floquet::{self, DisturbanceOptions, PhysicalParameters, ShootingOptions};
+use paritysim_dynamics::{Formulation, State};
 use paritysim_error::Result;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -104,6 +105,25 @@ bindings! {
         let device = parse_device(spec)?;
         let opts: ShootingOptions = options(options_json, "options")?;
         Ok(FloquetRecord::from(&floquet::floquet(&device, &opts)?))
+    }
+
+    /// The wing coordinates' derivative by a device's integrated ones: column `i` is
+    /// `∂p/∂x_i` (`p = p_part + N x`, `(φ, θ, ψ)` per wing), so a Floquet mode over `x` reads
+    /// in wing angles; `None` in drivetrain coordinates, which are already physical (`q`).
+    fn stability_coordinate_basis(spec: &str) -> Option<Vec<Vec<f64>>> {
+        let device = parse_device(spec)?;
+        if device.formulation() == Formulation::DrivetrainCoordinates {
+            return Ok(None);
+        }
+        let origin = device.coordinates(&State::default())?.0;
+        let column = |i: usize| {
+            let mut unit = State::default();
+            unit.coords[i] = 1.0;
+            device
+                .coordinates(&unit)
+                .map(|(p, _)| (p - origin).iter().copied().collect::<Vec<f64>>())
+        };
+        Ok(Some((0..device.n_dof()).map(column).collect::<Result<Vec<_>>>()?))
     }
 
     /// Floquet analysis over balance-beam stiffnesses `k2` (mN·mm/rad), in parallel
