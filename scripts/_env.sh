@@ -1,5 +1,5 @@
-# Shared set-up for scripts/run and scripts/test (sourced, not executed).
-# Creates .venv, installs the Python dependencies and builds the wheel in place (maturin develop).
+# Shared set-up for scripts/run, scripts/test and scripts/docs (sourced, not executed).
+# Creates .venv, installs the Python dependencies and builds the extension in place (maturin develop).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
@@ -7,16 +7,29 @@ cd "$ROOT"
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-${PARITYSIM_CACHE_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/paritysim}/target}"
 export PIP_DISABLE_PIP_VERSION_CHECK=1
 PYTHON="${PYTHON:-python3}"
+
+# stage NAME COMMAND...: runs COMMAND between "== NAME" and "== NAME: 12 s" (its output shown).
+stage() {
+    local name="$1" start=$SECONDS
+    shift
+    echo "== $name"
+    "$@"
+    echo "== $name: $((SECONDS - start)) s"
+}
+
 if [ ! -x .venv/bin/python ]; then
-    "$PYTHON" -m venv .venv
+    stage "create .venv" "$PYTHON" -m venv .venv
 fi
 # shellcheck disable=SC1091
 . .venv/bin/activate
-paritysim_install() {  # $1: pip extras, e.g. "test"
-    local extras="${1:-}"
+
+# What pip prints for requirements it skips or already has (maturin runs pip without -q).
+PIP_NOISE='^(Ignoring [^ ]+: markers |Requirement already satisfied|Looking in links|Obtaining |Checking if build backend)'
+
+_python_deps() {  # $1: pip extras, e.g. "test,docs"
     python -m pip install -q "maturin>=1.7,<2"
-    # Runtime (and test) dependencies from pyproject.toml, then the extension in release mode.
-    python - "$extras" <<'PY' > .venv/requirements.txt
+    # Runtime (and extra) dependencies from pyproject.toml: only the lines needed, no markers.
+    python - "$1" <<'PY' > .venv/requirements.txt
 import sys, tomllib
 meta = tomllib.load(open("pyproject.toml", "rb"))["project"]
 deps = list(meta["dependencies"])
@@ -25,6 +38,18 @@ for extra in filter(None, sys.argv[1].split(",")):
 print("\n".join(deps))
 PY
     python -m pip install -q -r .venv/requirements.txt
-    maturin develop --release --quiet 2>&1 | grep -vE '^\s*(Compiling|Finished|Building|Installed|📦|🔗|🐍|✏️|🛠)' || true
+}
+
+_build_extension() {
+    # Once the package is installed (editable), only the extension is rebuilt in place; the first
+    # time maturin also installs it. Cargo's "Compiling ..." lines show the progress.
+    local install=(--skip-install)
+    python -c "import importlib.metadata as m; m.version('paritysim')" 2>/dev/null || install=()
+    maturin develop --release "${install[@]}" 2>&1 | { grep --line-buffered -vE "$PIP_NOISE" || true; }
     python -c "import paritysim" || { echo "paritysim failed to import after the build" >&2; exit 1; }
+}
+
+paritysim_install() {  # $1: pip extras, e.g. "test"
+    stage "python dependencies (${1:-runtime})" _python_deps "${1:-}"
+    stage "build the extension (maturin develop --release; cold: ~4 min on 2 cores)" _build_extension
 }
