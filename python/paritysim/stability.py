@@ -235,15 +235,17 @@ class FloquetResult:
     growth_time_ms:
         ``T / ln|ρ|max`` of an unstable orbit (None otherwise).
     whippletree_multipliers:
-        Multipliers of the (q2, q2_dot) block for a Drag PARITY device in drivetrain
-        coordinates (exact for a symmetric orbit, see ``whippletree_coupling``), else None:
-        the rotating-wing devices (§3.4, §2.5) integrate null-space coordinates ``x0, x1, ...``
-        (``p = N x``, orthonormal ``N``), which have no (q2, q2_dot) block.
+        Multipliers of the (q2, q2_dot) block of ``monodromy`` for a device whose whippletree
+        angle ``q2`` is free (the Drag and Dual PARITY; exact for a symmetric orbit, see
+        ``whippletree_coupling``), else None (an HMF, or a Lift PARITY whose constraints hold q2).
     coordinates:
-        Names of the monodromy's rows: ``q1`` (actuator, mm), ``q2`` (whippletree angle, rad)
-        and their rates ``q1_dot, q2_dot`` in drivetrain coordinates, else ``x<i>`` and
-        ``x<i>_dot``. :attr:`frame` names the coordinate that carries each mode;
-        :attr:`dominant_mode` and :attr:`neutral_modes` the ones the verdict turns on.
+        Names of the monodromy's rows, physical: ``q1`` (actuator, mm), ``q2`` (whippletree
+        angle, rad), wing angles such as ``left_psi``, and their rates (``q2_dot``). The
+        rotating-wing devices (§3.4, §2.5) integrate null-space coordinates (``p = N x``); their
+        monodromy is read in these names (linear-map strokes as ``q1, q2``), or kept over
+        ``x<i>`` when the names do not determine ``x``. :attr:`frame` names the coordinate that
+        carries each mode; :attr:`dominant_mode` and :attr:`neutral_modes` the ones the verdict
+        turns on.
 
     ``repr`` is one line; :attr:`frame` has every multiplier.
     """
@@ -368,7 +370,16 @@ def floquet(spec: Simulation | dict[str, Any], **options: Any) -> FloquetResult:
     IntegrationError
         When no orbit is found (``.state`` holds the best state).
     """
-    raw = _core.stability_floquet(_device(spec), _shooting(options))
+    device = _device(spec)
+    raw = _core.stability_floquet(device, _shooting(options))
+    coordinates, monodromy = list(raw["coordinates"]), raw["monodromy"]
+    whippletree = None if raw["whippletree_multipliers"] is None else _complex(raw["whippletree_multipliers"])
+    coupling = raw["whippletree_coupling"]
+    basis = _core.stability_coordinate_basis(device)
+    if basis is not None:  # null-space coordinates x: named, and the monodromy read, physically
+        coordinates, monodromy = _physical(json.loads(device), np.asarray(basis, dtype=float).T, monodromy)
+        if whippletree is None and "q2" in coordinates:
+            whippletree, coupling = _whippletree_block(monodromy, coordinates)
     return FloquetResult(
         multipliers=_complex(raw["multipliers"]),
         spectral_radius=float(raw["spectral_radius"]),
@@ -377,17 +388,65 @@ def floquet(spec: Simulation | dict[str, Any], **options: Any) -> FloquetResult:
         growth_time_ms=raw["growth_time_ms"],
         max_exponent_per_ms=float(raw["max_exponent_per_ms"]),
         period_ms=float(raw["period_ms"]),
-        coordinates=list(raw["coordinates"]),
+        coordinates=coordinates,
         orbit_state=raw["orbit_state"],
-        monodromy=raw["monodromy"],
-        whippletree_multipliers=None if raw["whippletree_multipliers"] is None else _complex(raw["whippletree_multipliers"]),
-        whippletree_coupling=raw["whippletree_coupling"],
+        monodromy=monodromy,
+        whippletree_multipliers=whippletree,
+        whippletree_coupling=coupling,
         monodromy_uncertainty=float(raw["monodromy_uncertainty"]),
         method=str(raw["method"]),
         newton_iterations=int(raw["newton_iterations"]),
         cycles_simulated=int(raw["cycles_simulated"]),
         residual=float(raw["residual"]),
     )
+
+
+def _physical(spec: dict[str, Any], basis: np.ndarray, monodromy: np.ndarray) -> tuple[list[str], np.ndarray]:
+    """Names for null-space coordinates ``x`` (``p = p_part + N x``, ``basis`` = N, 6 × n) and
+    the monodromy over them: the wing angles ``left_psi, ...`` that the basis moves, with the
+    strokes of a linear-map drivetrain (eq. 2.15) as its coordinates ``q1, q2`` (``q = J⁻¹ φ``).
+    Coordinates the constraints tie together (``left_theta = right_theta``) count once. When the
+    named coordinates do not determine ``x`` one to one, ``x<i>`` is kept."""
+    n = basis.shape[1]
+    sides = ("left", "right") if len(spec.get("wings", [])) == 2 else ("wing", "unused")
+    names = [f"{side}_{angle}" for side in sides for angle in ("phi", "theta", "psi")]
+    rows, labels = list(basis), list(names)
+    drivetrain = spec.get("drivetrain") or {}
+    if drivetrain.get("kind") == "linear_differential" and sides[0] == "left":
+        from . import kinematics
+
+        drive = Simulation.from_dict(spec).drivetrain
+        jacobian = kinematics.drivetrain_map(drive, q1=[0.0], q2=[0.0])["jacobian"][0]
+        q = np.linalg.solve(jacobian, np.vstack([basis[0], basis[3]]))
+        rows = [q[0], q[1], *(basis[i] for i in (1, 2, 4, 5))]
+        labels = ["q1", "q2", *(names[i] for i in (1, 2, 4, 5))]
+    kept: list[np.ndarray] = []
+    kept_names: list[str] = []
+    for row, label in zip(rows, labels, strict=True):
+        norm = float(np.linalg.norm(row))
+        if norm < 1e-9:
+            continue  # a coordinate the constraints hold fixed
+        if any(abs(abs(float(row @ k)) - norm * float(np.linalg.norm(k))) < 1e-9 * norm for k in kept):
+            continue  # tied to one already named
+        kept.append(row)
+        kept_names.append(label)
+    transform = np.array(kept)
+    if transform.shape != (n, n) or abs(np.linalg.det(transform)) < 1e-9:
+        return [f"x{i}" for i in range(n)] + [f"x{i}_dot" for i in range(n)], monodromy
+    both = np.kron(np.eye(2), transform)  # positions and rates alike
+    physical = both @ monodromy @ np.linalg.inv(both)
+    return kept_names + [f"{c}_dot" for c in kept_names], physical
+
+
+def _whippletree_block(monodromy: np.ndarray, coordinates: list[str]) -> tuple[np.ndarray, float]:
+    """Multipliers of the (q2, q2_dot) block and its largest coupling to the other coordinates,
+    as the core computes them in drivetrain coordinates (exact for a symmetric orbit)."""
+    i, j = coordinates.index("q2"), coordinates.index("q2_dot")
+    block = monodromy[np.ix_([i, j], [i, j])]
+    others = [k for k in range(len(coordinates)) if k not in (i, j)]
+    coupling = max(float(np.abs(monodromy[np.ix_([i, j], others)]).max()), float(np.abs(monodromy[np.ix_(others, [i, j])]).max()))
+    values = np.linalg.eigvals(block)
+    return values[np.argsort(-np.abs(values), kind="stable")].astype(complex), coupling
 
 
 def k2_sweep(spec: Simulation | dict[str, Any], k2: Any, **options: Any) -> pl.DataFrame:
