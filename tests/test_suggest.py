@@ -29,3 +29,23 @@ def test_nothing_close_lists_nothing_long():
     assert "none close to `zzz`" in text and text.count("`") <= 8
     assert suggest("qqq", ["lift", "drag"]) == "one of: `lift`, `drag`"
     assert suggest("lfit", ["lift", "drag"]).startswith("did you mean `lift`?")
+
+
+def test_every_name_taking_argument_shows_a_handful_not_the_list():
+    spec = ps.devices.load("sreetharan2012_3_3_parity")
+    cases = [
+        (lambda: ps.sweep(spec, {"drivetrain.balance_sprng": [0.0, 1.0]}, progress=False), "drivetrain.balance_spring"),
+        (lambda: spec.with_paths({"actuator.force_per_vol": 1.0}), "actuator.force_per_volt"),
+        (lambda: ps.calibrate(spec, {"left_stroke_amplitude": 0.6}, {"actuator.force_per_vol": (0.5, 2.0)}), "actuator.force_per_volt"),
+        (lambda: ps.flight.trim(ps.devices.load("sreetharan2012_3_4_parity"), knobs=["actuator.waveform.amplitude"]), "actuator.waveform.amplitude_v"),
+    ]
+    for call, meant in cases:
+        try:
+            call()
+        except ps.InvalidParameterError as exc:
+            text = str(exc)
+        else:
+            raise AssertionError(f"no error for {meant}")
+        assert f"did you mean `{meant}`?" in text, text
+        assert text.count("`") <= 2 * 6 + 4, text  # the field, the value, at most five names
+        assert len(text) < 600, text

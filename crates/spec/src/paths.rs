@@ -17,7 +17,9 @@ use serde::Serialize;
 use serde_json::Value;
 
 use crate::migrate::migrate_path;
-use crate::schema::{Branch, classify, describe, join, node, schema, suggestion, unit};
+use crate::schema::{
+    Branch, SHOWN_NAMES, classify, describe, join, node, schema, suggestion, unit,
+};
 use crate::spec::Simulation;
 
 /// One settable path of a spec.
@@ -266,13 +268,28 @@ fn unknown(name: &str, paths: &[PathInfo]) -> Error {
     let best = crate::schema::nearest(last, siblings)
         .map(|l| format!("{parent}.{l}"))
         .or_else(|| crate::schema::nearest(name, spellings.iter().copied()).map(String::from));
+    // A handful of close names, never the whole list: `ps.spec_paths(spec)` prints that.
     let allowed = match best {
-        Some(best) => format!(
-            "a parameter path of this spec; did you mean `{best}`? (valid: {})",
-            valid.join(", ")
-        ),
+        Some(best) => {
+            let others: Vec<String> =
+                crate::schema::close(name, spellings.iter().copied(), SHOWN_NAMES)
+                    .into_iter()
+                    .filter(|c| *c != best)
+                    .take(SHOWN_NAMES - 1)
+                    .map(|c| format!("`{c}`"))
+                    .collect();
+            let also = if others.is_empty() {
+                String::new()
+            } else {
+                format!("also close: {}; ", others.join(", "))
+            };
+            format!(
+                "a parameter path of this spec; did you mean `{best}`? ({also}ps.spec_paths(spec) lists all {})",
+                valid.len()
+            )
+        }
         None => format!(
-            "a parameter path of this spec; {}",
+            "a parameter path of this spec; {} (ps.spec_paths(spec) lists them)",
             suggestion(name, valid.iter().copied())
         ),
     };

@@ -152,7 +152,7 @@ def trim(
         Unknown knob path or equation name, a spec without an actuator, or a drive the model
         rejects (the message names the field).
     """
-    from .._errors import finite_reals, invalid, real, whole
+    from .._errors import finite_reals, invalid, real, suggest, whole
 
     if not isinstance(spec, Simulation):
         raise invalid("spec", type(spec).__name__, "a paritysim.Simulation")
@@ -187,7 +187,7 @@ def trim(
     paths = {row[0]: row[3] for row in _path_values(clamped)}
     for k in knobs:
         if k not in paths:
-            raise invalid("knobs", k, "a spec path (paritysim.spec_paths)")
+            raise invalid("knobs", k, "a spec path; " + suggest(k, paths, listed_by="ps.spec_paths(spec)"))
     if initial is not None:
         x0 = np.atleast_1d(finite_reals("initial", initial))
         if x0.shape != (len(knobs),):

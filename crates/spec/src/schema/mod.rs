@@ -222,23 +222,62 @@ pub(crate) fn join(path: &str, key: &str) -> String {
 
 /// The nearest candidate by edit distance, when it is close enough to be a typo.
 pub fn nearest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
-    candidates
+    close(word, candidates, 1).into_iter().next()
+}
+
+/// At most `limit` candidates close enough to `word` to be a typo, nearest first.
+pub fn close<'a>(
+    word: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+    limit: usize,
+) -> Vec<&'a str> {
+    let mut ranked: Vec<(usize, &str)> = candidates
         .into_iter()
         .map(|c| (strsim::levenshtein(word, c), c))
         .filter(|(d, c)| *d <= 2.max(word.len().max(c.len()) / 3))
-        .min_by_key(|(d, _)| *d)
-        .map(|(_, c)| c)
+        .collect();
+    ranked.sort_by_key(|(d, _)| *d); // stable: equal distances keep the candidates' order
+    ranked.dedup_by(|a, b| a.1 == b.1);
+    ranked.into_iter().take(limit).map(|(_, c)| c).collect()
 }
 
-/// "a known name: did you mean `x`? (valid: ...)": the allowed text of an unknown name.
+/// Names a message shows at most: a handful of close ones, never a list of a hundred.
+pub const SHOWN_NAMES: usize = 5;
+
+/// "a known name: did you mean `x`? (also close: ...)": the allowed text of an unknown name,
+/// with the whole list only when it is short (the Python facade's `_errors.suggest` words its
+/// own arguments the same way).
 pub fn suggestion<'a>(word: &str, valid: impl IntoIterator<Item = &'a str> + Clone) -> String {
     let list: Vec<&str> = valid.clone().into_iter().collect();
-    match nearest(word, valid) {
-        Some(best) => format!(
-            "a known name: did you mean `{best}`? (valid: {})",
-            list.join(", ")
+    let near = close(word, valid, SHOWN_NAMES);
+    let quoted = |names: &[&str]| {
+        names
+            .iter()
+            .map(|n| format!("`{n}`"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if list.len() <= SHOWN_NAMES {
+        return match near.first() {
+            Some(best) => format!("did you mean `{best}`? (one of: {})", quoted(&list)),
+            None => format!("one of: {}", quoted(&list)),
+        };
+    }
+    match near.split_first() {
+        Some((best, [])) => format!(
+            "a known name: did you mean `{best}`? ({} names)",
+            list.len()
         ),
-        None => format!("a known name (valid: {})", list.join(", ")),
+        Some((best, others)) => format!(
+            "a known name: did you mean `{best}`? (also close: {}; {} names)",
+            quoted(others),
+            list.len()
+        ),
+        None => format!(
+            "a known name (none close to `{word}`; {} names, e.g. {})",
+            list.len(),
+            quoted(&list[..3])
+        ),
     }
 }
 
