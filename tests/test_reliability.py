@@ -513,7 +513,7 @@ def test_trim_and_calibrate_have_a_wall_budget_naming_max_wall_ms() -> None:
     flight = ps.load_spec(EXAMPLES / "free_flight.toml")
     start = time.monotonic()
     with pytest.raises(ps.IntegrationError) as info:
-        ps.flight.trim(flight, max_wall_ms=200.0)
+        ps.flight.trim(flight, max_wall_ms=1.0)
     assert info.value.field == "max_wall_ms" and time.monotonic() - start < 10.0
     calls = []
 
@@ -526,3 +526,17 @@ def test_trim_and_calibrate_have_a_wall_budget_naming_max_wall_ms() -> None:
         ps.calibrate(slow_model, {"y": 2.0}, {"x": (0.0, 3.0)}, max_wall_ms=120.0)
     assert info.value.field == "max_wall_ms" and 1 <= len(calls) <= 5
     _named(lambda: ps.calibrate(slow_model, {"y": 2.0}, {"x": (0.0, 3.0)}, max_wall_ms=math.nan), "max_wall_ms")
+
+
+def test_a_second_sweep_on_a_finished_checkpoint_keeps_the_first_ones_rows(tmp_path: Any) -> None:
+    """Found by the whole-surface fuzz: a sweep of another grid on a checkpoint another sweep
+    had finished replaced its table. The table now holds both grids' rows (this sweep's first)."""
+    import polars as pl
+
+    path = tmp_path / "study.parquet"
+    first = _shared_sweep(path, [100.0, 110.0])
+    second = _shared_sweep(path, [120.0, 110.0])
+    assert second["actuator.frequency_hz"].to_list() == [120.0, 110.0]
+    saved = pl.read_parquet(path)
+    assert saved["actuator.frequency_hz"].to_list() == [120.0, 110.0, 100.0]
+    assert saved.filter(pl.col("actuator.frequency_hz") == 100.0)["left_stroke_amplitude"][0] == first["left_stroke_amplitude"][0]

@@ -5,10 +5,10 @@ same sweep (``paritysim.sweep``'s ``checkpoint``).
 Several writers may share one checkpoint (two sweeps in threads or processes, issue 34): part
 names are unique per writer, every file is written to a temporary name and renamed, and the
 loads, flushes and finishes of every writer in the checkpoint's directory take turns under an
-``flock`` of that directory. A writer's finish deletes only the parts whose rows its table holds
-(the ones it wrote or loaded), and when another writer finished since this one loaded, its rows
-that this sweep does not have are kept in the final table: no writer deletes or replaces rows it
-does not hold.
+``flock`` of that directory. A writer's finish deletes only the parts it wrote or loaded, and the
+final table it writes holds its own rows followed by every stored row (of the final table found
+then, or of a part it loaded) whose point is not in its grid: no writer deletes or replaces rows
+another sweep sharing the checkpoint computed (those keep their own ``point`` numbers).
 """
 
 from __future__ import annotations
@@ -76,8 +76,8 @@ class _Checkpoint:
         self.fingerprint = fingerprint
         self.names = list(names)  # the grid's columns: a row's key
         self._writer = uuid.uuid4().hex[:12]
-        self._held: set[Path] = set()  # parts whose rows this writer's final table holds
-        self._seen: tuple[int, int, int] | None = None  # the final table as loaded
+        self._held: set[Path] = set()  # parts this writer wrote or loaded (deleted by finish)
+        self._loaded_parts: list[pl.DataFrame] = []  # rows of the parts it loaded
 
     @contextlib.contextmanager
     def _turn(self) -> Iterator[None]:
@@ -94,14 +94,6 @@ class _Checkpoint:
             yield
         finally:
             os.close(fd)  # releases the lock
-
-    @staticmethod
-    def _stamp(file: Path) -> tuple[int, int, int] | None:
-        try:
-            st = file.stat()
-        except FileNotFoundError:
-            return None
-        return (st.st_ino, st.st_mtime_ns, st.st_size)
 
     def _read(self, file: Path) -> pl.DataFrame | None:
         """One stored table after checking its fingerprint (None: removed meanwhile)."""
@@ -129,16 +121,15 @@ class _Checkpoint:
         """Every finished row stored so far (final table and parts), or None."""
         frames = []
         with self._turn():
-            self._seen = self._stamp(self.path)
-            if self._seen is not None:
-                df = self._read(self.path)
-                if df is not None:
-                    frames.append(df)
+            df = self._read(self.path)
+            if df is not None:
+                frames.append(df)
             if self.parts.is_dir():
                 for part in sorted(self.parts.glob("part-*.parquet")):
                     df = self._read(part)
                     if df is not None:
                         frames.append(df)
+                        self._loaded_parts.append(df)
                         self._held.add(part)
         if not frames:
             return None
@@ -164,22 +155,22 @@ class _Checkpoint:
 
     def finish(self, df: pl.DataFrame) -> None:
         with self._turn():
-            if self._stamp(self.path) not in (None, self._seen):
-                df = self._with_rows_of_another_writer(df)
-                if df is None:
-                    return
-            self._write(df, self.path)
+            kept = self._with_stored_rows(df)
+            if kept is None:
+                return
+            self._write(kept, self.path)
             for part in self._held:
                 with contextlib.suppress(FileNotFoundError):
                     part.unlink()
             with contextlib.suppress(OSError):
                 self.parts.rmdir()  # only when no other writer still has parts there
 
-    def _with_rows_of_another_writer(self, df: pl.DataFrame) -> pl.DataFrame | None:
-        """``df`` plus the rows of the final table another writer finished since this one
-        loaded that ``df`` lacks (None, with a warning, when that table is another sweep's)."""
+    def _with_stored_rows(self, df: pl.DataFrame) -> pl.DataFrame | None:
+        """``df`` followed by the stored rows (the final table now, the parts this writer loaded)
+        whose points ``df`` lacks; None, with a warning, when the final table is now another
+        sweep's (this sweep's rows then stay in its parts)."""
         try:
-            other = self._read(self.path)
+            final = self._read(self.path)
         except _core.InvalidParameterError:
             warnings.warn(
                 f"checkpoint {self.path} was finished meanwhile by a different sweep; this sweep's rows stay in {self.parts}",
@@ -187,14 +178,27 @@ class _Checkpoint:
                 stacklevel=4,
             )
             return None
-        if other is None or not other.height:
+        stored = [f for f in (final, *self._loaded_parts) if f is not None and f.height]
+        if not stored:
             return df
-        keys = {_key(r) for r in df.select(self.names).rows()} if self.names else {()}
-        rows = other.select(self.names).rows() if self.names else [()] * other.height
-        extra = [i for i, r in enumerate(rows) if _key(r) not in keys]
+        seen = {_key(r) for r in df.select(self.names).rows()} if self.names else {()}
+        extra = []
+        for frame in stored:
+            rows = frame.select(self.names).rows() if self.names else [()] * frame.height
+            take = []
+            for i, r in enumerate(rows):
+                k = _key(r)
+                if k not in seen:
+                    seen.add(k)
+                    take.append(i)
+            if take:
+                extra.append(frame[take])
         if not extra:
             return df
-        return pl.concat([df, other[extra]], how="vertical_relaxed")
+        try:
+            return pl.concat([df, *extra], how="vertical_relaxed")
+        except pl.exceptions.PolarsError:  # stored rows of another layout: this sweep's alone
+            return df
 
 
 def _fingerprint(spec: str, names: Sequence[str], metrics: Sequence[str], cycle: Sequence[str]) -> str:
