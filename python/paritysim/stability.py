@@ -119,10 +119,15 @@ def region(a: Any, b: Any) -> np.ndarray:
     Region I is ``b <= 1, |a| <= (1 + b)/2`` (docs/errata.md#9; the printed Region III bound
     ``a > (b - 1)/2`` would mark stable systems unstable).
     """
-    return _core.stability_region(_f64(a, "a"), _f64(b, "b"))
+    half_trace, det = _f64(a, "a"), _f64(b, "b")
+    if half_trace.size != det.size:
+        err = _core.ShapeError(f"shape mismatch: `a` has {half_trace.size} elements but `b` has {det.size}; they must match")
+        err.field = "b"  # type: ignore[attr-defined]
+        raise err
+    return _core.stability_region(half_trace, det)
 
 
-def stability_chart(beta0: Any, kappa: Any, *, brockett: bool = True) -> pl.DataFrame:
+def stability_chart(beta0: Any, kappa: Any, *, brockett: bool = True, max_wall_ms: float = 600_000.0) -> pl.DataFrame:
     """Floquet stability over the grid ``beta0 × kappa`` (computed in parallel in Rust).
 
     Returns one row per point (β0 outer, κ inner): ``beta0, kappa, a, b, spectral_radius,
@@ -135,8 +140,11 @@ def stability_chart(beta0: Any, kappa: Any, *, brockett: bool = True) -> pl.Data
     ``region_name`` (I-IV, ``marginal`` or ``failed``) and, with ``brockett=True``,
     ``brockett_bounded`` (Brockett's guarantee of eqs. 2.57-2.58; false where it does not
     apply, κ <= 0, or the point failed).
+
+    Up to 4M points; Ctrl-C stops it and ``max_wall_ms`` (default 10 min) bounds it
+    (``IntegrationError`` naming ``max_wall_ms``).
     """
-    raw = _core.stability_chart(_f64(beta0, "beta0"), _f64(kappa, "kappa"))
+    raw = _core.stability_chart(_f64(beta0, "beta0"), _f64(kappa, "kappa"), real("max_wall_ms", max_wall_ms))
     error_index, messages = raw.pop("error_index"), raw.pop("error")
     errors = pl.Series("error", [], dtype=pl.String).extend_constant(None, raw["beta0"].size)
     if messages:

@@ -169,14 +169,19 @@ bindings! {
 /// `beta0, kappa, a, b, spectral_radius, region` (int 1-4; 0 for a failed point, whose numbers
 /// are NaN), `multiplier_error`, `marginal` and `stable` (Region I and not marginal), and the
 /// failed points as `error_index` (flat indices) with their messages `error`.
+/// `max_wall_ms` bounds the whole chart (None: no budget of its own).
 #[pyfunction]
+#[pyo3(signature = (beta0, kappa, max_wall_ms = None))]
 fn stability_chart<'py>(
     py: Python<'py>,
     beta0: PyReadonlyArray1<'py, f64>,
     kappa: PyReadonlyArray1<'py, f64>,
+    max_wall_ms: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (beta0, kappa) = (to_vec(&beta0), to_vec(&kappa));
-    let c = cancellable(py, || floquet::stability_chart(&beta0, &kappa))?;
+    let c = cancellable(py, || {
+        within(max_wall_ms, || floquet::stability_chart(&beta0, &kappa))
+    })?;
     // Up to 4M points: numpy columns straight from the vectors, not the generic converter.
     let (stable, region) = (c.stable(), c.region_numbers());
     let out = PyDict::new(py);
