@@ -154,7 +154,9 @@ def moments(
             raise invalid("omegas", repr(omegas)[:60], "a dict with omega1..omega4 or a sequence [Ω1, Ω2, Ω3, Ω4]")
         values = [real(f"omegas[{i}]", v) for i, v in enumerate(omegas)]
         if len(values) != 4:
-            raise _core.ShapeError(f"`omegas` must have 4 values [Ω1, Ω2, Ω3, Ω4], got {len(values)}")
+            err = _core.ShapeError(f"`omegas` must have 4 values [Ω1, Ω2, Ω3, Ω4], got {len(values)}")
+            err.field = "omegas"  # type: ignore[attr-defined]
+            raise err
     names = ("phi", "theta", "psi", "phi_dot", "theta_dot", "psi_dot")
     given = [reals(n, v) for n, v in zip(names, (phi, theta, psi, phi_dot, theta_dot, psi_dot), strict=True)]
     try:

@@ -204,7 +204,13 @@ def continuation(spec: Simulation, path: str, stop: float, *, start: float | Non
         raise invalid(unknown[0], "<unknown setting>", _core.spec_suggestion(unknown[0], list(SETTINGS)) or "one of: " + ", ".join(SETTINGS))
     first = _current(spec, path) if start is None else real("start", start)
     settings_json = json.dumps(settings, default=lambda o: o.item() if hasattr(o, "item") else repr(o))  # Rust names a bad value
-    native = _core.continuation(spec.to_json(), path, first, real("stop", stop), settings_json, real("max_wall_ms", max_wall_ms))
+    try:
+        native = _core.continuation(spec.to_json(), path, first, real("stop", stop), settings_json, real("max_wall_ms", max_wall_ms))
+    except _core.ParitysimError as exc:
+        if not getattr(exc, "field", None):  # no periodic orbit at the start: its value is named
+            exc.field = "start"  # type: ignore[attr-defined]
+            exc.problems = [("start", repr(first), f"a value of `{path}` where the spec has a periodic orbit")]  # type: ignore[attr-defined]
+        raise
     record = native.record  # paritysim_spec::continuation::BranchRecord
     mus = record["multipliers"]
     states = record["states"]

@@ -78,7 +78,12 @@ class Planform:
     def __init__(self, points: npt.ArrayLike, *, closure_tolerance: float | None = None) -> None:
         pts = _as_points(points)
         tol = None if closure_tolerance is None else real("closure_tolerance", closure_tolerance)
-        props = _core.aero_planform_properties(pts, AIR_DENSITY, tol)
+        try:
+            props = _core.aero_planform_properties(pts, AIR_DENSITY, tol)
+        except _core.GeometryError as exc:  # an outline the model cannot use: its points
+            if not getattr(exc, "field", None):
+                exc.field = "points"  # type: ignore[attr-defined]
+            raise
         props["vertices"].setflags(write=False)
         object.__setattr__(self, "_props", props)
 
@@ -223,6 +228,14 @@ class Planform:
         f = real("fraction", fraction)
         if not (math.isfinite(f) and 0.0 <= f < 1.0):
             raise invalid("fraction", fraction, "in [0, 1)")
+        try:
+            return self._cut(f, where, measure)
+        except _core.GeometryError as exc:  # the line leaves no membrane, or splits it
+            if not getattr(exc, "field", None):
+                exc.field = "fraction"  # type: ignore[attr-defined]
+            raise
+
+    def _cut(self, f: float, where: str, measure: str) -> Planform:
         if measure == "span" or f == 0.0:
             return Planform(_core.aero_planform_cut(self.points, f, str(where)))
         from scipy.optimize import brentq
@@ -249,7 +262,7 @@ class Planform:
             raise invalid("rho", rho, "finite and > 0 (mg/mm^3; air is 1.2e-3)")
         p = _core.aero_planform_properties(self.points, r, None)
         for k in ("omega1", "omega2", "omega3", "omega4", "force"):
-            if not math.isfinite(float(p[k])):
+            if p[k] is None or not math.isfinite(float(p[k])):
                 raise invalid("rho", rho, f"small enough that {k} is finite")
         return {k: float(p[k]) for k in ("omega1", "omega2", "omega3", "omega4", "force")}
 

@@ -6,7 +6,7 @@ import math
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -126,11 +126,19 @@ def _control_call(controller: Controller) -> Callable[[float, list[tuple[str, fl
     return call
 
 
-def _names(names: Sequence[str] | None) -> list[str] | None:
+def _names(names: Sequence[str] | None, field: str) -> list[str] | None:
     """A column or metric selection as the core reads it (a lone string is one name)."""
     if names is None:
         return None
-    return [names] if isinstance(names, str) else [str(n) for n in names]
+    if isinstance(names, str):
+        return [names]
+    if isinstance(names, bytes | Mapping) or not isinstance(names, Iterable):
+        raise invalid(field, repr(names)[:60], "a name or a list of names (str)")
+    listed = list(names)
+    for n in listed:
+        if not isinstance(n, str):
+            raise invalid(field, repr(n)[:60], "names (str)")
+    return listed
 
 
 def simulate(
@@ -193,14 +201,14 @@ def simulate(
         if control_rate_hz is not None:
             raise invalid("control_rate_hz", control_rate_hz, "given only with a controller")
         # A drive typed in kHz runs for its whole wall budget: probed first, refused by field.
-        raw = _slow_drive.guarded(spec, lambda s: _core.simulate(s.to_json(), _names(columns), _names(metrics)))
+        raw = _slow_drive.guarded(spec, lambda s: _core.simulate(s.to_json(), _names(columns, "columns"), _names(metrics, "metrics")))
     else:
         if not callable(controller):
             raise invalid("controller", type(controller).__name__, "a callable (t_ms, body) -> dict")
         if control_rate_hz is None:
             raise invalid("control_rate_hz", None, "a positive control rate (Hz) with a controller")
         rate = real("control_rate_hz", control_rate_hz)
-        raw = _core.simulate_controlled(spec.to_json(), _control_call(controller), rate, _names(columns), _names(metrics))
+        raw = _core.simulate_controlled(spec.to_json(), _control_call(controller), rate, _names(columns, "columns"), _names(metrics, "metrics"))
     return SimulationResult(
         metrics={k: (v if math.isfinite(v) else None) for k, v in raw.metrics},
         cycles_run=raw.cycles_run,

@@ -431,6 +431,10 @@ class Simulation(_Node):
     def from_dict(cls, data: Mapping[str, Any]) -> Simulation:
         """Inverse of :meth:`to_dict`, validated in Rust (unknown keys raise
         ``InvalidParameterError`` naming the key and the nearest valid one)."""
+        if not isinstance(data, Mapping):
+            from ._errors import invalid
+
+            raise invalid("spec", repr(data)[:60], "a spec dict (a table of sections, see Simulation.to_dict())")
         canonical, notes = _core.spec_normalize(_dumps(data))
         return _canonical(canonical, notes)
 
@@ -441,7 +445,12 @@ class Simulation(_Node):
             from ._errors import invalid
 
             raise invalid("text", type(text).__name__, "JSON text (str)")
-        canonical, notes = _core.spec_normalize(text)
+        try:
+            canonical, notes = _core.spec_normalize(text)
+        except _core.InvalidParameterError as exc:
+            if getattr(exc, "field", None) == "":  # the document itself (not a table)
+                exc.field = "spec"  # type: ignore[attr-defined]
+            raise
         return _canonical(canonical, notes)
 
     def with_paths(self, values: Mapping[str, Any]) -> Simulation:
@@ -495,7 +504,12 @@ def load_spec(path: str | Path) -> Simulation:
         raise invalid("path", str(file), f"a UTF-8 text file ({exc.reason} at byte {exc.start})") from exc
     except OSError as exc:
         raise invalid("path", str(file), f"a readable TOML file ({exc.strerror or exc})") from exc
-    canonical, notes = _core.spec_from_toml(text)
+    try:
+        canonical, notes = _core.spec_from_toml(text)
+    except _core.InvalidParameterError as exc:
+        if getattr(exc, "field", None) == "":
+            exc.field = "spec"  # type: ignore[attr-defined]
+        raise
     return _canonical(canonical, notes)
 
 

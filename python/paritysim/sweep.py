@@ -146,6 +146,7 @@ def grid(axes: Mapping[str, Iterable[Any]]) -> pl.DataFrame:
     if not isinstance(axes, Mapping):
         raise invalid("grid", type(axes).__name__, "a mapping from parameter path to values")
     names = list(axes)
+    _check_columns(names)
     values = []
     for name in names:
         raw = axes[name]
@@ -166,11 +167,17 @@ def _table(spec_grid: Any) -> pl.DataFrame:
     if spec_grid is None:
         return pl.DataFrame()
     if isinstance(spec_grid, pl.DataFrame):
+        _check_columns(spec_grid.columns)
         return spec_grid
     if isinstance(spec_grid, Mapping):
         return grid(spec_grid)
-    if isinstance(spec_grid, Sequence) and all(isinstance(r, Mapping) for r in spec_grid):
-        return pl.DataFrame(list(spec_grid), strict=False)
+    if isinstance(spec_grid, Sequence) and not isinstance(spec_grid, str | bytes) and all(isinstance(r, Mapping) for r in spec_grid):
+        for row in spec_grid:
+            _check_columns(list(row))
+        try:
+            return pl.DataFrame(list(spec_grid), strict=False)
+        except (TypeError, ValueError, pl.exceptions.PolarsError) as exc:
+            raise invalid("grid", f"{len(spec_grid)} rows", f"row dicts of numbers or text ({str(exc)[:80]})") from exc
     raise invalid("grid", type(spec_grid).__name__, "a mapping of axes, a polars DataFrame of rows, or a list of row dicts")
 
 
@@ -526,6 +533,13 @@ def _caller_stacklevel() -> int:
     while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package):
         frame, level = frame.f_back, level + 1  # type: ignore[assignment]
     return level
+
+
+def _check_columns(names: Sequence[Any]) -> None:
+    """Grid columns are parameter paths or labels: non-empty text."""
+    for name in names:
+        if not isinstance(name, str) or not name.strip():
+            raise invalid("grid", repr(name)[:60], "columns named by parameter paths (see paritysim.spec_paths) or labels: non-empty text")
 
 
 def _names(field: str, value: Any) -> list[str]:

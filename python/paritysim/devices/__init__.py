@@ -67,7 +67,7 @@ def list() -> builtins.list[str]:  # noqa: A001  (the PyBaMM-style name is the p
 
 
 def _check(name: str) -> str:
-    if name not in _index():
+    if not isinstance(name, str) or name not in _index():
         from .._errors import invalid
 
         raise invalid("name", repr(name), "a shipped device: " + ", ".join(list()))
