@@ -1,20 +1,28 @@
-"""10,000 generated inputs across the public API and the split of their outcomes (issue 14).
+"""Generated inputs over the whole public surface and the split of their outcomes (issues 14, 34).
 
-Families: ``ps.simulate`` on specs with mutated fields (spec paths), spec TOML text with a
-mutated value, ``ps.Planform``, ``ps.kinematics``, ``ps.laminate.Flexure``, ``ps.stability``
-(Hill/LTI functions) and ``ps.sweep`` (100-point sweeps with about 10 % invalid points; each row
-counts as one input). Each input ends in one of:
+Every public function of ``paritysim`` (specs and files, simulate with and without a Python
+controller, sweeps with checkpoints and executors, calibrate, flight, continuation, stability,
+aero, kinematics, planform, laminate, devices), every CLI command, file and concurrency faults
+(two sweeps sharing a checkpoint, a process-pool executor) and Ctrl-C during the long calls.
+Each case runs in a worker process with a memory limit (``RLIMIT_AS``: what the worker maps
+after importing plus ``--memory-gb``) and a time limit (``--time-limit``): a worker that dies
+is an *abort*, one past the limit a *hang*; either is replaced and the run goes on. Cases are
+generated from ``(seed, index)`` alone, so any case can be replayed (``--replay N``).
 
-* finite result: every number reachable in the result is finite (None for undefined metrics);
-* typed error naming the field: a ``ParitysimError`` with ``.field`` set (also a failure
-  found only while running, a rod-crank driven past its reach or the shoulder's joint limit,
-  which names the field most responsible and its computed range);
-* typed model error: a ``ParitysimError`` without a field (the done-when of issue 14 asks for
-  none; seed 14: 6,210 naming the field, 3,790 finite, 0 of these);
-* typed error not naming the field: an ``InvalidParameterError`` without ``.field``;
-* other exception (not a ``ParitysimError``), non-finite result, or past the time limit.
+Outcomes (the classes of issue 34's table):
 
-    python benchmarks/fuzz_report.py [--n 10000] [--seed 14]
+* typed error naming the field: a ``ParitysimError`` with ``.field`` (a CLI error: exit status
+  1 or 2 with one line naming the argument or field, no traceback);
+* typed error naming no field;
+* finite result: every number reachable in the result is finite (None for undefined values),
+  a Ctrl-C honoured within ``--ctrl-c-s`` (0.1 s), a shared checkpoint with no row lost;
+* non-finite result;
+* foreign exception: anything not a ``ParitysimError`` (counted by type);
+* abort, hang, rows lost (a sweep or shared checkpoint that lost a row or a table).
+
+    python benchmarks/fuzz_report.py [--n 2000] [--seed 34] [--workers 2] [--families a,b]
+
+``tests/test_fuzz_surface.py`` runs a seeded sample of the fast families in CI.
 """
 
 from __future__ import annotations
@@ -22,205 +30,688 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import random
+import select
+import signal
+import subprocess
+import sys
 import tempfile
+import textwrap
 import time
 from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-import paritysim as ps
-from paritysim import laminate, stability
-
 ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+
+TYPED_FIELD = "typed error naming the field"
+TYPED_NO_FIELD = "typed error naming no field"
+FINITE = "finite result"
+NON_FINITE = "non-finite result"
+FOREIGN = "foreign exception"
+ABORT = "abort"
+HANG = "hang"
+ROWS_LOST = "rows lost"
+CLASSES = (TYPED_FIELD, TYPED_NO_FIELD, FINITE, NON_FINITE, FOREIGN, ABORT, HANG, ROWS_LOST)
+BAD = (ABORT, HANG, ROWS_LOST, FOREIGN, NON_FINITE, TYPED_NO_FIELD)
+
+# ------------------------------------------------------------------ generated values
+
+NAN, INF = math.nan, math.inf
+BAD_NUMBERS: list[Any] = [-1.0, 0.0, -0.0, 5e-324, 1e-300, 1e300, -1e300, 1e308, NAN, INF, -INF, "3", "x", None, True, [1.0], {"a": 1}, 2**63, -(2**70), 10**15, 1j]
+BAD_INTS: list[Any] = [-1, 0, 1, 2.5, "8", None, True, 2**63, 10**15, 10**9, NAN, [3]]
+BAD_NAMES: list[Any] = ["", "bogus", "max_cycle", None, 3, b"x", ["a"], "wings[9].aero.omega1", "actuator.frequency"]
+
+
+def bad_arrays(np: Any) -> list[Any]:
+    return [[], [NAN], [1e308, -1e308], "abc", [[1.0, 2.0], [3.0]], np.zeros((2, 2, 2)), None, [None, 1.0], np.array([1, 2], dtype=object), {"a": 1}, np.full(3, INF), np.zeros(10**6), np.zeros(10**7), [1j]]
+
+
+class Gen:
+    """Values for one case: plausible most of the time, hostile sometimes (at least once)."""
+
+    def __init__(self, rng: random.Random, np: Any) -> None:
+        self.rng, self.np = rng, np
+        self.hostile = rng.random() < 0.8
+        self.used = False
+
+    def _bad(self, p: float = 0.3) -> bool:
+        hit = self.hostile and (self.rng.random() < p or not self.used)
+        self.used |= hit
+        return hit
+
+    def num(self, typical: float) -> Any:
+        return self.rng.choice(BAD_NUMBERS) if self._bad() else typical * self.rng.uniform(0.5, 2.0)
+
+    def int(self, typical: int, lo: int = 1) -> Any:
+        return self.rng.choice(BAD_INTS) if self._bad() else max(lo, int(typical * self.rng.uniform(0.5, 2.0)))
+
+    def name(self, valid: list[str]) -> Any:
+        return self.rng.choice(BAD_NAMES) if self._bad() else self.rng.choice(valid)
+
+    def array(self, lo: float, hi: float, n: int = 8) -> Any:
+        if self._bad():
+            return self.rng.choice(bad_arrays(self.np))
+        return self.np.linspace(lo, hi, self.rng.randint(1, n))
+
+
+# ------------------------------------------------------------------ the cases
+
 SMALL = {"min_cycles": 1, "max_cycles": 4, "samples_per_cycle": 24, "record_cycles": 1, "max_wall_ms": 10_000.0}
-TIME_LIMIT_S = 20.0
-BAD = [-1.0, 0.0, -0.0, 5e-324, 1e-300, 1e300, -1e300, 1e308, math.nan, math.inf, -math.inf, "3", "x", None, True, [1.0], {"a": 1}, 2**63, -(2**70), 10**15]
 
 
-def _finite(value: Any) -> bool:
+def _specs(ps: Any) -> dict[str, Any]:
+    def small(name: str) -> Any:
+        return ps.load_spec(EXAMPLES / name).with_paths({f"options.{k}": v for k, v in SMALL.items()})
+
+    return {"hmf": small("hmf.toml"), "parity": small("drag_parity.toml"), "flight": small("free_flight.toml")}
+
+
+class Cases:
+    """Each family returns a zero-argument callable (run in the worker) from ``Gen`` values."""
+
+    def __init__(self, ps: Any, np: Any, tmp: Path) -> None:
+        self.ps, self.np, self.tmp = ps, np, tmp
+        self.specs = _specs(ps)
+        self.paths = {k: [(p, json.loads(v)) for p, _u, _a, v in ps.spec.spec_paths(s).rows()] for k, s in self.specs.items()}
+        self.files = self._files()
+
+    def _files(self) -> dict[str, Path]:
+        t = self.tmp
+        (t / "latin.toml").write_bytes("name = 'caf\xe9'\n".encode("latin-1"))
+        (t / "broken.toml").write_text('name = "x"\n[actuator\n')
+        (t / "empty.toml").write_text("")
+        (t / "a_dir").mkdir(exist_ok=True)
+        (t / "garbage.parquet").write_text("not parquet")
+        (t / "a_file").write_text("x")
+        good = t / "good.toml"
+        good.write_text(self.specs["hmf"].to_toml())
+        return {"latin": t / "latin.toml", "broken": t / "broken.toml", "empty": t / "empty.toml", "dir": t / "a_dir", "missing": t / "nope.toml", "good": good, "garbage": t / "garbage.parquet", "under_file": t / "a_file" / "x.parquet"}
+
+    # -- specs and files
+    def spec_mutation(self, g: Gen) -> Callable[[], Any]:
+        key = g.rng.choice(["hmf", "parity", "flight"])
+        spec, paths = self.specs[key], self.paths[key]
+        values: dict[str, Any] = {}
+        for p, v in paths:
+            if isinstance(v, float) and not p.startswith("options.") and g.rng.random() < 0.3:
+                values[p] = v * g.rng.uniform(0.7, 1.3)
+        for _ in range(g.rng.choice([1, 1, 2])):
+            p, _v = g.rng.choice(paths)
+            values[p] = g.rng.choice([*BAD_NUMBERS, object(), {1, 2}, b"x", "nan"])
+        return lambda: self.ps.simulate(spec.with_paths(values))
+
+    def spec_file(self, g: Gen) -> Callable[[], Any]:
+        target = g.rng.choice([*self.files.values(), 42, None, b"x"])
+        if g.rng.random() < 0.5:
+            lines = self.specs["hmf"].to_toml().splitlines()
+            numeric = [i for i, s in enumerate(lines) if "=" in s and s.split("=", 1)[1].strip()[:1] in "-0123456789"]
+            i = g.rng.choice(numeric)
+            lines[i] = lines[i].split("=", 1)[0] + "= " + g.rng.choice(["-1.0", "nan", "inf", '"x"', "true", "[1.0]", "{}", "18446744073709551616", "", "'", "[[", "9" * 400])
+            target = self.tmp / f"mutated_{g.rng.randrange(10**9)}.toml"
+            target.write_text("\n".join(lines) + "\n")
+        return lambda: self.ps.simulate(self.ps.load_spec(target))
+
+    def spec_dict(self, g: Gen) -> Callable[[], Any]:
+        d = self.specs["hmf"].to_dict()
+        kind = g.rng.randrange(5)
+        if kind == 0:
+            node = d
+            for _ in range(g.rng.choice([50, 500, 5000])):
+                node["x"] = {}
+                node = node["x"]
+        elif kind == 1:
+            d["actuator"] = g.rng.choice([None, 3, [1], "x", {"bogus": 1}])
+        elif kind == 2:
+            d = g.rng.choice([[], 3, "x", None, {"name": None}])
+        elif kind == 3:
+            return lambda: self.ps.Simulation.from_json(g.rng.choice(["{", "[]", "null", 3, json.dumps(self.specs["hmf"].to_dict())[:-5]]))
+        else:
+            d["options"] = {"max_cycles": g.rng.choice(BAD_INTS)}
+        return lambda: self.ps.Simulation.from_dict(d)
+
+    def spec_misc(self, g: Gen) -> Callable[[], Any]:
+        s = self.specs["hmf"]
+        k = g.rng.randrange(4)
+        if k == 0:
+            key = g.name(["actuator.frequency_hz"])
+            return lambda: s.with_paths(g.rng.choice([[1], None, {key if isinstance(key, str | int | bytes) or key is None else repr(key): g.num(120.0)}]))
+        if k == 1:
+            return lambda: s.save(g.rng.choice([self.files["dir"], self.files["under_file"], 3, self.tmp / "saved.toml"]))
+        if k == 2:
+            return lambda: self.ps.devices.load(g.name(self.ps.devices.list()))
+        return lambda: self.ps.devices.info(g.name(self.ps.devices.list()))
+
+    # -- simulate
+    def simulate(self, g: Gen) -> Callable[[], Any]:
+        key = g.rng.choice(["hmf", "parity"])
+        spec = self.specs[key]
+        kwargs: dict[str, Any] = {}
+        for opt, typical in (("record_cycles", 1), ("samples_per_cycle", 24), ("max_cycles", 4)):
+            if g.rng.random() < 0.3:
+                kwargs[opt] = g.int(typical)
+        if g.rng.random() < 0.3:
+            kwargs["columns"] = g.rng.choice([[], ["left_phi"], ["bogus"], 3, "left_phi"])
+        if g.rng.random() < 0.3:
+            kwargs["metrics"] = g.rng.choice([[], ["left_stroke_amplitude"], ["bogus"], [None]])
+        if g.rng.random() < 0.2:
+            kwargs["max_wall_ms"] = g.num(5000.0)
+        return lambda: self.ps.simulate(spec, **kwargs)
+
+    def controller(self, g: Gen) -> Callable[[], Any]:
+        spec = self.specs["flight"]
+        outs = [{}, {"q2_bias": 0.01}, {"bogus": 1.0}, {"q2_bias": NAN}, None, 3, {"q2_bias": "x"}]
+        out = g.rng.choice(outs) if g._bad() else {}
+        rate = g.num(500.0)
+        return lambda: self.ps.simulate(spec, controller=lambda t, b: out, control_rate_hz=rate)
+
+    # -- sweep
+    def sweep(self, g: Gen) -> Callable[[], Any]:
+        spec = self.specs["hmf"]
+        n = g.rng.randint(1, 6)
+        values = [100.0 * g.rng.uniform(0.8, 1.3) if g.rng.random() > 0.2 else g.rng.choice(BAD_NUMBERS + [object()]) for _ in range(n)]
+        kwargs: dict[str, Any] = {"progress": False, "metrics": ["left_stroke_amplitude"]}
+        for name, make in (
+            ("threads", lambda: g.int(2)),
+            ("chunk_size", lambda: g.int(2)),
+            ("options", lambda: g.rng.choice([{"max_cycles": g.int(4)}, [1], {"bogus": 1}, {"max_wall_ms": g.num(5000.0)}])),
+            ("keep_cycle", lambda: g.rng.choice([True, ["left_phi"], ["bogus"], 5, "left_phi"])),
+            ("labels", lambda: g.rng.choice([5, ["nope"], []])),
+            ("checkpoint", lambda: g.rng.choice([*self.files.values(), self.tmp / f"ck_{g.rng.randrange(10**9)}.parquet", 3])),
+            ("metrics", lambda: g.rng.choice([[1], ["bogus"], "left_stroke_amplitude", None])),
+        ):
+            if g.rng.random() < 0.2:
+                kwargs[name] = make()
+        key = g.name(["actuator.frequency_hz"]) if g.rng.random() < 0.2 else "actuator.frequency_hz"
+        grid = {key if isinstance(key, str | int | bytes) or key is None else repr(key): values}  # a dict key must hash
+
+        def run() -> Any:
+            import warnings
+
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                df = self.ps.sweep(spec, grid, **kwargs)
+            if df.height != n:
+                return {"__rows_lost__": n - df.height}
+            return df.drop(list(grid))  # the grid's own values come back as given (NaN too)
+
+        return run
+
+    def sweep_executor(self, g: Gen) -> Callable[[], Any]:
+        def run() -> Any:
+            import concurrent.futures as cf
+            import warnings
+
+            values = [100.0, g.num(110.0), 120.0]
+            with cf.ProcessPoolExecutor(2) as pool, warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                df = self.ps.sweep(self.specs["hmf"], {"actuator.frequency_hz": values}, executor=pool, chunk_size=1, progress=False, metrics=["left_stroke_amplitude"])
+            return {"__rows_lost__": 3 - df.height} if df.height != 3 else df.drop("actuator.frequency_hz")
+
+        return run
+
+    def shared_checkpoint(self, g: Gen) -> Callable[[], Any]:
+        """Two sweeps (threads, or a child process and this one) on one checkpoint."""
+
+        def run() -> Any:
+            import threading
+
+            import polars as pl
+
+            path = self.tmp / f"shared_{g.rng.randrange(10**9)}.parquet"
+            grids = [[100.0 + 5 * i for i in range(4)], [102.5 + 5 * i for i in range(4)]]
+            out: dict[int, Any] = {}
+
+            def one(i: int) -> None:
+                try:
+                    out[i] = self.ps.sweep(self.specs["hmf"], {"actuator.frequency_hz": grids[i]}, chunk_size=1, threads=1, checkpoint=path, progress=False, metrics=["left_stroke_amplitude"])
+                except BaseException as exc:  # noqa: BLE001 - a lost table
+                    out[i] = exc
+
+            if g.rng.random() < 0.5:
+                ts = [threading.Thread(target=one, args=(i,)) for i in range(2)]
+                for t in ts:
+                    t.start()
+                for t in ts:
+                    t.join()
+            else:
+                code = f"import paritysim as ps; spec = ps.load_spec({str(EXAMPLES / 'hmf.toml')!r}).with_paths({ {f'options.{k}': v for k, v in SMALL.items()}!r}); ps.sweep(spec, {{'actuator.frequency_hz': {grids[1]!r}}}, chunk_size=1, threads=1, checkpoint={str(path)!r}, progress=False, metrics=['left_stroke_amplitude'])"
+                child = subprocess.Popen([sys.executable, "-c", code], stderr=subprocess.PIPE, text=True)
+                one(0)
+                _, err = child.communicate(timeout=120)
+                out[1] = pl.DataFrame({"actuator.frequency_hz": grids[1]}) if child.returncode == 0 else RuntimeError(err[-300:])
+            lost = sum(1 for v in out.values() if not isinstance(v, pl.DataFrame))
+            saved = pl.read_parquet(path)["actuator.frequency_hz"].to_list() if path.exists() else []
+            lost += len(set(grids[0] + grids[1]) - set(saved))
+            return {"__rows_lost__": lost} if lost else {"rows": len(saved)}
+
+        return run
+
+    # -- calibrate, flight, continuation
+    def calibrate(self, g: Gen) -> Callable[[], Any]:
+        spec = self.specs["hmf"]
+        targets = g.rng.choice([{"left_stroke_amplitude": g.num(0.6)}, {"bogus": 1.0}, {}, 3, {"left_stroke_amplitude": None}])
+        free = g.rng.choice([{"actuator.force_per_volt": (g.num(0.5), g.num(2.0))}, {"actuator.force_per_volt": 5}, {"bogus": (0, 1)}, {}, [1]])
+        kwargs = g.rng.choice([{}, {"max_nfev": g.int(2)}, {"x0": {"actuator.force_per_volt": g.num(1.0)}}, {"diff_step": g.num(1e-4)}, {"workers": g.int(2)}, {"xtol": g.num(1e-10)}])
+        kwargs = {"max_nfev": 3, **kwargs}
+        return lambda: self.ps.calibrate(spec, targets, free, **kwargs)
+
+    def flight(self, g: Gen) -> Callable[[], Any]:
+        spec = self.specs["flight"]
+        k = g.rng.randrange(3)
+        if k == 0:
+            kwargs = g.rng.choice([{"tol": g.num(1e-4)}, {"max_evaluations": g.int(3)}, {"knobs": g.rng.choice([["bogus"], 3, [None]])}, {"initial": g.array(0, 100, 3)}, {"equations": ["bogus"]}])
+            return lambda: self.ps.flight.trim(spec, **{"max_evaluations": 2, **kwargs})
+        if k == 1:
+            return lambda: self.ps.flight.with_body(self.specs["hmf"], mode=g.name(["roll", "yaw", "free", "clamped"]), initial_attitude_rad=(g.num(0.1), 0.0, 0.0))
+        return lambda: self.ps.flight.body_of(g.rng.choice([spec, self.specs["hmf"], None, 3]))
+
+    def continuation(self, g: Gen) -> Callable[[], Any]:
+        spec = self.specs["parity"]
+        path = g.name(["drivetrain.balance_spring", "actuator.waveform.amplitude_v"])
+        settings = g.rng.choice([{}, {"max_points": g.int(3)}, {"method": g.name(["natural", "arclength"])}, {"bogus": 1}, {"initial_step": g.num(0.1)}])
+        settings = {"max_points": 3, **settings}
+        return lambda: self.ps.continuation(spec, path, g.num(50.0), start=g.num(100.0) if g.rng.random() < 0.5 else None, max_wall_ms=10_000.0, **settings)
+
+    # -- stability
+    def stability(self, g: Gen) -> Callable[[], Any]:
+        st = self.ps.stability
+        k = g.rng.randrange(11)
+        if k == 0:
+            return lambda: st.hill_monodromy(g.num(1.0), g.num(0.2), g.num(-1.5))
+        if k == 1:
+            return lambda: st.hill_solution(g.num(1.0), g.num(0.2), g.array(0.0, 50.0), max_wall_ms=10_000.0)
+        if k == 2:
+            return lambda: st.hill_floquet(g.num(1.0), g.num(0.2))
+        if k == 3:
+            return lambda: st.region(g.array(-1, 1), g.array(0, 1))
+        if k == 4:
+            return lambda: st.stability_chart(g.array(0, 3, 20), g.array(-1, 30, 20), brockett=g.rng.random() < 0.5, max_wall_ms=20_000.0)
+        if k == 5:
+            return lambda: st.brockett(g.num(0.5), g.num(6.0), g.num(0.1))
+        if k == 6:
+            return lambda: st.hill_parameters(inertia=g.num(50.0), drag=g.num(40.0), transmission_ratio=g.num(3.0), arm_length_mm=g.num(2.5), k1=g.num(300.0), k2=g.num(5.0), stroke_amplitude=g.num(1.0), frequency_hz=g.num(100.0))
+        if k == 7:
+            return lambda: st.lti_transfer(g.num(1.0), g.num(0.5), g.array(1, 300))
+        if k == 8:
+            return lambda: st.linearise(self.specs["parity"], samples=g.int(500, 8))
+        if k == 9:
+            opts = g.rng.choice([{}, {"samples_per_cycle": g.int(64, 16)}, {"max_window_cycles": g.int(2)}, {"settle_cycles": g.int(2, 0)}])
+            return lambda: st.disturbance_response(self.specs["parity"], g.array(20, 200, 2), g.num(0.1), **{"settle_cycles": 2, "max_window_cycles": 2, "samples_per_cycle": 32, **opts})
+        opts = g.rng.choice([{}, {"max_newton": g.int(5)}, {"tol": g.num(1e-8)}, {"bogus": 1}, {"fd_step": g.num(1e-5)}])
+        return lambda: st.floquet(self.specs["parity"], **opts)
+
+    # -- aero, kinematics, planform, laminate, dynamics
+    def aero(self, g: Gen) -> Callable[[], Any]:
+        a = self.ps.aero
+        k = g.rng.randrange(3)
+        if k == 0:
+            return lambda: a.center_of_pressure(g.rng.choice([None, NAN, 1e308, "x", 0.5, [0.1, 0.2]]) if g._bad() else g.array(0, 3))
+        if k == 1:
+            return lambda: a.coefficients(g.array(0, 3), model=g.name(list(a.MODELS)))
+        omegas = g.rng.choice([a.TABLE_3_3["left"], {**a.TABLE_3_3["left"], "force": g.num(1.0)}, [g.num(40.0), 0.5, 17.0, 0.7], {"omega1": 1.0}, "abcd", 3, [1, 2]])
+        kwargs = {name: g.array(-1, 1) if g.rng.random() < 0.5 else g.num(0.5) for name in ("phi", "theta", "psi", "phi_dot", "theta_dot", "psi_dot") if g.rng.random() < 0.5}
+        if g.rng.random() < 0.2:
+            kwargs["rotational_damping"] = g.num(5.0)
+        if g.rng.random() < 0.2:
+            kwargs["normal_force_law"] = g.name(["coefficient", "unit"])
+        return lambda: a.moments(omegas, **kwargs)
+
+    def kinematics(self, g: Gen) -> Callable[[], Any]:
+        kin, D = self.ps.kinematics, self.ps.Drivetrain
+        k = g.rng.randrange(5)
+        if k == 0:
+            return lambda: kin.shoulder_pose(g.num(2.0), g.num(1.0), g.num(0.3), g.num(0.1), g.num(0.0))
+        if k == 1:
+            return lambda: kin.shoulder_partials(g.num(2.0), g.num(1.0), g.num(0.3), g.num(0.1))
+        if k == 2:
+            return lambda: kin.shoulder_map(g.num(2.094), g.num(1.047), g.array(-0.5, 0.5), g.array(-0.1, 0.1))
+        if k == 3:
+            return lambda: kin.drivetrain_map(g.rng.choice([D.linkage_differential(), D.linear_differential(3.05, 2.5), D.hmf_four_bar(), None, 3]), g.array(-0.05, 0.05), g.array(-0.1, 0.1))
+        return lambda: D.linear_differential(g.num(3.05), g.num(2.5))
+
+    def planform(self, g: Gen) -> Callable[[], Any]:
+        P = self.ps.Planform
+        k = g.rng.randrange(8)
+        if k == 0:
+            return lambda: P.hmf_like(g.num(16.6), segments=g.int(32, 4))
+        if k == 1:
+            return lambda: P.rectangle(g.num(15.0), g.num(5.0), g.num(1.0), g.num(0.5))
+        if k == 2:
+            return lambda: P.semi_ellipse(g.num(15.0), g.num(5.0), segments=g.int(32, 4))
+        if k == 3:
+            pts = g.rng.choice([[[0, 0], [1], [1, 1]], [[0, 0]], "x", [[1e308, 0], [1, 1], [0, 1]], [[1.0, 0.0], [10.0, 0.0], [10.0, -3.0], [1.0, -3.0]], None])
+            return lambda: P.from_points(pts)
+        p = P.hmf_like()
+        if k == 4:
+            return lambda: p.scaled(g.num(1.2)).area
+        if k == 5:
+            return lambda: p.cut(g.num(0.2), where=g.name(["tip", "trailing"]), measure=g.name(["span", "area"])).area
+        if k == 6:
+            return lambda: p.inertia(g.num(0.01), point_masses=g.rng.choice([[], [[1.0, 0.0, 0.1]], [[1e200, 1e200, 1e200]], "x", [[1.0, 2.0]]]))
+        return lambda: (p.omegas(g.num(1.2e-3)), p.chord(g.array(0, 16)), p.translated(g.num(0.1), g.num(0.1)).area)
+
+    def laminate(self, g: Gen) -> Callable[[], Any]:
+        lam = self.ps.laminate
+        k = g.rng.randrange(3)
+        if k == 0:
+
+            def flex() -> Any:
+                f = lam.Flexure(g.num(3.0), g.num(0.5), g.num(7.5))
+                return {"stiffness": f.stiffness, "plate": f.plate_stiffness, "limit": f.elastic_limit_angle()}
+
+            return flex
+        if k == 1:
+
+            def bimorph() -> Any:
+                b = lam.Bimorph(lam.Layup.bimorph_mobee(), g.num(10.0), extension=g.num(2.0), base_width=g.num(1.0), width_ratio=g.num(0.5))
+                return {"stiffness": b.stiffness, "force_per_volt": b.force_per_volt, "active_mass": b.active_mass, "tip_width": b.tip_width}
+
+            return bimorph
+
+        def design() -> Any:
+            b = lam.Bimorph.design_for(width_ratio=g.num(0.5), extension_ratio=g.num(0.5))
+            return {"stiffness": b.stiffness, "length": b.length}
+
+        return design
+
+    def dynamics(self, g: Gen) -> Callable[[], Any]:
+        spec = g.rng.choice([self.specs["hmf"], self.specs["parity"], None, 3])
+        index = g.rng.choice([0, 1, -1, 2, "a", None, 2.0]) if g._bad() else 0
+        return lambda: self.ps.dynamics.wing_terms(spec, g.array(0, 0.3, 3) if g._bad() else [0.2, 0.05, 0.1], [g.num(1.0), 0.0, g.num(0.5)], index=index)
+
+    # -- the command line
+    def cli(self, g: Gen) -> Callable[[], Any]:
+        f = self.files
+        study = self.tmp / f"study_{g.rng.randrange(10**9)}.toml"
+        hmf_path = (EXAMPLES / "hmf.toml").as_posix()
+        max_cycles = g.rng.choice(["4", "-1", '"x"'])
+        axis = g.rng.choice(["[100.0, 120.0]", "[-1.0]", '"x"', "[]"])
+        study.write_text(f'spec = "{hmf_path}"\nmetrics = ["left_stroke_amplitude"]\n[options]\nmax_cycles = {max_cycles}\nsamples_per_cycle = 24\n[grid]\n"actuator.frequency_hz" = {axis}\n')
+        out = str(self.tmp / f"out_{g.rng.randrange(10**9)}")
+        commands = [
+            ["run", str(g.rng.choice([f["good"], f["latin"], f["broken"], f["dir"], f["missing"], f["empty"]])), "--out", g.rng.choice([out, str(f["a_dir"] if "a_dir" in f else f["dir"]), str(self.tmp / "a_file")])],
+            ["sweep", str(g.rng.choice([study, f["good"], f["missing"], f["dir"]])), "--out", out, "--quiet", "--threads", str(g.rng.choice([1, 0, -1, "x"]))],
+            ["continue", str(g.rng.choice([f["good"], f["missing"], study])), "--out", out],
+            ["devices", g.rng.choice(["", "sreetharan2012_3_3_parity", "bogus", "--list"])],
+            ["reproduce", g.rng.choice(["--list", "bogus", "fig2.99"]), "--out", out],
+            [g.rng.choice(["bogus", "--bogus", "run"])],
+        ]
+        args = [a for a in g.rng.choice(commands) if a != ""]
+
+        def run() -> Any:
+            proc = subprocess.run([sys.executable, "-m", "paritysim", *args], capture_output=True, text=True, timeout=120)
+            return {"__cli__": [proc.returncode, proc.stderr[-2000:], args]}
+
+        return run
+
+    # -- Ctrl-C
+    def ctrl_c(self, g: Gen) -> Callable[[], Any]:
+        st, np = self.ps.stability, self.np
+        slow_hmf = self.specs["hmf"].with_paths({"actuator.frequency_hz": 1e-3, "options.max_wall_ms": 600_000.0, "options.max_cycles": 200})
+        calls = {
+            "simulate": lambda: self.ps.simulate(slow_hmf),
+            "controller": lambda: self.ps.simulate(self.specs["flight"], controller=lambda t, b: {}, control_rate_hz=1000, max_cycles=100000, min_cycles=100000, max_steps=10**8, max_wall_ms=600_000.0),
+            "sweep": lambda: self.ps.sweep(slow_hmf, {"actuator.frequency_hz": [1e-3] * 4}, threads=2, progress=False),
+            "hill_solution": lambda: st.hill_solution(1.0, 0.2, np.linspace(0, 9990, 10**4)),
+            "floquet": lambda: st.floquet(slow_hmf),
+            "chart": lambda: st.stability_chart(np.linspace(0, 3, 2000), np.linspace(-1, 30, 2000), brockett=False),
+            "continuation": lambda: self.ps.continuation(slow_hmf, "actuator.waveform.frequency_hz", 2e-3, start=1e-3),
+            "trim": lambda: self.ps.flight.trim(self.specs["flight"].with_paths({"options.max_cycles": 200, "options.max_wall_ms": 600_000.0})),
+        }
+        name = g.rng.choice(sorted(calls))
+        call = calls[name]
+
+        def run() -> Any:
+            import threading
+
+            sent: list[float] = []
+
+            def fire() -> None:
+                sent.append(time.monotonic())
+                os.kill(os.getpid(), signal.SIGINT)
+
+            timer = threading.Timer(0.3, fire)
+            timer.start()
+            try:
+                call()
+            except KeyboardInterrupt:
+                return {"__ctrl_c__": [name, time.monotonic() - sent[0] if sent else 0.0]}
+            finally:
+                timer.cancel()
+            return {"__ctrl_c__": [name, None]}  # finished before the signal
+
+        return run
+
+
+FAMILIES: dict[str, float] = {
+    "spec_mutation": 0.09, "spec_file": 0.05, "spec_dict": 0.04, "spec_misc": 0.03, "simulate": 0.06, "controller": 0.02,
+    "sweep": 0.06, "sweep_executor": 0.005, "shared_checkpoint": 0.01, "calibrate": 0.02, "flight": 0.02, "continuation": 0.015,
+    "stability": 0.1, "aero": 0.1, "kinematics": 0.09, "planform": 0.1, "laminate": 0.07, "dynamics": 0.04, "cli": 0.025, "ctrl_c": 0.015,
+}  # fmt: skip
+#: Families cheap enough for the CI sample (no subprocess of their own, sub-second cases).
+FAST = ("spec_mutation", "spec_dict", "spec_misc", "simulate", "stability", "aero", "kinematics", "planform", "laminate", "dynamics", "sweep")
+
+
+def plan(n: int, seed: int, families: tuple[str, ...]) -> list[str]:
+    """The family of each of the ``n`` cases, in proportion to their weights, shuffled."""
+    weights = {f: FAMILIES[f] for f in families}
+    total = sum(weights.values())
+    names = [f for f, w in weights.items() for _ in range(max(1, round(n * w / total)))]
+    rng = random.Random(seed)
+    while len(names) < n:  # rounding: top up in proportion
+        names.append(rng.choices(list(weights), weights=list(weights.values()))[0])
+    rng.shuffle(names)
+    return names[:n]
+
+
+# ------------------------------------------------------------------ the worker
+
+
+def _finite(value: Any, np: Any) -> bool:
     if isinstance(value, dict):
-        return all(_finite(v) for v in value.values())
+        return all(_finite(v, np) for v in value.values())
     if isinstance(value, list | tuple):
-        return all(_finite(v) for v in value)
+        return all(_finite(v, np) for v in value)
     if isinstance(value, np.ndarray):
         return value.dtype.kind not in "fc" or bool(np.isfinite(value).all())
     if isinstance(value, float | complex):
         return math.isfinite(abs(value))
-    if hasattr(value, "to_numpy") and hasattr(value, "columns"):  # a polars DataFrame
-        return all(_finite(value[c].to_numpy()) for c in value.columns if value[c].dtype.is_float())
+    if hasattr(value, "columns") and hasattr(value, "height"):  # a polars DataFrame
+        return all(_finite(value[c].drop_nulls().to_numpy(), np) for c in value.columns if value[c].dtype.is_float())
+    for attr in ("metrics", "columns", "values", "residuals", "multipliers", "branch", "knobs"):  # result objects
+        if hasattr(value, attr) and not callable(getattr(value, attr)):
+            if not _finite(getattr(value, attr), np):
+                return False
     return True
 
 
-def classify(call: Callable[[], Any]) -> str:
-    start = time.perf_counter()
+def classify(call: Callable[[], Any], ps: Any, np: Any, ctrl_c_s: float) -> tuple[str, str]:
     try:
         result = call()
-        ok = _finite(result)
-        outcome = "finite result" if ok else "non-finite result"
     except ps.ParitysimError as exc:
-        if getattr(exc, "field", None):
-            outcome = "typed error naming the field"
-        elif isinstance(exc, ps.InvalidParameterError):
-            outcome = "typed error not naming the field"
-        else:
-            outcome = f"typed model error ({type(exc).__name__})"
+        return (TYPED_FIELD if getattr(exc, "field", None) else TYPED_NO_FIELD), f"{type(exc).__name__}: {str(exc)[:160]}"
+    except KeyboardInterrupt:
+        return HANG, "KeyboardInterrupt outside a Ctrl-C case"
     except Exception as exc:  # noqa: BLE001 - what we count
-        outcome = f"other exception ({type(exc).__name__}: {str(exc)[:60]})"
-    if time.perf_counter() - start > TIME_LIMIT_S:
-        outcome = "past the time limit"
-    return outcome
+        return FOREIGN, f"{type(exc).__name__}: {str(exc)[:160]}"
+    if isinstance(result, dict) and "__rows_lost__" in result:
+        return ROWS_LOST, f"{result['__rows_lost__']} rows or tables lost"
+    if isinstance(result, dict) and "__ctrl_c__" in result:
+        name, latency = result["__ctrl_c__"]
+        if latency is None:
+            return FINITE, f"ctrl-c {name}: finished before the signal"
+        return (FINITE if latency <= ctrl_c_s else HANG), f"ctrl-c {name}: {latency * 1e3:.1f} ms"
+    if isinstance(result, dict) and "__cli__" in result:
+        code, err, argv = result["__cli__"]
+        if "Traceback" in err:
+            return FOREIGN, "CLI traceback: " + err.strip().splitlines()[-1][:160]
+        if code == 0:
+            return FINITE, "CLI exit 0"
+        lines = [line for line in err.strip().splitlines() if line.strip()]
+        named = "`" in err or "--" in err or "argument" in err or "invalid choice" in err or any(len(a) > 2 and a in err for a in argv)
+        if code in (1, 2) and lines and named:
+            return TYPED_FIELD, f"CLI exit {code}: {lines[-1][:160]}"
+        return TYPED_NO_FIELD, f"CLI exit {code}: {(lines[-1] if lines else '')[:160]}"
+    return (FINITE if _finite(result, np) else NON_FINITE), type(result).__name__
 
 
-def _result_values(r: ps.SimulationResult) -> dict[str, Any]:
-    return {"metrics": r.metrics, "columns": r.columns, "residual": r.residual}
-
-
-def _number(rng: random.Random, typical: float) -> Any:
-    """A plausible value most of the time, a hostile one sometimes."""
-    return typical * rng.uniform(0.5, 2.0) if rng.random() < 0.7 else rng.choice(BAD)
-
-
-class Families:
-    def __init__(self, rng: random.Random) -> None:
-        self.rng = rng
-        self.bases = []
-        for name in ("hmf.toml", "drag_parity.toml"):
-            spec = ps.load_spec(ROOT / "examples" / name).with_paths({f"options.{k}": v for k, v in SMALL.items()})
-            paths = [(p, json.loads(v)) for p, _u, _a, v in ps.spec.spec_paths(spec).rows()]
-            self.bases.append((spec, paths))
-        self.tmp = Path(tempfile.mkdtemp(prefix="fuzz_report_"))
-        self.toml_count = 0
-
-    def simulate(self) -> Callable[[], Any]:
-        spec, paths = self.rng.choice(self.bases)
-        values: dict[str, Any] = {}
-        for p, v in paths:
-            if isinstance(v, float) and not p.startswith("options.") and self.rng.random() < 0.5:
-                values[p] = v * self.rng.uniform(0.7, 1.3)
-        for _ in range(self.rng.choice([0, 0, 1, 1, 2])):
-            p, _ = self.rng.choice(paths)
-            values[p] = self.rng.choice(BAD)
-
-        def run() -> Any:
-            return _result_values(ps.simulate(spec.with_paths(values)))
-
-        return run
-
-    def toml(self) -> Callable[[], Any]:
-        spec, _ = self.rng.choice(self.bases)
-        lines = spec.to_toml().splitlines()
-        numeric = [i for i, s in enumerate(lines) if "=" in s and s.split("=", 1)[1].strip()[:1] in "-0123456789"]
-        i = self.rng.choice(numeric)
-        token = self.rng.choice(["-1.0", "0", "1e300", "nan", "inf", '"x"', "true", "[1.0]", "{}", "18446744073709551616", "", "1.0.0", "'", "[[", "9" * 400, "-0.0"])
-        lines[i] = lines[i].split("=", 1)[0] + "= " + token
-        if self.rng.random() < 0.1:
-            lines.insert(self.rng.randrange(len(lines)), self.rng.choice(["[options", "bogus = 1", "[[wings]]", "=", "\x00"]))
-        self.toml_count += 1
-        path = self.tmp / f"spec_{self.toml_count}.toml"
-        path.write_text("\n".join(lines) + "\n")
-
-        def run() -> Any:
-            return _result_values(ps.simulate(ps.load_spec(path)))
-
-        return run
-
-    def planform(self) -> Callable[[], Any]:
-        r = self.rng
-        kind = r.randrange(3)
-        segs = r.choice([4, 16, 128, 512, -1, 0, 2.5, "8", 10**7, 2**64])
-        if kind == 0:
-            return lambda: (p := ps.Planform.hmf_like(_number(r, 16.6), segments=segs)) and {"area": p.area, "span": p.span, "mean_chord": p.mean_chord}
-        if kind == 1:
-            return lambda: (p := ps.Planform.rectangle(_number(r, 15.0), _number(r, 5.0), _number(r, 1.0), _number(r, 0.5))) and {"area": p.area, "mean_chord": p.mean_chord}
-        return lambda: (p := ps.Planform.semi_ellipse(_number(r, 15.0), _number(r, 5.0), segments=segs)) and {"area": p.area}
-
-    def kinematics(self) -> Callable[[], Any]:
-        r = self.rng
-        if r.random() < 0.5:
-            return lambda: ps.kinematics.shoulder_pose(_number(r, 0.5), _number(r, 0.3), _number(r, 0.4), _number(r, 0.1))
-        drive = ps.Drivetrain.linear_differential(3.05, 2.5)
-        return lambda: ps.kinematics.drivetrain_map(drive, [_number(r, 0.3)], _number(r, 0.1))
-
-    def laminate(self) -> Callable[[], Any]:
-        r = self.rng
-
-        def run() -> Any:
-            f = laminate.Flexure(_number(r, 3.0), _number(r, 0.5), _number(r, 7.5))
-            return {"stiffness": f.stiffness, "plate": f.plate_stiffness, "limit": f.elastic_limit_angle()}
-
-        return run
-
-    def stability(self) -> Callable[[], Any]:
-        r = self.rng
-        k = r.randrange(3)
-        if k == 0:
-            return lambda: stability.hill_floquet(_number(r, 1.0), _number(r, 0.2))
-        if k == 1:
-            return lambda: stability.lti_transfer(_number(r, 1.0), _number(r, 0.5), [_number(r, 50.0)])
-        return lambda: stability.brockett(_number(r, 0.5), _number(r, 6.0), _number(r, 0.1))
-
-
-def sweep_rows(rng: random.Random, families: Families, n_points: int) -> Counter[str]:
-    """One sweep of ``n_points`` with about 10 % invalid values; each row is one input."""
-    spec, _ = families.bases[0]
-    values = [100.0 * rng.uniform(0.6, 1.4) if rng.random() > 0.1 else rng.choice([-1.0, 0.0, math.nan, 1e9]) for _ in range(n_points)]
-    out: Counter[str] = Counter()
+def worker(seed: int, memory_gb: float, ctrl_c_s: float, families: tuple[str, ...], n: int) -> None:
+    """Reads case indices on stdin, writes one JSON outcome line per case on stdout."""
+    import resource
     import warnings
 
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
+    import numpy as np
+
+    import paritysim as ps
+
+    warnings.simplefilter("ignore")
+    tmp = Path(tempfile.mkdtemp(prefix="fuzz_surface_"))
+    cases = Cases(ps, np, tmp)
+    names = plan(n, seed, families)
+    vm = int(next(line for line in open("/proc/self/status") if line.startswith("VmSize")).split()[1]) * 1024
+    resource.setrlimit(resource.RLIMIT_AS, (vm + int(memory_gb * 2**30), resource.RLIM_INFINITY))
+    out = sys.stdout
+    sys.stdout = sys.stderr  # the cases' prints (progress bars, CLI) never reach the protocol
+    out.write("ready\n")
+    out.flush()
+    for line in sys.stdin:
+        i = int(line)
+        family = names[i]
+        rng = random.Random(f"{seed}:{i}")
+        start = time.monotonic()
         try:
-            df = ps.sweep(spec, {"actuator.frequency_hz": values}, metrics=["left_stroke_amplitude"], progress=False)
-        except Exception as exc:  # noqa: BLE001
-            out[f"other exception ({type(exc).__name__})"] += n_points
-            return out
-    out["sweep rows lost"] += n_points - df.height
-    for row in df.iter_rows(named=True):
-        if row["status"] == "ok":
-            v = row["left_stroke_amplitude"]
-            out["finite result" if v is None or math.isfinite(v) else "non-finite result"] += 1
-        elif "`" in (row["error"] or ""):  # the engine names the field in backticks
-            out["typed error naming the field"] += 1
-        else:
-            out[f"typed model error ({row['error_kind']}Error)"] += 1
-    return out
+            outcome, detail = classify(getattr(cases, family)(Gen(rng, np)), ps, np, ctrl_c_s)
+        except Exception as exc:  # noqa: BLE001 - building the case itself raised (a constructor)
+            outcome, detail = (TYPED_FIELD if isinstance(exc, ps.ParitysimError) and getattr(exc, "field", None) else TYPED_NO_FIELD if isinstance(exc, ps.ParitysimError) else FOREIGN), f"{type(exc).__name__}: {str(exc)[:160]}"
+        out.write(json.dumps({"i": i, "family": family, "outcome": outcome, "detail": detail, "s": time.monotonic() - start}) + "\n")
+        out.flush()
+
+
+# ------------------------------------------------------------------ the parent
+
+
+class Worker:
+    def __init__(self, args: argparse.Namespace, n: int) -> None:
+        cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", "--seed", str(args.seed), "--memory-gb", str(args.memory_gb), "--ctrl-c-s", str(args.ctrl_c_s), "--families", ",".join(args.families), "--n", str(n)]
+        self.proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, bufsize=1, start_new_session=True)
+        line = self._read(120.0)
+        if line != "ready":
+            raise SystemExit(f"fuzz worker did not start: {line!r}")
+
+    def _read(self, timeout: float) -> str | None:
+        assert self.proc.stdout is not None
+        ready, _, _ = select.select([self.proc.stdout], [], [], timeout)
+        if not ready:
+            return None
+        return self.proc.stdout.readline().strip() or None
+
+    def run(self, i: int, timeout: float) -> dict[str, Any]:
+        assert self.proc.stdin is not None
+        try:
+            self.proc.stdin.write(f"{i}\n")
+            self.proc.stdin.flush()
+        except BrokenPipeError:
+            return {"i": i, "outcome": ABORT, "detail": "worker gone"}
+        line = self._read(timeout)
+        if line is None:
+            if self.proc.poll() is None:
+                self.kill()
+                return {"i": i, "outcome": HANG, "detail": f"no answer within {timeout:g} s"}
+            code = self.proc.returncode
+            return {"i": i, "outcome": ABORT, "detail": f"worker died ({signal.Signals(-code).name if code < 0 else f'exit {code}'})"}
+        return json.loads(line)  # type: ignore[no-any-return]
+
+    def kill(self) -> None:
+        if self.proc.poll() is None:
+            os.killpg(self.proc.pid, signal.SIGKILL)  # the worker's own session: its children too
+        self.proc.wait()
+
+
+def run(args: argparse.Namespace, indices: list[int], n: int) -> list[dict[str, Any]]:
+    """Runs ``indices`` on ``args.workers`` workers (round robin), replacing dead ones."""
+    workers = [Worker(args, n) for _ in range(max(1, args.workers))]
+    results: list[dict[str, Any]] = []
+    pending = list(indices)
+    names = plan(n, args.seed, tuple(args.families))
+    try:
+        from concurrent.futures import ThreadPoolExecutor
+
+        def drain(k: int) -> None:
+            while pending:
+                i = pending.pop(0)
+                r = workers[k].run(i, args.time_limit)
+                r.setdefault("family", names[i])
+                results.append(r)
+                if r["outcome"] in (ABORT, HANG):
+                    workers[k].kill()
+                    workers[k] = Worker(args, n)
+                if args.verbose:
+                    print(f"{i:5d} {r['family']:18s} {r['outcome']:30s} {r.get('detail', '')[:100]}", flush=True)
+
+        with ThreadPoolExecutor(len(workers)) as pool:
+            list(pool.map(drain, range(len(workers))))
+    finally:
+        for w in workers:
+            w.kill()
+    return sorted(results, key=lambda r: r["i"])
+
+
+def table(results: list[dict[str, Any]]) -> str:
+    total = Counter(r["outcome"] for r in results)
+    lines = ["| outcome | count |", "|---|---:|"]
+    for c in CLASSES:
+        extra = ""
+        if c == FOREIGN and total[c]:
+            kinds = Counter(r["detail"].split(":")[0] for r in results if r["outcome"] == c)
+            extra = " (" + ", ".join(f"{k} {v}" for k, v in kinds.most_common()) + ")"
+        lines.append(f"| {c}{extra} | {total[c]} |")
+    return "\n".join(lines)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--n", type=int, default=10_000)
-    parser.add_argument("--seed", type=int, default=14)
+    parser.add_argument("--n", type=int, default=2000)
+    parser.add_argument("--seed", type=int, default=34)
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--time-limit", type=float, default=60.0, help="seconds per case before it counts as a hang")
+    parser.add_argument("--memory-gb", type=float, default=3.0, help="address space a worker may add after importing")
+    parser.add_argument("--ctrl-c-s", type=float, default=0.1, help="Ctrl-C latency bound (s)")
+    parser.add_argument("--families", type=lambda s: tuple(s.split(",")), default=tuple(FAMILIES))
+    parser.add_argument("--replay", type=int, default=None, help="run only this case index (verbose)")
+    parser.add_argument("--verbose", action="store_true")
+    parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
-    rng = random.Random(args.seed)
-    fam = Families(rng)
-    weights = {"simulate": 0.2, "toml": 0.15, "planform": 0.15, "kinematics": 0.15, "laminate": 0.15, "stability": 0.1}
-    n_sweep = round(args.n * 0.1)
+    unknown = set(args.families) - set(FAMILIES)
+    if unknown:
+        parser.error(f"unknown families {sorted(unknown)}; known: {', '.join(FAMILIES)}")
+    n = len(plan(args.n, args.seed, tuple(args.families)))
+    if args.worker:
+        worker(args.seed, args.memory_gb, args.ctrl_c_s, tuple(args.families), args.n)
+        return
+    indices = [args.replay] if args.replay is not None else list(range(n))
+    args.verbose |= args.replay is not None
+    start = time.monotonic()
+    results = run(args, indices, args.n)
+    print(f"\n{len(results)} cases in {time.monotonic() - start:.0f} s (seed {args.seed}, {args.workers} workers, {args.time_limit:g} s and +{args.memory_gb:g} GB per case)\n")
+    print(table(results))
     per_family: dict[str, Counter[str]] = {}
-    start = time.perf_counter()
-    for name, w in weights.items():
-        counter: Counter[str] = Counter()
-        for _ in range(round(args.n * w)):
-            counter[classify(getattr(fam, name)())] += 1
-        per_family[name] = counter
-    sweeps: Counter[str] = Counter()
-    while sum(sweeps.values()) < n_sweep:
-        sweeps += sweep_rows(rng, fam, min(100, n_sweep - sum(sweeps.values())))
-    per_family["sweep"] = sweeps
-    total: Counter[str] = Counter()
-    for c in per_family.values():
-        total += c
-    n = sum(total.values())
-    print(f"{n} inputs in {time.perf_counter() - start:.0f} s (seed {args.seed})\n")
-    print(f"{'outcome':60s} {'count':>7s}")
-    for outcome, count in total.most_common():
-        print(f"{outcome:60s} {count:7d}")
+    for r in results:
+        per_family.setdefault(r["family"], Counter())[r["outcome"]] += 1
     print("\nper family:")
-    for name, c in per_family.items():
-        print(f"  {name:10s} " + ", ".join(f"{k}: {v}" for k, v in c.most_common()))
+    for name, c in sorted(per_family.items()):
+        print(f"  {name:18s} " + ", ".join(f"{k}: {v}" for k, v in c.most_common()))
+    latencies = [r["detail"] for r in results if r.get("detail", "").startswith("ctrl-c")]
+    if latencies:
+        print("\nCtrl-C: " + "; ".join(sorted(latencies)))
+    bad = [r for r in results if r["outcome"] in BAD]
+    if bad:
+        print("\nnot clean (replay with --replay I):")
+        for r in bad[:60]:
+            print(f"  {r['i']:5d} {r['family']:18s} {r['outcome']}: {r.get('detail', '')[:140]}")
 
 
 if __name__ == "__main__":
