@@ -58,7 +58,8 @@ def test_a_bad_wall_budget_is_a_typed_error(hmf: ps.Simulation, value: float) ->
 def test_ctrl_c_interrupts_simulate_inside_the_integration(hmf: ps.Simulation) -> None:
     """SIGINT (``_thread.interrupt_main``) 0.3 s into a run that would take a minute: the
     integrator's cancel flag stops it and ``KeyboardInterrupt`` is raised."""
-    slow = hmf.with_paths({"actuator.frequency_hz": 1e-3})
+    # duration_ms: a slow drive on purpose, not refused after simulate's 3 s probe (_slow_drive)
+    slow = hmf.with_paths({"actuator.frequency_hz": 1e-3, "options.duration_ms": 1e7})
     timer = threading.Timer(0.3, _thread.interrupt_main)
     start = time.monotonic()
     timer.start()
@@ -76,7 +77,7 @@ def test_simulate_works_again_after_an_interrupt(hmf: ps.Simulation) -> None:
     timer = threading.Timer(0.2, _thread.interrupt_main)
     timer.start()
     with pytest.raises(KeyboardInterrupt):
-        ps.simulate(hmf.with_paths({"actuator.frequency_hz": 1e-3}))
+        ps.simulate(hmf.with_paths({"actuator.frequency_hz": 1e-3, "options.duration_ms": 1e7}))
     timer.cancel()
     assert ps.simulate(hmf, **fast).metrics == first
 
