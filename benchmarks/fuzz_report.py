@@ -569,6 +569,9 @@ def worker(seed: int, memory_gb: float, ctrl_c_s: float, families: tuple[str, ..
     import paritysim as ps
 
     warnings.simplefilter("ignore")
+    # Ctrl-C cases need Python's handler even when the run was started with SIGINT ignored (a
+    # background job of a shell).
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     tmp = Path(tempfile.mkdtemp(prefix="fuzz_surface_"))
     cases = Cases(ps, np, tmp)
     names = plan(n, seed, families)

@@ -540,3 +540,11 @@ def test_a_second_sweep_on_a_finished_checkpoint_keeps_the_first_ones_rows(tmp_p
     saved = pl.read_parquet(path)
     assert saved["actuator.frequency_hz"].to_list() == [120.0, 110.0, 100.0]
     assert saved.filter(pl.col("actuator.frequency_hz") == 100.0)["left_stroke_amplitude"][0] == first["left_stroke_amplitude"][0]
+
+
+def test_floquet_failures_name_the_option_or_the_spec() -> None:
+    """Found by the whole-surface fuzz: an orbit not found at a tolerance below round-off named
+    nothing, and ``fd_step = 5e-324`` returned None where a float was read (TypeError)."""
+    parity = ps.load_spec(EXAMPLES / "drag_parity.toml")
+    _named(lambda: ps.stability.floquet(parity, tol=1e-300), "options.tol")
+    _named(lambda: ps.stability.floquet(parity, fd_step=5e-324), "options.fd_step")

@@ -207,9 +207,15 @@ def continuation(spec: Simulation, path: str, stop: float, *, start: float | Non
     try:
         native = _core.continuation(spec.to_json(), path, first, real("stop", stop), settings_json, real("max_wall_ms", max_wall_ms))
     except _core.ParitysimError as exc:
-        if not getattr(exc, "field", None):  # no periodic orbit at the start: its value is named
-            exc.field = "start"  # type: ignore[attr-defined]
-            exc.problems = [("start", repr(first), f"a value of `{path}` where the spec has a periodic orbit")]  # type: ignore[attr-defined]
+        if not getattr(exc, "field", None):
+            import re
+
+            budget = re.search(r"`options\.([a-z_]+)`", str(exc))
+            if budget:  # a run stopped by a budget of the spec's options: that option
+                exc.field = f"options.{budget.group(1)}"  # type: ignore[attr-defined]
+            else:  # no periodic orbit at the start: its value is named
+                exc.field = "start"  # type: ignore[attr-defined]
+                exc.problems = [("start", repr(first), f"a value of `{path}` where the spec has a periodic orbit")]  # type: ignore[attr-defined]
         raise
     record = native.record  # paritysim_spec::continuation::BranchRecord
     mus = record["multipliers"]

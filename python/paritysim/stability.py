@@ -24,6 +24,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -361,6 +362,30 @@ def _complex(pairs: Any) -> np.ndarray:
     return a[..., 0] + 1j * a[..., 1]
 
 
+def _attributed(call: Any, options: dict[str, Any]) -> Any:
+    """``call()``; a failure naming no field (no periodic orbit, a spent budget) is attributed to
+    the option it names (``options.tol``, ``options.max_steps``, ...) or else to ``spec``: the
+    device has no orbit these options find (issue 34: such errors named nothing)."""
+    try:
+        return call()
+    except _core.ParitysimError as exc:
+        if not getattr(exc, "field", None):
+            text = str(exc)
+            named = re.search(r"`options\.([a-z_]+)`", text)
+            given = [k for k in options if options[k] is not None and re.search(rf"\b{k}\b", text)]
+            exc.field = f"options.{named.group(1)}" if named else f"options.{given[0]}" if given else "spec"  # type: ignore[attr-defined]
+        raise
+
+
+def _finite_floquet(raw: dict[str, Any], options: dict[str, Any]) -> None:
+    """A Floquet result with non-finite numbers (a finite-difference step below round-off)
+    is an error naming the option responsible (``fd_step``) or the spec."""
+    numbers = [raw[k] for k in ("spectral_radius", "max_exponent_per_ms", "period_ms", "monodromy_uncertainty", "residual")]
+    if any(v is None or not math.isfinite(float(v)) for v in numbers) or not np.isfinite(np.asarray(raw["monodromy"], dtype=float)).all():
+        field = "options.fd_step" if options.get("fd_step") is not None else "spec"
+        raise invalid(field, options.get("fd_step", "<spec>"), "a finite-difference step giving a finite monodromy (the result overflowed or was undefined)")
+
+
 def floquet(spec: Simulation | dict[str, Any], **options: Any) -> FloquetResult:
     """Periodic orbit of a driven device by shooting, and its Floquet multipliers.
 
@@ -379,7 +404,8 @@ def floquet(spec: Simulation | dict[str, Any], **options: Any) -> FloquetResult:
         When no orbit is found (``.state`` holds the best state).
     """
     device = _device(spec)
-    raw = _core.stability_floquet(device, _shooting(options))
+    raw = _attributed(lambda: _core.stability_floquet(device, _shooting(options)), options)
+    _finite_floquet(raw, options)
     coordinates, monodromy = list(raw["coordinates"]), raw["monodromy"]
     whippletree = None if raw["whippletree_multipliers"] is None else _complex(raw["whippletree_multipliers"])
     coupling = raw["whippletree_coupling"]
@@ -467,7 +493,7 @@ def k2_sweep(spec: Simulation | dict[str, Any], k2: Any, **options: Any) -> pl.D
     in :func:`paritysim.sweep`; the others are kept. The points run on the sweep engine's own
     thread pool (``PARITYSIM_THREADS``).
     """
-    raw = _core.stability_k2_sweep(_device(spec), _f64(k2, "k2"), _shooting(options))
+    raw = _attributed(lambda: _core.stability_k2_sweep(_device(spec), _f64(k2, "k2"), _shooting(options)), options)
     numeric = ["spectral_radius", "whippletree_radius", "max_exponent_per_ms", "slowest_decay_ms"]
     return pl.DataFrame(
         {
@@ -502,7 +528,7 @@ def linearise(spec: Simulation | dict[str, Any], samples: int = _LINEARISE_SAMPL
     """
     n = whole("samples", samples, 8, 10**9)
     sized("samples", n, n, _BYTES_PER_ORBIT_SAMPLE, "the orbit samples")
-    return _core.stability_linearise(_device(spec), _shooting(options), n)
+    return _attributed(lambda: _core.stability_linearise(_device(spec), _shooting(options), n), options)  # type: ignore[no-any-return]
 
 
 def disturbance_response(
@@ -541,12 +567,12 @@ def disturbance_response(
     sized("samples_per_cycle" if samples_per_cycle is not None else "max_window_cycles", samples_per_cycle or max_window_cycles, per_window * parallel, _BYTES_PER_WINDOW_SAMPLE, "the measurement windows")
     dist = {"settle_cycles": settle_cycles, "max_window_cycles": max_window_cycles, "samples_per_cycle": samples_per_cycle}
     device = _device(spec)
-    raw = _core.stability_disturbance_response(device, freqs, real("amplitude", amplitude), _shooting(options), _shooting(dist))
+    raw = _attributed(lambda: _core.stability_disturbance_response(device, freqs, real("amplitude", amplitude), _shooting(options), _shooting(dist)), {**options, **dist})
     h = _complex(raw["transfer"])
     lti = avg = np.full(freqs.size, np.nan + 0j)
     _, n_dof = _core.validate_spec(device)
     if n_dof == 2:  # eq. 2.59 models the whippletree mode of a 2-DOF (Drag PARITY) drivetrain
-        lin = _core.stability_linearise(device, _shooting(options), _LINEARISE_SAMPLES)
+        lin = _attributed(lambda: _core.stability_linearise(device, _shooting(options), _LINEARISE_SAMPLES), options)
         lti = lti_transfer(lin["lti"]["beta_star"], lin["lti"]["kappa0"], freqs)
         avg = lti_transfer(lin["lti_averaged"]["beta_star"], lin["lti_averaged"]["kappa0"], freqs)
     return pl.DataFrame(
