@@ -548,3 +548,10 @@ def test_floquet_failures_name_the_option_or_the_spec() -> None:
     parity = ps.load_spec(EXAMPLES / "drag_parity.toml")
     _named(lambda: ps.stability.floquet(parity, tol=1e-300), "options.tol")
     _named(lambda: ps.stability.floquet(parity, fd_step=5e-324), "options.fd_step")
+
+
+def test_a_grid_of_python_objects_is_refused_naming_its_column(tmp_path: Any) -> None:
+    """Found by the fuzz: with a checkpoint, a grid column of Python objects raised polars'
+    ComputeError (an Object column cannot be written); refused up front, naming the column."""
+    hmf = ps.load_spec(EXAMPLES / "hmf.toml")
+    _named(lambda: ps.sweep(hmf, {"actuator.frequency_hz": [100.0, object()]}, checkpoint=tmp_path / "s.parquet", progress=False), "actuator.frequency_hz")

@@ -389,6 +389,7 @@ def sweep(
     if options:
         spec = spec.replace(options=spec.options.with_fields("options", **{str(k): v for k, v in options.items()}))
     table = _table(grid)
+    _check_values(table)
     label_names = _names("labels", labels)
     if metrics is not None:
         metrics = _names("metrics", metrics)
@@ -540,6 +541,15 @@ def _check_columns(names: Sequence[Any]) -> None:
     for name in names:
         if not isinstance(name, str) or not name.strip():
             raise invalid("grid", repr(name)[:60], "columns named by parameter paths (see paritysim.spec_paths) or labels: non-empty text")
+
+
+def _check_values(table: pl.DataFrame) -> None:
+    """Grid values are plain data (numbers, text, booleans, lists of them): a column of Python
+    objects can be neither sent to the engine nor stored in a checkpoint (issue 34)."""
+    for column in table.get_columns():
+        if column.dtype == pl.Object:
+            shown = next((repr(v) for v in column.to_list() if not isinstance(v, int | float | str | bool) and v is not None), "?")
+            raise invalid(column.name, shown[:60], "numbers, text or booleans (grid values are plain data)")
 
 
 def _names(field: str, value: Any) -> list[str]:
