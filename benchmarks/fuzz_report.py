@@ -368,7 +368,12 @@ class Cases:
         if k == 1:
             return lambda: kin.shoulder_partials(g.num(2.0), g.num(1.0), g.num(0.3), g.num(0.1))
         if k == 2:
-            return lambda: kin.shoulder_map(g.num(2.094), g.num(1.047), g.array(-0.5, 0.5), g.array(-0.1, 0.1))
+
+            def shoulder_map() -> Any:  # NaN marks unreachable poses (documented, with `reachable`)
+                out = kin.shoulder_map(g.num(2.094), g.num(1.047), g.array(-0.5, 0.5), g.array(-0.1, 0.1))
+                return {k: v[out["reachable"]] for k, v in out.items()}
+
+            return shoulder_map
         if k == 3:
             return lambda: kin.drivetrain_map(g.rng.choice([D.linkage_differential(), D.linear_differential(3.05, 2.5), D.hmf_four_bar(), None, 3]), g.array(-0.05, 0.05), g.array(-0.1, 0.1))
         return lambda: D.linear_differential(g.num(3.05), g.num(2.5))

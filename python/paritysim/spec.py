@@ -460,6 +460,11 @@ class Simulation(_Node):
             from ._errors import invalid
 
             raise invalid("values", type(values).__name__, "a mapping {path: value}")
+        for key in values:
+            if not isinstance(key, str) or not key.strip():
+                from ._errors import invalid
+
+                raise invalid("values", repr(key)[:60], "parameter paths (non-empty text, see paritysim.spec_paths) as keys")
         canonical, notes = _core.spec_apply(self.to_json(), _dumps(dict(values)))
         return _canonical(canonical, notes)
 
