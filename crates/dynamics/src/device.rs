@@ -23,7 +23,6 @@ pub(crate) mod linear_map_jacobian;
 mod null_space;
 mod ode_system;
 mod stroke_plane;
-pub(crate) mod switched_lanes;
 mod switches;
 
 use drivetrain_coordinates::{StrokeOnly, stroke_only, stroke_torque};
@@ -31,9 +30,6 @@ use drivetrain_inverse::{
     NEWTON_MAX, NEWTON_TOL, check_plausible, invert_1dof, invert_2dof, singular_drive,
     unreachable_stroke,
 };
-pub(crate) use free_deviation::lanes as free_deviation_lanes;
-pub(crate) use stroke_plane::lanes as stroke_plane_lanes;
-pub(crate) use switches::branches as blade_branches;
 
 /// A drivetrain with its balance-beam spring.
 #[derive(Clone, Debug, PartialEq)]
@@ -439,6 +435,14 @@ impl Device {
     /// `device/stroke_plane/`), whose lean samples are [`crate::trajectory::PlaneSample`]s.
     pub fn has_stroke_plane_model(&self) -> bool {
         self.stroke_plane_rhs.is_some()
+    }
+
+    /// Whether the device has the closed-form free-deviation model (§2.5 Lift / Dual PARITY:
+    /// θ free). Such devices have coexisting stable orbits at one drive (docs/findings.md §23:
+    /// the Lift PARITY is bistable near 96 V), so a sweep does not continue their points from a
+    /// neighbour's orbit ([`crate::sweep::run_points`]).
+    pub fn has_free_deviation_model(&self) -> bool {
+        self.free_deviation_rhs.is_some()
     }
 
     /// The drive forces [`Self::drive_load`] applies at `t`: the actuator's and 0, or a dual

@@ -36,8 +36,6 @@
 //!   sweep's cancel is checked between periods.
 
 pub(crate) mod linear_stroke;
-mod plane_point;
-mod plane_rhs;
 mod point;
 mod schedule;
 
@@ -87,17 +85,12 @@ pub fn resolve_lanes(requested: Option<usize>) -> Result<usize> {
 /// §3.4 stroke-plane devices (blade elements on both wings, a single drive) and the §2.5
 /// free-deviation devices (Lift and Dual PARITY with blade elements).
 pub fn has_lane_model(device: &Device) -> bool {
-    LinearStroke::of(device).is_some() || plane_rhs::supports(device)
+    LinearStroke::of(device).is_some()
 }
 
 /// Points completed in lanes since the process started (tests and benchmarks read it to see
 /// that the lanes ran).
 pub(crate) static COMPLETED_IN_LANES: std::sync::atomic::AtomicUsize =
-    std::sync::atomic::AtomicUsize::new(0);
-
-/// Of [`COMPLETED_IN_LANES`], the switched devices' points (§3.4 stroke plane, §2.5 free
-/// deviation).
-pub(crate) static SWITCHED_COMPLETED_IN_LANES: std::sync::atomic::AtomicUsize =
     std::sync::atomic::AtomicUsize::new(0);
 
 /// A converged lane point as `simulate` and `run_point` report it (metrics only, one orbit
@@ -259,10 +252,4 @@ pub(super) fn broyden_update(
 /// rerun on the scalar path are not counted).
 pub fn points_completed_in_lanes() -> usize {
     COMPLETED_IN_LANES.load(std::sync::atomic::Ordering::Relaxed)
-}
-
-/// Of [`points_completed_in_lanes`], those of the switched devices (§3.4 stroke plane, §2.5
-/// free deviation).
-pub fn switched_points_completed_in_lanes() -> usize {
-    SWITCHED_COMPLETED_IN_LANES.load(std::sync::atomic::Ordering::Relaxed)
 }

@@ -181,84 +181,20 @@ fn a_lift_point_next_to_a_flip_converges_by_shooting() {
     assert!(largest < 1.0, "largest multiplier {largest}");
 }
 
-/// The held-branch equations in SIMD lanes are the scalar ones bit for bit: a batch of one
-/// device's states (the variational equations' central differences, `rhs_on_batch`) and four
-/// devices side by side (the sweep lanes, `lanes::FreeDeviationLanes`), on each state's own
-/// sides and on flipped ones (the scalar lanes), with an implausible state among them.
+/// The held-branch equations in batches (the variational equations' central differences,
+/// `rhs_on_batch`) are the scalar ones bit for bit, with an implausible state among them.
 #[test]
-#[allow(clippy::needless_range_loop)] // lanes and entries index several arrays
-fn held_branch_lanes_equal_the_scalar_right_hand_side_bit_for_bit() {
-    use crate::device::switched_lanes::SwitchedLanes;
-    use paritysim_simd::f64x4;
+fn held_branch_batches_equal_the_scalar_right_hand_side_bit_for_bit() {
     // The Dual PARITY (five coordinates) in batches.
     let dual = device("dual_parity");
     assert_batches_are_scalar_bit_for_bit(&dual, &states(&dual));
     let d = device("lift_parity");
     let mut ys = states(&d);
-    // Beyond the linkage's plausible range: the general path (and its error) in a lane.
+    // Beyond the linkage's plausible range: the general path (and its error) in a batch.
     let mut far = ys[0];
     far.coords[0] = 50.0;
     ys.insert(3, far);
     assert_batches_are_scalar_bit_for_bit(&d, &ys);
-    for flip in [None, Some(1), Some(4)] {
-        let sides = flipped_sides(&d, &ys[1], flip);
-        // Four devices' lanes (deviation springs apart), the implausible state left out.
-        let devices: Vec<Device> = (0..4)
-            .map(|l| lift_variant(8.0 + l as f64, 85.0, 85.0))
-            .collect();
-        let lanes =
-            super::lanes::FreeDeviationLanes::<4, 8>::new(std::array::from_fn(|l| &devices[l]))
-                .expect("lanes");
-        let (mut vector_lanes, mut scalar_lanes) = (0, 0);
-        for chunk in ys
-            .iter()
-            .filter(|y| y.coords[0] != 50.0)
-            .collect::<Vec<_>>()
-            .chunks_exact(4)
-        {
-            let y: [f64x4; 8] = std::array::from_fn(|i| {
-                f64x4::new(std::array::from_fn(|l| {
-                    if i < 4 {
-                        chunk[l].coords[i]
-                    } else {
-                        chunk[l].rates[i - 4]
-                    }
-                }))
-            });
-            let ts = [0.1, 0.2, 0.3, 0.4];
-            let forces = std::array::from_fn(|l| devices[l].drive_forces(ts[l]));
-            let mut dydt = [f64x4::splat(0.0); 8];
-            let super::super::switched_lanes::LaneEval { scalar, failed } =
-                lanes.eval(ts, forces, &y, [branches(sides); 4], &mut dydt);
-            assert_eq!(failed, 0);
-            for l in 0..4 {
-                if scalar & (1 << l) == 0 {
-                    vector_lanes += 1;
-                } else {
-                    scalar_lanes += 1;
-                }
-                let mut one = State::default();
-                let lean_l = devices[l].free_deviation_rhs.unwrap();
-                devices[l]
-                    .rhs_free_deviation(&lean_l, ts[l], chunk[l], Some(branches(sides)), &mut one)
-                    .unwrap();
-                for i in 0..8 {
-                    let want = if i < 4 {
-                        one.coords[i]
-                    } else {
-                        one.rates[i - 4]
-                    };
-                    assert_eq!(
-                        dydt[i].to_array()[l].to_bits(),
-                        want.to_bits(),
-                        "lane {l} entry {i}"
-                    );
-                }
-            }
-        }
-        eprintln!("sides {flip:?}: {vector_lanes} vector lanes, {scalar_lanes} scalar");
-        assert!(vector_lanes >= 12, "{vector_lanes} vector lanes");
-    }
 }
 
 /// The sides of the switching functions at `y`, with switch `flip` flipped when given.

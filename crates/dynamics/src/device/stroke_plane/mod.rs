@@ -468,7 +468,5 @@ impl Device {
     }
 }
 
-pub(crate) mod lanes;
-
 #[cfg(test)]
 mod tests;
