@@ -1,5 +1,5 @@
 //! One shooting point in a lane: the state machine of `simulate::shooting_steady_state` and
-//! `grid_shooting::shoot` that hands out one period at a time (see the module `lanes`).
+//! `shooting::grid::shoot` that hands out one period at a time (see the module `lanes`).
 
 use std::rc::Rc;
 
@@ -7,15 +7,12 @@ use nalgebra::{DMatrix, DVector};
 
 use super::linear_stroke::LinearStroke;
 use crate::device::Device;
-use crate::grid_shooting::REPICK_RESIDUAL;
 use crate::integrate::lanes::{LaneOutcome, LaneProblem, SampleBlock};
 use crate::integrate::{Method, RungeKutta, State};
 use crate::metrics::{MetricsAccumulator, StrokeBlock};
+use crate::shooting::newton::{self, REPICK_RESIDUAL};
 use crate::simulate::{SimulationOptions, SteadyState, UNSTABLE_MARGIN};
 use crate::sweep::PointOutput;
-
-/// Newton steps of the shooting (as `simulate` gives `grid_shooting::shoot`).
-const MAX_NEWTON: usize = 20;
 
 /// The fixed-grid period a lane point waits for.
 #[derive(Clone, Debug)]
@@ -34,7 +31,7 @@ enum Pending {
         candidate: Option<(State, DVector<f64>, f64)>,
     },
     /// The adaptive period that picks the grid again at the converged `y_new` (the grid was
-    /// picked far from the orbit: `grid_shooting::REPICK_RESIDUAL`).
+    /// picked far from the orbit: `shooting::grid::REPICK_RESIDUAL`).
     Repick { y_new: State },
     /// A Newton trial from `y_new`; `last`: the recorded window.
     Trial {
@@ -57,7 +54,7 @@ pub(super) enum Next {
     Scalar,
 }
 
-/// One shooting point in a lane: `simulate::shooting_steady_state` and `grid_shooting::shoot`
+/// One shooting point in a lane: `simulate::shooting_steady_state` and `shooting::grid::shoot`
 /// as a state machine that hands out one period at a time (see the module).
 pub(super) struct LanePoint<'a> {
     device: &'a Device,
@@ -75,7 +72,7 @@ pub(super) struct LanePoint<'a> {
     /// Whether `jac` is an exact Jacobian at `y` (after a re-linearisation).
     fresh: bool,
     /// Whether the grid was picked far from the orbit and is to be picked again once Newton
-    /// converges on it (`grid_shooting::REPICK_RESIDUAL`).
+    /// converges on it (`shooting::grid::REPICK_RESIDUAL`).
     repick: bool,
     /// Warm-up periods of a cold point: at most `min_cycles`.
     min_cycles: usize,
@@ -107,14 +104,9 @@ fn expand4(c: &[f64; 4]) -> State {
     y
 }
 
-/// `(P(y) − y, ‖P(y) − y‖∞ / (1 + ‖y‖∞))` (as `grid_shooting`).
+/// `(P(y) − y, ‖P(y) − y‖∞ / (1 + ‖y‖∞))` on the two drivetrain coordinates.
 fn residual(y: &State, py: &State) -> (DVector<f64>, f64) {
-    super::residual(2, y, py)
-}
-
-/// Least-squares Newton step (as `grid_shooting`).
-fn newton_step(jac: &DMatrix<f64>, eye: &DMatrix<f64>, f: &DVector<f64>) -> Option<DVector<f64>> {
-    crate::grid_shooting::least_squares_step(jac - eye, f)
+    newton::residual(2, y, py)
 }
 
 impl<'a> LanePoint<'a> {
@@ -327,20 +319,26 @@ impl<'a> LanePoint<'a> {
 
     /// The next Newton trial from the current iterate (the head of `shoot`'s loop).
     fn iterate(&mut self) -> Next {
-        if self.iterations >= MAX_NEWTON {
+        if self.iterations >= newton::MAX_NEWTON {
             return Next::Scalar;
         }
         self.iterations += 1;
         let model = (&self.jac, &self.eye, &self.f);
-        let trial = super::newton_trial(
+        let trial = newton::trial(
             2,
             &self.y,
             model,
-            self.last_step,
-            self.fresh,
+            (self.last_step, self.fresh, None),
             self.limits.tol,
         );
-        let Some((delta, step, y_new, last)) = trial else {
+        let Some(newton::Trial {
+            delta,
+            step,
+            y_new,
+            last,
+            ..
+        }) = trial
+        else {
             return Next::Scalar;
         };
         if last && self.repick {
@@ -432,7 +430,7 @@ impl<'a> LanePoint<'a> {
                 }
                 let neutral = || {
                     res_new <= self.limits.accept_tol
-                        && newton_step(&self.jac, &self.eye, &f_new)
+                        && newton::least_squares_step(&self.jac - &self.eye, &f_new)
                             .is_some_and(|d| d.amax() / (1.0 + y_new.compact(2).amax()) <= tol)
                 };
                 if last && (res_new <= tol || neutral()) {
@@ -445,7 +443,7 @@ impl<'a> LanePoint<'a> {
                     }
                     return self.relinearise(&self.y.clone(), None);
                 }
-                super::broyden_update(&mut self.jac, &self.eye, &delta, (&self.f, &f_new));
+                newton::broyden_update(&mut self.jac, &self.eye, &delta, (&self.f, &f_new));
                 self.fresh = false;
                 (self.y, self.f, self.res) = (y_new, f_new, res_new);
                 self.last_step = Some(step);
