@@ -16,6 +16,8 @@ use crate::actuator::Actuator;
 use crate::integrate::State;
 use crate::wing::{Wing, WingTerms};
 
+mod drive;
+pub(crate) use drive::DriveSprings;
 mod drivetrain_coordinates;
 mod drivetrain_inverse;
 mod free_deviation;
@@ -120,6 +122,8 @@ pub struct Device {
     /// The free-deviation equations on a held branch written over `Real` (four coordinates,
     /// blade elements on both wings): the scalar and SIMD-lane path's common code.
     free_deviation_held: Option<free_deviation::HeldConstants>,
+    /// The drive's springs (`K1`, `K2`, dual or not): the one drive load.
+    drive: drive::DriveSprings<f64>,
     /// Switching functions of the right-hand side (three per wing with blade elements whose
     /// `ω` has a closed form; see [`Self::blade_switching_functions`]).
     n_switches: usize,
@@ -154,6 +158,9 @@ pub struct DriveState {
     pub q_dot: Vector2<f64>,
     /// Actuator force F(t) (mN).
     pub actuator_force: f64,
+    /// The drive load `Q` on `(q1, q2)` (mN, mN·mm): the actuator and the drivetrain springs
+    /// (see `device/drive.rs`).
+    pub load: Vector2<f64>,
     /// Generalised torques on `(φL, φR)` from the drivetrain (mN·mm).
     pub stroke_torque: Vector2<f64>,
     /// Drivetrain spring energy ½K1q1² + ½K2q2² (µJ).
@@ -271,8 +278,12 @@ impl Device {
             stroke_plane_rhs: None,
             free_deviation_rhs: None,
             free_deviation_held: None,
+            drive: drive::DriveSprings::single(0.0, 0.0),
             n_switches: 0,
         };
+        // A dual drivetrain drives both sides through the actuator, when there is one.
+        let dual = device.spec.actuator.is_some() && device.is_dual();
+        device.drive = drive::DriveSprings::of(&device.spec, dual);
         device.stroke_plane_rhs = stroke_plane::StrokePlane::of(&device);
         device.free_deviation_rhs = free_deviation::FreeDeviation::of(&device);
         device.free_deviation_held = free_deviation::HeldConstants::of(&device);
@@ -405,30 +416,15 @@ impl Device {
         })
     }
 
-    /// Actuator force `F(t)`, drivetrain load `Q = (F − K1 q1, −K2 q2)` and its spring energy
-    /// `½K1q1² + ½K2q2²`.
-    ///
-    /// A dual drivetrain (one drive per wing) has the actuator on both coordinates instead:
-    /// `Q = (F_L − K1 q1, F_R − K1 q2)` ([`Actuator::side_force`]); the returned force is
-    /// then the left side's.
+    /// Actuator force `F(t)` (the left side's on a dual drivetrain), drivetrain load `Q`
+    /// ([`drive::DriveSprings::load`]) and the drive springs' energy.
     // Always inlined: every right-hand side calls it (a call and its spills cost more than it).
     #[inline(always)]
     fn drive_load(&self, t: f64, q: &Vector2<f64>) -> (f64, Vector2<f64>, f64) {
-        let actuator = self.spec.actuator.as_ref();
-        let k1 = actuator.map_or(0.0, |a| a.stiffness());
-        if let (Some(a), true) = (actuator, self.is_dual()) {
-            let (left, right) = (a.side_force(t, 0), a.side_force(t, 1));
-            let load = Vector2::new(left - k1 * q.x, right - k1 * q.y);
-            return (left, load, 0.5 * k1 * q.norm_squared());
-        }
-        let force = actuator.map_or(0.0, |a| a.force(t));
-        let k2 = self
-            .spec
-            .transmission
-            .as_ref()
-            .map_or(0.0, |tr| tr.balance_stiffness);
-        let load = Vector2::new(force - k1 * q.x, -k2 * q.y);
-        (force, load, 0.5 * k1 * q.x * q.x + 0.5 * k2 * q.y * q.y)
+        let forces = self.drive_forces(t);
+        let [q1, q2] = [q.x, q.y];
+        let [l1, l2] = self.drive.load(forces, [q1, q2]);
+        (forces[0], Vector2::new(l1, l2), self.drive.energy([q1, q2]))
     }
 
     /// Whether the device has the closed-form stroke-plane model (§3.4 rotating wings:
@@ -456,19 +452,10 @@ impl Device {
         }
     }
 
-    /// `∂Q/∂q` of [`Self::drive_load`] (constant: the actuator and balance springs,
-    /// `−diag(K1, K2)`, or `−K1` on both drives of a dual drivetrain).
+    /// `∂Q/∂q` of [`Self::drive_load`] ([`drive::DriveSprings::slope`]).
     pub(crate) fn drive_load_slope(&self) -> nalgebra::Matrix2<f64> {
-        let k1 = self.spec.actuator.as_ref().map_or(0.0, |a| a.stiffness());
-        let k2 = match (&self.spec.actuator, self.is_dual()) {
-            (Some(_), true) => k1,
-            _ => self
-                .spec
-                .transmission
-                .as_ref()
-                .map_or(0.0, |tr| tr.balance_stiffness),
-        };
-        nalgebra::Matrix2::new(-k1, 0.0, 0.0, -k2)
+        let [s1, s2] = self.drive.slope();
+        nalgebra::Matrix2::new(s1, 0.0, 0.0, s2)
     }
 
     /// Whether the drivetrain is a dual one (one actuator per wing, `q2` the right drive).
@@ -533,6 +520,7 @@ impl Device {
                 q,
                 q_dot: Vector2::new(p_dot[0] / slope, 0.0),
                 actuator_force: force,
+                load,
                 stroke_torque: stroke_torque(1, &Matrix2::new(slope, 0.0, slope, 0.0), &q, &load)?,
                 potential,
             });
@@ -575,6 +563,7 @@ impl Device {
                 q,
                 q_dot,
                 actuator_force: force,
+                load,
                 stroke_torque: stroke_torque(2, jac, &q, &load)?,
                 potential,
             });
@@ -589,6 +578,7 @@ impl Device {
             q,
             q_dot,
             actuator_force: force,
+            load,
             stroke_torque: stroke_torque(2, &jac, &q, &load)?,
             potential,
         })
@@ -635,6 +625,7 @@ impl Device {
             q: step.q,
             q_dot: step.q_dot,
             actuator_force: step.force,
+            load: step.load,
             stroke_torque: stroke_torque(self.n_dof, &e.jacobian, &step.q, &step.load)?,
             potential: step.potential,
         };

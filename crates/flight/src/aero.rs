@@ -86,7 +86,12 @@ pub fn wrench(
             };
             Wrench {
                 force: Vector3::zeros(),
-                torque: Vector3::x() * (-omega1 * coefficient * magnitude * rate),
+                torque: Vector3::x()
+                    * paritysim_aero::stroke_drag(
+                        paritysim_aero::stroke_drag_constant(*omega1, *coefficient),
+                        magnitude,
+                        rate,
+                    ),
             }
         }
         WingAero::BladeElement(model) => {

@@ -1,7 +1,9 @@
 //! A wing's aerodynamic model inside the right-hand side: stroke drag or the blade element.
 
 use nalgebra::{Matrix3, Vector3};
-use paritysim_aero::{BladeElementModel, Branch, CoefficientSet};
+use paritysim_aero::{
+    BladeElementModel, Branch, CoefficientSet, stroke_drag_constant, stroke_drag_torque,
+};
 use paritysim_error::{Result, check_non_negative};
 
 /// Aerodynamic model of a wing, evaluated inside the right-hand side (allocation-free).
@@ -39,7 +41,7 @@ impl WingAero {
             WingAero::StrokeDrag {
                 omega1,
                 coefficient,
-            } => -omega1 * coefficient * phi_dot.abs() * phi_dot,
+            } => stroke_drag_torque(stroke_drag_constant(*omega1, *coefficient), phi_dot),
             WingAero::BladeElement(model) => {
                 model.moments_omega(&Vector3::new(phi_dot, 0.0, 0.0)).normal
             }
@@ -80,7 +82,8 @@ impl WingAero {
                 coefficient,
             } => {
                 // Torque about the stroke axis x̂ (ground), expressed in frame 6.
-                *stroke_axis_6 * (-omega1 * coefficient * phi_dot.abs() * phi_dot)
+                *stroke_axis_6
+                    * stroke_drag_torque(stroke_drag_constant(*omega1, *coefficient), phi_dot)
             }
         }
     }
