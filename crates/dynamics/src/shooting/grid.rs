@@ -15,13 +15,11 @@
 //! once the predicted error of the next iterate (step × observed contraction) is below `tol`.
 //! The residual of that recorded period is reported.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 use paritysim_error::Result;
 
-use super::newton::{
-    GRID_TOLERANCE_FACTOR, REPICK_RESIDUAL, Trial, broyden_update, least_squares_step,
-    out_of_budget, residual, trial,
-};
+use super::machine::{GridNewton, Limits, Reply, Request, Start, Verdict};
+use super::newton::{GRID_TOLERANCE_FACTOR, out_of_budget};
 use crate::device::Device;
 use crate::integrate::{RungeKutta, State};
 
@@ -97,7 +95,7 @@ pub(crate) fn shoot(
     let chooser = rk.tightened(GRID_TOLERANCE_FACTOR);
     let n = device.n_dof();
     let m = 2 * n;
-    let mut y = y0.without_work();
+    let y = y0.without_work();
     let guess = guess.filter(|g| g.jacobian.shape() == (m, m));
     let guess_contraction = guess.and_then(|g| g.contraction);
     let guess_grid = guess.and_then(|g| g.grid);
@@ -128,132 +126,69 @@ pub(crate) fn shoot(
             .flow_with_sensitivity_and_steps(device, t0, &y, t_end)
             .map(|(py, j, grid)| (py, j, grid, true)),
     };
-    let (py, mut jac, mut grid, mut fresh) = match first {
+    let (mapped, jacobian, grid, exact) = match first {
         Ok(v) => v,
         Err(e) if out_of_budget(&e) => return Err(e),
         Err(_) => return Ok(None),
     };
-    let mut periods = 1;
-    let (mut f, mut res) = residual(n, &y, &py);
-    let mut repick = picked_here && res > REPICK_RESIDUAL;
-    let eye = DMatrix::<f64>::identity(m, m);
-    let mut last_step: Option<f64> = None;
-    let mut iterations = 0;
-    let newton_step = |jac: &DMatrix<f64>, f: &DVector<f64>| least_squares_step(jac - &eye, f);
-    while iterations < max_newton {
-        iterations += 1;
-        let Some(Trial {
-            delta,
-            step,
-            contraction,
-            y_new,
-            last,
-        }) = trial(
-            n,
-            &y,
-            (&jac, &eye, &f),
-            (last_step, fresh, guess_contraction),
-            tol,
-        )
-        else {
-            return Ok(None);
+    let start = Start {
+        y,
+        mapped,
+        jacobian,
+        exact,
+        grid: grid.into(),
+        picked_here,
+        guess_contraction,
+    };
+    let limits = Limits {
+        tol,
+        accept_tol,
+        max_newton,
+    };
+    let (mut machine, mut verdict) = GridNewton::start(n, start, limits);
+    // The scalar executor: each requested period at once.
+    loop {
+        let request = match verdict {
+            Verdict::Run(request) => request,
+            Verdict::GaveUp => return Ok(None),
+            Verdict::Converged(accepted) => {
+                return Ok(Some(GridOrbit {
+                    state: accepted.state,
+                    residual: accepted.residual,
+                    jacobian: machine.jacobian,
+                    periods: machine.periods - 1,
+                    iterations: machine.iterations,
+                    grid: machine.grid.to_vec(),
+                    jacobian_at_orbit: accepted.jacobian_at_orbit,
+                    contraction: Some(accepted.contraction),
+                }));
+            }
         };
-        if last && repick {
-            // Converged on a grid picked far from the orbit: the grid again, from here
-            // ([`REPICK_RESIDUAL`]); Newton goes on on it with the Jacobian it has.
-            repick = false;
-            let (p_new, picked) = match chooser.advance_with_steps(device, t0, &y_new, t_end) {
-                Ok(v) => v,
-                Err(e) if out_of_budget(&e) => return Err(e),
-                Err(_) => return Ok(None),
-            };
-            periods += 1;
-            grid = picked;
-            (f, res) = residual(n, &y_new, &p_new);
-            y = y_new;
-            continue;
-        }
-        let trial = if last {
-            finish(&grid, &y_new)
-        } else {
-            rk.integrate_on_grid(device, &grid, &y_new, &[], &mut |_, _, _| Ok(()))
-                .map(|p| (p, None))
-        };
-        let (p_new, exact) = match trial {
-            Ok(p) => p,
-            Err(e) if out_of_budget(&e) => return Err(e),
+        let grid = &machine.grid;
+        let reply = match request {
             // `finish` failing is the recorded window's error: report it.
-            Err(e) if last => return Err(e),
-            Err(_) => return Ok(None),
-        };
-        periods += 1;
-        let (f_new, res_new) = residual(n, &y_new, &p_new);
-        let exact = exact.filter(|j| j.shape() == (m, m));
-        let at_orbit = exact.is_some();
-        if let Some(j) = exact {
-            // The final period's own variational equations: the exact Jacobian at `y_new`.
-            jac = j;
-            fresh = true;
-            last_step = None;
-        }
-        // Only an exact Jacobian tells a neutral direction from a stale model's small step
-        // (measured: a neighbour's Broyden-updated Jacobian accepted a residual of 2.5e-9
-        // with the state 4e-7 off the orbit).
-        let neutral = || {
-            res_new <= accept_tol
-                && newton_step(&jac, &f_new)
-                    .is_some_and(|d| d.amax() / (1.0 + y_new.compact(n).amax()) <= tol)
-        };
-        if last && res_new > tol && res_new <= accept_tol && !fresh {
-            // Re-linearise at the candidate, then decide with the exact Jacobian.
-            match rk.flow_with_sensitivity_on_grid(device, &grid, &y_new) {
-                Ok((_, j)) => jac = j,
+            Request::Trial { y, last: true } => {
+                let (mapped, exact) = finish(grid, &y)?;
+                Reply::Mapped(mapped, exact)
+            }
+            Request::Trial { y, last: false } => {
+                match rk.integrate_on_grid(device, grid, &y, &[], &mut |_, _, _| Ok(())) {
+                    Ok(mapped) => Reply::Mapped(mapped, None),
+                    Err(e) if out_of_budget(&e) => return Err(e),
+                    Err(_) => Reply::Failed,
+                }
+            }
+            Request::Linearise { y } => match rk.flow_with_sensitivity_on_grid(device, grid, &y) {
+                Ok((_, jacobian)) => Reply::Linearised(jacobian),
                 Err(e) if out_of_budget(&e) => return Err(e),
-                Err(_) => return Ok(None),
-            }
-            periods += 1;
-            fresh = true;
-            last_step = None;
-            (y, f, res) = (y_new, f_new, res_new);
-            continue;
-        }
-        if last && (res_new <= tol || neutral()) {
-            return Ok(Some(GridOrbit {
-                state: y_new,
-                residual: res_new,
-                jacobian: jac,
-                periods: periods - 1,
-                iterations,
-                grid,
-                jacobian_at_orbit: at_orbit,
-                contraction: Some(contraction),
-            }));
-        }
-        if at_orbit {
-            // Not accepted, but linearised at `y_new`: Newton goes on from there.
-            (y, f, res) = (y_new, f_new, res_new);
-            continue;
-        }
-        if res_new >= res || res_new.is_nan() {
-            if fresh {
-                return Ok(None);
-            }
-            // A stale (neighbour's or updated) Jacobian that no longer descends: the exact
-            // one at the current iterate, on the same grid.
-            match rk.flow_with_sensitivity_on_grid(device, &grid, &y) {
-                Ok((_, j)) => jac = j,
+                Err(_) => Reply::Failed,
+            },
+            Request::Pick { y } => match chooser.advance_with_steps(device, t0, &y, t_end) {
+                Ok((mapped, picked)) => Reply::Picked(mapped, picked),
                 Err(e) if out_of_budget(&e) => return Err(e),
-                Err(_) => return Ok(None),
-            }
-            periods += 1;
-            fresh = true;
-            last_step = None;
-            continue;
-        }
-        broyden_update(&mut jac, &eye, &delta, (&f, &f_new));
-        fresh = false;
-        (y, f, res) = (y_new, f_new, res_new);
-        last_step = Some(step);
+                Err(_) => Reply::Failed,
+            },
+        };
+        verdict = machine.resume(reply);
     }
-    Ok(None)
 }
