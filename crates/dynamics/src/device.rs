@@ -33,11 +33,12 @@ use drivetrain_inverse::{
     unreachable_stroke,
 };
 
-/// A drivetrain with its balance-beam spring.
+/// A drivetrain with its balance-beam spring (and an optional preload on the whippletree).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Transmission {
     kinematics: Drivetrain,
     balance_stiffness: f64,
+    preload: f64,
 }
 
 impl Transmission {
@@ -47,7 +48,31 @@ impl Transmission {
         Ok(Self {
             kinematics,
             balance_stiffness: check_non_negative("balance_stiffness", balance_stiffness)?,
+            preload: 0.0,
         })
+    }
+
+    /// With a constant torque `preload` (mN·mm) on the whippletree `q2` (a preloaded centring
+    /// spring: the drive load on `q2` becomes `P − K2 q2`).
+    ///
+    /// # Errors
+    /// [`paritysim_error::Error::InvalidParameter`] naming `balance_preload` when it is not
+    /// finite, or nonzero on a drivetrain without a whippletree (1 DOF).
+    pub fn with_preload(mut self, preload: f64) -> Result<Self> {
+        if !preload.is_finite() || (preload != 0.0 && self.kinematics.dof() != 2) {
+            return Err(paritysim_error::Error::invalid(
+                "balance_preload",
+                preload,
+                "a finite torque (mN·mm), and 0 on a 1-DOF drivetrain",
+            ));
+        }
+        self.preload = preload;
+        Ok(self)
+    }
+
+    /// The preload torque on `q2` (mN·mm).
+    pub fn preload(&self) -> f64 {
+        self.preload
     }
 
     /// Drivetrain kinematics.

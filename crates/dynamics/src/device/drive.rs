@@ -8,12 +8,14 @@ use paritysim_simd::Real;
 use super::DeviceSpec;
 
 /// The springs of the drive: the actuator stiffness `K1` (mN/mm) on `q1`, the balance spring
-/// `K2` (mN·mm/rad) on the whippletree `q2`, and whether the drivetrain is dual (one actuator
-/// per wing: `K1` on both drives, no balance spring). One device, or one device per lane.
+/// `K2` (mN·mm/rad) and a constant preload torque `P` (mN·mm) on the whippletree `q2`, and
+/// whether the drivetrain is dual (one actuator per wing: `K1` on both drives, no balance
+/// spring). One device, or one device per lane.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct DriveSprings<R: Real> {
     pub(crate) k1: R,
     pub(crate) k2: R,
+    pub(crate) preload: R,
     pub(crate) dual: R::Mask,
 }
 
@@ -24,18 +26,23 @@ impl<R: Real> DriveSprings<R> {
         Self {
             k1,
             k2,
+            preload: zero,
             dual: zero.lt(zero),
         }
     }
 
     /// The drive load `Q` on `q` from the drive forces `forces` ([`super::Device::drive_forces`]:
     /// the actuator's and 0, or a dual drivetrain's left and right sides'):
-    /// `Q = (F − K1 q1, −K2 q2)`, or `(F_L − K1 q1, F_R − K1 q2)` on a dual drivetrain.
+    /// `Q = (F − K1 q1, −K2 q2 + P)`, or `(F_L − K1 q1, F_R − K1 q2)` on a dual drivetrain.
     #[inline(always)]
     pub(crate) fn load(&self, forces: [R; 2], q: [R; 2]) -> [R; 2] {
         [
             forces[0] - self.k1 * q[0],
-            R::select(self.dual, forces[1] - self.k1 * q[1], -self.k2 * q[1]),
+            R::select(
+                self.dual,
+                forces[1] - self.k1 * q[1],
+                -self.k2 * q[1] + self.preload,
+            ),
         ]
     }
 
@@ -55,17 +62,18 @@ impl DriveSprings<f64> {
                 .transmission
                 .as_ref()
                 .map_or(0.0, |tr| tr.balance_stiffness()),
+            preload: spec.transmission.as_ref().map_or(0.0, |tr| tr.preload()),
             dual,
         }
     }
 
-    /// The energy stored in the drive's springs at `q` (µJ): `½K1q1² + ½K2q2²`, or `½K1|q|²`
-    /// on a dual drivetrain.
+    /// The energy stored in the drive's springs at `q` (µJ): `½K1q1² + ½K2q2² − P q2`, or
+    /// `½K1|q|²` on a dual drivetrain.
     pub(crate) fn energy(&self, q: [f64; 2]) -> f64 {
         if self.dual {
             0.5 * self.k1 * (q[0] * q[0] + q[1] * q[1])
         } else {
-            0.5 * self.k1 * q[0] * q[0] + 0.5 * self.k2 * q[1] * q[1]
+            0.5 * self.k1 * q[0] * q[0] + 0.5 * self.k2 * q[1] * q[1] - self.preload * q[1]
         }
     }
 }
@@ -78,14 +86,15 @@ mod tests {
     /// slope is its derivative, for a single and a dual drive.
     #[test]
     fn the_load_is_the_forces_minus_the_energy_gradient() {
-        for springs in [
-            DriveSprings::single(2.0, 0.3),
-            DriveSprings {
-                k1: 2.0,
-                k2: 0.3,
-                dual: true,
-            },
-        ] {
+        let preloaded = DriveSprings {
+            preload: 0.7,
+            ..DriveSprings::single(2.0, 0.3)
+        };
+        let dual = DriveSprings {
+            dual: true,
+            ..DriveSprings::single(2.0, 0.3)
+        };
+        for springs in [DriveSprings::single(2.0, 0.3), preloaded, dual] {
             let forces = if springs.dual {
                 [1.5, -0.5]
             } else {

@@ -157,6 +157,7 @@ impl<'a> LinearStrokeLanes<'a> {
         }
         set(&mut lane.drive.k1, l, device.drive.k1);
         set(&mut lane.drive.k2, l, device.drive.k2);
+        set(&mut lane.drive.preload, l, device.drive.preload);
     }
 }
 

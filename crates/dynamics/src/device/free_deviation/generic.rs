@@ -118,6 +118,7 @@ impl<const N: usize> Constants<paritysim_simd::f64x4, N> {
             drive: DriveSprings {
                 k1: v(&|d| d.drive.k1),
                 k2: v(&|d| d.drive.k2),
+                preload: v(&|d| d.drive.preload),
                 dual: mask(&|d| d.drive.dual),
             },
             wings: [wing(0), wing(1)],
