@@ -15,9 +15,10 @@ Each point is the base spec with some fields overridden, run to periodic steady 
 Rust engine on a local thread pool (GIL released). The result has one row per point in input
 order: ``point`` (its index), one column per swept parameter, the metrics, ``converged``,
 ``cycles_run``, ``orbit_cycles`` (drive periods per period of the steady state: 1, or 2 where
-the point's orbit has period-doubled; its metrics then span both cycles), ``status`` (``"ok"``
-or ``"error"``), ``error`` and ``error_kind`` (the message and class of a failing point; every
-other row is kept).
+the point's orbit has period-doubled; its metrics then span both cycles), ``status`` (``"ok"``:
+converged; ``"unconverged"``: ran, but did not reach its steady state, with a warning naming how
+many; ``"error"``: failed), ``error`` and ``error_kind`` (why a point failed or did not converge;
+every row is kept).
 
 Parameter paths
 ---------------
@@ -107,6 +108,12 @@ THREADS_ENV: str = _core.SWEEP_THREADS_ENV
 
 #: Result columns besides the parameters and metrics.
 STATUS_COLUMNS = ("converged", "cycles_run", "orbit_cycles", "status", "error", "error_kind")
+
+# The `error` of a row with status "unconverged".
+UNCONVERGED_REASON = (
+    "no periodic steady state within options.steady_tol after {cycles} cycles (raise options.max_cycles "
+    "or loosen options.steady_tol); the metrics are those of the last cycles run"
+)
 
 #: Points per thread in a local chunk of a metrics-only sweep (see ``sweep``'s ``chunk_size``).
 _LOCAL_CHUNK_PER_THREAD = 1024
@@ -290,9 +297,17 @@ def _frame(raw: dict[str, Any], params: pl.DataFrame, points: Sequence[int], met
     # Failed points have no convergence, cycle count or orbit length: null, not a number.
     for name, dtype, np_dtype in (("converged", pl.Boolean, bool), ("cycles_run", pl.Int64, np.int64), ("orbit_cycles", pl.Int64, np.int64)):
         cols[name] = pl.Series(name, np.asarray(raw[name], dtype=np_dtype)[idx], dtype=dtype).scatter(failed, None)
-    cols["status"] = pl.Series("status", np.where(ok_f, "ok", "error"), dtype=pl.String)
+    # "ok" means converged: a point that ran but did not reach its steady state is
+    # "unconverged", with the reason in `error` (its metrics are those of the last cycles run).
+    converged_f = np.asarray(raw["converged"], dtype=bool)[idx]
+    unconverged = ok_f & ~converged_f
+    cols["status"] = pl.Series("status", np.where(ok_f, np.where(converged_f, "ok", "unconverged"), "error"), dtype=pl.String)
     errors = list(raw["error"]) if every else [raw["error"][i] for i in idx]
     kinds = list(raw["error_kind"]) if every else [raw["error_kind"][i] for i in idx]
+    cycles = np.asarray(raw["cycles_run"], dtype=np.int64)[idx]
+    for i in np.flatnonzero(unconverged):
+        errors[i] = UNCONVERGED_REASON.format(cycles=int(cycles[i]))
+        kinds[i] = "Unconverged"
     cols["error"] = pl.Series("error", errors, dtype=pl.String)
     cols["error_kind"] = pl.Series("error_kind", kinds, dtype=pl.String)
     if cycle_columns:
@@ -367,9 +382,10 @@ def sweep(
     -------
     polars.DataFrame
         ``point``, the parameter columns, the metrics, ``converged``, ``cycles_run``,
-        ``status`` (``"ok"``/``"error"``), ``error``, ``error_kind`` (and ``cycle_*``).
-        When more than half of the points fail, a ``RuntimeWarning`` names the most common
-        error (and the ``"paritysim"`` logger records it).
+        ``status`` (``"ok"`` converged, ``"unconverged"``, ``"error"``), ``error``,
+        ``error_kind`` (and ``cycle_*``). A ``RuntimeWarning`` names how many points did not
+        converge, and, when more than half of the points fail, the most common error (the
+        ``"paritysim"`` logger records both).
 
     Raises
     ------
@@ -509,7 +525,15 @@ def _report_failures(result: pl.DataFrame) -> None:
     if not result.height or "status" not in result.columns:
         return
     failed = result.filter(pl.col("status") == "error")
-    logger.info("sweep: %d points, %d failed", result.height, failed.height)
+    unconverged = int((result["status"] == "unconverged").sum())
+    logger.info("sweep: %d points, %d failed, %d unconverged", result.height, failed.height, unconverged)
+    if unconverged:
+        message = (
+            f"{unconverged} of {result.height} sweep points did not converge (status = 'unconverged'; "
+            "the 'error' column says why): filter on status == 'ok' for converged rows"
+        )
+        logger.warning(message)
+        warnings.warn(message, RuntimeWarning, stacklevel=_caller_stacklevel())
     if 2 * failed.height <= result.height:
         return
     kinds = Counter(zip(failed["error_kind"].fill_null("?").to_list(), failed["error"].fill_null("").to_list(), strict=True))

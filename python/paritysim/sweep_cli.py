@@ -160,7 +160,8 @@ def _main(args: argparse.Namespace) -> int:
         return 130
     if not args.quiet:
         n_err = df.filter(pl.col("status") == "error").height
-        print(f"{stem}: {df.height} points ({n_err} failed) in {time.perf_counter() - start:.2f} s -> " + ", ".join(str(p) for p in written.values()))
+        n_unconverged = df.filter(pl.col("status") == "unconverged").height
+        print(f"{stem}: {df.height} points ({n_err} failed, {n_unconverged} unconverged) in {time.perf_counter() - start:.2f} s -> " + ", ".join(str(p) for p in written.values()))
     return 0
 
 

@@ -35,6 +35,8 @@ pub mod cut;
 pub mod inertia;
 pub mod planform;
 pub mod records;
+pub mod stroke_drag;
+pub mod wing_aero;
 
 pub use blade::{
     AeroLoads, AeroMoments, BladeElementModel, Branch, HeldBranch, NormalForceLaw, Omegas,
@@ -49,3 +51,5 @@ pub use cut::CutEdge;
 pub use inertia::{LineMass, MassDistribution, PointMass, WingInertia};
 pub use paritysim_error::{Error, Result};
 pub use planform::{DEFAULT_AIR_DENSITY, Planform, PlanformIntegrals};
+pub use stroke_drag::{stroke_drag, stroke_drag_constant, stroke_drag_slope, stroke_drag_torque};
+pub use wing_aero::WingAero;

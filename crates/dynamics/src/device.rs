@@ -16,6 +16,8 @@ use crate::actuator::Actuator;
 use crate::integrate::State;
 use crate::wing::{Wing, WingTerms};
 
+mod drive;
+pub(crate) use drive::DriveSprings;
 mod drivetrain_coordinates;
 mod drivetrain_inverse;
 mod free_deviation;
@@ -23,7 +25,6 @@ pub(crate) mod linear_map_jacobian;
 mod null_space;
 mod ode_system;
 mod stroke_plane;
-pub(crate) mod switched_lanes;
 mod switches;
 
 use drivetrain_coordinates::{StrokeOnly, stroke_only, stroke_torque};
@@ -31,15 +32,13 @@ use drivetrain_inverse::{
     NEWTON_MAX, NEWTON_TOL, check_plausible, invert_1dof, invert_2dof, singular_drive,
     unreachable_stroke,
 };
-pub(crate) use free_deviation::lanes as free_deviation_lanes;
-pub(crate) use stroke_plane::lanes as stroke_plane_lanes;
-pub(crate) use switches::branches as blade_branches;
 
-/// A drivetrain with its balance-beam spring.
+/// A drivetrain with its balance-beam spring (and an optional preload on the whippletree).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Transmission {
     kinematics: Drivetrain,
     balance_stiffness: f64,
+    preload: f64,
 }
 
 impl Transmission {
@@ -49,7 +48,31 @@ impl Transmission {
         Ok(Self {
             kinematics,
             balance_stiffness: check_non_negative("balance_stiffness", balance_stiffness)?,
+            preload: 0.0,
         })
+    }
+
+    /// With a constant torque `preload` (mN·mm) on the whippletree `q2` (a preloaded centring
+    /// spring: the drive load on `q2` becomes `P − K2 q2`).
+    ///
+    /// # Errors
+    /// [`paritysim_error::Error::InvalidParameter`] naming `balance_preload` when it is not
+    /// finite, or nonzero on a drivetrain without a whippletree (1 DOF).
+    pub fn with_preload(mut self, preload: f64) -> Result<Self> {
+        if !preload.is_finite() || (preload != 0.0 && self.kinematics.dof() != 2) {
+            return Err(paritysim_error::Error::invalid(
+                "balance_preload",
+                preload,
+                "a finite torque (mN·mm), and 0 on a 1-DOF drivetrain",
+            ));
+        }
+        self.preload = preload;
+        Ok(self)
+    }
+
+    /// The preload torque on `q2` (mN·mm).
+    pub fn preload(&self) -> f64 {
+        self.preload
     }
 
     /// Drivetrain kinematics.
@@ -124,6 +147,8 @@ pub struct Device {
     /// The free-deviation equations on a held branch written over `Real` (four coordinates,
     /// blade elements on both wings): the scalar and SIMD-lane path's common code.
     free_deviation_held: Option<free_deviation::HeldConstants>,
+    /// The drive's springs (`K1`, `K2`, dual or not): the one drive load.
+    drive: drive::DriveSprings<f64>,
     /// Switching functions of the right-hand side (three per wing with blade elements whose
     /// `ω` has a closed form; see [`Self::blade_switching_functions`]).
     n_switches: usize,
@@ -158,6 +183,9 @@ pub struct DriveState {
     pub q_dot: Vector2<f64>,
     /// Actuator force F(t) (mN).
     pub actuator_force: f64,
+    /// The drive load `Q` on `(q1, q2)` (mN, mN·mm): the actuator and the drivetrain springs
+    /// (see `device/drive.rs`).
+    pub load: Vector2<f64>,
     /// Generalised torques on `(φL, φR)` from the drivetrain (mN·mm).
     pub stroke_torque: Vector2<f64>,
     /// Drivetrain spring energy ½K1q1² + ½K2q2² (µJ).
@@ -275,8 +303,12 @@ impl Device {
             stroke_plane_rhs: None,
             free_deviation_rhs: None,
             free_deviation_held: None,
+            drive: drive::DriveSprings::single(0.0, 0.0),
             n_switches: 0,
         };
+        // A dual drivetrain drives both sides through the actuator, when there is one.
+        let dual = device.spec.actuator.is_some() && device.is_dual();
+        device.drive = drive::DriveSprings::of(&device.spec, dual);
         device.stroke_plane_rhs = stroke_plane::StrokePlane::of(&device);
         device.free_deviation_rhs = free_deviation::FreeDeviation::of(&device);
         device.free_deviation_held = free_deviation::HeldConstants::of(&device);
@@ -409,36 +441,29 @@ impl Device {
         })
     }
 
-    /// Actuator force `F(t)`, drivetrain load `Q = (F − K1 q1, −K2 q2)` and its spring energy
-    /// `½K1q1² + ½K2q2²`.
-    ///
-    /// A dual drivetrain (one drive per wing) has the actuator on both coordinates instead:
-    /// `Q = (F_L − K1 q1, F_R − K1 q2)` ([`Actuator::side_force`]); the returned force is
-    /// then the left side's.
+    /// Actuator force `F(t)` (the left side's on a dual drivetrain), drivetrain load `Q`
+    /// ([`drive::DriveSprings::load`]) and the drive springs' energy.
     // Always inlined: every right-hand side calls it (a call and its spills cost more than it).
     #[inline(always)]
     fn drive_load(&self, t: f64, q: &Vector2<f64>) -> (f64, Vector2<f64>, f64) {
-        let actuator = self.spec.actuator.as_ref();
-        let k1 = actuator.map_or(0.0, |a| a.stiffness());
-        if let (Some(a), true) = (actuator, self.is_dual()) {
-            let (left, right) = (a.side_force(t, 0), a.side_force(t, 1));
-            let load = Vector2::new(left - k1 * q.x, right - k1 * q.y);
-            return (left, load, 0.5 * k1 * q.norm_squared());
-        }
-        let force = actuator.map_or(0.0, |a| a.force(t));
-        let k2 = self
-            .spec
-            .transmission
-            .as_ref()
-            .map_or(0.0, |tr| tr.balance_stiffness);
-        let load = Vector2::new(force - k1 * q.x, -k2 * q.y);
-        (force, load, 0.5 * k1 * q.x * q.x + 0.5 * k2 * q.y * q.y)
+        let forces = self.drive_forces(t);
+        let [q1, q2] = [q.x, q.y];
+        let [l1, l2] = self.drive.load(forces, [q1, q2]);
+        (forces[0], Vector2::new(l1, l2), self.drive.energy([q1, q2]))
     }
 
     /// Whether the device has the closed-form stroke-plane model (§3.4 rotating wings:
     /// `device/stroke_plane/`), whose lean samples are [`crate::trajectory::PlaneSample`]s.
     pub fn has_stroke_plane_model(&self) -> bool {
         self.stroke_plane_rhs.is_some()
+    }
+
+    /// Whether the device has the closed-form free-deviation model (§2.5 Lift / Dual PARITY:
+    /// θ free). Such devices have coexisting stable orbits at one drive (docs/findings.md §23:
+    /// the Lift PARITY is bistable near 96 V), so a sweep does not continue their points from a
+    /// neighbour's orbit ([`crate::sweep::run_points`]).
+    pub fn has_free_deviation_model(&self) -> bool {
+        self.free_deviation_rhs.is_some()
     }
 
     /// The drive forces [`Self::drive_load`] applies at `t`: the actuator's and 0, or a dual
@@ -452,19 +477,10 @@ impl Device {
         }
     }
 
-    /// `∂Q/∂q` of [`Self::drive_load`] (constant: the actuator and balance springs,
-    /// `−diag(K1, K2)`, or `−K1` on both drives of a dual drivetrain).
+    /// `∂Q/∂q` of [`Self::drive_load`] ([`drive::DriveSprings::slope`]).
     pub(crate) fn drive_load_slope(&self) -> nalgebra::Matrix2<f64> {
-        let k1 = self.spec.actuator.as_ref().map_or(0.0, |a| a.stiffness());
-        let k2 = match (&self.spec.actuator, self.is_dual()) {
-            (Some(_), true) => k1,
-            _ => self
-                .spec
-                .transmission
-                .as_ref()
-                .map_or(0.0, |tr| tr.balance_stiffness),
-        };
-        nalgebra::Matrix2::new(-k1, 0.0, 0.0, -k2)
+        let [s1, s2] = self.drive.slope();
+        nalgebra::Matrix2::new(s1, 0.0, 0.0, s2)
     }
 
     /// Whether the drivetrain is a dual one (one actuator per wing, `q2` the right drive).
@@ -529,6 +545,7 @@ impl Device {
                 q,
                 q_dot: Vector2::new(p_dot[0] / slope, 0.0),
                 actuator_force: force,
+                load,
                 stroke_torque: stroke_torque(1, &Matrix2::new(slope, 0.0, slope, 0.0), &q, &load)?,
                 potential,
             });
@@ -571,6 +588,7 @@ impl Device {
                 q,
                 q_dot,
                 actuator_force: force,
+                load,
                 stroke_torque: stroke_torque(2, jac, &q, &load)?,
                 potential,
             });
@@ -585,6 +603,7 @@ impl Device {
             q,
             q_dot,
             actuator_force: force,
+            load,
             stroke_torque: stroke_torque(2, &jac, &q, &load)?,
             potential,
         })
@@ -631,6 +650,7 @@ impl Device {
             q: step.q,
             q_dot: step.q_dot,
             actuator_force: step.force,
+            load: step.load,
             stroke_torque: stroke_torque(self.n_dof, &e.jacobian, &step.q, &step.load)?,
             potential: step.potential,
         };

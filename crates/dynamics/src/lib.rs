@@ -18,10 +18,10 @@
 pub mod actuator;
 pub mod continuation;
 pub mod device;
-mod grid_shooting;
 pub mod integrate;
 pub mod lanes;
 pub mod metrics;
+mod shooting;
 pub mod simulate;
 pub mod stability;
 pub mod sweep;

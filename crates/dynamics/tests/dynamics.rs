@@ -3,6 +3,8 @@
 
 #[path = "dynamics/continuation.rs"]
 mod continuation;
+#[path = "dynamics/drive.rs"]
+mod drive;
 #[path = "dynamics/floquet.rs"]
 mod floquet;
 #[path = "dynamics/lanes.rs"]

@@ -593,8 +593,7 @@ impl FlightModel {
             }
             // Eq. 5.1: Q2 = Q1 (J01 q3 + J11) / (J00 q3 + J10) gives τL/τR = q3.
             let q3 = log_q3.exp();
-            let k1 = actuator.map_or(0.0, |a| a.stiffness());
-            let q1_load = drive.actuator_force - k1 * drive.q.x + dq.x;
+            let q1_load = drive.load.x + dq.x;
             let den = jac[(0, 0)] * q3 + jac[(1, 0)];
             if den == 0.0 || !den.is_finite() {
                 return Err(Error::Singular(format!(

@@ -31,6 +31,8 @@ pub trait Real:
 {
     /// A lane-wise boolean (`bool`, or all bits of a lane set).
     type Mask: Copy
+        + std::fmt::Debug
+        + PartialEq
         + BitAnd<Output = Self::Mask>
         + BitOr<Output = Self::Mask>
         + Not<Output = Self::Mask>;

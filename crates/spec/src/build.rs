@@ -49,6 +49,7 @@ impl Simulation {
             Some(d) => Some(
                 d.kinematics()
                     .and_then(|k| Transmission::new(k, d.balance_spring()))
+                    .and_then(|t| t.with_preload(d.balance_preload()))
                     .map_err(|e| rename_field(e, "balance_stiffness", "balance_spring"))
                     .map_err(|e| e.in_field("drivetrain"))?,
             ),

@@ -20,7 +20,6 @@ use super::{Device, Formulation};
 use crate::integrate::State;
 
 pub(crate) mod generic;
-pub(crate) mod lanes;
 #[cfg(test)]
 mod tests;
 

@@ -17,12 +17,13 @@
 use paritysim_simd::Real;
 
 use super::DeviceSpec;
+use super::drive::DriveSprings;
 use crate::wing::WingAero;
 use paritysim_kinematics::Drivetrain;
 
 /// The constants of the linear-map equations (one device, or one device per lane).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct LinearMapTerms<S> {
+pub(crate) struct LinearMapTerms<S: Real> {
     /// `J` by rows: `(J00, J01, J10, J11)` (row `k` is wing `k`'s `J_k`).
     pub(crate) jacobian: [S; 4],
     /// `M_q` entries `(m00, m01, m11)`.
@@ -35,9 +36,8 @@ pub(crate) struct LinearMapTerms<S> {
     pub(crate) stiffness: [S; 2],
     pub(crate) cubic: [S; 2],
     pub(crate) rest: [S; 2],
-    /// Actuator stiffness `K1` and balance spring `K2`.
-    pub(crate) k1: S,
-    pub(crate) k2: S,
+    /// The drive's springs (a single drive: the linear map is never dual).
+    pub(crate) drive: DriveSprings<S>,
 }
 
 impl LinearMapTerms<f64> {
@@ -70,7 +70,7 @@ impl LinearMapTerms<f64> {
                 WingAero::StrokeDrag {
                     omega1,
                     coefficient,
-                } => -omega1 * coefficient,
+                } => paritysim_aero::stroke_drag_constant(*omega1, *coefficient),
                 WingAero::BladeElement(_) => return None,
             };
             let s = &wing.springs()[0];
@@ -88,8 +88,7 @@ impl LinearMapTerms<f64> {
             stiffness,
             cubic,
             rest,
-            k1: spec.actuator.as_ref().map_or(0.0, |a| a.stiffness()),
-            k2: transmission.balance_stiffness(),
+            drive: DriveSprings::of(spec, false),
         })
     }
 }
@@ -109,7 +108,8 @@ pub(crate) fn variational<S: Real>(
     let rows = [(j00, j01), (j10, j11)];
     // ∂g/∂q and ∂g/∂q̇, symmetric: entries (00, 01, 11).
     let zero = S::splat(0.0);
-    let (mut gq00, mut gq01, mut gq11) = (-terms.k1, zero, -terms.k2);
+    let [slope1, slope2] = terms.drive.slope();
+    let (mut gq00, mut gq01, mut gq11) = (slope1, zero, slope2);
     let (mut gv00, mut gv01, mut gv11) = (zero, zero, zero);
     for (k, (a, b)) in rows.into_iter().enumerate() {
         let stroke = a * q1 + b * q2;
@@ -117,7 +117,7 @@ pub(crate) fn variational<S: Real>(
         let d = stroke - terms.rest[k];
         // s'(φ) of A.7 with the cubic term; ∂(−Ω C φ̇|φ̇|)/∂φ̇ = −2 Ω C |φ̇| (eq. 2.16).
         let spring = terms.stiffness[k] + S::splat(3.0) * terms.cubic[k] * d * d;
-        let damping = S::splat(2.0) * terms.drag[k] * rate.abs();
+        let damping = paritysim_aero::stroke_drag_slope(terms.drag[k], rate);
         gq00 = gq00 - spring * a * a;
         gq01 = gq01 - spring * a * b;
         gq11 = gq11 - spring * b * b;

@@ -5,8 +5,8 @@ use paritysim_error::Result;
 
 use super::switched::Branch;
 use super::{
-    IntegrationStats, MAX_SWITCHES, Method, Rhs, Sides, Sink, State, Stepper, Tolerances, budget,
-    dop853, dopri5, events, integration_error,
+    IntegrationStats, MAX_SWITCHES, Method, Rhs, Sink, State, Stepper, Tolerances, budget, dop853,
+    dopri5, events, integration_error,
 };
 
 /// Safety factor of the step-size controller.
@@ -281,90 +281,4 @@ impl<const M: usize> AdaptiveRun<M> {
             Ok(Attempt::Retry)
         }
     }
-}
-
-/// An adaptive run between attempts as a SIMD lane carries it, with the branch it holds.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct HeldRun<const M: usize> {
-    pub(crate) t: f64,
-    pub(crate) y: [f64; M],
-    pub(crate) f0: [f64; M],
-    pub(crate) h: f64,
-    pub(crate) fac_old: f64,
-    pub(crate) rejected_last: bool,
-    /// Attempts so far (accepted and rejected).
-    pub(crate) attempts: usize,
-    pub(crate) sides: Sides,
-    /// The switching functions at `t`.
-    pub(crate) g: [f64; MAX_SWITCHES],
-}
-
-/// The DOP853 attempts of [`drive`] for `system` on `M` compact entries (`[coords, rates]`,
-/// no work integrals, no samples) from `run` up to and including the next accepted step,
-/// with the same operations as the scalar run: what the SIMD lanes replay for an adaptive
-/// lane whose accepted step crosses a switch (the root located and the step cut there, or
-/// redone on the far side). `run` moves on; each accepted step's end time is pushed to
-/// `steps`. Returns whether the run reached `t_end` (`h_max`: `t_end − t0`).
-///
-/// # Errors
-/// As the scalar run: the step limit, a step-size underflow, a failing model or switching
-/// function.
-pub(crate) fn replay_adaptive_step<const M: usize>(
-    system: &dyn super::OdeSystem,
-    (rtol, atol): (f64, f64),
-    max_steps: usize,
-    (t_end, h_max): (f64, f64),
-    run: &mut HeldRun<M>,
-    steps: &mut Vec<f64>,
-) -> Result<bool> {
-    let mut rhs = super::runge_kutta::Adapter::held(system, run.sides);
-    let n_switches = Rhs::<M>::n_switches(&rhs).min(MAX_SWITCHES);
-    let mut scalar = AdaptiveRun {
-        t: run.t,
-        y: run.y,
-        f0: run.f0,
-        h: run.h,
-        fac_old: run.fac_old,
-        rejected_last: run.rejected_last,
-        // A redo is once per step start; the lane's earlier starts are behind `t`.
-        redone_at: None,
-        branch: Branch::resume(n_switches, run.sides, run.g),
-        stats: IntegrationStats {
-            accepted: run.attempts,
-            ..IntegrationStats::default()
-        },
-    };
-    let tol = Tolerances {
-        rtol,
-        atol,
-        controlled: M,
-    };
-    let mut stepper = dop853::Dop853::<M>::new();
-    let finished = loop {
-        match scalar.attempt(
-            &mut stepper,
-            &mut rhs,
-            &tol,
-            max_steps,
-            (t_end, h_max),
-            (&[], &mut 0, &mut |_, _, _| Ok(())),
-            &mut |t, _| steps.push(t),
-        )? {
-            Attempt::Retry => {}
-            Attempt::Accepted => break false,
-            Attempt::Finished => break true,
-        }
-    };
-    *run = HeldRun {
-        t: scalar.t,
-        y: scalar.y,
-        f0: scalar.f0,
-        h: scalar.h,
-        fac_old: scalar.fac_old,
-        rejected_last: scalar.rejected_last,
-        attempts: scalar.stats.accepted + scalar.stats.rejected,
-        sides: scalar.branch.sides(),
-        g: scalar.branch.g0(),
-    };
-    Ok(finished)
 }

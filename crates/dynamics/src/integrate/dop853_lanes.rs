@@ -28,9 +28,9 @@ use paritysim_error::Error;
 
 use wide::f64x4;
 
+use super::super::State;
 use super::super::budget::{self, CHECK_EVERY};
 use super::super::lane_control::{Adaptive, Control};
-use super::super::{HeldRun, State};
 use super::*;
 
 /// Problems integrated at once.
@@ -52,13 +52,6 @@ fn with_lane(v: V, l: usize, x: f64) -> V {
     V::new(a)
 }
 
-/// Writes `values` into lane `l` of `v`, entry by entry.
-pub(crate) fn put_lane<const M: usize>(v: &mut [V; M], l: usize, values: &[f64; M]) {
-    for (entry, &x) in v.iter_mut().zip(values) {
-        *entry = with_lane(*entry, l, x);
-    }
-}
-
 /// The right-hand side of several lanes on the compact layout `[q1, q2, q̇1, q̇2]`.
 pub(crate) trait LaneRhs<const M: usize> {
     /// Writes `f(t, y)` of every lane; `stage[l]` is lane `l`'s position in the list of
@@ -66,62 +59,6 @@ pub(crate) trait LaneRhs<const M: usize> {
     /// tabulate their time dependence. Returns the bit mask of lanes whose evaluation failed
     /// (left out of the domain of the model).
     fn eval(&self, t: [f64; LANES], stage: [usize; LANES], y: &[V; M], dydt: &mut [V; M]) -> u32;
-
-    /// Whether the right-hand side has switching functions: then every fixed-grid lane holds
-    /// the branch of its own (the scalar `drive_on_grid_events`), [`Self::begin`] takes its
-    /// start's sides, [`Self::crossed`] checks every step and a step that crosses a switch is
-    /// [`Self::replay`]ed on the scalar path. Default: smooth.
-    fn switched(&self) -> bool {
-        false
-    }
-
-    /// Lane `l` starts a fixed-grid problem at `(t0, y0)`: it takes the sides of the
-    /// switching functions there (the scalar `Branch::start`); `false` when they fail.
-    fn begin(&self, _l: usize, _t0: f64, _y0: &[f64; M]) -> bool {
-        true
-    }
-
-    /// Whether lane `l`'s step ending at `(t_new, y1)` crosses a switching function from the
-    /// side it holds (the scalar `first_switch`'s test); if not, the values there start its
-    /// next step. `None` when they fail.
-    fn crossed(&self, _l: usize, _t_new: f64, _y1: &[f64; M]) -> Option<bool> {
-        Some(false)
-    }
-
-    /// Lane `l`'s grid step `[t, t_new]` from `(y, f0)` replayed on the scalar path (cut at
-    /// its roots, samples of `times[*next..]` inside to `sink`): the state and derivative at
-    /// `t_new` and the sub-steps over tolerance; the lane then holds the branch it ends on.
-    /// `None` where the scalar run fails.
-    #[allow(clippy::too_many_arguments)]
-    fn replay(
-        &self,
-        _l: usize,
-        _tol: LaneTolerances,
-        _span: (f64, f64),
-        _start: (&[f64; M], &[f64; M]),
-        _times: &[f64],
-        _next: &mut usize,
-        _sink: &mut dyn FnMut(usize, f64, &State) -> bool,
-    ) -> Option<([f64; M], [f64; M], usize)> {
-        None
-    }
-
-    /// Adaptive lane `l`'s attempts from `run` up to and including its next accepted step,
-    /// replayed on the scalar path (its accepted step crossed a switch: the root located and
-    /// the step cut there, or redone on the far side); `run` moves on and the accepted step
-    /// times go to `steps`. Returns whether the lane reached `t_end` (`h_max`: `t_end − t0`),
-    /// `None` where the scalar run fails.
-    fn replay_adaptive(
-        &self,
-        _l: usize,
-        _tol: LaneTolerances,
-        _max_steps: usize,
-        _span: (f64, f64),
-        _run: &mut HeldRun<M>,
-        _steps: &mut Vec<f64>,
-    ) -> Option<bool> {
-        None
-    }
 }
 
 /// Right-hand side evaluations per step in [`stage_times`]: the step's start, stages 2–12,
@@ -381,20 +318,8 @@ impl<const M: usize, const C: usize> LaneStepper<M, C> {
                     NO_STAGE
                 }
             });
-            let mut begun = 0u32;
-            if rhs.switched() {
-                for l in 0..LANES {
-                    let p = &self.lanes[l];
-                    if fresh & (1 << l) != 0 && p.active {
-                        let y0: [f64; M] = std::array::from_fn(|i| lane(self.y[i], l));
-                        if !rhs.begin(l, t0[l], &y0) {
-                            begun |= 1 << l;
-                        }
-                    }
-                }
-            }
             let mut f = [V::splat(0.0); M];
-            let failed = rhs.eval(t0, stage, &self.y, &mut f) | begun;
+            let failed = rhs.eval(t0, stage, &self.y, &mut f);
             for l in 0..LANES {
                 if fresh & (1 << l) == 0 || !self.lanes[l].active {
                     continue;
@@ -581,7 +506,6 @@ impl<const M: usize, const C: usize> LaneStepper<M, C> {
             failed |= self.prepare_dense(rhs, &t, &base, h, &f1);
         }
         let mut accepted = [true; LANES];
-        let switched = rhs.switched();
         for l in 0..LANES {
             if !self.lanes[l].active {
                 continue;
@@ -589,23 +513,6 @@ impl<const M: usize, const C: usize> LaneStepper<M, C> {
             let bit = 1 << l;
             if self.lanes[l].adaptive.is_some() {
                 let err = lane(err, l);
-                let completes = failed_f1 & bit == 0 && y1_finite & bit != 0;
-                if switched && err <= 1.0 && (given_up | failed) & bit == 0 && completes {
-                    // An accepted step that crosses a switch: replayed on the scalar path.
-                    let y1: [f64; M] = std::array::from_fn(|i| lane(self.y1[i], l));
-                    match rhs.crossed(l, t_new[l], &y1) {
-                        None => {
-                            self.lanes[l].active = false;
-                            finished.push((l, LaneOutcome::Failed));
-                            continue;
-                        }
-                        Some(true) => {
-                            self.replay_adaptive(rhs, l, &mut f1, finished);
-                            continue;
-                        }
-                        Some(false) => {}
-                    }
-                }
                 let p = &mut self.lanes[l];
                 let a = p.adaptive.as_mut().expect("an adaptive lane");
                 let outcome = a.control(err, given_up & bit != 0, failed & bit != 0, || {
@@ -632,30 +539,14 @@ impl<const M: usize, const C: usize> LaneStepper<M, C> {
                 }
                 continue;
             }
-            let mut ok = failed & bit == 0
+            let ok = failed & bit == 0
                 && failed_f1 & bit == 0
                 && err_finite & bit != 0
-                && y1_finite & bit != 0;
-            let mut replayed = None;
-            if ok && switched {
-                let y1: [f64; M] = std::array::from_fn(|i| lane(self.y1[i], l));
-                match rhs.crossed(l, t_new[l], &y1) {
-                    None => ok = false,
-                    Some(false) => {}
-                    Some(true) => {
-                        replayed = self.replay(rhs, l, (t[l], t_new[l]), &mut f1, sink);
-                        ok = replayed.is_some();
-                    }
-                }
-            }
-            if ok && replayed.is_none() {
-                ok = self.emit(l, t[l], hs[l], t_new[l], sink);
-            }
+                && y1_finite & bit != 0
+                && self.emit(l, t[l], hs[l], t_new[l], sink);
             let p = &mut self.lanes[l];
-            match replayed {
-                Some(over) => p.over_tolerance += over,
-                None if lane(err, l) > 1.0 => p.over_tolerance += 1,
-                None => {}
+            if lane(err, l) > 1.0 {
+                p.over_tolerance += 1;
             }
             p.step += 1;
             if !ok {
@@ -688,113 +579,6 @@ impl<const M: usize, const C: usize> LaneStepper<M, C> {
                 self.y[i] = V::new(y);
                 self.f0[i] = V::new(f0);
             }
-        }
-    }
-
-    /// Lane `l`'s step `[t, t_new]` replayed on the scalar path ([`LaneRhs::replay`]): its
-    /// end state and derivative replace the lane's (`y1`, `f1`); returns the sub-steps over
-    /// tolerance, `None` where the scalar run fails.
-    fn replay<R: LaneRhs<M>>(
-        &mut self,
-        rhs: &R,
-        l: usize,
-        span: (f64, f64),
-        f1: &mut [V; M],
-        sink: &mut LaneSink<'_, C>,
-    ) -> Option<usize> {
-        let y: [f64; M] = std::array::from_fn(|i| lane(self.y[i], l));
-        let f0: [f64; M] = std::array::from_fn(|i| lane(self.f0[i], l));
-        let tol = LaneTolerances {
-            rtol: lane(self.rtol, l),
-            atol: lane(self.atol, l),
-        };
-        let p = &mut self.lanes[l];
-        let times = p.times.clone();
-        let mut block_sink = |i: usize, t: f64, state: &State| {
-            let compact: [f64; C] = std::array::from_fn(|e| {
-                if e < C / 2 {
-                    state.coords[e]
-                } else {
-                    state.rates[e - C / 2]
-                }
-            });
-            let block = SampleBlock {
-                first: i,
-                count: 1,
-                t: [t; 4],
-                y: compact.map(V::splat),
-            };
-            sink(l, &block)
-        };
-        let (y_end, f_end, over) = rhs.replay(
-            l,
-            tol,
-            span,
-            (&y, &f0),
-            &times,
-            &mut p.next,
-            &mut block_sink,
-        )?;
-        for i in 0..M {
-            self.y1[i] = with_lane(self.y1[i], l, y_end[i]);
-            f1[i] = with_lane(f1[i], l, f_end[i]);
-        }
-        Some(over)
-    }
-
-    /// Adaptive lane `l`'s attempts replayed on the scalar path up to its next accepted step
-    /// ([`LaneRhs::replay_adaptive`]): its state and derivative there replace the lane's
-    /// (`y1`, `f1`); a lane that reached its end, or whose scalar run fails, finishes.
-    fn replay_adaptive<R: LaneRhs<M>>(
-        &mut self,
-        rhs: &R,
-        l: usize,
-        f1: &mut [V; M],
-        finished: &mut Vec<(usize, LaneOutcome<M>)>,
-    ) {
-        let tol = LaneTolerances {
-            rtol: lane(self.rtol, l),
-            atol: lane(self.atol, l),
-        };
-        let y: [f64; M] = std::array::from_fn(|i| lane(self.y[i], l));
-        let f0: [f64; M] = std::array::from_fn(|i| lane(self.f0[i], l));
-        let p = &mut self.lanes[l];
-        let a = p.adaptive.as_mut().expect("an adaptive lane");
-        // The right-hand side fills in the branch its lane holds.
-        let mut run = HeldRun {
-            t: a.t,
-            y,
-            f0,
-            h: a.h,
-            fac_old: a.fac_old,
-            rejected_last: a.rejected_last,
-            attempts: a.attempts,
-            sides: Default::default(),
-            g: [0.0; super::super::MAX_SWITCHES],
-        };
-        let span = (a.t_end, a.t_end - a.steps[0]);
-        let Some(done) = rhs.replay_adaptive(l, tol, a.max_steps, span, &mut run, &mut a.steps)
-        else {
-            p.active = false;
-            finished.push((l, LaneOutcome::Failed));
-            return;
-        };
-        (a.t, a.h, a.fac_old, a.rejected_last, a.attempts) =
-            (run.t, run.h, run.fac_old, run.rejected_last, run.attempts);
-        for i in 0..M {
-            self.y1[i] = with_lane(self.y1[i], l, run.y[i]);
-            f1[i] = with_lane(f1[i], l, run.f0[i]);
-        }
-        if done {
-            p.active = false;
-            finished.push((
-                l,
-                LaneOutcome::Done {
-                    y: run.y,
-                    over_tolerance: 0,
-                    steps: std::mem::take(&mut a.steps),
-                },
-            ));
         }
     }
 

@@ -3,11 +3,10 @@
 
 use paritysim_error::{Error, Result};
 
-use super::runge_kutta::Adapter;
 use super::switched::Branch;
 use super::{
-    IntegrationStats, MAX_SWITCHES, Method, OdeSystem, Rhs, Sides, Sink, Stepper, Tolerances,
-    budget, dop853, dopri5, events, integration_error, sample_step,
+    IntegrationStats, MAX_SWITCHES, Method, Rhs, Sink, Stepper, Tolerances, budget, dop853, dopri5,
+    events, integration_error, sample_step,
 };
 
 /// A step grid: at least two finite, strictly increasing times.
@@ -227,64 +226,4 @@ fn grid_step_with_events<const M: usize, S: Stepper<M>>(
         redone = false;
     }
     Ok(())
-}
-
-/// Where a replayed grid step ended ([`replay_grid_step`]).
-pub(crate) struct GridStepEnd<const M: usize> {
-    /// The state and derivative at the step's end.
-    pub(crate) y: [f64; M],
-    pub(crate) f: [f64; M],
-    /// The sides held there and the switching functions' values.
-    pub(crate) sides: Sides,
-    pub(crate) g: [f64; MAX_SWITCHES],
-    /// Sub-steps whose error estimate exceeded the tolerances.
-    pub(crate) over_tolerance: usize,
-}
-
-/// One DOP853 grid step of [`drive_on_grid_events`] for `system` on `M` compact entries
-/// (`[coords, rates]`, no work integrals), from `(t, y, f0)` on the held `sides` with the
-/// switching functions `g0` there: what the SIMD lanes replay for a lane whose step crosses
-/// a switch, with the same operations as the scalar run (so the same bits). Samples of
-/// `times[*next..]` inside the step go to `sink`.
-///
-/// # Errors
-/// As the scalar fixed-grid run: a failing model or switching function, a non-finite state,
-/// whatever `sink` returns.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn replay_grid_step<const M: usize>(
-    system: &dyn OdeSystem,
-    (rtol, atol): (f64, f64),
-    (t, t_new): (f64, f64),
-    (mut y, mut f0): ([f64; M], [f64; M]),
-    (sides, g0): (Sides, [f64; MAX_SWITCHES]),
-    times: &[f64],
-    next: &mut usize,
-    sink: &mut Sink<'_>,
-) -> Result<GridStepEnd<M>> {
-    let mut rhs = Adapter::held(system, sides);
-    let n_switches = Rhs::<M>::n_switches(&rhs);
-    let mut branch = Branch::resume(n_switches, sides, g0);
-    let tol = Tolerances {
-        rtol,
-        atol,
-        controlled: M,
-    };
-    let mut stats = IntegrationStats::default();
-    grid_step_with_events(
-        &mut dop853::Dop853::<M>::new(),
-        &mut rhs,
-        &tol,
-        &mut branch,
-        (t, t_new),
-        (&mut y, &mut f0),
-        (times, next, sink),
-        &mut stats,
-    )?;
-    Ok(GridStepEnd {
-        y,
-        f: f0,
-        sides: branch.sides(),
-        g: branch.g0(),
-        over_tolerance: stats.over_tolerance,
-    })
 }

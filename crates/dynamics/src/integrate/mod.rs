@@ -48,12 +48,11 @@ pub(crate) use dop853::lanes;
 
 use paritysim_error::{Error, Result};
 
-pub(crate) use adaptive::{HeldRun, replay_adaptive_step};
 use adaptive::{SAFE, drive_method, initial_step};
 pub use array::{ArrayRhs, ArraySink, ArraySystem, integrate_array, integrate_system};
+pub(crate) use events::WithoutEvents;
 pub use events::{MAX_SWITCHES, Sides};
-pub(crate) use events::{WithoutEvents, crossed};
-pub(crate) use fixed_grid::{check_grid, drive_method_on_grid, replay_grid_step};
+pub(crate) use fixed_grid::{check_grid, drive_method_on_grid};
 pub use runge_kutta::RungeKutta;
 pub use state::State;
 use stepper::sample_step;

@@ -270,18 +270,6 @@ pub(super) struct Adapter<'a> {
 }
 
 impl<'a> Adapter<'a> {
-    /// `system` on the held branch `sides`, its work integrals zero (the states of a
-    /// shooting period): as [`RungeKutta::solve`] sets it up once event location took the
-    /// start's sides.
-    pub(super) fn held(system: &'a dyn OdeSystem, sides: Sides) -> Self {
-        Self {
-            system,
-            template: State::default(),
-            calls: 0,
-            sides: Some(sides),
-        }
-    }
-
     /// The active coordinates `n` of an `M`-entry array (`2n` or `2n + 2` entries with
     /// `n ∈ {2, 4, 6}`, see [`RungeKutta::dispatch`]): a constant, so the copies in and out
     /// of [`State`] compile to a few moves instead of `memcpy` calls.

@@ -43,27 +43,6 @@ impl Branch {
         Ok(branch)
     }
 
-    /// The branch `sides` held at a step's start where the switching functions are `g0` (a
-    /// grid step replayed from the middle of a run, `fixed_grid::replay_grid_step`).
-    pub(super) fn resume(n: usize, sides: Sides, g0: [f64; MAX_SWITCHES]) -> Self {
-        Self {
-            n,
-            sides,
-            g0,
-            g1: [0.0; MAX_SWITCHES],
-        }
-    }
-
-    /// The sides held.
-    pub(super) fn sides(&self) -> Sides {
-        self.sides
-    }
-
-    /// The switching functions at the current step's start.
-    pub(super) fn g0(&self) -> [f64; MAX_SWITCHES] {
-        self.g0
-    }
-
     /// The first switch inside the computed step `[t, t_new]` (size `h`) from `(y, f0)` to `(y1, f1)`,
     /// located on its dense output (prepared here) to `root_tolerance × h`; `None` when no
     /// switching function ends across the held sides, or when `search` is false.

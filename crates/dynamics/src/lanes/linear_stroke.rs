@@ -14,6 +14,7 @@ use crate::actuator::Actuator;
 use crate::device::{Device, Formulation};
 use std::rc::Rc;
 
+use crate::device::DriveSprings;
 use crate::device::linear_map_jacobian::{self, LinearMapTerms};
 use crate::integrate::lanes::{LANES, LaneRhs, stage_times};
 use crate::wing::WingAero;
@@ -90,7 +91,7 @@ impl LinearStroke<'_> {
             if self.vacuum[k] {
                 V::splat(0.0)
             } else {
-                V::splat(self.terms.drag[k]) * rate[k].abs() * rate[k]
+                paritysim_aero::stroke_drag_torque(V::splat(self.terms.drag[k]), rate[k])
             }
         };
         (inside, stroke, [-torque(0), torque(1)])
@@ -127,8 +128,7 @@ impl<'a> LinearStrokeLanes<'a> {
                 stiffness: [z; 2],
                 cubic: [z; 2],
                 rest: [z; 2],
-                k1: z,
-                k2: z,
+                drive: DriveSprings::single(z, z),
             },
         }
     }
@@ -155,8 +155,9 @@ impl<'a> LinearStrokeLanes<'a> {
             set(&mut lane.cubic[k], l, device.cubic[k]);
             set(&mut lane.rest[k], l, device.rest[k]);
         }
-        set(&mut lane.k1, l, device.k1);
-        set(&mut lane.k2, l, device.k2);
+        set(&mut lane.drive.k1, l, device.drive.k1);
+        set(&mut lane.drive.k2, l, device.drive.k2);
+        set(&mut lane.drive.preload, l, device.drive.preload);
     }
 }
 
@@ -188,12 +189,11 @@ impl LinearStrokeLanes<'_> {
         let [j00, j01, j10, j11] = c.jacobian;
         let stroke = [j00 * q1 + j01 * q2, j10 * q1 + j11 * q2];
         let phi_dot = [j00 * q1_dot + j01 * q2_dot, j10 * q1_dot + j11 * q2_dot];
-        let mut g0 = force - c.k1 * q1;
-        let mut g1 = -c.k2 * q2;
+        let [mut g0, mut g1] = c.drive.load([force, V::splat(0.0)], [q1, q2]);
         let rows = [(j00, j01), (j10, j11)];
         for k in 0..2 {
             let (a, b) = rows[k];
-            let tau_aero = c.drag[k] * phi_dot[k].abs() * phi_dot[k];
+            let tau_aero = paritysim_aero::stroke_drag_torque(c.drag[k], phi_dot[k]);
             let d = stroke[k] - c.rest[k];
             let spring = c.stiffness[k] * d + c.cubic[k] * d * d * d;
             let tau = tau_aero - spring;

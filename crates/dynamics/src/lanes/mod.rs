@@ -21,7 +21,7 @@
 //!   functions and replay a step that crosses one on the scalar path (`plane_rhs`), so their
 //!   periods stay the scalar ones bit for bit.
 //! * **Same results.** The lanes perform the scalar path's floating-point operations in its
-//!   order, and the Newton logic here (`LanePoint`) is that of `grid_shooting::shoot` and
+//!   order, and the Newton logic here (`LanePoint`) is that of `shooting::grid::shoot` and
 //!   `simulate::shooting_steady_state`. The branches it does not follow (a failing period, a
 //!   singular Newton step, no convergence, an unstable orbit: `shoot`'s `Ok(None)` and errors)
 //!   rerun the point on the scalar path from the same start, so every point's result is
@@ -36,8 +36,6 @@
 //!   sweep's cancel is checked between periods.
 
 pub(crate) mod linear_stroke;
-mod plane_point;
-mod plane_rhs;
 mod point;
 mod schedule;
 
@@ -87,17 +85,12 @@ pub fn resolve_lanes(requested: Option<usize>) -> Result<usize> {
 /// §3.4 stroke-plane devices (blade elements on both wings, a single drive) and the §2.5
 /// free-deviation devices (Lift and Dual PARITY with blade elements).
 pub fn has_lane_model(device: &Device) -> bool {
-    LinearStroke::of(device).is_some() || plane_rhs::supports(device)
+    LinearStroke::of(device).is_some()
 }
 
 /// Points completed in lanes since the process started (tests and benchmarks read it to see
 /// that the lanes ran).
 pub(crate) static COMPLETED_IN_LANES: std::sync::atomic::AtomicUsize =
-    std::sync::atomic::AtomicUsize::new(0);
-
-/// Of [`COMPLETED_IN_LANES`], the switched devices' points (§3.4 stroke plane, §2.5 free
-/// deviation).
-pub(crate) static SWITCHED_COMPLETED_IN_LANES: std::sync::atomic::AtomicUsize =
     std::sync::atomic::AtomicUsize::new(0);
 
 /// A converged lane point as `simulate` and `run_point` report it (metrics only, one orbit
@@ -145,7 +138,7 @@ impl Converged<'_> {
     }
 }
 
-/// The shooting's tolerances of a lane point, as `simulate` gives `grid_shooting::shoot`.
+/// The shooting's tolerances of a lane point, as `simulate` gives `shooting::grid::shoot`.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Limits {
     /// Newton's convergence tolerance and the residual a neutral orbit is accepted at.
@@ -159,14 +152,13 @@ pub(super) struct Limits {
 
 impl Limits {
     pub(super) fn of(options: &crate::simulate::SimulationOptions) -> Self {
-        let chooser = crate::grid_shooting::GRID_TOLERANCE_FACTOR.clamp(f64::MIN_POSITIVE, 1.0);
+        let chooser = crate::shooting::newton::GRID_TOLERANCE_FACTOR.clamp(f64::MIN_POSITIVE, 1.0);
         let tolerances = |factor: f64| crate::integrate::lanes::LaneTolerances {
             rtol: options.rtol * factor,
             atol: options.atol * factor,
         };
         Self {
-            // Below the integration's own accuracy (~rtol) a tighter orbit changes nothing.
-            tol: (1e-2 * options.steady_tol).min(0.1 * options.rtol),
+            tol: crate::shooting::newton::newton_tolerance(options),
             accept_tol: options.steady_tol,
             newton: crate::integrate::lanes::LaneTolerances {
                 rtol: options.rtol,
@@ -196,73 +188,8 @@ pub(super) fn cached_window_times(
     }
 }
 
-/// `(P(y) − y, ‖P(y) − y‖∞ / (1 + ‖y‖∞))` on `n` coordinates (as `grid_shooting`).
-pub(super) fn residual(
-    n: usize,
-    y: &crate::integrate::State,
-    py: &crate::integrate::State,
-) -> (nalgebra::DVector<f64>, f64) {
-    let (yv, pv) = (y.compact(n), py.compact(n));
-    let f = pv - &yv;
-    let r = f.amax() / (1.0 + yv.amax());
-    (f, r)
-}
-
-/// A Newton trial of `grid_shooting::shoot`'s loop: its step `delta`, the step's size
-/// relative to the iterate, the next iterate, and whether it is the last (the predicted error,
-/// step × contraction, below `tol`). `None` for a singular step.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn newton_trial(
-    n: usize,
-    y: &crate::integrate::State,
-    (jac, eye, f): (
-        &nalgebra::DMatrix<f64>,
-        &nalgebra::DMatrix<f64>,
-        &nalgebra::DVector<f64>,
-    ),
-    last_step: Option<f64>,
-    fresh: bool,
-    tol: f64,
-) -> Option<(nalgebra::DVector<f64>, f64, crate::integrate::State, bool)> {
-    let delta = crate::grid_shooting::least_squares_step(jac - eye, f)?;
-    let scale = 1.0 + y.compact(n).amax();
-    let step = delta.amax() / scale;
-    // The next iterate's error: the step times the contraction seen so far (Newton's
-    // quadratic model after a fresh Jacobian; unknown, so 1, after a neighbour's).
-    let contraction = match last_step {
-        Some(s) => step / s,
-        None if fresh => step,
-        None => 1.0,
-    }
-    .min(1.0);
-    let y_new = crate::integrate::State::from_compact(n, &(y.compact(n) + &delta));
-    let last = contraction * step <= tol || step <= 1e-3 * tol;
-    Some((delta, step, y_new, last))
-}
-
-/// Good Broyden (`grid_shooting::shoot`): the secant condition on the step `delta` just taken,
-/// from the residual `f` to `f_new`.
-pub(super) fn broyden_update(
-    jac: &mut nalgebra::DMatrix<f64>,
-    eye: &nalgebra::DMatrix<f64>,
-    delta: &nalgebra::DVector<f64>,
-    (f, f_new): (&nalgebra::DVector<f64>, &nalgebra::DVector<f64>),
-) {
-    let s_dot = delta.dot(delta);
-    if s_dot > 0.0 {
-        let mismatch = (f_new - f) - (&*jac - eye) * delta;
-        *jac += mismatch * delta.transpose() / s_dot;
-    }
-}
-
 /// How many sweep points the SIMD lanes have completed in this process (monotonic; points
 /// rerun on the scalar path are not counted).
 pub fn points_completed_in_lanes() -> usize {
     COMPLETED_IN_LANES.load(std::sync::atomic::Ordering::Relaxed)
-}
-
-/// Of [`points_completed_in_lanes`], those of the switched devices (§3.4 stroke plane, §2.5
-/// free deviation).
-pub fn switched_points_completed_in_lanes() -> usize {
-    SWITCHED_COMPLETED_IN_LANES.load(std::sync::atomic::Ordering::Relaxed)
 }

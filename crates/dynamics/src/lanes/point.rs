@@ -1,48 +1,33 @@
-//! One shooting point in a lane: the state machine of `simulate::shooting_steady_state` and
-//! `grid_shooting::shoot` that hands out one period at a time (see the module `lanes`).
+//! One shooting point in a lane: the lanes as an executor of the shooting machine
+//! (`shooting::machine`), one period at a time (see the module `lanes`).
 
 use std::rc::Rc;
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 
 use super::linear_stroke::LinearStroke;
 use crate::device::Device;
-use crate::grid_shooting::REPICK_RESIDUAL;
 use crate::integrate::lanes::{LaneOutcome, LaneProblem, SampleBlock};
 use crate::integrate::{Method, RungeKutta, State};
 use crate::metrics::{MetricsAccumulator, StrokeBlock};
+use crate::shooting::machine::{GridNewton, Limits, Reply, Request, Start, Verdict};
+use crate::shooting::newton;
 use crate::simulate::{SimulationOptions, SteadyState, UNSTABLE_MARGIN};
 use crate::sweep::PointOutput;
 
-/// Newton steps of the shooting (as `simulate` gives `grid_shooting::shoot`).
-const MAX_NEWTON: usize = 20;
-
-/// The fixed-grid period a lane point waits for.
+/// The period a lane point waits for.
 #[derive(Clone, Debug)]
 enum Pending {
+    /// A cold point's transient warm-up period.
+    WarmUp,
+    /// A cold point's variational period (picks the grid, gives the exact Jacobian).
+    Sensitivity,
     /// The neighbour's grid from the start state, its error estimates counted.
     Map,
     /// The adaptive period that picks a new grid (the neighbour's no longer suits).
     Pick,
-    /// A cold point's transient warm-up period.
-    WarmUp,
-    /// A cold point's variational period.
-    Sensitivity,
-    /// The variational equations on the grid (an exact Jacobian); then the iterate becomes
-    /// `candidate` `(y, f, residual)` when given.
-    Relinearise {
-        candidate: Option<(State, DVector<f64>, f64)>,
-    },
-    /// The adaptive period that picks the grid again at the converged `y_new` (the grid was
-    /// picked far from the orbit: `grid_shooting::REPICK_RESIDUAL`).
-    Repick { y_new: State },
-    /// A Newton trial from `y_new`; `last`: the recorded window.
-    Trial {
-        y_new: State,
-        delta: DVector<f64>,
-        step: f64,
-        last: bool,
-    },
+    /// A period the shooting machine requested (`pick`: an adaptive one that picks a grid).
+    Newton { pick: bool },
 }
 
 /// What a lane point does next.
@@ -57,8 +42,9 @@ pub(super) enum Next {
     Scalar,
 }
 
-/// One shooting point in a lane: `simulate::shooting_steady_state` and `grid_shooting::shoot`
-/// as a state machine that hands out one period at a time (see the module).
+/// One shooting point in a lane: the warm-up and first map of `simulate`'s shooting, then the
+/// shooting machine ([`GridNewton`]) with the lanes as its executor, one period at a time
+/// (see the module).
 pub(super) struct LanePoint<'a> {
     device: &'a Device,
     pub(super) model: LinearStroke<'a>,
@@ -66,27 +52,19 @@ pub(super) struct LanePoint<'a> {
     samples_per_cycle: usize,
     period: f64,
     limits: super::Limits,
+    /// The step grid (the neighbour's, then the machine's).
     pub(super) grid: Rc<[f64]>,
     /// The actuator force at the grid's stage times (`None` until asked, and after the grid
     /// changes).
     pub(super) forcing: Option<Rc<[f64]>>,
     times: Rc<[f64]>,
-    jac: DMatrix<f64>,
-    /// Whether `jac` is an exact Jacobian at `y` (after a re-linearisation).
-    fresh: bool,
-    /// Whether the grid was picked far from the orbit and is to be picked again once Newton
-    /// converges on it (`grid_shooting::REPICK_RESIDUAL`).
-    repick: bool,
+    /// The neighbour's Jacobian (a continued point), until the machine starts.
+    guess: DMatrix<f64>,
     /// Warm-up periods of a cold point: at most `min_cycles`.
     min_cycles: usize,
     warm_cycles: usize,
-    eye: DMatrix<f64>,
     y: State,
-    f: DVector<f64>,
-    res: f64,
-    last_step: Option<f64>,
-    iterations: usize,
-    periods: usize,
+    machine: Option<GridNewton>,
     pending: Pending,
     metrics: MetricsAccumulator,
     with_force: bool,
@@ -105,16 +83,6 @@ fn expand4(c: &[f64; 4]) -> State {
     y.coords[..2].copy_from_slice(&c[..2]);
     y.rates[..2].copy_from_slice(&c[2..]);
     y
-}
-
-/// `(P(y) − y, ‖P(y) − y‖∞ / (1 + ‖y‖∞))` (as `grid_shooting`).
-fn residual(y: &State, py: &State) -> (DVector<f64>, f64) {
-    super::residual(2, y, py)
-}
-
-/// Least-squares Newton step (as `grid_shooting`).
-fn newton_step(jac: &DMatrix<f64>, eye: &DMatrix<f64>, f: &DVector<f64>) -> Option<DVector<f64>> {
-    crate::grid_shooting::least_squares_step(jac - eye, f)
 }
 
 impl<'a> LanePoint<'a> {
@@ -189,18 +157,11 @@ impl<'a> LanePoint<'a> {
             grid: grid.into(),
             forcing: None,
             times,
-            jac,
-            fresh: false,
-            repick: false,
+            guess: jac,
             min_cycles,
             warm_cycles: 0,
-            eye: DMatrix::identity(4, 4),
             y,
-            f: DVector::zeros(4),
-            res: f64::NAN,
-            last_step: None,
-            iterations: 0,
-            periods: 0,
+            machine: None,
             pending: Pending::Map,
             metrics: MetricsAccumulator::new(device, Some(period)),
             with_force: metric_names.iter().any(|m| m == "actuator_force_peak"),
@@ -208,7 +169,7 @@ impl<'a> LanePoint<'a> {
         };
         let mut point = point;
         let first = if !cold {
-            Next::Integrate(point.problem(&point.y, false))
+            Next::Integrate(point.problem(&point.y, false, point.limits.grid))
         } else if min_cycles > 0 {
             point.warm_up()
         } else {
@@ -253,31 +214,24 @@ impl<'a> LanePoint<'a> {
         let LaneOutcome::Done { y: c, steps, .. } = outcome else {
             return Next::Scalar;
         };
-        if let Pending::Relinearise { candidate } =
-            std::mem::replace(&mut self.pending, Pending::Map)
-        {
-            self.jac = DMatrix::from_fn(4, 4, |i, j| c[4 + j * 4 + i]);
-            self.periods += 1;
-            self.fresh = true;
-            self.last_step = None;
-            if let Some((y, f, res)) = candidate {
-                (self.y, self.f, self.res) = (y, f, res);
+        let jacobian = DMatrix::from_fn(4, 4, |i, j| c[4 + j * 4 + i]);
+        match std::mem::replace(&mut self.pending, Pending::Map) {
+            Pending::Newton { .. } => self.reply(Reply::Linearised(jacobian)),
+            Pending::Sensitivity => {
+                let mapped = expand4(&[c[0], c[1], c[2], c[3]]);
+                self.start_machine(mapped, jacobian, true, steps.into(), true)
             }
-            return self.iterate();
+            _ => Next::Scalar,
         }
-        let py = expand4(&[c[0], c[1], c[2], c[3]]);
-        self.jac = DMatrix::from_fn(4, 4, |i, j| c[4 + j * 4 + i]);
-        self.grid = steps.into();
-        self.forcing = None;
-        self.fresh = true;
-        self.periods = 1;
-        (self.f, self.res) = residual(&self.y, &py);
-        self.repick = self.res > REPICK_RESIDUAL;
-        self.iterate()
     }
 
-    /// The fixed-grid period from `y` (`record`: with the window's samples).
-    fn problem(&self, y: &State, record: bool) -> LaneProblem<4> {
+    /// The fixed-grid period from `y` (`record`: with the window's samples) at `tol`.
+    fn problem(
+        &self,
+        y: &State,
+        record: bool,
+        tol: crate::integrate::lanes::LaneTolerances,
+    ) -> LaneProblem<4> {
         LaneProblem {
             grid: self.grid.clone(),
             adaptive: None,
@@ -287,14 +241,7 @@ impl<'a> LanePoint<'a> {
             } else {
                 Rc::from([])
             },
-            tol: match self.pending {
-                Pending::Map | Pending::Pick | Pending::Repick { .. } | Pending::Sensitivity => {
-                    self.limits.grid
-                }
-                Pending::Trial { .. } | Pending::WarmUp | Pending::Relinearise { .. } => {
-                    self.limits.newton
-                }
-            },
+            tol,
         }
     }
 
@@ -325,43 +272,87 @@ impl<'a> LanePoint<'a> {
         true
     }
 
-    /// The next Newton trial from the current iterate (the head of `shoot`'s loop).
-    fn iterate(&mut self) -> Next {
-        if self.iterations >= MAX_NEWTON {
-            return Next::Scalar;
+    /// Starts the shooting machine from the first map `mapped` of the iterate on `grid`.
+    fn start_machine(
+        &mut self,
+        mapped: State,
+        jacobian: DMatrix<f64>,
+        exact: bool,
+        grid: Rc<[f64]>,
+        picked_here: bool,
+    ) -> Next {
+        if !Rc::ptr_eq(&grid, &self.grid) {
+            self.forcing = None;
         }
-        self.iterations += 1;
-        let model = (&self.jac, &self.eye, &self.f);
-        let trial = super::newton_trial(
-            2,
-            &self.y,
-            model,
-            self.last_step,
-            self.fresh,
-            self.limits.tol,
-        );
-        let Some((delta, step, y_new, last)) = trial else {
-            return Next::Scalar;
+        self.grid = grid.clone();
+        let start = Start {
+            y: self.y,
+            mapped,
+            jacobian,
+            exact,
+            grid,
+            picked_here,
+            guess_contraction: None,
         };
-        if last && self.repick {
-            self.repick = false;
-            self.pending = Pending::Repick { y_new };
-            return Next::Integrate(self.adaptive_grid_period(&y_new));
-        }
-        self.pending = Pending::Trial {
-            y_new,
-            delta,
-            step,
-            last,
+        let limits = Limits {
+            tol: self.limits.tol,
+            accept_tol: self.limits.accept_tol,
+            max_newton: newton::MAX_NEWTON,
         };
-        if last {
-            // A fresh window (a refused earlier window's samples are not kept).
-            self.metrics = MetricsAccumulator::new(self.device, Some(self.period));
-        }
-        Next::Integrate(self.problem(&y_new, last))
+        let (machine, verdict) = GridNewton::start(2, start, limits);
+        self.machine = Some(machine);
+        self.follow(verdict)
     }
 
-    /// Continues after the lane's period ended with `outcome` (the rest of `shoot`'s loop).
+    /// Hands the machine `reply`; a grid it picked replaces the lane's.
+    fn reply(&mut self, reply: Reply) -> Next {
+        let Some(machine) = self.machine.as_mut() else {
+            return Next::Scalar;
+        };
+        let verdict = machine.resume(reply);
+        if !Rc::ptr_eq(&machine.grid, &self.grid) {
+            self.grid = machine.grid.clone();
+            self.forcing = None;
+        }
+        self.follow(verdict)
+    }
+
+    /// The lane period (or the end) the machine's `verdict` asks for.
+    fn follow(&mut self, verdict: Verdict) -> Next {
+        match verdict {
+            Verdict::Run(Request::Trial { y, last }) => {
+                self.pending = Pending::Newton { pick: false };
+                if last {
+                    // A fresh window (a refused earlier window's samples are not kept).
+                    self.metrics = MetricsAccumulator::new(self.device, Some(self.period));
+                }
+                Next::Integrate(self.problem(&y, last, self.limits.newton))
+            }
+            Verdict::Run(Request::Linearise { y }) => {
+                self.pending = Pending::Newton { pick: false };
+                let mut c0 = [0.0; 20];
+                c0[..4].copy_from_slice(&compact4(&y));
+                for j in 0..4 {
+                    c0[4 + j * 4 + j] = 1.0;
+                }
+                Next::Sensitivity(LaneProblem {
+                    grid: self.grid.clone(),
+                    adaptive: None,
+                    y0: c0,
+                    times: Rc::from([]),
+                    tol: self.limits.newton,
+                })
+            }
+            Verdict::Run(Request::Pick { y }) => {
+                self.pending = Pending::Newton { pick: true };
+                Next::Integrate(self.adaptive_grid_period(&y))
+            }
+            Verdict::Converged(accepted) => self.done(accepted.state, accepted.residual),
+            Verdict::GaveUp => Next::Scalar,
+        }
+    }
+
+    /// Continues after the lane's period ended with `outcome`.
     pub(super) fn resume(&mut self, outcome: LaneOutcome<4>) -> Next {
         match (std::mem::replace(&mut self.pending, Pending::Map), outcome) {
             (Pending::WarmUp, LaneOutcome::Done { y, .. }) => {
@@ -377,7 +368,7 @@ impl<'a> LanePoint<'a> {
             }
             // A failing warm-up period ends the warm-up (the shooting decides).
             (Pending::WarmUp, LaneOutcome::Failed) => self.sensitivity(),
-            (Pending::Sensitivity | Pending::Relinearise { .. }, _) => Next::Scalar,
+            (Pending::Sensitivity, _) => Next::Scalar,
             (
                 Pending::Map,
                 LaneOutcome::Done {
@@ -386,9 +377,8 @@ impl<'a> LanePoint<'a> {
                     ..
                 },
             ) => {
-                self.periods = 1;
-                (self.f, self.res) = residual(&self.y, &expand4(&y));
-                self.iterate()
+                let (grid, guess) = (self.grid.clone(), self.guess.clone());
+                self.start_machine(expand4(&y), guess, false, grid, false)
             }
             (Pending::Map, _) => {
                 // The neighbour's grid no longer suits: one adaptive period picks another
@@ -397,60 +387,17 @@ impl<'a> LanePoint<'a> {
                 Next::Integrate(self.adaptive_grid_period(&self.y.clone()))
             }
             (Pending::Pick, LaneOutcome::Done { y, steps, .. }) => {
-                self.grid = steps.into();
-                self.forcing = None;
-                self.periods = 1;
-                (self.f, self.res) = residual(&self.y, &expand4(&y));
-                self.repick = self.res > REPICK_RESIDUAL;
-                self.iterate()
+                let guess = self.guess.clone();
+                self.start_machine(expand4(&y), guess, false, steps.into(), true)
             }
-            (Pending::Repick { y_new }, LaneOutcome::Done { y, steps, .. }) => {
-                self.grid = steps.into();
-                self.forcing = None;
-                self.periods += 1;
-                (self.f, self.res) = residual(&y_new, &expand4(&y));
-                self.y = y_new;
-                self.iterate()
+            (Pending::Pick, LaneOutcome::Failed) => Next::Scalar,
+            (Pending::Newton { pick: true }, LaneOutcome::Done { y, steps, .. }) => {
+                self.reply(Reply::Picked(expand4(&y), steps))
             }
-            (Pending::Pick | Pending::Repick { .. }, LaneOutcome::Failed) => Next::Scalar,
-            (Pending::Trial { .. }, LaneOutcome::Failed) => Next::Scalar,
-            (
-                Pending::Trial {
-                    y_new,
-                    delta,
-                    step,
-                    last,
-                },
-                LaneOutcome::Done { y, .. },
-            ) => {
-                self.periods += 1;
-                let (f_new, res_new) = residual(&y_new, &expand4(&y));
-                let tol = self.limits.tol;
-                if last && res_new > tol && res_new <= self.limits.accept_tol && !self.fresh {
-                    // Re-linearise at the candidate, then decide with the exact Jacobian.
-                    return self.relinearise(&y_new, Some((y_new, f_new, res_new)));
-                }
-                let neutral = || {
-                    res_new <= self.limits.accept_tol
-                        && newton_step(&self.jac, &self.eye, &f_new)
-                            .is_some_and(|d| d.amax() / (1.0 + y_new.compact(2).amax()) <= tol)
-                };
-                if last && (res_new <= tol || neutral()) {
-                    return self.done(y_new, res_new);
-                }
-                if res_new >= self.res || res_new.is_nan() {
-                    // A stale Jacobian that no longer descends: the exact one at the iterate.
-                    if self.fresh {
-                        return Next::Scalar;
-                    }
-                    return self.relinearise(&self.y.clone(), None);
-                }
-                super::broyden_update(&mut self.jac, &self.eye, &delta, (&self.f, &f_new));
-                self.fresh = false;
-                (self.y, self.f, self.res) = (y_new, f_new, res_new);
-                self.last_step = Some(step);
-                self.iterate()
+            (Pending::Newton { pick: false }, LaneOutcome::Done { y, .. }) => {
+                self.reply(Reply::Mapped(expand4(&y), None))
             }
+            (Pending::Newton { .. }, LaneOutcome::Failed) => Next::Scalar,
         }
     }
 
@@ -466,27 +413,12 @@ impl<'a> LanePoint<'a> {
         }
     }
 
-    /// The exact Jacobian at `at` on the grid (`rk.flow_with_sensitivity_on_grid`, in the
-    /// lane), then the iterate `candidate` when given.
-    fn relinearise(&mut self, at: &State, candidate: Option<(State, DVector<f64>, f64)>) -> Next {
-        self.pending = Pending::Relinearise { candidate };
-        let mut c0 = [0.0; 20];
-        c0[..4].copy_from_slice(&compact4(at));
-        for j in 0..4 {
-            c0[4 + j * 4 + j] = 1.0;
-        }
-        Next::Sensitivity(LaneProblem {
-            grid: self.grid.clone(),
-            adaptive: None,
-            y0: c0,
-            times: Rc::from([]),
-            tol: self.limits.newton,
-        })
-    }
-
     /// The converged point as `simulate` and `run_point` report it.
     fn done(&mut self, state: State, residual: f64) -> Next {
-        let multipliers = crate::floquet::eigenvalues(&self.jac).unwrap_or_default();
+        let Some(machine) = self.machine.as_ref() else {
+            return Next::Scalar;
+        };
+        let multipliers = crate::floquet::eigenvalues(&machine.jacobian).unwrap_or_default();
         if multipliers
             .first()
             .is_some_and(|m| m.norm() > 1.0 + UNSTABLE_MARGIN)
@@ -500,11 +432,11 @@ impl<'a> LanePoint<'a> {
                 samples_per_cycle: self.samples_per_cycle,
                 period: self.period,
                 metrics: self.metrics.finish(),
-                cycles_run: self.warm_cycles + self.periods - 1,
+                cycles_run: self.warm_cycles + machine.periods - 1,
                 residual,
                 state,
                 multipliers,
-                jacobian: self.jac.clone(),
+                jacobian: machine.jacobian.clone(),
                 grid: self.grid.to_vec(),
             }
             .output(),

@@ -9,8 +9,6 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use paritysim_error::Result;
 
 use super::linear_stroke::{LinearStrokeLanes, VariationalLanes};
-use super::plane_point::{PlanePoint, PlaneStep};
-use super::plane_rhs::{self, M, M12, PlaneLanes};
 use super::point::{LanePoint, Next};
 use crate::device::Device;
 use crate::integrate::lanes::{LaneOutcome, LaneStepper, SampleBlock};
@@ -57,30 +55,13 @@ struct Cursor<'a> {
     previous: Vec<Converged>,
     out: Vec<Result<PointOutput>>,
     /// The point in the lane: its index, start and state.
-    point: Option<(usize, ChainStart, Task<'a>)>,
-}
-
-/// A point in a lane: a drivetrain-coordinate one, or a switched device's on four
-/// coordinates (`M` compact entries) or five (`M12`).
-enum Task<'a> {
-    Linear(LanePoint<'a>),
-    Plane(PlanePoint<'a, M>),
-    Plane12(PlanePoint<'a, M12>),
-}
-
-/// What a point does next, of its kind.
-enum Step {
-    Linear(Next),
-    Plane(PlaneStep<M>),
-    Plane12(PlaneStep<M12>),
+    point: Option<(usize, ChainStart, LanePoint<'a>)>,
 }
 
 /// How a lane's period ended, by stepper.
 enum Ended {
     State(LaneOutcome<4>),
     Variational(LaneOutcome<20>),
-    Plane(LaneOutcome<M>),
-    Plane12(LaneOutcome<M12>),
 }
 
 type ChainResults = Vec<Option<Result<Vec<Result<PointOutput>>>>>;
@@ -164,104 +145,24 @@ pub(crate) fn run_chains(
         .collect())
 }
 
-/// The worker's lane steppers (the drivetrain state, with its variational equations, and
-/// the switched devices' states).
+/// The worker's lane steppers (the drivetrain state, with its variational equations).
 struct Steppers {
     state: LaneStepper<4>,
     variational: LaneStepper<20>,
-    plane: LaneStepper<M, M>,
-    plane12: LaneStepper<M12, M12>,
     /// Lanes started since each stepper's last run.
-    fresh: [u32; 4],
-}
-
-/// The right-hand sides of a worker's lanes.
-struct Models<'a> {
-    linear: LinearStrokeLanes<'a>,
-    plane: PlaneLanes<'a, M>,
-    plane12: PlaneLanes<'a, M12>,
-}
-
-/// Runs a switched-device stepper when busy (see [`LaneStepper::run`]): its samples go to the
-/// point in each lane (`point_of` picks it from the lane's task).
-fn run_plane<'a, const M: usize>(
-    stepper: &mut LaneStepper<M, M>,
-    lanes: &PlaneLanes<'a, M>,
-    fresh: &mut u32,
-    cursors: &mut [Option<Cursor<'a>>],
-    point_of: for<'t> fn(&'t mut Task<'a>) -> Option<&'t mut PlanePoint<'a, M>>,
-) -> Vec<(usize, LaneOutcome<M>)> {
-    if !stepper.any_busy() {
-        return Vec::new();
-    }
-    let mut sink = |l: usize, block: &SampleBlock<M>| {
-        cursors[l]
-            .as_mut()
-            .and_then(|c| c.point.as_mut())
-            .and_then(|(_, _, task)| point_of(task))
-            .is_some_and(|p| p.sample(block))
-    };
-    stepper.run(lanes, std::mem::take(fresh), &mut sink)
-}
-
-/// Starts a switched point's `step` in lane `l` (see [`launch`]).
-fn launch_plane<'a, const M: usize>(
-    l: usize,
-    step: PlaneStep<M>,
-    point: &mut PlanePoint<'a, M>,
-    (stepper, fresh): (&mut LaneStepper<M, M>, &mut u32),
-    lanes: &mut PlaneLanes<'a, M>,
-) -> Option<Option<PointOutput>> {
-    match step {
-        PlaneStep::Integrate(problem) => {
-            lanes.load(l, point.device);
-            if problem.adaptive.is_none() {
-                lanes.load_forcing(l, point.forcing());
-            }
-            stepper.set_deadline(l, point.deadline);
-            let mut sink = |_: usize, block: &SampleBlock<M>| point.sample(block);
-            if stepper.start(l, problem, &mut sink) {
-                *fresh |= 1 << l;
-                None
-            } else {
-                Some(None)
-            }
-        }
-        PlaneStep::Done(output) => Some(Some(*output)),
-        PlaneStep::Scalar => Some(None),
-    }
+    fresh: [u32; 2],
 }
 
 /// Starts `next` of `task` in lane `l`: `None` while it is in flight, else the point is
 /// complete (`Some(Some(output))` from the lanes, `Some(None)`: run it on the scalar path).
 fn launch<'a>(
     l: usize,
-    next: Step,
-    task: &mut Task<'a>,
+    next: Next,
+    point: &mut LanePoint<'a>,
     steppers: &mut Steppers,
-    models: &mut Models<'a>,
+    models: &mut LinearStrokeLanes<'a>,
     forcing_cache: &mut ForcingCache,
 ) -> Option<Option<PointOutput>> {
-    let (next, point) = match (next, task) {
-        (Step::Linear(next), Task::Linear(point)) => (next, point),
-        (Step::Plane(step), Task::Plane(point)) => {
-            let fresh = &mut steppers.fresh[2];
-            return launch_plane(
-                l,
-                step,
-                point,
-                (&mut steppers.plane, fresh),
-                &mut models.plane,
-            );
-        }
-        (Step::Plane12(step), Task::Plane12(point)) => {
-            let fresh = &mut steppers.fresh[3];
-            let stepper = &mut steppers.plane12;
-            return launch_plane(l, step, point, (stepper, fresh), &mut models.plane12);
-        }
-        // A period of another kind than the point's (not handed out).
-        _ => return Some(None),
-    };
     let deadline = point.deadline;
     match next {
         Next::Integrate(problem) => {
@@ -270,7 +171,7 @@ fn launch<'a>(
                 .adaptive
                 .is_none()
                 .then(|| forcing(point, forcing_cache));
-            models.linear.load_forcing(l, table);
+            models.load_forcing(l, table);
             steppers.state.set_deadline(l, deadline);
             let mut sink = |_: usize, block: &SampleBlock| point.sample(block);
             if steppers.state.start(l, problem, &mut sink) {
@@ -285,7 +186,7 @@ fn launch<'a>(
                 .adaptive
                 .is_none()
                 .then(|| forcing(point, forcing_cache));
-            models.linear.load_forcing(l, table);
+            models.load_forcing(l, table);
             steppers.variational.set_deadline(l, deadline);
             if steppers
                 .variational
@@ -317,15 +218,9 @@ fn run_worker(
     let mut steppers = Steppers {
         state: LaneStepper::new(),
         variational: LaneStepper::new(),
-        plane: LaneStepper::new(),
-        plane12: LaneStepper::new(),
-        fresh: [0; 4],
+        fresh: [0; 2],
     };
-    let mut models = Models {
-        linear: LinearStrokeLanes::new(),
-        plane: PlaneLanes::new(plane_rhs::build),
-        plane12: PlaneLanes::new(plane_rhs::build12),
-    };
+    let mut models = LinearStrokeLanes::new();
     let mut times_cache = None;
     // One per lane: a lane's next point usually has its chain predecessor's grid (one cache
     // for the worker was overwritten by the other lanes' chains: 366 tables for 256 points).
@@ -371,23 +266,12 @@ fn run_worker(
                     let options = continued_options(points, i, &start);
                     let options = options.as_ref().unwrap_or(own);
                     LanePoint::new(device, options, metric_names, &mut times_cache)
-                        .map(|(p, next)| (Task::Linear(p), Step::Linear(next)))
-                        .or_else(|| {
-                            PlanePoint::new(device, options, metric_names, &mut times_cache)
-                                .map(|(p, step)| (Task::Plane(p), Step::Plane(step)))
-                        })
-                        .or_else(|| {
-                            PlanePoint::new(device, options, metric_names, &mut times_cache)
-                                .map(|(p, step)| (Task::Plane12(p), Step::Plane12(step)))
-                        })
                 });
                 let Some((mut point, next)) = lane_point else {
                     finish_point(points, metric_names, cursor, i, &start, None, control);
                     continue;
                 };
-                if let Task::Linear(p) = &point {
-                    models.linear.load(l, &p.model);
-                }
+                models.load(l, &point.model);
                 match launch(
                     l,
                     next,
@@ -409,10 +293,7 @@ fn run_worker(
                 }
             }
         }
-        let busy = steppers.state.any_busy()
-            || steppers.variational.any_busy()
-            || steppers.plane.any_busy()
-            || steppers.plane12.any_busy();
+        let busy = steppers.state.any_busy() || steppers.variational.any_busy();
         if control.is_cancelled() || !busy {
             break;
         }
@@ -422,23 +303,20 @@ fn run_worker(
                 cursors[l]
                     .as_mut()
                     .and_then(|c| c.point.as_mut())
-                    .is_some_and(|(_, _, task)| match task {
-                        Task::Linear(p) => p.sample(block),
-                        _ => false,
-                    })
+                    .is_some_and(|(_, _, point)| point.sample(block))
             };
             let fresh = std::mem::take(&mut steppers.fresh[0]);
             finished.extend(
                 steppers
                     .state
-                    .run(&models.linear, fresh, &mut sink)
+                    .run(&models, fresh, &mut sink)
                     .into_iter()
                     .map(|(l, o)| (l, Ended::State(o))),
             );
         }
         if steppers.variational.any_busy() {
             let fresh = std::mem::take(&mut steppers.fresh[1]);
-            let rhs = VariationalLanes(&models.linear);
+            let rhs = VariationalLanes(&models);
             finished.extend(
                 steppers
                     .variational
@@ -447,34 +325,6 @@ fn run_worker(
                     .map(|(l, o)| (l, Ended::Variational(o))),
             );
         }
-        finished.extend(
-            run_plane(
-                &mut steppers.plane,
-                &models.plane,
-                &mut steppers.fresh[2],
-                &mut cursors,
-                |t| match t {
-                    Task::Plane(p) => Some(p),
-                    _ => None,
-                },
-            )
-            .into_iter()
-            .map(|(l, o)| (l, Ended::Plane(o))),
-        );
-        finished.extend(
-            run_plane(
-                &mut steppers.plane12,
-                &models.plane12,
-                &mut steppers.fresh[3],
-                &mut cursors,
-                |t| match t {
-                    Task::Plane12(p) => Some(p),
-                    _ => None,
-                },
-            )
-            .into_iter()
-            .map(|(l, o)| (l, Ended::Plane12(o))),
-        );
         for (l, outcome) in finished {
             let cursor = cursors[l].as_mut().expect("a busy lane has a chain");
             let (i, start, mut point) = cursor.point.take().expect("a busy lane has a point");
@@ -483,8 +333,6 @@ fn run_worker(
             let timeout = match outcome {
                 Ended::State(_) => steppers.state.take_timeout(l),
                 Ended::Variational(_) => steppers.variational.take_timeout(l),
-                Ended::Plane(_) => steppers.plane.take_timeout(l),
-                Ended::Plane12(_) => steppers.plane12.take_timeout(l),
             };
             if let Some(error) = timeout {
                 finish_point(
@@ -498,12 +346,9 @@ fn run_worker(
                 );
                 continue;
             }
-            let next = match (outcome, &mut point) {
-                (Ended::State(o), Task::Linear(p)) => Step::Linear(p.resume(o)),
-                (Ended::Variational(o), Task::Linear(p)) => Step::Linear(p.resume_sensitivity(o)),
-                (Ended::Plane(o), Task::Plane(p)) => Step::Plane(p.resume(o)),
-                (Ended::Plane12(o), Task::Plane12(p)) => Step::Plane12(p.resume(o)),
-                _ => Step::Linear(Next::Scalar),
+            let next = match outcome {
+                Ended::State(o) => point.resume(o),
+                Ended::Variational(o) => point.resume_sensitivity(o),
             };
             match launch(
                 l,

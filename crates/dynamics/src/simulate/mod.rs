@@ -22,7 +22,6 @@ pub use options::{
     PERIOD_DOUBLED_SETTLED, PerturbTarget, Perturbation, SHOOTING_RETRY_APART, SimulationOptions,
     SimulationResult, SteadyState,
 };
-pub(crate) use shooting::BROYDEN_VERDICT_CHECKED_BELOW;
 use shooting::Shot;
 pub use shooting::UNSTABLE_MARGIN;
 pub(crate) use shooting::shooting_steady_state;

@@ -4,9 +4,10 @@
 use paritysim_error::Result;
 
 use crate::device::Device;
-use crate::grid_shooting::{Finished, Guess};
 use crate::integrate::{Integrator, RungeKutta, State};
 use crate::metrics::StrokeNeeds;
+use crate::shooting::grid::{Finished, Guess};
+use crate::shooting::newton::{MAX_NEWTON, newton_tolerance};
 use crate::trajectory::Trajectory;
 
 use super::{SimulationOptions, record_window, state_change};
@@ -103,7 +104,7 @@ pub(crate) fn shooting_steady_state(
             let next = match warm_up.advance(warm_up_system, 0.0, &y, period) {
                 Ok(next) => next,
                 // A spent budget ends the run; any other failure is left to the fallback.
-                Err(e) if crate::grid_shooting::out_of_budget(&e) => return Err(e),
+                Err(e) if crate::shooting::newton::out_of_budget(&e) => return Err(e),
                 Err(_) => break,
             };
             let change = state_change(&next, &y);
@@ -114,8 +115,7 @@ pub(crate) fn shooting_steady_state(
             }
         }
     }
-    // Below the integration's own accuracy (~rtol) a tighter orbit changes nothing.
-    let tol = (1e-2 * options.steady_tol).min(0.1 * options.rtol);
+    let tol = newton_tolerance(options);
     let n_samples = options.samples_per_cycle * orbit_cycles;
     let records = options.record_cycles == 1 && options.perturbation.is_none();
     let mut recorded = None;
@@ -178,7 +178,7 @@ pub(crate) fn shooting_steady_state(
         } else {
             tol
         };
-        if let Some(first) = crate::grid_shooting::shoot(
+        if let Some(first) = crate::shooting::grid::shoot(
             device,
             &first_rk,
             map_period,
@@ -187,7 +187,7 @@ pub(crate) fn shooting_steady_state(
             None,
             first_tol,
             options.steady_tol,
-            20,
+            MAX_NEWTON,
             &mut plain,
         )? {
             y = first.state;
@@ -209,7 +209,7 @@ pub(crate) fn shooting_steady_state(
             contraction: None,
         }),
     };
-    let Some(mut orbit) = crate::grid_shooting::shoot(
+    let Some(mut orbit) = crate::shooting::grid::shoot(
         device,
         transient,
         map_period,
@@ -218,7 +218,7 @@ pub(crate) fn shooting_steady_state(
         guess,
         tol,
         options.steady_tol,
-        20,
+        MAX_NEWTON,
         &mut finish,
     )?
     else {
@@ -281,7 +281,7 @@ fn exact_jacobian_at_orbit(
     device: &Device,
     rk: &RungeKutta,
     grid: &[f64],
-    orbit: &mut crate::grid_shooting::GridOrbit,
+    orbit: &mut crate::shooting::grid::GridOrbit,
 ) -> Result<()> {
     match rk.flow_with_sensitivity_on_grid(device, grid, &orbit.state) {
         Ok((_, jacobian)) => {
@@ -289,7 +289,7 @@ fn exact_jacobian_at_orbit(
             orbit.jacobian_at_orbit = true;
             Ok(())
         }
-        Err(e) if crate::grid_shooting::out_of_budget(&e) => Err(e),
+        Err(e) if crate::shooting::newton::out_of_budget(&e) => Err(e),
         Err(_) => Ok(()),
     }
 }

@@ -56,7 +56,7 @@ impl Default for ShootingOptions {
             t0: 0.0,
             warmup_cycles: 20,
             warmup_tol: 1e-6,
-            max_newton: 20,
+            max_newton: crate::shooting::newton::MAX_NEWTON,
             tol: 1e-10,
             fd_step: 1e-5,
             fallback_cycles: 2000,
@@ -176,15 +176,9 @@ pub fn stroboscopic_map(
     Ok(out.without_work())
 }
 
+/// The shooting residual `‖P(y) − y‖∞ / (1 + ‖y‖∞)` ([`crate::shooting::newton::residual`]).
 fn residual_norm(n: usize, y: &State, py: &State) -> f64 {
-    let (mut num, mut den): (f64, f64) = (0.0, 0.0);
-    let pairs =
-        (py.coords[..n].iter().zip(&y.coords[..n])).chain(py.rates[..n].iter().zip(&y.rates[..n]));
-    for (a, b) in pairs {
-        num = num.max((a - b).abs());
-        den = den.max(b.abs());
-    }
-    num / (1.0 + den)
+    crate::shooting::newton::residual(n, y, py).1
 }
 
 /// Finite-difference steps: `fd_step ×` the largest |coordinate| (resp. |rate|) of `y`, with a
@@ -292,17 +286,17 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
         |y: &State, guess: Option<&DMatrix<f64>>, before: usize| -> Result<Option<PeriodicOrbit>> {
             // The final period integrates the variational equations: the monodromy at the
             // orbit it accepts comes with it.
-            let mut finish = |grid: &[f64], y: &State| -> Result<crate::grid_shooting::Finished> {
+            let mut finish = |grid: &[f64], y: &State| -> Result<crate::shooting::grid::Finished> {
                 plain
                     .flow_with_sensitivity_on_grid(device, grid, y)
                     .map(|(end, monodromy)| (end, Some(monodromy)))
             };
-            let guess = guess.map(|jacobian| crate::grid_shooting::Guess {
+            let guess = guess.map(|jacobian| crate::shooting::grid::Guess {
                 jacobian,
                 grid: None,
                 contraction: None,
             });
-            let Some(shot) = crate::grid_shooting::shoot(
+            let Some(shot) = crate::shooting::grid::shoot(
                 device,
                 &integrator,
                 period,
@@ -438,7 +432,7 @@ fn damped_newton(
             res = residual_norm(n, &y, &py);
             jacobian = Some((phi, y));
         }
-        Err(e) if crate::grid_shooting::out_of_budget(&e) => return Err(e),
+        Err(e) if crate::shooting::newton::out_of_budget(&e) => return Err(e),
         Err(_) => {}
     }
     while res > until && iterations < options.max_newton {
@@ -449,7 +443,7 @@ fn damped_newton(
         iterations += 1;
         let a = jac - DMatrix::<f64>::identity(2 * n, 2 * n);
         let f = compact(n, &py) - compact(n, &y);
-        let delta = crate::grid_shooting::least_squares_step(a, &f).ok_or_else(|| {
+        let delta = crate::shooting::newton::least_squares_step(a, &f).ok_or_else(|| {
             Error::Singular("Newton step of the shooting method: non-finite Jacobian".into())
         })?;
         let mut lambda = 1.0;
@@ -467,7 +461,7 @@ fn damped_newton(
                         break;
                     }
                 }
-                Err(e) if crate::grid_shooting::out_of_budget(&e) => return Err(e),
+                Err(e) if crate::shooting::newton::out_of_budget(&e) => return Err(e),
                 Err(_) => {}
             }
             lambda *= 0.5;
@@ -484,7 +478,7 @@ fn damped_newton(
                 res = residual_norm(n, &y, &py);
                 jacobian = Some((phi, y));
             }
-            Err(e) if crate::grid_shooting::out_of_budget(&e) => return Err(e),
+            Err(e) if crate::shooting::newton::out_of_budget(&e) => return Err(e),
             Err(_) => break,
         }
     }

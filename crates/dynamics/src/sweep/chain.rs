@@ -142,9 +142,14 @@ pub(crate) fn chain_range(c: usize, n_points: usize) -> std::ops::Range<usize> {
     c * CHAIN_LENGTH..((c + 1) * CHAIN_LENGTH).min(n_points)
 }
 
-/// Whether point `i` continues its chain (shooting, no initial state of its own).
+/// Whether point `i` continues its chain (shooting, no initial state of its own, and a device
+/// whose orbit at one drive is unique where the shipped studies go: a device with coexisting
+/// stable orbits, [`Device::has_free_deviation_model`], would continue its neighbour's branch
+/// instead of reaching the orbit a run from rest reaches, and its points run on their own).
 pub(crate) fn continued(points: &[Result<(Device, SimulationOptions)>], i: usize) -> bool {
-    matches!(&points[i], Ok((_, o)) if o.steady_state == SteadyState::Shooting && o.initial.is_none())
+    matches!(&points[i], Ok((d, o)) if o.steady_state == SteadyState::Shooting
+        && o.initial.is_none()
+        && !d.has_free_deviation_model())
 }
 
 /// Where point `i` of a chain starts: the prediction from its converged predecessors
@@ -235,10 +240,13 @@ pub(crate) fn chain_point(
     match started {
         Err(Error::Cancelled) => Err(Error::Cancelled),
         Err(_) if start.guess.is_some() => run_point(device, options, metric_names, keep_cycle),
+        // A neutral orbit (one of a family) started from a neighbour is another member of the
+        // family than the run from the spec's own start reaches: rerun from there.
         Ok(o)
             if start.guess.is_some()
                 && continued(points, i)
-                && !(o.converged && o.monodromy.is_some() && o.orbit_cycles == 1) =>
+                && (o.neutral
+                    || !(o.converged && o.monodromy.is_some() && o.orbit_cycles == 1)) =>
         {
             run_point(device, options, metric_names, keep_cycle)
         }
@@ -247,11 +255,14 @@ pub(crate) fn chain_point(
 }
 
 /// Keeps a converged result of point `i` as a predecessor (the last two). Only an orbit
-/// found by shooting (a stable one, with its monodromy) continues into the next point.
+/// found by shooting (a stable, non-neutral one, with its monodromy) continues into the next
+/// point.
 pub(crate) fn remember(previous: &mut Vec<Converged>, i: usize, result: &Result<PointOutput>) {
     if let Ok(o) = result {
         // A period-doubled orbit's map (two cycles) is no guess for a neighbour's one-cycle map.
-        let continues = o.monodromy.is_some() && o.orbit_cycles == 1;
+        // A neutral orbit is no start for a neighbour: it would land on the neighbour's family
+        // member nearest to it, not on the one its own start reaches.
+        let continues = o.monodromy.is_some() && o.orbit_cycles == 1 && !o.neutral;
         if let (true, Some(state), true) = (o.converged, o.steady_state, continues) {
             if previous.len() == 2 {
                 previous.remove(0);

@@ -78,7 +78,7 @@ pub use chain::{CHAIN_LENGTH, run_points, run_points_with_lanes};
 pub(crate) use chain::{
     ChainStart, Converged, chain_point, chain_range, chain_start, continued_options, remember,
 };
-pub use point::{PointOutput, SweepSettings, run_point};
+pub use point::{NEUTRAL_MULTIPLIER_TOL, PointOutput, SweepSettings, has_neutral_mode, run_point};
 pub(crate) use pool::run_tasks;
 pub use pool::{MAX_THREADS, SweepControl, THREADS_ENV, resolve_threads, run_indexed};
 pub use select::{metric_names, select, trajectory_columns};

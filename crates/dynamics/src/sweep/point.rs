@@ -41,6 +41,24 @@ pub struct PointOutput {
     pub step_grid: Vec<f64>,
     /// Drive periods per period of the steady state ([`crate::SimulationResult::orbit_cycles`]).
     pub orbit_cycles: usize,
+    /// Whether the orbit belongs to a family of orbits (a Floquet multiplier within
+    /// [`NEUTRAL_MULTIPLIER_TOL`] of 1, e.g. the whippletree's differential offset at K2 = 0):
+    /// such an orbit neither continues a chain nor is taken from one ([`super::chain`]).
+    pub neutral: bool,
+}
+
+/// A multiplier within this distance of 1 marks a family of periodic orbits (a neutral mode):
+/// which member a run reaches depends on where it starts, so only a run from the spec's own
+/// start gives *the* answer (the orbit an experiment started from rest sees). Structural
+/// neutral modes (a cyclic coordinate) sit at 1 to the Jacobian's accuracy (about 1e-8);
+/// the slowest decaying modes of the shipped devices are farther than 1e-2 from 1.
+pub const NEUTRAL_MULTIPLIER_TOL: f64 = 1e-3;
+
+/// Whether `multipliers` contain a neutral one ([`NEUTRAL_MULTIPLIER_TOL`]).
+pub fn has_neutral_mode(multipliers: &[nalgebra::Complex<f64>]) -> bool {
+    multipliers
+        .iter()
+        .any(|m| (m - 1.0).norm() <= NEUTRAL_MULTIPLIER_TOL)
 }
 
 /// Simulates one point and keeps what the sweep asked for.
@@ -115,6 +133,7 @@ impl PointOutput {
         });
         Self {
             metrics,
+            neutral: has_neutral_mode(&result.multipliers),
             converged: result.converged,
             cycles_run: result.cycles_run,
             cycle,

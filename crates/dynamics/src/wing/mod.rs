@@ -18,13 +18,12 @@ use paritysim_aero::Branch;
 use paritysim_error::{Error, Result};
 use paritysim_kinematics::SphericalShoulder;
 
-mod aero;
 mod free_deviation;
 mod record;
 mod springs;
 mod stroke_plane;
 
-pub use aero::WingAero;
+pub use paritysim_aero::WingAero;
 pub use record::WingTermsRecord;
 pub use springs::{JointSpring, TunableHinge};
 

@@ -31,6 +31,13 @@ pub trait DrivetrainConfig {
     fn balance_spring(&self) -> f64 {
         0.0
     }
+
+    /// A constant torque on the whippletree `q2` (mN·mm), e.g. a preloaded centring spring:
+    /// the drive load on `q2` is `P − K2 q2` (`device/drive.rs`); 0 unless a configuration
+    /// has one.
+    fn balance_preload(&self) -> f64 {
+        0.0
+    }
 }
 
 macro_rules! registry {
@@ -81,6 +88,11 @@ impl Drivetrain {
     /// K2 (mN·mm/rad).
     pub fn balance_spring(&self) -> f64 {
         self.config().balance_spring()
+    }
+
+    /// The preload torque on `q2` (mN·mm).
+    pub fn balance_preload(&self) -> f64 {
+        self.config().balance_preload()
     }
 }
 

@@ -16,6 +16,7 @@ use paritysim_aero::{BladeElementModel, CoefficientSet, HeldBranch};
 use paritysim_simd::{Real, sin_cos};
 
 use super::super::Device;
+use super::super::drive::DriveSprings;
 use crate::WingAero;
 
 type V3<R> = [R; 3];
@@ -38,11 +39,8 @@ pub(crate) struct Constants<R: Real, const N: usize> {
     offset: [R; 6],
     inverse: [[R; 2]; 2],
     inverse_transpose: [[R; 2]; 2],
-    /// The actuator and balance springs `K1`, `K2`; where the drivetrain is dual (`K1` on
-    /// both drives).
-    k1: R,
-    k2: R,
-    dual: R::Mask,
+    /// The drive's springs ([`DriveSprings`]).
+    drive: DriveSprings<R>,
     wings: [WingConstants<R>; 2],
 }
 
@@ -64,7 +62,6 @@ impl<const N: usize> Constants<f64, N> {
         if device.n_dof != N {
             return None;
         }
-        let actuator = device.spec.actuator.as_ref();
         let wing = |w: usize| {
             let wing = &device.spec.wings[w];
             let inertia = wing.inertia();
@@ -87,13 +84,7 @@ impl<const N: usize> Constants<f64, N> {
             inverse_transpose: std::array::from_fn(|r| {
                 std::array::from_fn(|c| lean.inverse_transpose[(r, c)])
             }),
-            k1: actuator.map_or(0.0, |a| a.stiffness()),
-            k2: device
-                .spec
-                .transmission
-                .as_ref()
-                .map_or(0.0, |tr| tr.balance_stiffness),
-            dual: actuator.is_some() && device.is_dual(),
+            drive: device.drive,
             wings: [wing(0), wing(1)],
         })
     }
@@ -124,9 +115,12 @@ impl<const N: usize> Constants<paritysim_simd::f64x4, N> {
             inverse_transpose: std::array::from_fn(|r| {
                 std::array::from_fn(|c| v(&|d| d.inverse_transpose[r][c]))
             }),
-            k1: v(&|d| d.k1),
-            k2: v(&|d| d.k2),
-            dual: mask(&|d| d.dual),
+            drive: DriveSprings {
+                k1: v(&|d| d.drive.k1),
+                k2: v(&|d| d.drive.k2),
+                preload: v(&|d| d.drive.preload),
+                dual: mask(&|d| d.drive.dual),
+            },
             wings: [wing(0), wing(1)],
         }
     }
@@ -322,11 +316,7 @@ pub(crate) fn step<R: Real, const N: usize>(
     let plausible = q[0].abs().le(k(paritysim_error::plausible::OFFSET_MM))
         & q[1].abs().le(k(paritysim_error::plausible::ANGLE_RAD));
     let q_dot = mat2(&c.inverse, [p_dot[0], p_dot[3]]);
-    // Device::drive_load: a dual drivetrain drives both sides through K1.
-    let load = [
-        forces[0] - c.k1 * q[0],
-        R::select(c.dual, forces[1] - c.k1 * q[1], -c.k2 * q[1]),
-    ];
+    let load = c.drive.load(forces, q);
     let drive_torque = mat2(&c.inverse_transpose, load);
     let mut reduced_mass = [[zero; N]; N];
     let mut reduced_force = [zero; N];

@@ -409,9 +409,10 @@ impl Device {
                     coefficient,
                 } => {
                     // τ = −Ω C |φ̇| φ̇ a (eq. 2.16).
-                    let k = -omega1 * coefficient;
-                    let m = k * phi_dot.abs() * phi_dot;
-                    [a * (2.0 * k * phi_dot.abs()), a1 * m, Vector3::zeros()]
+                    let drag = paritysim_aero::stroke_drag_constant(*omega1, *coefficient);
+                    let m = paritysim_aero::stroke_drag_torque(drag, phi_dot);
+                    let slope = paritysim_aero::stroke_drag_slope(drag, phi_dot);
+                    [a * slope, a1 * m, Vector3::zeros()]
                 }
                 WingAero::None => [Vector3::zeros(); 3],
             };
@@ -467,8 +468,6 @@ impl Device {
         Some(Ok(()))
     }
 }
-
-pub(crate) mod lanes;
 
 #[cfg(test)]
 mod tests;
