@@ -158,7 +158,7 @@ impl Limits {
             atol: options.atol * factor,
         };
         Self {
-            tol: crate::shooting::newton::newton_tolerance(options),
+            tol: crate::shooting::newton::newton_tolerance(options.steady_tol, options.rtol),
             accept_tol: options.steady_tol,
             newton: crate::integrate::lanes::LaneTolerances {
                 rtol: options.rtol,

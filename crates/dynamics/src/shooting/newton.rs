@@ -7,16 +7,15 @@ use nalgebra::{DMatrix, DVector};
 use paritysim_error::Error;
 
 use crate::integrate::State;
-use crate::simulate::SimulationOptions;
 
 /// Newton steps of a steady-state shooting pass (the limit every caller uses).
 pub(crate) const MAX_NEWTON: usize = 20;
 
-/// Newton's convergence tolerance for a run's `options`: the predicted error of the next
-/// iterate, relative to `1 + ‖y‖∞`. Below the integration's own accuracy (~rtol) a tighter
-/// orbit changes nothing.
-pub(crate) fn newton_tolerance(options: &SimulationOptions) -> f64 {
-    (1e-2 * options.steady_tol).min(0.1 * options.rtol)
+/// Newton's convergence tolerance for a run's `steady_tol` and `rtol`: the predicted error of
+/// the next iterate, relative to `1 + ‖y‖∞`. Below the integration's own accuracy (~rtol) a
+/// tighter orbit changes nothing.
+pub(crate) fn newton_tolerance(steady_tol: f64, rtol: f64) -> f64 {
+    (1e-2 * steady_tol).min(0.1 * rtol)
 }
 
 /// `(P(y) − y, ‖P(y) − y‖∞ / (1 + ‖y‖∞))`.

@@ -115,7 +115,7 @@ pub(crate) fn shooting_steady_state(
             }
         }
     }
-    let tol = newton_tolerance(options);
+    let tol = newton_tolerance(options.steady_tol, options.rtol);
     let n_samples = options.samples_per_cycle * orbit_cycles;
     let records = options.record_cycles == 1 && options.perturbation.is_none();
     let mut recorded = None;
