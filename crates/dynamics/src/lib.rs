@@ -21,6 +21,7 @@ pub mod device;
 pub mod integrate;
 pub mod lanes;
 pub mod metrics;
+pub mod sensitivity;
 mod shooting;
 pub mod simulate;
 pub mod stability;

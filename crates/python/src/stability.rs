@@ -36,6 +36,15 @@ bindings! {
     extra stability_region;
     extra stability_lti_transfer;
 
+    /// Derivatives of a JSON spec's steady-state metrics (`metrics`, or all) by the continuous
+    /// spec paths `params` (`paritysim_spec::sensitivity`), as plain columns.
+    #[pyo3(signature = (json, params, metrics = None))]
+    fn sensitivity(json: &str, params: Vec<String>, metrics: Option<Vec<String>>) {
+        let spec = crate::spec::parse(json)?;
+        paritysim_spec::sensitivity::sensitivity(&spec, &params, metrics.as_deref())
+            .map(|s| s.record())
+    }
+
     /// Monodromy matrix `M(t0)` of eq. 2.25 (`x'' + β0|cos t| x' + κ x = 0`, period π), 2×2.
     fn stability_hill_monodromy(beta0: f64, kappa: f64, t0: f64) {
         Ok(rows2(&floquet::hill_monodromy(beta0, kappa, t0)?))

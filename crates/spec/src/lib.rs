@@ -23,6 +23,7 @@ pub mod migrate;
 pub mod options;
 pub mod paths;
 pub mod schema;
+pub mod sensitivity;
 pub mod spec;
 pub mod sweep;
 pub mod watch;

@@ -51,6 +51,40 @@ pub fn orbit_metrics(
     Ok(metrics)
 }
 
+/// The metrics of the orbit's window recorded on the fixed step `grid` (over one or two
+/// periods, as the shooting's last period) from `y` at `grid[0]`, with `options`' metrics and
+/// `samples_per_cycle`: a smooth function of `y` and of the device (the sensitivities'
+/// central differences, [`crate::sensitivity`]).
+///
+/// # Errors
+/// Integration errors; a bad grid.
+pub(crate) fn grid_window(
+    device: &Device,
+    integrator: &RungeKutta,
+    grid: &[f64],
+    period: f64,
+    y: &State,
+    options: &SimulationOptions,
+) -> Result<Vec<(String, f64)>> {
+    let window = grid[grid.len() - 1] - grid[0];
+    let cycles = ((window / period).round() as usize).max(1);
+    let stroke = stroke_sampling(device, options.metrics.as_deref(), &[]);
+    let (_, metrics, _) = record_window(
+        device,
+        integrator,
+        grid[0],
+        &y.without_work(),
+        window,
+        options.samples_per_cycle * cycles,
+        Some(period),
+        None,
+        Vec::new(),
+        stroke,
+        Some(grid),
+    )?;
+    Ok(metrics)
+}
+
 /// How samples are taken (see [`SimulationOptions::metrics`]): `Some(needs)` for lean
 /// [`StrokeSample`]s (no column asked, drivetrain coordinates) or [`PlaneSample`]s (no column
 /// asked, the stroke-plane model), else `None` (full samples).

@@ -1,0 +1,279 @@
+//! Derivatives of steady-state metrics with respect to design parameters (issue 31).
+//!
+//! The steady state `x*` solves `P(x*, p) = x*`, `P` the period map on the section `t ≡ 0
+//! (mod T)`. The implicit function theorem gives `dx*/dp = −(∂P/∂x − I)⁺ ∂P/∂p`: `∂P/∂x` is
+//! the exact monodromy at the orbit (the variational equations on the shooting's step grid),
+//! `∂P/∂p` a central difference of the map on that same fixed grid (a smooth function of `p`:
+//! no step-size control to make it noisy; a frequency change scales the grid with the
+//! period). A metric's derivative is the central difference of the recorded window (on that
+//! grid) along the direction `(dx*/dp, 1)`: the orbit moves with the parameter, so no
+//! finite difference ever runs through the shooting's convergence. Directions with a
+//! multiplier at 1 (a neutral family, K2 = 0's whippletree) are left out of `(∂P/∂x − I)⁺`,
+//! not divided by; a metric that changes along them, or whose one-sided differences disagree
+//! (a peak jumping between two maxima), is flagged as not differentiable there.
+
+use nalgebra::{DMatrix, DVector};
+use paritysim_error::{Error, Result};
+
+use crate::device::Device;
+use crate::integrate::{RungeKutta, State};
+use crate::shooting::newton::NEUTRAL_SINGULAR_TOL;
+use crate::simulate::{SimulationOptions, SteadyState, simulate};
+
+/// One-sided differences of a metric that disagree by more than this (relative to the larger)
+/// mark a kink: a peak switching between two maxima, a clipped quantity.
+pub const KINK_TOLERANCE: f64 = 1e-2;
+
+/// A metric that changes along a neutral direction of the orbit by more than this (relative to
+/// its size, per unit of the neutral vector) depends on which member of the family is meant.
+pub const NEUTRAL_CHANGE_TOLERANCE: f64 = 1e-6;
+
+/// Relative finite-difference step of the parameters (absolute below a size of 1e-3).
+pub const PARAMETER_STEP: f64 = 1e-5;
+
+/// What [`steady_sensitivity`] computes.
+#[derive(Clone, Debug)]
+pub struct SteadySensitivity {
+    /// The metrics at the base point (name, value), in the window's order.
+    pub metrics: Vec<(String, f64)>,
+    /// `∂metric/∂parameter`: one row per metric, one column per parameter.
+    pub jacobian: DMatrix<f64>,
+    /// `dx*/dp`: the orbit's start state (coordinates, then rates) per parameter.
+    pub state_jacobian: DMatrix<f64>,
+    /// Floquet multipliers of the exact monodromy at the orbit, largest modulus first.
+    pub multipliers: Vec<nalgebra::Complex<f64>>,
+    /// How many directions were neutral (a multiplier at 1) and left out.
+    pub neutral_directions: usize,
+    /// Per metric: why its derivative is not to be trusted (`None`: differentiable).
+    pub not_differentiable: Vec<Option<String>>,
+    /// The period-map residual `‖P(x*) − x*‖∞ / (1 + ‖x*‖∞)` on the fixed grid.
+    pub residual: f64,
+}
+
+/// A perturbed device with its period and the base grid scaled to it.
+struct Point {
+    device: Device,
+    grid: Vec<f64>,
+    period: f64,
+}
+
+/// Derivatives of the steady-state metrics of `device_at(p0)` with respect to `p` (see the
+/// module). `steps[j]`: the finite-difference step of parameter `j` (`None`:
+/// [`PARAMETER_STEP`] × max(|p0[j]|, 1e-3)).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for a non-finite or non-positive step; those of `device_at`
+/// and [`simulate`]; [`Error::Integration`] when the base point does not converge to a
+/// periodic orbit or a perturbed period fails.
+pub fn steady_sensitivity(
+    device_at: &(dyn Fn(&[f64]) -> Result<Device> + Sync),
+    p0: &[f64],
+    steps: Option<&[f64]>,
+    options: &SimulationOptions,
+) -> Result<SteadySensitivity> {
+    let steps: Vec<f64> = match steps {
+        Some(s) => s.to_vec(),
+        None => p0
+            .iter()
+            .map(|p| PARAMETER_STEP * p.abs().max(1e-3))
+            .collect(),
+    };
+    if steps.len() != p0.len() {
+        return Err(Error::invalid(
+            "steps",
+            steps.len().to_string(),
+            format!("one step per parameter ({})", p0.len()),
+        ));
+    }
+    if let Some(bad) = steps.iter().find(|h| !(h.is_finite() && **h > 0.0)) {
+        return Err(Error::invalid(
+            "steps",
+            bad.to_string(),
+            "finite positive steps",
+        ));
+    }
+    let device = device_at(p0)?;
+    let mut run_options = options.clone();
+    run_options.record_cycles = 1;
+    run_options.columns = Some(Vec::new());
+    if run_options.steady_state == SteadyState::Transient {
+        run_options.steady_state = SteadyState::Shooting;
+    }
+    let run = simulate(&device, &run_options)?;
+    if !run.converged {
+        return Err(Error::Integration {
+            time: run.cycles_run as f64 * run.period_ms,
+            state: run.steady_state.to_vec(),
+            reason: format!(
+                "no steady state to differentiate: the run ended unconverged (residual {:e})",
+                run.residual
+            ),
+        });
+    }
+    let n = device.n_dof();
+    let map_cycles = run.orbit_cycles as f64;
+    let rk = RungeKutta::new(
+        options.method,
+        options.rtol,
+        options.atol,
+        options.max_steps,
+    )?;
+    let x_star = run.steady_state.without_work();
+    let grid = if run.step_grid.len() >= 2 {
+        run.step_grid.clone()
+    } else {
+        // A transient steady state: one adaptive period picks the grid.
+        let (_, steps) = rk.with_work(false).advance_with_steps(
+            &device,
+            0.0,
+            &x_star,
+            run.period_ms * map_cycles,
+        )?;
+        steps
+    };
+    let period = run.period_ms;
+    let (mapped, monodromy) = rk
+        .with_work(false)
+        .flow_with_sensitivity_on_grid(&device, &grid, &x_star)?;
+    let residual = crate::shooting::newton::residual(n, &x_star, &mapped.without_work()).1;
+    let multipliers = crate::stability::eigenvalues(&monodromy).unwrap_or_default();
+    let a = monodromy - DMatrix::identity(2 * n, 2 * n);
+    let svd = a.clone().svd(true, true);
+    let cutoff = NEUTRAL_SINGULAR_TOL * svd.singular_values.max().max(f64::MIN_POSITIVE);
+    let neutral: Vec<DVector<f64>> = match &svd.v_t {
+        Some(v_t) => (0..svd.singular_values.len())
+            .filter(|&i| svd.singular_values[i] <= cutoff)
+            .map(|i| v_t.row(i).transpose())
+            .collect(),
+        None => Vec::new(),
+    };
+    let window = |point: &Point, y: &State| -> Result<Vec<(String, f64)>> {
+        crate::simulate::grid_window(&point.device, &rk, &point.grid, point.period, y, options)
+    };
+    let base_metrics = crate::simulate::grid_window(&device, &rk, &grid, period, &x_star, options)?;
+    let n_params = p0.len();
+    let base_map = mapped.without_work().compact(n);
+    // Per parameter: dx*/dp_j, and the metrics along (dx*/dp_j, 1): central differences at
+    // p0 ± h, or the second-order one-sided formula at p0 + h, p0 + 2h where p0 − h is outside
+    // the parameter's range (K2 = 0).
+    let columns = crate::stability::rows::run_parts(n_params, |j| {
+        let h = steps[j];
+        let at = |offset: f64| -> Result<Option<Point>> {
+            let mut p = p0.to_vec();
+            p[j] += offset * h;
+            let device = match device_at(&p) {
+                Ok(d) => d,
+                Err(Error::InvalidParameter { .. }) if offset < 0.0 => return Ok(None),
+                Err(e) => return Err(e),
+            };
+            let shifted = device.period().unwrap_or(period);
+            Ok(Some(Point {
+                grid: grid.iter().map(|t| t * (shifted / period)).collect(),
+                device,
+                period: shifted,
+            }))
+        };
+        let (near, far, central) = match at(-1.0)? {
+            Some(minus) => (minus, at(1.0)?.expect("a forward step"), true),
+            None => (
+                at(1.0)?.expect("a forward step"),
+                at(2.0)?.expect("a forward step"),
+                false,
+            ),
+        };
+        let map = |point: &Point, y: &State| -> Result<DVector<f64>> {
+            let end = rk.with_work(false).integrate_on_grid(
+                &point.device,
+                &point.grid,
+                y,
+                &[],
+                &mut |_, _, _| Ok(()),
+            )?;
+            Ok(end.without_work().compact(n))
+        };
+        // (f(near), f(far)) -> df/dp: central (p0 - h, p0 + h) or one-sided (p0 + h, p0 + 2h).
+        let derivative = |f0: f64, f_near: f64, f_far: f64| {
+            if central {
+                (f_far - f_near) / (2.0 * h)
+            } else {
+                (-3.0 * f0 + 4.0 * f_near - f_far) / (2.0 * h)
+            }
+        };
+        let (p_near, p_far) = (map(&near, &x_star)?, map(&far, &x_star)?);
+        let dp = DVector::from_fn(2 * n, |i, _| derivative(base_map[i], p_near[i], p_far[i]));
+        let dx = crate::shooting::newton::least_squares_step(a.clone(), &dp).ok_or_else(|| {
+            Error::Singular("the orbit's sensitivity: non-finite monodromy".into())
+        })?;
+        let (o_near, o_far) = if central { (-1.0, 1.0) } else { (1.0, 2.0) };
+        let moved = |offset: f64| State::from_compact(n, &(x_star.compact(n) + &dx * (offset * h)));
+        let m_near = window(&near, &moved(o_near))?;
+        let m_far = window(&far, &moved(o_far))?;
+        Ok((dx, m_near, m_far, central))
+    })?;
+    let n_metrics = base_metrics.len();
+    let mut jacobian = DMatrix::zeros(n_metrics, n_params);
+    let mut state_jacobian = DMatrix::zeros(2 * n, n_params);
+    let mut not_differentiable: Vec<Option<String>> = base_metrics
+        .iter()
+        .map(|(_, m)| (!m.is_finite()).then(|| "not defined at this point (NaN)".to_string()))
+        .collect();
+    for (j, (dx, m_near, m_far, central)) in columns.iter().enumerate() {
+        state_jacobian.set_column(j, dx);
+        let h = steps[j];
+        for (i, (name, m0)) in base_metrics.iter().enumerate() {
+            let (near, far) = (value_of(m_near, name), value_of(m_far, name));
+            if !*central {
+                jacobian[(i, j)] = (-3.0 * m0 + 4.0 * near - far) / (2.0 * h);
+                continue;
+            }
+            jacobian[(i, j)] = (far - near) / (2.0 * h);
+            let (right, left) = ((far - m0) / h, (m0 - near) / h);
+            let scale = right.abs().max(left.abs());
+            if not_differentiable[i].is_none()
+                && (right - left).abs() > KINK_TOLERANCE * scale + 1e-9 * (1.0 + m0.abs()) / h
+            {
+                not_differentiable[i] = Some(format!(
+                    "one-sided differences disagree along parameter {j} ({left:e} and \
+                     {right:e}): a kink (a peak between two maxima, a clipped value)"
+                ));
+            }
+        }
+    }
+    // A metric that moves along a neutral direction depends on the member of the family.
+    for v in &neutral {
+        let eps = 1e-6;
+        let along = |sign: f64| State::from_compact(n, &(x_star.compact(n) + v * (sign * eps)));
+        let base =
+            |y: &State| crate::simulate::grid_window(&device, &rk, &grid, period, y, options);
+        let (mp, mm) = (base(&along(1.0))?, base(&along(-1.0))?);
+        for (i, (name, m0)) in base_metrics.iter().enumerate() {
+            let slope = (value_of(&mp, name) - value_of(&mm, name)) / (2.0 * eps);
+            if not_differentiable[i].is_none()
+                && slope.abs() > NEUTRAL_CHANGE_TOLERANCE.max(1e-4 * m0.abs())
+            {
+                not_differentiable[i] = Some(format!(
+                    "changes along a neutral direction of the orbit (slope {slope:e}): a \
+                     family of orbits (a multiplier at 1), so the derivative depends on the \
+                     member"
+                ));
+            }
+        }
+    }
+    Ok(SteadySensitivity {
+        metrics: base_metrics,
+        jacobian,
+        state_jacobian,
+        multipliers,
+        neutral_directions: neutral.len(),
+        not_differentiable,
+        residual,
+    })
+}
+
+/// The value of metric `name` (NaN when absent).
+fn value_of(metrics: &[(String, f64)], name: &str) -> f64 {
+    metrics
+        .iter()
+        .find(|(m, _)| m == name)
+        .map_or(f64::NAN, |(_, v)| *v)
+}

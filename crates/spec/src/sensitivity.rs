@@ -1,0 +1,169 @@
+//! Steady-state sensitivities with the parameters named by spec paths (`ps.sensitivity`):
+//! the paths resolved and checked once here, the derivatives from
+//! [`paritysim_dynamics::sensitivity`].
+
+use paritysim_dynamics::sensitivity::{SteadySensitivity, steady_sensitivity};
+use paritysim_error::{Error, Result};
+use serde_json::Value;
+
+use crate::paths::{Parameter, apply, resolve_in, spec_paths};
+use crate::spec::Simulation;
+
+/// What [`sensitivity`] returns: the resolved parameters with their units and base values,
+/// and the derivatives.
+#[derive(Clone, Debug)]
+pub struct Sensitivity {
+    /// The parameters as resolved (canonical targets), in the caller's order.
+    pub parameters: Vec<Parameter>,
+    /// Each parameter's unit (`1` for dimensionless).
+    pub units: Vec<String>,
+    /// Each parameter's value in the spec.
+    pub values: Vec<f64>,
+    /// The derivatives (metric × parameter) and the orbit's multipliers.
+    pub result: SteadySensitivity,
+}
+
+/// Derivatives of `spec`'s steady-state metrics (`metrics`, or all) with respect to the
+/// continuous fields `params` (any spelling `ps.spec_paths` lists, `wings[*].…` included).
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming a path that is unknown (with the nearest ones), not a
+/// continuous number (a name, a kind, a count, a flag), or whose `wings[*]` targets differ;
+/// a flying spec (`body.mode` other than fixed); those of
+/// [`steady_sensitivity`].
+pub fn sensitivity(
+    spec: &Simulation,
+    params: &[String],
+    metrics: Option<&[String]>,
+) -> Result<Sensitivity> {
+    if params.is_empty() {
+        return Err(Error::invalid(
+            "params",
+            "[]",
+            "at least one continuous spec path (see ps.spec_paths)",
+        ));
+    }
+    let (device, options) = spec.model()?;
+    if spec.flight(&device)?.is_some() {
+        return Err(Error::invalid(
+            "body.mode",
+            "a moving body",
+            "a fixed body: sensitivities are of the fixed-body steady state",
+        ));
+    }
+    let options = spec.with_outputs(&device, &options, Some(&[]), metrics)?;
+    let listed = spec_paths(spec);
+    let mut parameters = Vec::new();
+    let mut units = Vec::new();
+    let mut values = Vec::new();
+    for name in params {
+        let param = resolve_in(spec, &listed, name)?;
+        let mut base = None;
+        for (path, scale) in &param.targets {
+            let info = listed
+                .iter()
+                .find(|i| &i.path == path)
+                .expect("a resolved path is listed");
+            let Some(x) = info.value.as_f64().filter(|_| continuous(&info.value)) else {
+                return Err(Error::invalid(
+                    name.clone(),
+                    info.value.to_string(),
+                    format!(
+                        "a continuous number to differentiate by ({}: {} is discrete or not a number)",
+                        path, info.allowed
+                    ),
+                ));
+            };
+            let x = scale.map_or(x, |s| x / s);
+            match base {
+                None => {
+                    base = Some(x);
+                    units.push(info.unit.clone());
+                }
+                Some(b) if b != x => {
+                    return Err(Error::invalid(
+                        name.clone(),
+                        format!("{b} and {x}"),
+                        "one value on every wing: name each wing's path to differentiate by it",
+                    ));
+                }
+                Some(_) => {}
+            }
+        }
+        values.push(base.expect("a resolved parameter has a target"));
+        parameters.push(param);
+    }
+    let device_at = |p: &[f64]| -> Result<paritysim_dynamics::Device> {
+        let numbers: Vec<Value> = p.iter().map(|&x| Value::from(x)).collect();
+        let pairs: Vec<(&Parameter, &Value)> = parameters.iter().zip(&numbers).collect();
+        apply(spec, &pairs)?.device()
+    };
+    let result = steady_sensitivity(&device_at, &values, None, &options)?;
+    Ok(Sensitivity {
+        parameters,
+        units,
+        values,
+        result,
+    })
+}
+
+/// [`Sensitivity`] as plain columns for the bindings (`ps.sensitivity`'s table).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SensitivityRecord {
+    /// Metric names, in the window's order.
+    pub metric: Vec<String>,
+    /// The metrics at the spec's point.
+    pub value: Vec<f64>,
+    /// Per metric: why its derivatives are not to be trusted (empty: differentiable).
+    pub not_differentiable: Vec<String>,
+    /// Parameter names as the caller gave them.
+    pub parameter: Vec<String>,
+    /// Their units.
+    pub unit: Vec<String>,
+    /// Their values in the spec.
+    pub parameter_value: Vec<f64>,
+    /// `∂metric/∂parameter`: one column (over the metrics) per parameter.
+    pub jacobian: Vec<Vec<f64>>,
+    /// `dx*/dp`: the orbit's start state (coordinates, then rates), one column per parameter.
+    pub state_jacobian: Vec<Vec<f64>>,
+    /// Floquet multipliers of the exact monodromy, largest modulus first, as `[re, im]`.
+    pub multipliers: Vec<[f64; 2]>,
+    /// Neutral directions (multiplier 1) left out of the orbit's derivative.
+    pub neutral_directions: usize,
+    /// The orbit's period-map residual on its grid.
+    pub residual: f64,
+}
+
+impl Sensitivity {
+    /// The plain-column form.
+    pub fn record(&self) -> SensitivityRecord {
+        let r = &self.result;
+        let columns = |m: &nalgebra::DMatrix<f64>| {
+            m.column_iter()
+                .map(|c| c.iter().copied().collect())
+                .collect()
+        };
+        SensitivityRecord {
+            metric: r.metrics.iter().map(|(m, _)| m.clone()).collect(),
+            value: r.metrics.iter().map(|(_, v)| *v).collect(),
+            not_differentiable: r
+                .not_differentiable
+                .iter()
+                .map(|f| f.clone().unwrap_or_default())
+                .collect(),
+            parameter: self.parameters.iter().map(|p| p.name.clone()).collect(),
+            unit: self.units.clone(),
+            parameter_value: self.values.clone(),
+            jacobian: columns(&r.jacobian),
+            state_jacobian: columns(&r.state_jacobian),
+            multipliers: r.multipliers.iter().map(|z| [z.re, z.im]).collect(),
+            neutral_directions: r.neutral_directions,
+            residual: r.residual,
+        }
+    }
+}
+
+/// A JSON number that is a float field (integers are counts and indices: discrete).
+fn continuous(value: &Value) -> bool {
+    value.is_f64()
+}
