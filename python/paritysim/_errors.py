@@ -68,6 +68,31 @@ def finite_reals(field: str, value: Any) -> Any:
     return a
 
 
+def read_toml(field: str, path: Any, what: str) -> dict[str, Any]:
+    """The table of the TOML file ``path`` (``what`` it should hold, e.g. ``"a sweep study"``),
+    or an ``InvalidParameterError`` naming ``field``, the path and what was expected: a missing
+    file, a directory, an unreadable file, bytes that are not UTF-8, malformed TOML."""
+    import os
+    import tomllib
+    from pathlib import Path
+
+    if isinstance(path, bytes) or not isinstance(path, str | os.PathLike):
+        raise invalid(field, repr(path)[:60], f"the path of {what} (a UTF-8 TOML file)")
+    file = Path(path)
+    try:
+        raw = file.read_bytes()
+    except OSError as exc:
+        raise invalid(field, str(file), f"a readable file holding {what} ({exc.strerror or exc})") from exc
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise invalid(field, str(file), f"a UTF-8 text file holding {what} ({exc.reason} at byte {exc.start})") from exc
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise invalid(field, str(file), f"{what} in valid TOML ({exc})") from exc
+
+
 #: Environment variable bounding the bytes one call may allocate (see `memory_limit`).
 MAX_BYTES_ENV = "PARITYSIM_MAX_BYTES"
 

@@ -28,7 +28,6 @@ import argparse
 import shutil
 import sys
 import time
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -37,7 +36,7 @@ import numpy as np
 import polars as pl
 
 from . import _core
-from ._errors import invalid
+from ._errors import invalid, read_toml
 from .spec import Simulation, load_spec
 
 __all__ = ["Study", "add_parser", "load_study", "run_study"]
@@ -79,9 +78,8 @@ def _axis(name: str, value: Any) -> list[Any]:
 
 def load_study(path: str | Path) -> Study:
     """Parses a study TOML (see the module docstring)."""
+    data = read_toml("study", path, "a sweep study")
     path = Path(path)
-    with open(path, "rb") as f:
-        data = tomllib.load(f)
     unknown = sorted(set(data) - set(_KEYS))
     if unknown:
         raise invalid(unknown[0], "<unknown key>", _core.spec_suggestion(unknown[0], list(_KEYS)))
