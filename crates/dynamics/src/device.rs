@@ -20,14 +20,15 @@ mod drive;
 pub(crate) use drive::DriveSprings;
 mod drivetrain_coordinates;
 mod drivetrain_inverse;
+mod form;
 mod free_deviation;
-pub(crate) mod linear_map_jacobian;
+pub(crate) mod linear_map;
 mod null_space;
 mod ode_system;
 mod stroke_plane;
 mod switches;
 
-use drivetrain_coordinates::{StrokeOnly, stroke_only, stroke_torque};
+use drivetrain_coordinates::{stroke_only, stroke_torque};
 use drivetrain_inverse::{
     NEWTON_MAX, NEWTON_TOL, check_plausible, invert_1dof, invert_2dof, singular_drive,
     unreachable_stroke,
@@ -129,7 +130,8 @@ pub struct Device {
     offset: Vec6,
     n_dof: usize,
     formulation: Formulation,
-    stroke_only: Option<StrokeOnly>,
+    /// The equations it integrates, chosen once ([`form::Form::choose`]).
+    form: form::Form,
     /// Wings whose deviation C holds at zero on an α2 = 90° shoulder: their terms are closed form
     /// ([`Wing::stroke_plane_terms`]).
     stroke_plane: [bool; 2],
@@ -139,14 +141,6 @@ pub struct Device {
     /// The constant Jacobian of a 2-DOF linear-map drivetrain (eq. 2.15): its inverse
     /// kinematics need no drivetrain evaluations.
     linear_jacobian: Option<Matrix2<f64>>,
-    /// The lean right-hand side of a stroke-plane device (§3.4), when it applies.
-    stroke_plane_rhs: Option<stroke_plane::StrokePlane>,
-    /// The lean right-hand side of a free-deviation device (§2.5 Lift / Dual PARITY), when it
-    /// applies.
-    free_deviation_rhs: Option<free_deviation::FreeDeviation>,
-    /// The free-deviation equations on a held branch written over `Real` (four coordinates,
-    /// blade elements on both wings): the scalar and SIMD-lane path's common code.
-    free_deviation_held: Option<free_deviation::HeldConstants>,
     /// The drive's springs (`K1`, `K2`, dual or not): the one drive load.
     drive: drive::DriveSprings<f64>,
     /// Switching functions of the right-hand side (three per wing with blade elements whose
@@ -252,11 +246,9 @@ impl Device {
             }
             (f, _) => f,
         };
-        let stroke_only = if formulation == Formulation::DrivetrainCoordinates {
-            fast.ok()
-        } else {
-            None
-        };
+        let stroke_only = fast
+            .ok()
+            .filter(|_| formulation == Formulation::DrivetrainCoordinates);
         let (basis, offset, n_dof) = match formulation {
             Formulation::NullSpace | Formulation::Auto | Formulation::DrivetrainCoordinates => (
                 *spec.constraints.null_basis(),
@@ -296,22 +288,17 @@ impl Device {
             offset,
             n_dof,
             formulation,
-            stroke_only,
+            form: form::Form::General(form::General),
             stroke_plane,
             free_deviation,
             linear_jacobian,
-            stroke_plane_rhs: None,
-            free_deviation_rhs: None,
-            free_deviation_held: None,
             drive: drive::DriveSprings::single(0.0, 0.0),
             n_switches: 0,
         };
         // A dual drivetrain drives both sides through the actuator, when there is one.
         let dual = device.spec.actuator.is_some() && device.is_dual();
         device.drive = drive::DriveSprings::of(&device.spec, dual);
-        device.stroke_plane_rhs = stroke_plane::StrokePlane::of(&device);
-        device.free_deviation_rhs = free_deviation::FreeDeviation::of(&device);
-        device.free_deviation_held = free_deviation::HeldConstants::of(&device);
+        device.form = form::Form::choose(&device, stroke_only);
         device.n_switches = device.blade_switches();
         Ok(device)
     }
@@ -352,7 +339,7 @@ impl Device {
     /// With drivetrain coordinates, [`Error::OutOfDomain`] when `q` is beyond the linkage's reach.
     #[inline]
     pub fn coordinates(&self, y: &State) -> Result<(Vec6, Vec6)> {
-        if self.stroke_only.is_some() {
+        if self.form.stroke_only().is_some() {
             let (q, q_dot) = self.drive_coordinates(y);
             let e = self.drivetrain().evaluate(q.x, q.y)?;
             let phi_dot = e.jacobian * q_dot;
@@ -392,7 +379,7 @@ impl Device {
     /// `(φ, φ̇, q2)`: stroke angles, stroke rates and `q2` of a drivetrain-coordinate state
     /// (the forward map only); `None` for other formulations.
     pub fn stroke_state(&self, y: &State) -> Option<Result<StrokeState>> {
-        self.stroke_only.as_ref()?;
+        self.form.stroke_only()?;
         Some(self.stroke_state_unchecked(y))
     }
 
@@ -414,14 +401,15 @@ impl Device {
     #[inline]
     pub(crate) fn stroke_motion_unchecked(&self, t: f64, y: &State) -> Result<StrokeMotion> {
         let fast = self
-            .stroke_only
-            .as_ref()
+            .form
+            .stroke_only()
             .expect("only called for drivetrain-coordinate devices");
-        if let Some(map) = &fast.linear {
+        if let Some(terms) = &fast.linear {
             // φ̈ = J q̈: the linear map has no velocity product.
-            let (q_dot, q_ddot, force, _) = self.linear_map_step(map, t, y)?;
+            let (q_dot, q_ddot, force, _) = self.linear_map_step(terms, t, y)?;
             let (q, _) = self.drive_coordinates(y);
-            let j = &map.jacobian;
+            let [j00, j01, j10, j11] = terms.jacobian;
+            let j = Matrix2::new(j00, j01, j10, j11);
             return Ok(StrokeMotion {
                 stroke: j * q,
                 rate: j * q_dot,
@@ -455,7 +443,7 @@ impl Device {
     /// Whether the device has the closed-form stroke-plane model (§3.4 rotating wings:
     /// `device/stroke_plane/`), whose lean samples are [`crate::trajectory::PlaneSample`]s.
     pub fn has_stroke_plane_model(&self) -> bool {
-        self.stroke_plane_rhs.is_some()
+        self.form.stroke_plane().is_some()
     }
 
     /// Whether the device has the closed-form free-deviation model (§2.5 Lift / Dual PARITY:
@@ -463,7 +451,7 @@ impl Device {
     /// the Lift PARITY is bistable near 96 V), so a sweep does not continue their points from a
     /// neighbour's orbit ([`crate::sweep::run_points`]).
     pub fn has_free_deviation_model(&self) -> bool {
-        self.free_deviation_rhs.is_some()
+        self.form.free_deviation().is_some()
     }
 
     /// The drive forces [`Self::drive_load`] applies at `t`: the actuator's and 0, or a dual
@@ -512,7 +500,7 @@ impl Device {
         paritysim_error::check_all_finite("initial.p", p.as_slice())?;
         paritysim_error::check_all_finite("initial.p_dot", p_dot.as_slice())?;
         self.spec.constraints.check_consistent(p, p_dot, 1e-10)?;
-        if self.stroke_only.is_some() {
+        if self.form.stroke_only().is_some() {
             let drive = self.drive(0.0, p, p_dot)?;
             let mut y = State::default();
             for i in 0..self.n_dof {
@@ -611,23 +599,16 @@ impl Device {
 
     /// The right-hand side `ẏ = f(t, y)`; also integrates the actuator work and the
     /// aerodynamic work into the last two state entries.
+    #[inline]
     pub fn rhs(&self, t: f64, y: &State, dydt: &mut State) -> Result<()> {
-        if let Some(fast) = &self.stroke_only {
-            return self.rhs_drivetrain(fast, t, y, dydt);
-        }
-        if let Some(lean) = &self.stroke_plane_rhs {
-            return self.rhs_stroke_plane(lean, t, y, None, dydt);
-        }
-        if let Some(lean) = &self.free_deviation_rhs {
-            return self.rhs_free_deviation(lean, t, y, None, dydt);
-        }
-        self.rhs_null_space(t, y, dydt)
+        use form::Equations;
+        self.form.rhs(self, t, y, None, dydt)
     }
 
     /// Full evaluation from an integrator state. Drivetrain-coordinate devices use the forward
     /// map and their own equations (no inverse kinematics); others go through [`Self::evaluate`].
     pub fn evaluate_state(&self, t: f64, y: &State) -> Result<Evaluation> {
-        let Some(fast) = &self.stroke_only else {
+        let Some(fast) = self.form.stroke_only() else {
             let (p, p_dot) = self.coordinates(y)?;
             return self.evaluate(t, &p, &p_dot);
         };

@@ -40,6 +40,8 @@ pub trait Real:
     fn splat(x: f64) -> Self;
     /// `|self|`.
     fn abs(self) -> Self;
+    /// The larger of `self` and `other` (the other one where one is NaN, as `f64::max`).
+    fn max(self, other: Self) -> Self;
     /// The correctly rounded square root.
     fn sqrt(self) -> Self;
     /// `self < other`, lane by lane (false for NaN).
@@ -105,6 +107,10 @@ impl Real for f64 {
     #[inline(always)]
     fn abs(self) -> Self {
         f64::abs(self)
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        f64::max(self, other)
     }
     #[inline(always)]
     fn round_ties_even(self) -> Self {
@@ -180,6 +186,10 @@ impl Real for f64x4 {
     #[inline(always)]
     fn abs(self) -> Self {
         f64x4::abs(self)
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        f64x4::max(self, other)
     }
     #[inline(always)]
     fn round_ties_even(self) -> Self {

@@ -3,55 +3,23 @@
 //! kinematics or shoulder evaluations.
 
 use nalgebra::{Matrix2, Vector2};
+use paritysim_aero::Branch;
 use paritysim_error::Result;
-use paritysim_kinematics::Drivetrain;
 
 use super::drivetrain_inverse::singular_drive;
-use super::linear_map_jacobian::LinearMapTerms;
+use super::form::Equations;
+use super::linear_map::{self, LinearMapTerms};
 use super::{Device, DeviceSpec};
 use crate::integrate::State;
 
 /// Inertias about the stroke axis of a stroke-only device (see
 /// [`Formulation::DrivetrainCoordinates`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct StrokeOnly {
+pub(crate) struct StrokeOnly {
     pub(super) stroke_inertia: [f64; 2],
-    /// The linear map's constants (None for the linkages).
-    pub(super) linear: Option<ConstantMap>,
-    /// The linear map's analytic Jacobian constants (None where it does not apply).
-    pub(super) jacobian: Option<LinearMapTerms<f64>>,
-}
-
-/// A drivetrain with a constant Jacobian (the linear map, eq. 2.15): `φ = J q`, `h = 0` and a
-/// constant `M_q = Σ_k I_k J_kᵀ J_k`, precomputed with the operations of the general
-/// drivetrain step (so the lean right-hand side gives its numbers).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct ConstantMap {
-    pub(super) jacobian: Matrix2<f64>,
-    /// `M_q` entries `(m00, m01, m11)` and `det M_q`.
-    pub(super) mass: (f64, f64, f64),
-    pub(super) det: f64,
-}
-
-impl ConstantMap {
-    fn of(kinematics: &Drivetrain, stroke_inertia: [f64; 2]) -> Option<Self> {
-        let Drivetrain::LinearDifferential(map) = kinematics else {
-            return None;
-        };
-        let j = map.evaluate(0.0, 0.0).jacobian;
-        let (mut m00, mut m01, mut m11) = (0.0, 0.0, 0.0);
-        for (k, inertia) in stroke_inertia.iter().enumerate() {
-            let (a, b) = (j[(k, 0)], j[(k, 1)]);
-            m00 += inertia * a * a;
-            m01 += inertia * a * b;
-            m11 += inertia * b * b;
-        }
-        Some(Self {
-            jacobian: j,
-            mass: (m00, m01, m11),
-            det: m00 * m11 - m01 * m01,
-        })
-    }
+    /// The linear map's constants (None for the linkages): its equations are
+    /// [`linear_map::accelerations`], with no drivetrain evaluation.
+    pub(super) linear: Option<LinearMapTerms<f64>>,
 }
 
 /// Why a device cannot use drivetrain coordinates (None when it can).
@@ -95,8 +63,7 @@ pub(super) fn stroke_only(spec: &DeviceSpec) -> std::result::Result<StrokeOnly, 
     }
     Ok(StrokeOnly {
         stroke_inertia,
-        linear: ConstantMap::of(&tr.kinematics, stroke_inertia),
-        jacobian: LinearMapTerms::of(spec),
+        linear: LinearMapTerms::of(spec),
     })
 }
 
@@ -211,14 +178,13 @@ impl Device {
         Ok(())
     }
 
-    /// [`Self::drivetrain_step`] for the linear map (eq. 2.15) in scalars: `φ = J q`,
-    /// `φ̇ = J q̇`, no velocity product, the constant `M_q` solved by Cramer's rule. The same
-    /// operations in the same order as the general step, without its linkage evaluation,
-    /// Hessians and mass assembly: `(q̇, q̈, F, aerodynamic power)`.
+    /// [`Self::drivetrain_step`] for the linear map (eq. 2.15): `φ = J q`, `φ̇ = J q̇`, no
+    /// velocity product, the constant `M_q` ([`linear_map::accelerations`], the lanes' code):
+    /// `(q̇, q̈, F, aerodynamic power)`.
     #[inline(always)]
     pub(super) fn linear_map_step(
         &self,
-        map: &ConstantMap,
+        terms: &LinearMapTerms<f64>,
         t: f64,
         y: &State,
     ) -> Result<(Vector2<f64>, Vector2<f64>, f64, f64)> {
@@ -229,31 +195,46 @@ impl Device {
             // The drivetrain names the implausible coordinate.
             self.drivetrain().evaluate(q.x, q.y)?;
         }
-        let j = &map.jacobian;
-        let (force, load, _) = self.drive_load(t, &q);
-        let (mut g0, mut g1) = (load.x, load.y);
-        let mut aero_power = 0.0;
-        for k in 0..2 {
-            let wing = &self.spec.wings[k];
-            let (a, b) = (j[(k, 0)], j[(k, 1)]);
-            let phi = a * q.x + b * q.y;
-            let phi_dot = a * q_dot.x + b * q_dot.y;
-            let tau_aero = wing.aero().stroke_torque(phi_dot);
-            let tau = tau_aero - wing.springs()[0].torque(phi);
-            g0 += a * tau;
-            g1 += b * tau;
-            aero_power += tau_aero * phi_dot;
+        if terms.det == 0.0 || !terms.det.is_finite() {
+            return Err(singular_drive(&q));
         }
-        let (m00, m01, m11) = map.mass;
-        let q_ddot = if self.n_dof == 2 {
-            let det = map.det;
-            if det == 0.0 || !det.is_finite() {
-                return Err(singular_drive(&q));
-            }
-            Vector2::new((m11 * g0 - m01 * g1) / det, (m00 * g1 - m01 * g0) / det)
-        } else {
-            Vector2::new(g0 / m00, 0.0)
-        };
-        Ok((q_dot, q_ddot, force, aero_power))
+        let force = self.drive_forces(t)[0];
+        let y = [q.x, q.y, q_dot.x, q_dot.y];
+        let wings = &self.spec.wings;
+        let (q_ddot, aero_power) = linear_map::accelerations(terms, force, &y, |k, rate| {
+            wings[k].aero().stroke_torque(rate)
+        });
+        Ok((q_dot, q_ddot.into(), force, aero_power))
+    }
+}
+
+impl Equations for StrokeOnly {
+    #[inline(always)]
+    fn rhs(
+        &self,
+        device: &Device,
+        t: f64,
+        y: &State,
+        _branches: Option<[Branch; 2]>,
+        dydt: &mut State,
+    ) -> Result<()> {
+        device.rhs_drivetrain(self, t, y, dydt)
+    }
+
+    fn variational(
+        &self,
+        _device: &Device,
+        _t: f64,
+        y: &State,
+        _branches: Option<[Branch; 2]>,
+        n: usize,
+        rhs: Option<&mut [f64]>,
+        phi: &[f64],
+        dphi: &mut [f64],
+    ) -> Option<Result<()>> {
+        let terms = (self.linear.as_ref()).filter(|t| t.analytic && n == 2 && rhs.is_none())?;
+        let y = [y.coords[0], y.coords[1], y.rates[0], y.rates[1]];
+        linear_map::variational(terms, &y, phi, dphi);
+        Some(Ok(()))
     }
 }

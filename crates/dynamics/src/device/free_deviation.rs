@@ -16,6 +16,7 @@ use nalgebra::{Matrix2, SMatrix, SVector, Vector2, Vector3};
 use paritysim_aero::Branch;
 use paritysim_error::{Error, Result};
 
+use super::form::Equations;
 use super::{Device, Formulation};
 use crate::integrate::State;
 
@@ -33,8 +34,8 @@ pub(crate) struct Held<const N: usize> {
 }
 
 impl<const N: usize> Held<N> {
-    fn of(device: &Device) -> Option<Self> {
-        let constants = generic::Constants::of(device)?;
+    fn of(device: &Device, lean: &FreeDeviation) -> Option<Self> {
+        let constants = generic::Constants::of(device, lean)?;
         Some(Self {
             constants,
             splat: generic::Constants::lanes([&constants; 4]),
@@ -60,21 +61,23 @@ impl PartialEq for HeldConstants {
 impl HeldConstants {
     /// Those of `device`, or `None` unless it has the lean free-deviation model on four or
     /// five coordinates with blade elements on both wings.
-    pub(super) fn of(device: &Device) -> Option<Self> {
+    fn of(device: &Device, lean: &FreeDeviation) -> Option<Self> {
         match device.n_dof {
-            4 => Held::of(device).map(|h| Self::Four(Box::new(h))),
-            5 => Held::of(device).map(|h| Self::Five(Box::new(h))),
+            4 => Held::of(device, lean).map(|h| Self::Four(Box::new(h))),
+            5 => Held::of(device, lean).map(|h| Self::Five(Box::new(h))),
             _ => None,
         }
     }
 }
 
 /// The constants of [`Device::rhs_free_deviation`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct FreeDeviation {
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct FreeDeviation {
     /// `J⁻¹` and `J⁻ᵀ` of the linear map.
-    inverse: Matrix2<f64>,
-    inverse_transpose: Matrix2<f64>,
+    pub(crate) inverse: Matrix2<f64>,
+    pub(crate) inverse_transpose: Matrix2<f64>,
+    /// The held-branch equations over `Real` ([`generic::step`]), where they apply.
+    held: Option<HeldConstants>,
 }
 
 impl FreeDeviation {
@@ -83,14 +86,16 @@ impl FreeDeviation {
     pub(super) fn of(device: &Device) -> Option<Self> {
         let applies = device.formulation == Formulation::NullSpace
             && device.n_wings() == 2
-            && device.free_deviation == [true, true]
-            && device.stroke_only.is_none();
+            && device.free_deviation == [true, true];
         let jacobian = device.linear_jacobian.filter(|_| applies)?;
         let inverse = jacobian.try_inverse()?;
-        Some(Self {
+        let mut lean = Self {
             inverse,
             inverse_transpose: inverse.transpose(),
-        })
+            held: None,
+        };
+        lean.held = HeldConstants::of(device, &lean);
+        Some(lean)
     }
 }
 
@@ -111,7 +116,7 @@ impl Device {
         branches: Option<[Branch; 2]>,
         dydt: &mut State,
     ) -> Result<()> {
-        match (&self.free_deviation_held, branches) {
+        match (&lean.held, branches) {
             (Some(HeldConstants::Four(held)), Some(branches)) => {
                 return self.rhs_free_deviation_held(held, t, y, branches, dydt);
             }
@@ -294,5 +299,37 @@ impl Device {
         dydt.work_actuator = self.actuator_power(t, force, &q_dot);
         dydt.work_aero = aero_power;
         Ok(Some(dydt))
+    }
+}
+
+impl Equations for FreeDeviation {
+    #[inline]
+    fn rhs(
+        &self,
+        device: &Device,
+        t: f64,
+        y: &State,
+        branches: Option<[Branch; 2]>,
+        dydt: &mut State,
+    ) -> Result<()> {
+        device.rhs_free_deviation(self, t, y, branches, dydt)
+    }
+
+    fn rhs_batch(
+        &self,
+        device: &Device,
+        t: f64,
+        branches: [Branch; 2],
+        ys: &[State],
+        out: &mut [State],
+    ) -> Option<std::result::Result<(), (usize, Error)>> {
+        Some(match self.held.as_ref()? {
+            HeldConstants::Four(held) => {
+                device.free_deviation_batch((held, self), t, branches, ys, out)
+            }
+            HeldConstants::Five(held) => {
+                device.free_deviation_batch((held, self), t, branches, ys, out)
+            }
+        })
     }
 }

@@ -1,15 +1,16 @@
-//! The device as an [`OdeSystem`](crate::integrate::OdeSystem) of the integrator.
+//! The device as an [`OdeSystem`](crate::integrate::OdeSystem) of the integrator: every call
+//! goes to the device's one [`Form`](super::form::Form).
 
 use paritysim_error::Result;
 
-use super::free_deviation::HeldConstants;
-use super::linear_map_jacobian::{self, LinearMapTerms};
+use super::Device;
+use super::form::Equations;
 use super::switches::branches;
-use super::{Device, stroke_plane};
-use crate::integrate::State;
+use crate::integrate::{MAX_SWITCHES, Sides, State};
 
 // The device is an ODE system of the integrator (the integrator itself knows no device).
 impl crate::integrate::OdeSystem for Device {
+    #[inline]
     fn rhs(&self, t: f64, y: &State, dydt: &mut State) -> Result<()> {
         Device::rhs(self, t, y, dydt)
     }
@@ -22,52 +23,26 @@ impl crate::integrate::OdeSystem for Device {
         self.n_switches
     }
 
-    fn switches(
-        &self,
-        _t: f64,
-        y: &State,
-        g: &mut [f64; crate::integrate::MAX_SWITCHES],
-    ) -> Result<()> {
-        if self.stroke_plane_rhs.is_some() {
-            self.stroke_plane_switching_functions(y, g);
-            return Ok(());
-        }
-        self.blade_switching_functions(y, g)
+    fn switches(&self, _t: f64, y: &State, g: &mut [f64; MAX_SWITCHES]) -> Result<()> {
+        self.form.switches(self, y, g)
     }
 
-    fn rhs_on(
-        &self,
-        t: f64,
-        y: &State,
-        sides: crate::integrate::Sides,
-        dydt: &mut State,
-    ) -> Result<()> {
-        match &self.stroke_plane_rhs {
-            Some(lean) => self.rhs_stroke_plane(lean, t, y, Some(branches(sides)), dydt),
-            None if self.n_switches > 0 => match &self.free_deviation_rhs {
-                Some(lean) => self.rhs_free_deviation(lean, t, y, Some(branches(sides)), dydt),
-                None => self.rhs_null_space_on(t, y, Some(branches(sides)), dydt),
-            },
-            None => Device::rhs(self, t, y, dydt),
-        }
+    #[inline]
+    fn rhs_on(&self, t: f64, y: &State, sides: Sides, dydt: &mut State) -> Result<()> {
+        self.form.rhs(self, t, y, self.held(sides), dydt)
     }
 
     fn rhs_on_batch(
         &self,
         t: f64,
-        sides: crate::integrate::Sides,
+        sides: Sides,
         ys: &[State],
         out: &mut [State],
     ) -> Option<std::result::Result<(), (usize, paritysim_error::Error)>> {
-        let lean = self.free_deviation_rhs.as_ref()?;
-        if self.n_switches == 0 || ys.len() < 2 {
+        if ys.len() < 2 {
             return None;
         }
-        let b = branches(sides);
-        Some(match self.free_deviation_held.as_ref()? {
-            HeldConstants::Four(held) => self.free_deviation_batch((held, lean), t, b, ys, out),
-            HeldConstants::Five(held) => self.free_deviation_batch((held, lean), t, b, ys, out),
-        })
+        self.form.rhs_batch(self, t, self.held(sides)?, ys, out)
     }
 
     fn variational(
@@ -78,48 +53,43 @@ impl crate::integrate::OdeSystem for Device {
         phi: &[f64],
         dphi: &mut [f64],
     ) -> Option<Result<()>> {
-        if let Some(lean) = &self.stroke_plane_rhs {
-            if n != self.n_dof {
-                return None;
-            }
-            let mut f = [0.0; 2 * stroke_plane::N];
-            return self.stroke_plane_variational(lean, t, y, None, &mut f, phi, dphi);
-        }
-        let terms = self.stroke_only.as_ref()?.jacobian.as_ref()?;
-        if n != 2 {
-            return None;
-        }
-        let y = [y.coords[0], y.coords[1], y.rates[0], y.rates[1]];
-        linear_map_jacobian::variational(terms, &y, phi, dphi);
-        Some(Ok(()))
+        self.form.variational(self, t, y, None, n, None, phi, dphi)
     }
 
     fn variational_with_rhs(
         &self,
         t: f64,
         y: &State,
-        sides: Option<crate::integrate::Sides>,
+        sides: Option<Sides>,
         n: usize,
         f: &mut [f64],
         phi: &[f64],
         dphi: &mut [f64],
     ) -> Option<Result<()>> {
-        let lean = self.stroke_plane_rhs.as_ref().filter(|_| n == self.n_dof)?;
-        self.stroke_plane_variational(lean, t, y, sides.map(branches), f, phi, dphi)
+        let branches = sides.and_then(|s| self.held(s));
+        self.form
+            .variational(self, t, y, branches, n, Some(f), phi, dphi)
     }
 }
 
 impl Device {
+    /// The blade-element branches the integrator holds (`None` without switching functions:
+    /// the right-hand side is smooth and evaluates each state's own sides).
+    #[inline]
+    fn held(&self, sides: Sides) -> Option<[paritysim_aero::Branch; 2]> {
+        (self.n_switches > 0).then(|| branches(sides))
+    }
+
     /// Whether the variational equations have an analytic Jacobian (the stroke-plane model,
     /// the linear map's drivetrain coordinates) rather than central differences of the
     /// right-hand side.
     pub(crate) fn has_analytic_jacobian(&self) -> bool {
-        self.stroke_plane_rhs.is_some() || self.linear_map_terms().is_some()
+        self.form.has_analytic_jacobian()
     }
 
     /// The linear map's analytic Jacobian constants (drivetrain coordinates of a two-DOF
-    /// linear differential with stroke drag; see [`linear_map_jacobian`]).
-    pub(crate) fn linear_map_terms(&self) -> Option<&LinearMapTerms<f64>> {
-        self.stroke_only.as_ref()?.jacobian.as_ref()
+    /// linear differential with stroke drag; see [`super::linear_map`]).
+    pub(crate) fn linear_map_terms(&self) -> Option<&super::linear_map::LinearMapTerms<f64>> {
+        self.form.linear_map_terms()
     }
 }

@@ -37,12 +37,12 @@ impl Device {
             .wings
             .iter()
             .any(|w| matches!(w.aero(), WingAero::BladeElement(_)));
-        if !blade || self.stroke_only.is_some() {
+        if !blade || self.form.stroke_only().is_some() {
             return 0;
         }
         let closed_form =
             (0..self.n_wings()).all(|w| self.stroke_plane[w] || self.free_deviation[w]);
-        if self.stroke_plane_rhs.is_some() || closed_form {
+        if self.form.stroke_plane().is_some() || closed_form {
             3 * self.n_wings()
         } else {
             0

@@ -12,6 +12,7 @@
 
 use super::{Rhs, Stepper, Tolerances};
 use paritysim_error::Result;
+use paritysim_simd::Real;
 
 // The SIMD-lane ensemble version shares this file's coefficients (child modules see them).
 #[path = "dop853_lanes.rs"]
@@ -179,30 +180,168 @@ const D714: f64 = 0.96324553959188282948394950600E+02;
 const D715: f64 = -0.39177261675615439165231486172E+02;
 const D716: f64 = -0.14972683625798562581422125276E+03;
 
-/// Stage storage of one DOP853 step on a state of `M` entries.
-pub(crate) struct Dop853<const M: usize> {
-    k: [[f64; M]; 10],
-    y1: [f64; M],
-    cont: [[f64; M]; 8],
-}
-
-impl<const M: usize> Dop853<M> {
-    pub(crate) fn new() -> Self {
-        Self {
-            k: [[0.0; M]; 10],
-            y1: [0.0; M],
-            cont: [[0.0; M]; 8],
-        }
-    }
+/// One DOP853 step on `M` entries of any number type: `f64` (the scalar stepper) or one
+/// problem per SIMD lane (`lanes`), so both run the same operations in the same order and a
+/// lane is bit-identical to the scalar integration of its problem.
+pub(crate) struct Dop853<const M: usize, S = f64> {
+    k: [[S; M]; 10],
+    pub(crate) y1: [S; M],
+    pub(crate) cont: [[S; M]; 8],
 }
 
 /// `y + h Σ aᵢ kᵢ` written once per stage (the compiler keeps the loop over `M` tight).
 macro_rules! stage {
     ($out:expr, $y:expr, $h:expr, $( $a:expr => $k:expr ),+ ) => {
         for i in 0..M {
-            $out[i] = $y[i] + $h * (0.0 $( + $a * $k[i] )+);
+            $out[i] = $y[i] + $h * (S::splat(0.0) $( + S::splat($a) * $k[i] )+);
         }
     };
+}
+
+/// `Σ cᵢ kᵢ[i]`, left to right (the increment, error and dense-output sums), optionally
+/// added to a first term.
+macro_rules! sum {
+    ($i:expr; $first:expr $(, $c:expr => $k:expr )+ ) => {
+        $first $( + S::splat($c) * $k[$i] )+
+    };
+    ($i:expr, $c0:expr => $k0:expr $(, $c:expr => $k:expr )* ) => {
+        S::splat($c0) * $k0[$i] $( + S::splat($c) * $k[$i] )*
+    };
+}
+
+impl<const M: usize, S: Real> Dop853<M, S> {
+    pub(crate) fn new() -> Self {
+        let z = [S::splat(0.0); M];
+        Self {
+            k: [z; 10],
+            y1: z,
+            cont: [z; 8],
+        }
+    }
+
+    /// The step from `y` (`f0 = f(t, y)`) by `h`: its stages, `y1`, and the error norm over
+    /// the first `controlled` entries. `eval(stage, c, y, f)` writes `f(t + c h, y)` of
+    /// stage 1..=11 (its position in the step, for right-hand sides that tabulate time).
+    pub(crate) fn try_step<E>(
+        &mut self,
+        y: &[S; M],
+        f0: &[S; M],
+        h: S,
+        (controlled, atol, rtol): (usize, S, S),
+        mut eval: impl FnMut(usize, f64, &[S; M], &mut [S; M]) -> std::result::Result<(), E>,
+    ) -> std::result::Result<S, E> {
+        // Hairer's storage names (k1 = f0; k2, k3 hold stages 11, 12 at the end).
+        let [k2, k3, k4, k5, k6, k7, k8, k9, k10, _] = &mut self.k;
+        let k1 = f0;
+        let mut ys = [S::splat(0.0); M];
+        stage!(ys, y, h, A21 => k1);
+        eval(1, C2, &ys, k2)?;
+        stage!(ys, y, h, A31 => k1, A32 => k2);
+        eval(2, C3, &ys, k3)?;
+        stage!(ys, y, h, A41 => k1, A43 => k3);
+        eval(3, C4, &ys, k4)?;
+        stage!(ys, y, h, A51 => k1, A53 => k3, A54 => k4);
+        eval(4, C5, &ys, k5)?;
+        stage!(ys, y, h, A61 => k1, A64 => k4, A65 => k5);
+        eval(5, C6, &ys, k6)?;
+        stage!(ys, y, h, A71 => k1, A74 => k4, A75 => k5, A76 => k6);
+        eval(6, C7, &ys, k7)?;
+        stage!(ys, y, h, A81 => k1, A84 => k4, A85 => k5, A86 => k6, A87 => k7);
+        eval(7, C8, &ys, k8)?;
+        stage!(ys, y, h, A91 => k1, A94 => k4, A95 => k5, A96 => k6, A97 => k7, A98 => k8);
+        eval(8, C9, &ys, k9)?;
+        stage!(ys, y, h, A101 => k1, A104 => k4, A105 => k5, A106 => k6, A107 => k7, A108 => k8,
+            A109 => k9);
+        eval(9, C10, &ys, k10)?;
+        stage!(ys, y, h, A111 => k1, A114 => k4, A115 => k5, A116 => k6, A117 => k7, A118 => k8,
+            A119 => k9, A1110 => k10);
+        eval(10, C11, &ys, k2)?;
+        stage!(ys, y, h, A121 => k1, A124 => k4, A125 => k5, A126 => k6, A127 => k7, A128 => k8,
+            A129 => k9, A1210 => k10, A1211 => k2);
+        eval(11, 1.0, &ys, k3)?;
+        // The 8th-order increment gives y1; the 5th- and 3rd-order estimates its error.
+        let mut err5 = S::splat(0.0);
+        let mut err3 = S::splat(0.0);
+        for i in 0..M {
+            let inc = sum!(i, B1 => k1, B6 => k6, B7 => k7, B8 => k8, B9 => k9, B10 => k10,
+                B11 => k2, B12 => k3);
+            let y1 = y[i] + h * inc;
+            self.y1[i] = y1;
+            if i < controlled {
+                let sk = atol + rtol * y[i].abs().max(y1.abs());
+                let e3 =
+                    inc - S::splat(BHH1) * k1[i] - S::splat(BHH2) * k9[i] - S::splat(BHH3) * k3[i];
+                let e5 = sum!(i, ER1 => k1, ER6 => k6, ER7 => k7, ER8 => k8, ER9 => k9,
+                    ER10 => k10, ER11 => k2, ER12 => k3);
+                err3 = err3 + (e3 / sk) * (e3 / sk);
+                err5 = err5 + (e5 / sk) * (e5 / sk);
+            }
+        }
+        let deno = err5 + S::splat(0.01) * err3;
+        let deno = S::select(deno.le(S::splat(0.0)), S::splat(1.0), deno);
+        Ok(h.abs() * err5 * (S::splat(1.0) / (S::splat(controlled as f64) * deno)).sqrt())
+    }
+
+    /// The dense output of the step just taken (`f1 = f(t + h, y1)`); `eval` as in
+    /// [`Self::try_step`], stages 12..=14.
+    pub(crate) fn dense_output<E>(
+        &mut self,
+        y: &[S; M],
+        f0: &[S; M],
+        f1: &[S; M],
+        h: S,
+        mut eval: impl FnMut(usize, f64, &[S; M], &mut [S; M]) -> std::result::Result<(), E>,
+    ) -> std::result::Result<(), E> {
+        let [k2, k3, _k4, _k5, k6, k7, k8, k9, k10, kx] = &mut self.k;
+        let k1 = f0;
+        let k13 = f1;
+        let [r1, r2, r3, r4, r5, r6, r7, r8] = &mut self.cont;
+        for i in 0..M {
+            let ydiff = self.y1[i] - y[i];
+            let bspl = h * k1[i] - ydiff;
+            r1[i] = y[i];
+            r2[i] = ydiff;
+            r3[i] = bspl;
+            r4[i] = ydiff - h * k13[i] - bspl;
+            r5[i] = sum!(i, D41 => k1, D46 => k6, D47 => k7, D48 => k8, D49 => k9, D410 => k10,
+                D411 => k2, D412 => k3);
+            r6[i] = sum!(i, D51 => k1, D56 => k6, D57 => k7, D58 => k8, D59 => k9, D510 => k10,
+                D511 => k2, D512 => k3);
+            r7[i] = sum!(i, D61 => k1, D66 => k6, D67 => k7, D68 => k8, D69 => k9, D610 => k10,
+                D611 => k2, D612 => k3);
+            r8[i] = sum!(i, D71 => k1, D76 => k6, D77 => k7, D78 => k8, D79 => k9, D710 => k10,
+                D711 => k2, D712 => k3);
+        }
+        // The three extra stages (14, 15, 16); k10 and k2/k3 are still needed, so 14 goes to the
+        // spare slot, 15 and 16 reuse slots whose stages are already folded into r5..r8.
+        let mut ys = [S::splat(0.0); M];
+        stage!(ys, y, h, A141 => k1, A147 => k7, A148 => k8, A149 => k9, A1410 => k10,
+            A1411 => k2, A1412 => k3, A1413 => k13);
+        eval(12, C14, &ys, kx)?;
+        let k14 = *kx;
+        stage!(ys, y, h, A151 => k1, A156 => k6, A157 => k7, A158 => k8, A1511 => k2,
+            A1512 => k3, A1513 => k13, A1514 => &k14);
+        eval(13, C15, &ys, k10)?;
+        let k15 = *k10;
+        stage!(ys, y, h, A161 => k1, A166 => k6, A167 => k7, A168 => k8, A169 => k9,
+            A1613 => k13, A1614 => &k14, A1615 => &k15);
+        eval(14, C16, &ys, k2)?;
+        let k16 = &*k2;
+        for i in 0..M {
+            r5[i] = h * sum!(i; r5[i], D413 => k13, D414 => k14, D415 => k15, D416 => k16);
+            r6[i] = h * sum!(i; r6[i], D513 => k13, D514 => k14, D515 => k15, D516 => k16);
+            r7[i] = h * sum!(i; r7[i], D613 => k13, D614 => k14, D615 => k15, D616 => k16);
+            r8[i] = h * sum!(i; r8[i], D713 => k13, D714 => k14, D715 => k15, D716 => k16);
+        }
+        Ok(())
+    }
+}
+
+/// The interpolant at `s ∈ [0, 1]` of the step, from one entry's coefficients `r1..r8`.
+#[inline]
+pub(crate) fn interpolate<S: Real>(r: [S; 8], s: S) -> S {
+    let s1 = S::splat(1.0) - s;
+    r[0] + s * (r[1] + s1 * (r[2] + s * (r[3] + s1 * (r[4] + s * (r[5] + s1 * (r[6] + s * r[7]))))))
 }
 
 impl<const M: usize> Stepper<M> for Dop853<M> {
@@ -221,69 +360,8 @@ impl<const M: usize> Stepper<M> for Dop853<M> {
         h: f64,
         tol: &Tolerances,
     ) -> Result<f64> {
-        // Hairer's storage names (k1 = f0; k2, k3 hold stages 11, 12 at the end).
-        let [k2, k3, k4, k5, k6, k7, k8, k9, k10, _] = &mut self.k;
-        let k1 = f0;
-        let mut ys = [0.0; M];
-        stage!(ys, y, h, A21 => k1);
-        rhs.eval(t + C2 * h, &ys, k2)?;
-        stage!(ys, y, h, A31 => k1, A32 => k2);
-        rhs.eval(t + C3 * h, &ys, k3)?;
-        stage!(ys, y, h, A41 => k1, A43 => k3);
-        rhs.eval(t + C4 * h, &ys, k4)?;
-        stage!(ys, y, h, A51 => k1, A53 => k3, A54 => k4);
-        rhs.eval(t + C5 * h, &ys, k5)?;
-        stage!(ys, y, h, A61 => k1, A64 => k4, A65 => k5);
-        rhs.eval(t + C6 * h, &ys, k6)?;
-        stage!(ys, y, h, A71 => k1, A74 => k4, A75 => k5, A76 => k6);
-        rhs.eval(t + C7 * h, &ys, k7)?;
-        stage!(ys, y, h, A81 => k1, A84 => k4, A85 => k5, A86 => k6, A87 => k7);
-        rhs.eval(t + C8 * h, &ys, k8)?;
-        stage!(ys, y, h, A91 => k1, A94 => k4, A95 => k5, A96 => k6, A97 => k7, A98 => k8);
-        rhs.eval(t + C9 * h, &ys, k9)?;
-        stage!(ys, y, h, A101 => k1, A104 => k4, A105 => k5, A106 => k6, A107 => k7, A108 => k8,
-            A109 => k9);
-        rhs.eval(t + C10 * h, &ys, k10)?;
-        stage!(ys, y, h, A111 => k1, A114 => k4, A115 => k5, A116 => k6, A117 => k7, A118 => k8,
-            A119 => k9, A1110 => k10);
-        rhs.eval(t + C11 * h, &ys, k2)?;
-        stage!(ys, y, h, A121 => k1, A124 => k4, A125 => k5, A126 => k6, A127 => k7, A128 => k8,
-            A129 => k9, A1210 => k10, A1211 => k2);
-        rhs.eval(t + h, &ys, k3)?;
-        // The 8th-order increment gives y1; the 5th- and 3rd-order estimates its error.
-        let mut err5 = 0.0;
-        let mut err3 = 0.0;
-        for i in 0..M {
-            let inc = B1 * k1[i]
-                + B6 * k6[i]
-                + B7 * k7[i]
-                + B8 * k8[i]
-                + B9 * k9[i]
-                + B10 * k10[i]
-                + B11 * k2[i]
-                + B12 * k3[i];
-            let y1 = y[i] + h * inc;
-            self.y1[i] = y1;
-            if i < tol.controlled {
-                let sk = tol.atol + tol.rtol * y[i].abs().max(y1.abs());
-                let e3 = inc - BHH1 * k1[i] - BHH2 * k9[i] - BHH3 * k3[i];
-                let e5 = ER1 * k1[i]
-                    + ER6 * k6[i]
-                    + ER7 * k7[i]
-                    + ER8 * k8[i]
-                    + ER9 * k9[i]
-                    + ER10 * k10[i]
-                    + ER11 * k2[i]
-                    + ER12 * k3[i];
-                err3 += (e3 / sk) * (e3 / sk);
-                err5 += (e5 / sk) * (e5 / sk);
-            }
-        }
-        let mut deno = err5 + 0.01 * err3;
-        if deno <= 0.0 {
-            deno = 1.0;
-        }
-        Ok(h.abs() * err5 * (1.0 / (tol.controlled as f64 * deno)).sqrt())
+        let tol = (tol.controlled, tol.atol, tol.rtol);
+        self.try_step(y, f0, h, tol, |_, c, ys, f| rhs.eval(t + c * h, ys, f))
     }
 
     fn y1(&self) -> &[f64; M] {
@@ -308,82 +386,12 @@ impl<const M: usize> Stepper<M> for Dop853<M> {
         f1: &[f64; M],
         h: f64,
     ) -> Result<()> {
-        let [k2, k3, _k4, _k5, k6, k7, k8, k9, k10, kx] = &mut self.k;
-        let k1 = f0;
-        let k13 = f1;
-        let [r1, r2, r3, r4, r5, r6, r7, r8] = &mut self.cont;
-        for i in 0..M {
-            let ydiff = self.y1[i] - y[i];
-            let bspl = h * k1[i] - ydiff;
-            r1[i] = y[i];
-            r2[i] = ydiff;
-            r3[i] = bspl;
-            r4[i] = ydiff - h * k13[i] - bspl;
-            r5[i] = D41 * k1[i]
-                + D46 * k6[i]
-                + D47 * k7[i]
-                + D48 * k8[i]
-                + D49 * k9[i]
-                + D410 * k10[i]
-                + D411 * k2[i]
-                + D412 * k3[i];
-            r6[i] = D51 * k1[i]
-                + D56 * k6[i]
-                + D57 * k7[i]
-                + D58 * k8[i]
-                + D59 * k9[i]
-                + D510 * k10[i]
-                + D511 * k2[i]
-                + D512 * k3[i];
-            r7[i] = D61 * k1[i]
-                + D66 * k6[i]
-                + D67 * k7[i]
-                + D68 * k8[i]
-                + D69 * k9[i]
-                + D610 * k10[i]
-                + D611 * k2[i]
-                + D612 * k3[i];
-            r8[i] = D71 * k1[i]
-                + D76 * k6[i]
-                + D77 * k7[i]
-                + D78 * k8[i]
-                + D79 * k9[i]
-                + D710 * k10[i]
-                + D711 * k2[i]
-                + D712 * k3[i];
-        }
-        // The three extra stages (14, 15, 16); k10 and k2/k3 are still needed, so 14 goes to the
-        // spare slot, 15 and 16 reuse slots whose stages are already folded into r5..r8.
-        let mut ys = [0.0; M];
-        stage!(ys, y, h, A141 => k1, A147 => k7, A148 => k8, A149 => k9, A1410 => k10,
-            A1411 => k2, A1412 => k3, A1413 => k13);
-        rhs.eval(t + C14 * h, &ys, kx)?;
-        let k14 = *kx;
-        stage!(ys, y, h, A151 => k1, A156 => k6, A157 => k7, A158 => k8, A1511 => k2,
-            A1512 => k3, A1513 => k13, A1514 => &k14);
-        rhs.eval(t + C15 * h, &ys, k10)?;
-        let k15 = *k10;
-        stage!(ys, y, h, A161 => k1, A166 => k6, A167 => k7, A168 => k8, A169 => k9,
-            A1613 => k13, A1614 => &k14, A1615 => &k15);
-        rhs.eval(t + C16 * h, &ys, k2)?;
-        let k16 = &*k2;
-        for i in 0..M {
-            r5[i] = h * (r5[i] + D413 * k13[i] + D414 * k14[i] + D415 * k15[i] + D416 * k16[i]);
-            r6[i] = h * (r6[i] + D513 * k13[i] + D514 * k14[i] + D515 * k15[i] + D516 * k16[i]);
-            r7[i] = h * (r7[i] + D613 * k13[i] + D614 * k14[i] + D615 * k15[i] + D616 * k16[i]);
-            r8[i] = h * (r8[i] + D713 * k13[i] + D714 * k14[i] + D715 * k15[i] + D716 * k16[i]);
-        }
-        Ok(())
+        self.dense_output(y, f0, f1, h, |_, c, ys, f| rhs.eval(t + c * h, ys, f))
     }
 
     fn dense(&self, s: f64, out: &mut [f64; M]) {
-        let s1 = 1.0 - s;
-        let [r1, r2, r3, r4, r5, r6, r7, r8] = &self.cont;
-        for i in 0..M {
-            out[i] = r1[i]
-                + s * (r2[i]
-                    + s1 * (r3[i]
-                        + s * (r4[i] + s1 * (r5[i] + s * (r6[i] + s1 * (r7[i] + s * r8[i]))))));
+        for (i, out) in out.iter_mut().enumerate() {
+            *out = interpolate(std::array::from_fn(|r| self.cont[r][i]), s);
         }
     }
 }

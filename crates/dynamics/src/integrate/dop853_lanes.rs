@@ -21,6 +21,7 @@
 // Index loops on purpose: they mirror dop853.rs line by line (the operation order is the contract).
 #![allow(clippy::needless_range_loop)]
 
+use std::convert::Infallible;
 use std::rc::Rc;
 use std::time::Instant;
 
@@ -164,9 +165,7 @@ struct Progress {
 pub(crate) struct LaneStepper<const M: usize, const C: usize = 4> {
     y: [V; M],
     f0: [V; M],
-    k: [[V; M]; 10],
-    y1: [V; M],
-    cont: [[V; M]; 8],
+    stages: Dop853<M, V>,
     rtol: V,
     atol: V,
     lanes: [Progress; LANES],
@@ -178,15 +177,6 @@ pub(crate) struct LaneStepper<const M: usize, const C: usize = 4> {
     steps: usize,
 }
 
-/// `y + h Σ aᵢ kᵢ` on vectors (the scalar `stage!` of dop853.rs, same operation order).
-macro_rules! vstage {
-    ($out:expr, $y:expr, $h:expr, $( $a:expr => $k:expr ),+ ) => {
-        for i in 0..M {
-            $out[i] = $y[i] + $h * (V::splat(0.0) $( + V::splat($a) * $k[i] )+);
-        }
-    };
-}
-
 impl<const M: usize, const C: usize> LaneStepper<M, C> {
     /// All lanes idle.
     pub(crate) fn new() -> Self {
@@ -194,9 +184,7 @@ impl<const M: usize, const C: usize> LaneStepper<M, C> {
         Self {
             y: z,
             f0: z,
-            k: [z; 10],
-            y1: z,
-            cont: [z; 8],
+            stages: Dop853::new(),
             rtol: V::splat(1.0),
             atol: V::splat(1.0),
             lanes: std::array::from_fn(|_| Progress::default()),
@@ -421,77 +409,19 @@ impl<const M: usize, const C: usize> LaneStepper<M, C> {
         });
         let idx = |s: usize| -> [usize; LANES] { base.map(|b| b.saturating_add(s)) };
         let mut failed = 0u32;
-        let y = self.y;
-        let k1 = self.f0;
-        let [k2, k3, k4, k5, k6, k7, k8, k9, k10, _] = &mut self.k;
-        let mut ys = [V::splat(0.0); M];
-        vstage!(ys, y, h, A21 => k1);
-        failed |= rhs.eval(at(C2), idx(1), &ys, k2);
-        vstage!(ys, y, h, A31 => k1, A32 => k2);
-        failed |= rhs.eval(at(C3), idx(2), &ys, k3);
-        vstage!(ys, y, h, A41 => k1, A43 => k3);
-        failed |= rhs.eval(at(C4), idx(3), &ys, k4);
-        vstage!(ys, y, h, A51 => k1, A53 => k3, A54 => k4);
-        failed |= rhs.eval(at(C5), idx(4), &ys, k5);
-        vstage!(ys, y, h, A61 => k1, A64 => k4, A65 => k5);
-        failed |= rhs.eval(at(C6), idx(5), &ys, k6);
-        vstage!(ys, y, h, A71 => k1, A74 => k4, A75 => k5, A76 => k6);
-        failed |= rhs.eval(at(C7), idx(6), &ys, k7);
-        vstage!(ys, y, h, A81 => k1, A84 => k4, A85 => k5, A86 => k6, A87 => k7);
-        failed |= rhs.eval(at(C8), idx(7), &ys, k8);
-        vstage!(ys, y, h, A91 => k1, A94 => k4, A95 => k5, A96 => k6, A97 => k7, A98 => k8);
-        failed |= rhs.eval(at(C9), idx(8), &ys, k9);
-        vstage!(ys, y, h, A101 => k1, A104 => k4, A105 => k5, A106 => k6, A107 => k7, A108 => k8,
-            A109 => k9);
-        failed |= rhs.eval(at(C10), idx(9), &ys, k10);
-        vstage!(ys, y, h, A111 => k1, A114 => k4, A115 => k5, A116 => k6, A117 => k7, A118 => k8,
-            A119 => k9, A1110 => k10);
-        failed |= rhs.eval(at(C11), idx(10), &ys, k2);
-        vstage!(ys, y, h, A121 => k1, A124 => k4, A125 => k5, A126 => k6, A127 => k7, A128 => k8,
-            A129 => k9, A1210 => k10, A1211 => k2);
-        failed |= rhs.eval(at(1.0), idx(11), &ys, k3);
-        // The scalar attempt's increment, new state and error norm (every entry controlled).
-        let mut err5 = V::splat(0.0);
-        let mut err3 = V::splat(0.0);
-        for i in 0..M {
-            let inc = V::splat(B1) * k1[i]
-                + V::splat(B6) * k6[i]
-                + V::splat(B7) * k7[i]
-                + V::splat(B8) * k8[i]
-                + V::splat(B9) * k9[i]
-                + V::splat(B10) * k10[i]
-                + V::splat(B11) * k2[i]
-                + V::splat(B12) * k3[i];
-            let y1 = y[i] + h * inc;
-            self.y1[i] = y1;
-            if i >= C {
-                continue;
-            }
-            let sk = self.atol + self.rtol * y[i].abs().max(y1.abs());
-            let e3 = inc - V::splat(BHH1) * k1[i] - V::splat(BHH2) * k9[i] - V::splat(BHH3) * k3[i];
-            let e5 = V::splat(ER1) * k1[i]
-                + V::splat(ER6) * k6[i]
-                + V::splat(ER7) * k7[i]
-                + V::splat(ER8) * k8[i]
-                + V::splat(ER9) * k9[i]
-                + V::splat(ER10) * k10[i]
-                + V::splat(ER11) * k2[i]
-                + V::splat(ER12) * k3[i];
-            err3 += (e3 / sk) * (e3 / sk);
-            err5 += (e5 / sk) * (e5 / sk);
-        }
-        let mut deno = (err5 + V::splat(0.01) * err3).to_array();
-        for d in &mut deno {
-            if *d <= 0.0 {
-                *d = 1.0;
-            }
-        }
-        let err = h.abs() * err5 * (V::splat(1.0) / (V::splat(C as f64) * V::new(deno))).sqrt();
+        let (y, f0, tol) = (self.y, self.f0, (C, self.atol, self.rtol));
+        let err = self
+            .stages
+            .try_step(&y, &f0, h, tol, |stage, c, ys, f| {
+                failed |= rhs.eval(at(c), idx(stage), ys, f);
+                Ok::<(), Infallible>(())
+            })
+            .unwrap_or_else(|never| match never {});
         // Failures of the new derivative count only on accepted steps (the scalar evaluates
         // it after accepting).
         let mut f1 = [V::splat(0.0); M];
-        let failed_f1 = rhs.eval(t_new, idx(STAGES_PER_STEP), &self.y1, &mut f1);
-        let y1_finite = self.y1[..C]
+        let failed_f1 = rhs.eval(t_new, idx(STAGES_PER_STEP), &self.stages.y1, &mut f1);
+        let y1_finite = self.stages.y1[..C]
             .iter()
             .fold(V::splat(0.0).simd_eq(V::splat(0.0)), |all, v| {
                 all & v.is_finite()
@@ -529,7 +459,7 @@ impl<const M: usize, const C: usize> LaneStepper<M, C> {
                         finished.push((
                             l,
                             LaneOutcome::Done {
-                                y: std::array::from_fn(|i| lane(self.y1[i], l)),
+                                y: std::array::from_fn(|i| lane(self.stages.y1[i], l)),
                                 over_tolerance: 0,
                                 steps: std::mem::take(&mut a.steps),
                             },
@@ -557,7 +487,7 @@ impl<const M: usize, const C: usize> LaneStepper<M, C> {
                 finished.push((
                     l,
                     LaneOutcome::Done {
-                        y: std::array::from_fn(|i| lane(self.y1[i], l)),
+                        y: std::array::from_fn(|i| lane(self.stages.y1[i], l)),
                         over_tolerance: p.over_tolerance,
                         steps: Vec::new(),
                     },
@@ -565,13 +495,13 @@ impl<const M: usize, const C: usize> LaneStepper<M, C> {
             }
         }
         if accepted.iter().all(|&a| a) {
-            self.y = self.y1;
+            self.y = self.stages.y1;
             self.f0 = f1;
         } else {
             // Rejected lanes retry from the same state and derivative.
             for i in 0..M {
                 let (mut y, mut f0) = (self.y[i].to_array(), self.f0[i].to_array());
-                let (y1, f1) = (self.y1[i].to_array(), f1[i].to_array());
+                let (y1, f1) = (self.stages.y1[i].to_array(), f1[i].to_array());
                 for l in (0..LANES).filter(|&l| accepted[l]) {
                     y[l] = y1[l];
                     f0[l] = f1[l];
@@ -590,22 +520,15 @@ impl<const M: usize, const C: usize> LaneStepper<M, C> {
         if inside > p.next {
             // This lane's interpolant, broadcast: the vector lanes now hold samples.
             let c: [[V; C]; 8] = std::array::from_fn(|r| {
-                std::array::from_fn(|i| V::splat(lane(self.cont[r][i], l)))
+                std::array::from_fn(|i| V::splat(lane(self.stages.cont[r][i], l)))
             });
             while p.next < inside {
                 let count = (inside - p.next).min(4);
                 let mut ts = [t; 4];
                 ts[..count].copy_from_slice(&p.times[p.next..p.next + count]);
                 let s = (V::new(ts) - V::splat(t)) / V::splat(h);
-                let s1 = V::splat(1.0) - s;
-                let y: [V; C] = std::array::from_fn(|i| {
-                    c[0][i]
-                        + s * (c[1][i]
-                            + s1 * (c[2][i]
-                                + s * (c[3][i]
-                                    + s1 * (c[4][i]
-                                        + s * (c[5][i] + s1 * (c[6][i] + s * c[7][i]))))))
-                });
+                let y: [V; C] =
+                    std::array::from_fn(|i| interpolate(std::array::from_fn(|r| c[r][i]), s));
                 let finite = y
                     .iter()
                     .fold(V::splat(0.0).simd_eq(V::splat(0.0)), |all, v| {
@@ -625,7 +548,7 @@ impl<const M: usize, const C: usize> LaneStepper<M, C> {
             }
         }
         let at_end = p.next + p.times[p.next..].partition_point(|&s| s <= t_new);
-        let end: [V; C] = std::array::from_fn(|i| V::splat(lane(self.y1[i], l)));
+        let end: [V; C] = std::array::from_fn(|i| V::splat(lane(self.stages.y1[i], l)));
         let ok = emit_constant(l, &p.times, p.next, at_end, &end, sink);
         p.next = at_end;
         ok
@@ -643,92 +566,14 @@ impl<const M: usize, const C: usize> LaneStepper<M, C> {
         let hs = h.to_array();
         let at = |c: f64| -> [f64; LANES] { std::array::from_fn(|l| t[l] + c * hs[l]) };
         let idx = |s: usize| -> [usize; LANES] { base.map(|b| b.saturating_add(s)) };
-        let y = self.y;
-        let k1 = self.f0;
-        let k13 = *f1;
-        let [k2, k3, _k4, _k5, k6, k7, k8, k9, k10, kx] = &mut self.k;
-        let [r1, r2, r3, r4, r5, r6, r7, r8] = &mut self.cont;
-        let s = V::splat;
-        for i in 0..M {
-            let ydiff = self.y1[i] - y[i];
-            let bspl = h * k1[i] - ydiff;
-            r1[i] = y[i];
-            r2[i] = ydiff;
-            r3[i] = bspl;
-            r4[i] = ydiff - h * k13[i] - bspl;
-            r5[i] = s(D41) * k1[i]
-                + s(D46) * k6[i]
-                + s(D47) * k7[i]
-                + s(D48) * k8[i]
-                + s(D49) * k9[i]
-                + s(D410) * k10[i]
-                + s(D411) * k2[i]
-                + s(D412) * k3[i];
-            r6[i] = s(D51) * k1[i]
-                + s(D56) * k6[i]
-                + s(D57) * k7[i]
-                + s(D58) * k8[i]
-                + s(D59) * k9[i]
-                + s(D510) * k10[i]
-                + s(D511) * k2[i]
-                + s(D512) * k3[i];
-            r7[i] = s(D61) * k1[i]
-                + s(D66) * k6[i]
-                + s(D67) * k7[i]
-                + s(D68) * k8[i]
-                + s(D69) * k9[i]
-                + s(D610) * k10[i]
-                + s(D611) * k2[i]
-                + s(D612) * k3[i];
-            r8[i] = s(D71) * k1[i]
-                + s(D76) * k6[i]
-                + s(D77) * k7[i]
-                + s(D78) * k8[i]
-                + s(D79) * k9[i]
-                + s(D710) * k10[i]
-                + s(D711) * k2[i]
-                + s(D712) * k3[i];
-        }
         let mut failed = 0;
-        let mut ys = [V::splat(0.0); M];
-        vstage!(ys, y, h, A141 => k1, A147 => k7, A148 => k8, A149 => k9, A1410 => k10,
-            A1411 => k2, A1412 => k3, A1413 => k13);
-        failed |= rhs.eval(at(C14), idx(12), &ys, kx);
-        let k14 = *kx;
-        vstage!(ys, y, h, A151 => k1, A156 => k6, A157 => k7, A158 => k8, A1511 => k2,
-            A1512 => k3, A1513 => k13, A1514 => k14);
-        failed |= rhs.eval(at(C15), idx(13), &ys, k10);
-        let k15 = *k10;
-        vstage!(ys, y, h, A161 => k1, A166 => k6, A167 => k7, A168 => k8, A169 => k9,
-            A1613 => k13, A1614 => k14, A1615 => k15);
-        failed |= rhs.eval(at(C16), idx(14), &ys, k2);
-        let k16 = *k2;
-        for i in 0..M {
-            r5[i] = h
-                * (r5[i]
-                    + s(D413) * k13[i]
-                    + s(D414) * k14[i]
-                    + s(D415) * k15[i]
-                    + s(D416) * k16[i]);
-            r6[i] = h
-                * (r6[i]
-                    + s(D513) * k13[i]
-                    + s(D514) * k14[i]
-                    + s(D515) * k15[i]
-                    + s(D516) * k16[i]);
-            r7[i] = h
-                * (r7[i]
-                    + s(D613) * k13[i]
-                    + s(D614) * k14[i]
-                    + s(D615) * k15[i]
-                    + s(D616) * k16[i]);
-            r8[i] = h
-                * (r8[i]
-                    + s(D713) * k13[i]
-                    + s(D714) * k14[i]
-                    + s(D715) * k15[i]
-                    + s(D716) * k16[i]);
-        }
+        let (y, f0) = (self.y, self.f0);
+        self.stages
+            .dense_output(&y, &f0, f1, h, |stage, c, ys, f| {
+                failed |= rhs.eval(at(c), idx(stage), ys, f);
+                Ok::<(), Infallible>(())
+            })
+            .unwrap_or_else(|never| match never {});
         failed
     }
 }

@@ -1,12 +1,8 @@
 //! The drivetrain-coordinate right-hand side of [`Formulation::DrivetrainCoordinates`] for the
-//! linear differential map (eq. 2.15) in SIMD lanes, one device per lane.
-//!
-//! With the constant Jacobian `J` of eq. 2.15 the mass matrix `M_q = Σ_k I_k J_kᵀ J_k` is
-//! constant and the velocity products vanish: per lane only the stroke springs, the stroke
-//! drag (eq. 2.16) and the actuator force `F(t)` remain. Every operation is the one of
-//! `Device::drivetrain_step` in the same order, so a lane's derivative is bit-identical to
-//! the scalar one; the force is the scalar [`Actuator::force`] of each lane's time (any
-//! waveform).
+//! linear differential map (eq. 2.15) in SIMD lanes, one device per lane: the scalar form's own
+//! equations ([`linear_map::accelerations`] and [`linear_map::variational`], generic over the
+//! number type), so a lane's derivative is bit-identical to the scalar one; the force is the
+//! scalar [`Actuator::force`] of each lane's time (any waveform).
 
 use wide::f64x4;
 
@@ -15,7 +11,7 @@ use crate::device::{Device, Formulation};
 use std::rc::Rc;
 
 use crate::device::DriveSprings;
-use crate::device::linear_map_jacobian::{self, LinearMapTerms};
+use crate::device::linear_map::{self, LinearMapTerms};
 use crate::integrate::lanes::{LANES, LaneRhs, stage_times};
 use crate::wing::WingAero;
 
@@ -40,6 +36,9 @@ impl<'a> LinearStroke<'a> {
             return None;
         }
         let terms = *device.linear_map_terms()?;
+        if terms.det == 0.0 || !terms.det.is_finite() {
+            return None; // the scalar path reports the singular drivetrain
+        }
         let spec = device.spec();
         let actuator = spec.actuator.as_ref()?;
         let vacuum = [0, 1].map(|k| matches!(spec.wings[k].aero(), WingAero::None));
@@ -125,6 +124,7 @@ impl<'a> LinearStrokeLanes<'a> {
                 mass: [one, z, one],
                 det: one,
                 drag: [z; 2],
+                analytic: true,
                 stiffness: [z; 2],
                 cubic: [z; 2],
                 rest: [z; 2],
@@ -185,26 +185,12 @@ impl LinearStrokeLanes<'_> {
             & q2.abs()
                 .simd_le(V::splat(paritysim_error::plausible::ANGLE_RAD));
         let failed = !inside.to_bitmask() & ((1 << LANES) - 1);
-        let c = &self.terms;
-        let [j00, j01, j10, j11] = c.jacobian;
-        let stroke = [j00 * q1 + j01 * q2, j10 * q1 + j11 * q2];
-        let phi_dot = [j00 * q1_dot + j01 * q2_dot, j10 * q1_dot + j11 * q2_dot];
-        let [mut g0, mut g1] = c.drive.load([force, V::splat(0.0)], [q1, q2]);
-        let rows = [(j00, j01), (j10, j11)];
-        for k in 0..2 {
-            let (a, b) = rows[k];
-            let tau_aero = paritysim_aero::stroke_drag_torque(c.drag[k], phi_dot[k]);
-            let d = stroke[k] - c.rest[k];
-            let spring = c.stiffness[k] * d + c.cubic[k] * d * d * d;
-            let tau = tau_aero - spring;
-            g0 += a * tau;
-            g1 += b * tau;
-        }
-        let [m00, m01, m11] = c.mass;
-        dydt[0] = q1_dot;
-        dydt[1] = q2_dot;
-        dydt[2] = (m11 * g0 - m01 * g1) / c.det;
-        dydt[3] = (m00 * g1 - m01 * g0) / c.det;
+        let drag = self.terms.drag;
+        let ([q1_ddot, q2_ddot], _) =
+            linear_map::accelerations(&self.terms, force, y, |k, rate| {
+                paritysim_aero::stroke_drag_torque(drag[k], rate)
+            });
+        *dydt = [q1_dot, q2_dot, q1_ddot, q2_ddot];
         failed
     }
 }
@@ -219,7 +205,7 @@ impl LaneRhs<4> for LinearStrokeLanes<'_> {
 
 /// The variational equations of [`LinearStrokeLanes`] on `[y (4), Φ (4 × 4, by columns)]`,
 /// as integrate/variational.rs forms them for the scalar device: the right-hand side, then
-/// `J Φ` from the analytic Jacobian ([`crate::device::linear_map_jacobian::variational`], the same
+/// `J Φ` from the analytic Jacobian ([`crate::device::linear_map::variational`], the same
 /// function, so the same operations), one device per lane.
 pub(crate) struct VariationalLanes<'m, 'a>(pub(crate) &'m LinearStrokeLanes<'a>);
 
@@ -230,7 +216,7 @@ impl LaneRhs<20> for VariationalLanes<'_, '_> {
         let mut f = [V::splat(0.0); 4];
         let failed = rhs.eval_with(rhs.force(t, stage), &y, &mut f);
         dc[..4].copy_from_slice(&f);
-        linear_map_jacobian::variational(&rhs.terms, &y, &c[4..], &mut dc[4..]);
+        linear_map::variational(&rhs.terms, &y, &c[4..], &mut dc[4..]);
         failed
     }
 }

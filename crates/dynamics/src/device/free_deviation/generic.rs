@@ -56,8 +56,7 @@ pub(crate) fn blade_models(device: &Device) -> Option<[BladeElementModel<Coeffic
 impl<const N: usize> Constants<f64, N> {
     /// The constants of a free-deviation device on `N` coordinates with blade elements on both
     /// wings, or `None`.
-    pub(crate) fn of(device: &Device) -> Option<Self> {
-        let lean = device.free_deviation_rhs.as_ref()?;
+    pub(crate) fn of(device: &Device, lean: &super::FreeDeviation) -> Option<Self> {
         blade_models(device)?;
         if device.n_dof != N {
             return None;

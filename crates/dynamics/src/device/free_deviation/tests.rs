@@ -16,7 +16,11 @@ use crate::integrate::{MAX_SWITCHES, OdeSystem, Sides};
 fn lean_free_deviation_rhs_equals_the_null_space_path() {
     for configuration in ["lift_parity", "dual_parity"] {
         let d = device(configuration);
-        let lean = d.free_deviation_rhs.expect("a free-deviation device");
+        let lean = d
+            .form
+            .free_deviation()
+            .expect("a free-deviation device")
+            .clone();
         let ys = states(&d);
         assert!(ys.len() > 20, "{} states", ys.len());
         let mut worst: f64 = 0.0;
@@ -53,7 +57,7 @@ fn lean_free_deviation_rhs_equals_the_null_space_path() {
 #[test]
 fn lean_path_applies_to_free_deviation_only_and_reports_implausible_coordinates() {
     let d = device("drag_parity");
-    assert!(d.free_deviation_rhs.is_none() && d.stroke_plane_rhs.is_some());
+    assert!(d.form.free_deviation().is_none() && d.form.stroke_plane().is_some());
     let d = device("lift_parity");
     assert_implausible_coordinates_get_the_general_error(&d);
 }
@@ -210,7 +214,11 @@ fn assert_batches_are_scalar_bit_for_bit(d: &Device, ys: &[State]) {
         v.extend([s.work_actuator.to_bits(), s.work_aero.to_bits()]);
         v
     };
-    let lean = d.free_deviation_rhs.expect("a free-deviation device");
+    let lean = d
+        .form
+        .free_deviation()
+        .expect("a free-deviation device")
+        .clone();
     let t = 0.61;
     for flip in [None, Some(1), Some(4)] {
         let sides = flipped_sides(d, &ys[1], flip);

@@ -19,6 +19,7 @@ use paritysim_aero::Branch;
 use paritysim_error::{Error, Result};
 
 use super::Device;
+use super::form::Equations;
 use crate::WingAero;
 use crate::integrate::{MAX_SWITCHES, State};
 use crate::metrics::needs::StrokeNeeds;
@@ -35,7 +36,7 @@ pub(super) const N: usize = 4;
 const ORTHOGONALITY_TOL: f64 = 1e-12;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct StrokePlane {
+pub(crate) struct StrokePlane {
     /// Rows `φ` (3w) and `ψ` (3w + 2) of the null basis `N`, per wing.
     rows: [[[f64; N]; 2]; 2],
     /// The particular solution's `(φ, ψ)` per wing.
@@ -95,10 +96,12 @@ impl Device {
     /// `(ω_x, ω_y, ω_z)` of `ω = φ̇ (cos ψ, −sin ψ, 0) + ψ̇ ẑ` where the model switches (the
     /// stroke reversal, α = π/2 where the fit jumps, the rotational damping's `ω_z = 0`),
     /// `1` elsewhere.
-    pub(super) fn stroke_plane_switching_functions(&self, y: &State, g: &mut [f64; MAX_SWITCHES]) {
-        let Some(lean) = &self.stroke_plane_rhs else {
-            return;
-        };
+    fn stroke_plane_switching_functions(
+        &self,
+        lean: &StrokePlane,
+        y: &State,
+        g: &mut [f64; MAX_SWITCHES],
+    ) {
         let (x, x_dot) = (&y.coords[..N], &y.rates[..N]);
         for (w, wing) in self.spec.wings.iter().enumerate() {
             let [row_phi, row_psi] = &lean.rows[w];
@@ -291,7 +294,7 @@ impl Device {
         y: &State,
         needs: StrokeNeeds,
     ) -> Option<Result<PlaneSample>> {
-        let lean = self.stroke_plane_rhs.as_ref()?;
+        let lean = self.form.stroke_plane()?;
         let step = match self.stroke_plane_step(lean, t, y, None) {
             Ok(Some(step)) => step,
             Ok(None) => return None,
@@ -466,6 +469,44 @@ impl Device {
             }
         }
         Some(Ok(()))
+    }
+}
+
+impl Equations for StrokePlane {
+    #[inline]
+    fn rhs(
+        &self,
+        device: &Device,
+        t: f64,
+        y: &State,
+        branches: Option<[Branch; 2]>,
+        dydt: &mut State,
+    ) -> Result<()> {
+        device.rhs_stroke_plane(self, t, y, branches, dydt)
+    }
+
+    fn switches(&self, device: &Device, y: &State, g: &mut [f64; MAX_SWITCHES]) -> Result<()> {
+        device.stroke_plane_switching_functions(self, y, g);
+        Ok(())
+    }
+
+    fn variational(
+        &self,
+        device: &Device,
+        t: f64,
+        y: &State,
+        branches: Option<[Branch; 2]>,
+        n: usize,
+        rhs: Option<&mut [f64]>,
+        phi: &[f64],
+        dphi: &mut [f64],
+    ) -> Option<Result<()>> {
+        if n != device.n_dof {
+            return None;
+        }
+        let mut own = [0.0; 2 * N];
+        let f = rhs.unwrap_or(&mut own);
+        device.stroke_plane_variational(self, t, y, branches, f, phi, dphi)
     }
 }
 

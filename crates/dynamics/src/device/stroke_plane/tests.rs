@@ -90,7 +90,7 @@ fn lean_stroke_plane_rhs_equals_the_null_space_path() {
     let mut worst: f64 = 0.0;
     for (aero, hinge, k2) in [(true, false, 0.0), (true, true, 3.0), (false, false, 1.0)] {
         let d = device(aero, hinge, k2);
-        let lean = d.stroke_plane_rhs.expect("a stroke-plane device");
+        let lean = *d.form.stroke_plane().expect("a stroke-plane device");
         // x = Nᵀ (p − p0): map (φL, ψL, φR, ψR) into the device's coordinates.
         let values = [-0.61, -0.2, -1e-3, 0.0, 2e-4, 0.17, 0.55];
         let rates = [-3.1, -0.4, 0.0, 0.03, 1.7];
@@ -239,7 +239,7 @@ fn analytic_stroke_plane_jacobian_equals_central_differences() {
 #[test]
 fn lean_path_is_used_and_reports_implausible_coordinates() {
     let d = device(true, false, 0.0);
-    assert!(d.stroke_plane_rhs.is_some());
+    assert!(d.form.stroke_plane().is_some());
     assert_implausible_coordinates_get_the_general_error(&d);
 }
 

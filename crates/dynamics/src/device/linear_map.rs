@@ -1,18 +1,20 @@
-//! The analytic Jacobian of the drivetrain-coordinate equations of the linear differential map
-//! (eq. 2.15), written once for both scalar (`f64`) and SIMD-lane (`wide::f64x4`) arithmetic.
+//! The drivetrain-coordinate equations of the linear differential map (eq. 2.15) and their
+//! analytic Jacobian, written once for both scalar (`f64`) and SIMD-lane (`wide::f64x4`)
+//! arithmetic.
 //!
 //! With `φ_k = J_k q` constant in `q`, `M_q = Σ_k I_k J_kᵀ J_k` constant and no velocity
 //! product, the equations are `M_q q̈ = g(t, q, q̇)`,
-//! `g = (F(t) − K1 q1, −K2 q2) + Σ_k J_kᵀ τ_k`, `τ_k = −Ω_k C φ̇_k |φ̇_k| − s_k(φ_k)`
-//! (stroke drag, eq. 2.16, and the stroke spring, A.7). So
+//! `g = (F(t) − K1 q1, −K2 q2) + Σ_k J_kᵀ τ_k`, `τ_k = τ_aero,k(φ̇_k) − s_k(φ_k)` (the wing's
+//! stroke torque: the stroke drag of eq. 2.16 `−Ω_k C φ̇_k |φ̇_k|` or a fixed blade element, and
+//! the stroke spring, A.7). So, with stroke drag,
 //! `∂g/∂q = −diag(K1, K2) − Σ_k s_k'(φ_k) J_kᵀ J_k` and
 //! `∂g/∂q̇ = Σ_k (−2 Ω_k C |φ̇_k|) J_kᵀ J_k`, and the variational equations
 //! `Φ̇ = J Φ` of the state `(q, q̇)` are, per column `(u, v)` of `Φ`: `u̇ = v`,
 //! `v̇ = M_q⁻¹ (∂g/∂q u + ∂g/∂q̇ v)`.
 //!
-//! Why generic: the scalar path (`Device`'s [`crate::integrate::OdeSystem::variational`])
-//! and the lanes (`lanes::linear_stroke`) call this one function, so a lane's monodromy is
-//! bit-identical to the scalar one with no mirrored code to keep in step.
+//! Why generic: the scalar path (`Device`'s drivetrain-coordinate form) and the lanes
+//! (`lanes::linear_stroke`) call these functions, so a lane's derivative and monodromy are
+//! bit-identical to the scalar ones with no mirrored code to keep in step.
 
 use paritysim_simd::Real;
 
@@ -30,8 +32,11 @@ pub(crate) struct LinearMapTerms<S: Real> {
     pub(crate) mass: [S; 3],
     /// `det M_q`.
     pub(crate) det: S,
-    /// `−Ω1 C` per wing (0 without aerodynamics).
+    /// `−Ω1 C` per wing (0 without aerodynamics or with a blade element).
     pub(crate) drag: [S; 2],
+    /// Whether every wing has stroke drag or no aerodynamics: the torque is
+    /// [`paritysim_aero::stroke_drag_torque`] of `drag` and [`variational`] is the Jacobian.
+    pub(crate) analytic: bool,
     /// Stroke springs per wing: linear stiffness, cubic coefficient, rest angle.
     pub(crate) stiffness: [S; 2],
     pub(crate) cubic: [S; 2],
@@ -42,8 +47,7 @@ pub(crate) struct LinearMapTerms<S: Real> {
 
 impl LinearMapTerms<f64> {
     /// The constants of `spec`, or `None` unless it is a two-DOF linear differential (not a
-    /// dual drive) whose wings have stroke drag or no aerodynamics and a non-singular `M_q`.
-    /// The entries are summed as the scalar right-hand side sums them.
+    /// dual drive) on two wings.
     pub(crate) fn of(spec: &DeviceSpec) -> Option<Self> {
         let transmission = spec.transmission.as_ref()?;
         let Drivetrain::LinearDifferential(d) = transmission.kinematics() else {
@@ -58,6 +62,7 @@ impl LinearMapTerms<f64> {
         let jacobian = [-t, t * hl, -t, -t * hr];
         let (mut m00, mut m01, mut m11) = (0.0, 0.0, 0.0);
         let mut drag = [0.0; 2];
+        let mut analytic = true;
         let (mut stiffness, mut cubic, mut rest) = ([0.0; 2], [0.0; 2], [0.0; 2]);
         for (k, wing) in spec.wings.iter().enumerate() {
             let (a, b) = (jacobian[2 * k], jacobian[2 * k + 1]);
@@ -71,26 +76,58 @@ impl LinearMapTerms<f64> {
                     omega1,
                     coefficient,
                 } => paritysim_aero::stroke_drag_constant(*omega1, *coefficient),
-                WingAero::BladeElement(_) => return None,
+                WingAero::BladeElement(_) => {
+                    analytic = false;
+                    0.0
+                }
             };
             let s = &wing.springs()[0];
             (stiffness[k], cubic[k], rest[k]) = (s.stiffness(), s.cubic(), s.rest_angle());
         }
-        let det = m00 * m11 - m01 * m01;
-        if det == 0.0 || !det.is_finite() {
-            return None;
-        }
         Some(Self {
             jacobian,
             mass: [m00, m01, m11],
-            det,
+            det: m00 * m11 - m01 * m01,
             drag,
+            analytic,
             stiffness,
             cubic,
             rest,
             drive: DriveSprings::of(spec, false),
         })
     }
+}
+
+/// `(q̈, aerodynamic power)` of `M_q q̈ = g` at the state `y = (q1, q2, q̇1, q̇2)` and the
+/// actuator force `force`, with wing `k`'s aerodynamic stroke torque `aero(k, φ̇_k)` (see the
+/// module); `M_q` is solved by Cramer's rule.
+#[inline(always)]
+pub(crate) fn accelerations<S: Real>(
+    terms: &LinearMapTerms<S>,
+    force: S,
+    y: &[S; 4],
+    aero: impl Fn(usize, S) -> S,
+) -> ([S; 2], S) {
+    let [q1, q2, q1_dot, q2_dot] = *y;
+    let [j00, j01, j10, j11] = terms.jacobian;
+    let [mut g0, mut g1] = terms.drive.load([force, S::splat(0.0)], [q1, q2]);
+    let mut aero_power = S::splat(0.0);
+    for (k, (a, b)) in [(j00, j01), (j10, j11)].into_iter().enumerate() {
+        let stroke = a * q1 + b * q2;
+        let rate = a * q1_dot + b * q2_dot;
+        let tau_aero = aero(k, rate);
+        let d = stroke - terms.rest[k];
+        let tau = tau_aero - (terms.stiffness[k] * d + terms.cubic[k] * d * d * d);
+        g0 = g0 + a * tau;
+        g1 = g1 + b * tau;
+        aero_power = aero_power + tau_aero * rate;
+    }
+    let [m00, m01, m11] = terms.mass;
+    let det = terms.det;
+    (
+        [(m11 * g0 - m01 * g1) / det, (m00 * g1 - m01 * g0) / det],
+        aero_power,
+    )
 }
 
 /// `dphi = J(y) phi` for the state `y = (q1, q2, q̇1, q̇2)` and the four columns of `phi`
