@@ -152,6 +152,8 @@ def calibrate(
             t = traj["time_ms"].to_numpy() - traj["time_ms"][0]
             res = []
             for c in columns:
+                if c not in traj.columns:  # polars' ColumnNotFoundError otherwise
+                    raise invalid(f"targets.{c}", "<unknown column>", suggest(c, traj.columns, what="a trajectory column"))
                 sim = np.interp(t_target, t, traj[c].to_numpy())
                 res.append((sim - targets[c].to_numpy()) / max(float(np.abs(targets[c].to_numpy()).max()), 1e-12))
             return np.concatenate(res)

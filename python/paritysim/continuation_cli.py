@@ -23,7 +23,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from ._errors import invalid, read_toml
+from ._errors import invalid, read_toml, suggest
 
 __all__ = ["add_parser", "run_study"]
 
@@ -40,9 +40,7 @@ def run_study(study: str | Path, out: str | Path) -> dict[str, Any]:
     study = Path(study)
     unknown = sorted(set(data) - set(_KEYS))
     if unknown:
-        from . import _core
-
-        raise invalid(unknown[0], "<unknown key>", _core.spec_suggestion(unknown[0], list(_KEYS)))
+        raise invalid(unknown[0], "<unknown key>", suggest(unknown[0], _KEYS, what="a key of the study file"))
     for key in ("spec", "path", "stop"):
         if key not in data:
             raise invalid(key, "<missing>", "given (see `paritysim continue --help`)")

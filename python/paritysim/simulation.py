@@ -14,7 +14,7 @@ import polars as pl
 from matplotlib.figure import Figure
 
 from . import _core, _slow_drive
-from ._errors import invalid, real
+from ._errors import invalid, real, suggest
 from .spec import Simulation
 
 __all__ = ["SimulationResult", "simulate"]
@@ -116,7 +116,7 @@ def _control_call(controller: Controller) -> Callable[[float, list[tuple[str, fl
         checked = []
         for name in out:
             if name not in CONTROL_INPUTS:
-                raise invalid(f"controller[{name!r}]", out[name], f"one of {', '.join(CONTROL_INPUTS)}")
+                raise invalid(f"controller[{name!r}]", out[name], suggest(str(name), CONTROL_INPUTS, what="a control input"))
             v = real(f"controller[{name!r}]", out[name])
             if not math.isfinite(v):
                 raise invalid(f"controller[{name!r}]", v, "a finite number")

@@ -35,8 +35,7 @@ from typing import Any
 import numpy as np
 import polars as pl
 
-from . import _core
-from ._errors import invalid, read_toml
+from ._errors import invalid, read_toml, suggest
 from .spec import Simulation, load_spec
 
 __all__ = ["Study", "add_parser", "load_study", "run_study"]
@@ -82,7 +81,7 @@ def load_study(path: str | Path) -> Study:
     path = Path(path)
     unknown = sorted(set(data) - set(_KEYS))
     if unknown:
-        raise invalid(unknown[0], "<unknown key>", _core.spec_suggestion(unknown[0], list(_KEYS)))
+        raise invalid(unknown[0], "<unknown key>", suggest(unknown[0], _KEYS, what="a key of the study file"))
     raw_spec = data.get("spec")
     if isinstance(raw_spec, str):
         spec = load_spec(path.parent / raw_spec)

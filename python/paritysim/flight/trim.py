@@ -178,7 +178,7 @@ def trim(
     equations = tuple(equations) if equations is not None else order[: len(knobs)]
     for e in equations:
         if e not in EQUATIONS:
-            raise invalid("equations", e, f"one of {', '.join(EQUATIONS)}")
+            raise invalid("equations", repr(e), suggest(str(e), EQUATIONS, what="an equation"))
     if not knobs or len(equations) < len(knobs):
         raise invalid("equations", len(equations), f"at least one equation per knob ({len(knobs)} knobs)")
     clamped, body = _clamped(spec)
@@ -187,7 +187,7 @@ def trim(
     paths = {row[0]: row[3] for row in _path_values(clamped)}
     for k in knobs:
         if k not in paths:
-            raise invalid("knobs", k, "a spec path; " + suggest(k, paths, listed_by="ps.spec_paths(spec)"))
+            raise invalid("knobs", repr(k), suggest(k, paths, listed_by="ps.spec_paths(spec)", what="a parameter path of this spec"))
     if initial is not None:
         x0 = np.atleast_1d(finite_reals("initial", initial))
         if x0.shape != (len(knobs),):
