@@ -175,8 +175,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     matplotlib.use("Agg")  # the CLI only writes files
     args = build_parser().parse_args(argv)
     debug = bool(getattr(args, "debug", False))
+    from contextlib import nullcontext
+
+    from ._progress import quiet
+
     try:
-        return int(args.func(args))
+        with quiet() if getattr(args, "quiet", False) else nullcontext():  # no bar of a long run either
+            return int(args.func(args))
     except KeyboardInterrupt:
         if debug:
             raise
