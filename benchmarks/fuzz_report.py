@@ -611,11 +611,13 @@ class Worker:
             raise SystemExit(f"fuzz worker did not start: {line!r}")
 
     def _read(self, timeout: float) -> str | None:
+        """The worker's next line; ``None`` when none came within ``timeout``, ``""`` at the end
+        of its output (it died)."""
         assert self.proc.stdout is not None
         ready, _, _ = select.select([self.proc.stdout], [], [], timeout)
         if not ready:
             return None
-        return self.proc.stdout.readline().strip() or None
+        return self.proc.stdout.readline().strip()
 
     def run(self, i: int, timeout: float) -> dict[str, Any]:
         assert self.proc.stdin is not None
@@ -625,11 +627,15 @@ class Worker:
         except BrokenPipeError:
             return {"i": i, "outcome": ABORT, "detail": "worker gone"}
         line = self._read(timeout)
-        if line is None:
-            if self.proc.poll() is None:
+        if line is None and self.proc.poll() is None:
+            self.kill()
+            return {"i": i, "outcome": HANG, "detail": f"no answer within {timeout:g} s"}
+        if not line:  # the end of its output: it died (an abort, even if not yet reaped)
+            try:
+                code = self.proc.wait(timeout=10.0)
+            except subprocess.TimeoutExpired:
                 self.kill()
-                return {"i": i, "outcome": HANG, "detail": f"no answer within {timeout:g} s"}
-            code = self.proc.returncode
+                code = self.proc.returncode
             return {"i": i, "outcome": ABORT, "detail": f"worker died ({signal.Signals(-code).name if code < 0 else f'exit {code}'})"}
         return json.loads(line)  # type: ignore[no-any-return]
 

@@ -9,13 +9,23 @@ instantaneous and peak imbalance %) of the last cycle from ``--samples`` samples
 
 Also timed in the same rounds: one §3.4 rotating trial (the shipped
 ``sreetharan2012_3_4_parity_1cut`` device at its default options: blade-element wings on the
-stroke plane), against the same run at rtol 1e-12.
+stroke plane), against the same run at rtol 1e-12; and a §3.4 design sweep (issue 30) against
+its JAX + diffrax peer (``benchmarks/_jax_3_4.py``: the same blade-element model with passive
+rotation, written from the equations, smooth through stroke reversal, no event location): the
+``sreetharan2012_3_4_parity`` device with a K2 = 100 mN·mm/rad balance spring (K2 = 0 leaves the
+whippletree's offset a family of orbits, docs/findings.md §26-27: a script's run from rest and
+paritysim's shooting land on members 1e-5 rad apart), hinge stiffness × right membrane cut
+(``--grid-3-4`` per axis), mean yaw torque, stroke amplitudes and means, rotation amplitudes of
+the last cycle; ``ps.sweep`` at the device's default options against the peer's
+``--cycles-3-4`` cycles from rest, both checked against an rtol 1e-12 ``ps.sweep`` (itself checked
+against the peer at rtol 1e-12 on three points).
 
 Every peer's metrics are compared with an rtol 1e-12 reference (paritysim, Newton shooting to a
 residual of 1e-11 at rtol 1e-12; checked against a 1e-12 long transient on a few points).
 The script peers run a fixed number of cycles from rest (``--cycles``), as a script would.
 
 Run:  python benchmarks/vs_jax.py [--grid 32] [--cycles 60] [--scipy-points 4] [--repeat 3]
+                                   [--grid-3-4 8] [--cycles-3-4 60]   # --grid-3-4 0: no §3.4 sweep
       python benchmarks/vs_jax.py --scale 100000   # peak RSS of 100,000 Table 3.2 points, and
                                                    # the 1- vs 2-thread speedup (same results?)
 JAX and diffrax are the optional ``bench`` extra (``pip install -e .[bench]``); without them
@@ -29,11 +39,13 @@ import math
 import os
 import statistics
 import time
+import warnings
 from collections.abc import Callable
 
 # Two host devices for shard_map (must be set before JAX is imported).
 os.environ.setdefault("XLA_FLAGS", "--xla_force_host_platform_device_count=2")
 
+import _jax_3_4 as peer_3_4
 import numpy as np
 from scipy.integrate import solve_ivp
 
@@ -42,6 +54,7 @@ import paritysim as ps
 T_RATIO, ARM, INERTIA, C, OMEGA_R = 2.5, 2.5, 29.0, 1.0, 31.3
 ROTATING_DEVICE = "sreetharan2012_3_4_parity_1cut"
 ROTATING_PEER = "paritysim simulate, §3.4 rotating 1-Cut trial"
+SWEEP_3_4_DEVICE, K2_3_4 = "sreetharan2012_3_4_parity", 100.0  # mN·mm/rad: the §3.3 grid's stiffest
 K1, FORCE_PER_VOLT, AMPLITUDE_V, FREQUENCY_HZ = 467.0, 1.2, 100.0, 110.0
 W = 2 * math.pi * FREQUENCY_HZ * 1e-3  # rad/ms
 PERIOD = 2 * math.pi / W
@@ -160,12 +173,26 @@ def jax_runners(cycles: int, samples: int, rtol: float, atol: float) -> tuple[Ca
 # ------------------------------------------------------------------------------ paritysim
 
 
-def ps_sweep(ratios: np.ndarray, k2s: np.ndarray, base: ps.Simulation, threads: int) -> np.ndarray:
-    df = ps.sweep(
-        base, {"wings.left.omega_ratio": ratios, "drivetrain.k2": k2s}, metrics=list(METRICS), threads=threads, progress=False
-    )
-    if (df["status"] != "ok").any():
-        raise SystemExit(f"paritysim: {int((df['status'] != 'ok').sum())} failed points: {df.filter(df['status'] != 'ok')['error'][0]}")
+UNCONVERGED: dict[str, int] = {}  # rows a peer's sweep ran without converging (kept: metrics of its last cycles)
+
+
+def ps_sweep(ratios: np.ndarray, k2s: np.ndarray, base: ps.Simulation, threads: int, unconverged_as: str | None = None) -> np.ndarray:
+    """Table 3.2 metrics of the grid; every row must be "ok", except "unconverged" rows of a
+    peer that names itself (``unconverged_as``): the transient steady state from rest at
+    default options leaves the K2 = 3.2 row (a slow whippletree mode) short of steady_tol after
+    max_cycles; such rows keep the metrics of their last cycles and are counted."""
+    with warnings.catch_warnings():
+        if unconverged_as:
+            warnings.simplefilter("ignore")
+        df = ps.sweep(
+            base, {"wings.left.omega_ratio": ratios, "drivetrain.balance_spring": k2s}, metrics=list(METRICS), threads=threads, progress=False
+        )
+    allowed = ["ok", "unconverged"] if unconverged_as else ["ok"]
+    if (~df["status"].is_in(allowed)).any():
+        bad = df.filter(~df["status"].is_in(allowed))
+        raise SystemExit(f"paritysim: {len(bad)} points not {' or '.join(allowed)}: {bad['error'][0]}")
+    if unconverged_as:
+        UNCONVERGED[unconverged_as] = int((df["status"] == "unconverged").sum())
     return df.select(METRICS).to_numpy()
 
 
@@ -175,6 +202,20 @@ def errors(values: np.ndarray, reference: np.ndarray) -> tuple[float, float]:
     rel = np.abs(values[:, :3] - reference[:, :3]) / np.abs(reference[:, 1:2])
     pct = np.abs(values[:, 3:] - reference[:, 3:])
     return float(rel.max()), float(pct.max())
+
+
+def ps_sweep_3_4(base: ps.Simulation, rows: object, threads: int) -> np.ndarray:
+    df = ps.sweep(base, rows, metrics=list(peer_3_4.METRICS), threads=threads, progress=False)
+    if (df["status"] != "ok").any():
+        raise SystemExit(f"paritysim §3.4: {int((df['status'] != 'ok').sum())} points not ok: {df.filter(df['status'] != 'ok')['error'][0]}")
+    return df.select(peer_3_4.METRICS).to_numpy()
+
+
+def errors_3_4(values: np.ndarray, reference: np.ndarray) -> tuple[float, float, float]:
+    """Worst error of the mean yaw torque (mN·mm, and relative to the grid's largest |mean yaw|)
+    and of the stroke and rotation angles (rad)."""
+    yaw = float(np.abs(values[:, 0] - reference[:, 0]).max())
+    return yaw, yaw / float(np.abs(reference[:, 0]).max()), float(np.abs(values[:, 1:] - reference[:, 1:]).max())
 
 
 def timed(f: Callable[[], np.ndarray]) -> tuple[float, np.ndarray]:
@@ -223,6 +264,8 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--rtol", type=float, default=1e-8)
+    parser.add_argument("--grid-3-4", type=int, default=8, help="points per axis of the §3.4 sweep (0: none)")
+    parser.add_argument("--cycles-3-4", type=int, default=60, help="fixed cycles of the §3.4 JAX peer")
     parser.add_argument("--scale", type=int, default=0, help="run only the memory / thread-scaling check with this many points")
     args = parser.parse_args()
     if args.scale:
@@ -245,14 +288,16 @@ def main() -> None:
         options=ps.Options(rtol=1e-12, atol=1e-14, samples_per_cycle=args.samples, steady_tol=1e-12, max_cycles=20000)
     )
     for i in check:
-        r = ps.sweep(long, [{"wings.left.omega_ratio": omega_l[i] / OMEGA_R, "drivetrain.k2": k2[i]}], metrics=list(METRICS), progress=False)
+        r = ps.sweep(long, [{"wings.left.omega_ratio": omega_l[i] / OMEGA_R, "drivetrain.balance_spring": k2[i]}], metrics=list(METRICS), progress=False)
         rel, pct = errors(r.select(METRICS).to_numpy(), reference[i : i + 1])
         print(f"  point {i}: long transient vs reference: torques {rel:.1e} rel, percentages {pct:.1e} points")
 
     jax_run = jax_runners(args.cycles, args.samples, args.rtol, atol)
     peers: dict[str, Callable[[], np.ndarray]] = {
         "paritysim sweep, shooting (metrics only)": lambda: ps_sweep(ratios, k2s, spec(args.rtol, atol, args.samples), args.threads),
-        "paritysim sweep, transient": lambda: ps_sweep(ratios, k2s, spec(args.rtol, atol, args.samples, "transient"), args.threads),
+        "paritysim sweep, transient": lambda: ps_sweep(
+            ratios, k2s, spec(args.rtol, atol, args.samples, "transient"), args.threads, unconverged_as="paritysim sweep, transient"
+        ),
     }
     sizes = {name: n for name in peers}
     if isinstance(jax_run, str):
@@ -289,13 +334,47 @@ def main() -> None:
     peers[ROTATING_PEER] = lambda: np.array([list(ps.simulate(rotating, columns=[], metrics=METRICS).metrics.values())])
     sizes[ROTATING_PEER] = 1
 
-    times: dict[str, list[float]] = {name: [] for name in peers}
+    # The §3.4 design sweep and its JAX peer.
+    peers_3_4: dict[str, Callable[[], np.ndarray]] = {}
+    if args.grid_3_4:
+        base_3_4 = ps.devices.load(SWEEP_3_4_DEVICE).with_paths({"drivetrain.balance_spring": K2_3_4})
+        rows, hinge, omegas_right = peer_3_4.grid(base_3_4, args.grid_3_4)
+        n_3_4 = len(hinge)
+        samples_3_4 = base_3_4.options.samples_per_cycle
+        print(f"\n§3.4 {SWEEP_3_4_DEVICE} with K2 = {K2_3_4:g} mN·mm/rad, hinge stiffness × right membrane cut, "
+              f"{args.grid_3_4}×{args.grid_3_4} = {n_3_4} points, {samples_3_4} samples per cycle")  # fmt: skip
+        tight = base_3_4.with_paths({"options.rtol": 1e-12, "options.atol": 1e-14, "options.steady_tol": 1e-12})
+        t_ref, reference_3_4 = timed(lambda: ps_sweep_3_4(tight, rows, args.threads))
+        print(f"reference: paritysim ps.sweep at rtol 1e-12, steady_tol 1e-12 ({t_ref:.1f} s)")
+        jax_3_4 = peer_3_4.runners(base_3_4, args.cycles_3_4, samples_3_4, args.rtol, atol)
+        peers_3_4["paritysim ps.sweep (device defaults)"] = lambda: ps_sweep_3_4(base_3_4, rows, args.threads)
+        if isinstance(jax_3_4, str):
+            print(f"JAX skipped: {jax_3_4}")
+        else:
+            # The peer's equations against paritysim's: both at rtol 1e-12 on three points.
+            check = [0, n_3_4 // 2 - 1, n_3_4 - 1]
+            tight_peer = peer_3_4.runners(base_3_4, 100, samples_3_4, 1e-12, 1e-14)
+            assert not isinstance(tight_peer, str)
+            out = tight_peer[0](hinge[check], omegas_right[check])
+            yaw, yaw_rel, angles = errors_3_4(out, reference_3_4[check])
+            print(f"  points {check}: JAX peer at rtol 1e-12 (100 cycles) vs reference: mean yaw {yaw:.1e} mN·mm, angles {angles:.1e} rad")
+            for name, f in [("JAX+diffrax Dopri5 jit(vmap)", jax_3_4[0]), ("JAX+diffrax Dopri5 shard_map x2", jax_3_4[1])]:
+                if f is None:
+                    print(f"{name} skipped: fewer than 2 host devices")
+                    continue
+                t_compile, _ = timed(lambda f=f: f(hinge, omegas_right))
+                print(f"{name}: first call (compile + run) {t_compile:.1f} s")
+                peers_3_4[name] = lambda f=f: f(hinge, omegas_right)
+
+    times: dict[str, list[float]] = {name: [] for name in [*peers, *(f"3.4 {k}" for k in peers_3_4)]}
     results: dict[str, np.ndarray] = {}
-    for _ in range(args.repeat):  # interleaved rounds
-        for name, f in peers.items():
+    for _ in range(args.repeat):  # interleaved rounds, both sections
+        for name, f in [*peers.items(), *((f"3.4 {k}", g) for k, g in peers_3_4.items())]:
             dt, out = timed(f)
             times[name].append(dt)
             results[name] = out
+    for name in peers_3_4:
+        sizes[f"3.4 {name}"] = n_3_4
     ms = {name: 1e3 * statistics.median(ts) / sizes[name] for name, ts in times.items()}
     ours = ms["paritysim sweep, shooting (metrics only)"]
     jax_best = min((v for k, v in ms.items() if k.startswith("JAX")), default=float("nan"))
@@ -305,11 +384,27 @@ def main() -> None:
         ref = rotating_reference if name == ROTATING_PEER else ref
         rel, pct = errors(results[name], ref)
         print(f"{name:48s} {ms[name]:10.3f} {ms[name] / ours:12.1f}x {rel:11.1e} {pct:9.1e}")
+    for name, count in UNCONVERGED.items():
+        if count:
+            print(f"{name}: {count} of {n} rows unconverged after max_cycles (their last cycles' metrics are in its errors)")
     ours_on_scipy_points = errors(results["paritysim sweep, shooting (metrics only)"][pick], reference[pick])
     print(f"paritysim on the scipy points: torque err {ours_on_scipy_points[0]:.1e}, pct err {ours_on_scipy_points[1]:.1e}")
     if math.isfinite(jax_best):
         print(f"\nparitysim per point = {ours / jax_best:.3f} × the best JAX set-up's time")
-    print(f"(medians of {args.repeat} interleaved rounds; {args.threads} paritysim threads; script peers run {args.cycles} cycles from rest)")
+    ratio_3_3 = ours / jax_best if math.isfinite(jax_best) else float("nan")
+    if peers_3_4:
+        ours_3_4 = ms["3.4 paritysim ps.sweep (device defaults)"]
+        print(f"\n{'§3.4 implementation':48s} {'ms/point':>10s} {'vs paritysim':>13s} {'yaw err':>9s} {'yaw rel':>9s} {'angle err':>10s}")
+        for name in peers_3_4:
+            yaw, yaw_rel, angles = errors_3_4(results[f"3.4 {name}"], reference_3_4)
+            print(f"{name:48s} {ms[f'3.4 {name}']:10.3f} {ms[f'3.4 {name}'] / ours_3_4:12.1f}x {yaw:9.1e} {yaw_rel:9.1e} {angles:10.1e}")
+        print("(yaw err: worst |Δ mean yaw torque|, mN·mm; yaw rel: over the grid's largest |mean yaw|; angle err: strokes and rotations, rad)")
+        best_3_4 = min((v for k, v in ms.items() if k.startswith("3.4 JAX")), default=float("nan"))
+        if math.isfinite(best_3_4):
+            print(f"\nparitysim per point = {ratio_3_3:.3f} × the best JAX set-up's time (§3.3), "
+                  f"{ours_3_4 / best_3_4:.3f} × (§3.4)")  # fmt: skip
+    print(f"(medians of {args.repeat} interleaved rounds; {args.threads} paritysim threads; script peers run {args.cycles} cycles "
+          f"(§3.4: {args.cycles_3_4}) from rest)")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -7,12 +7,21 @@ every test that checks trial outputs or the report reads that directory (and is 
 
 from __future__ import annotations
 
+import signal
 from pathlib import Path
 
 import matplotlib
 import pytest
 
 matplotlib.use("Agg")
+
+# A shell starts a background job (`cmd &`, nohup) with SIGINT ignored, and Python then leaves
+# it ignored: `_thread.interrupt_main()` does nothing and the Ctrl-C tests fail. Python's own
+# handler, as in a foreground run. The subprocesses these tests start (the CLI, spawned
+# process-pool workers) exec a new interpreter, which resets a handled signal to its default
+# and so installs Python's handler again (an ignored one would be inherited as ignored).
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture(scope="session")

@@ -47,7 +47,11 @@ def test_cli_writes_parquet_csv_and_png(tmp_path: Path) -> None:
 
 def test_cli_unknown_trial_fails_clearly(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["reproduce", "fig9.99", "--out", "unused"]) == 2
-    assert "available" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "unknown trial `fig9.99`" in err and "paritysim reproduce --list` lists all" in err
+    assert main(["reproduce", "fig2.99", "--out", "unused"]) == 2
+    err = capsys.readouterr().err  # a typo names the trial meant, and a handful at most
+    assert "did you mean `fig2.9`?" in err and err.count("`") <= 2 * 6 + 2, err
 
 
 def test_console_script_runs() -> None:

@@ -31,7 +31,7 @@ def _cases(tmp: Path) -> dict[str, tuple[list[str], str]]:
         "missing spec": (["run", str(tmp / "missing.toml")], "missing.toml"),
         "empty spec": (["run", str(tmp / "empty.toml")], ""),
         "malformed spec": (["run", str(tmp / "malformed.toml")], "TOML"),
-        "binary spec": (["run", str(tmp / "binary.toml")], ""),
+        "binary spec": (["run", str(tmp / "binary.toml")], "binary.toml"),
         "directory as spec": (["run", str(tmp / "a_directory.toml")], "a_directory.toml"),
         "wrong type": (["run", str(tmp / "wrong_type.toml")], "crank_mm"),
         "negative frequency": (["run", str(tmp / "negative.toml")], "frequency_hz"),
@@ -42,6 +42,14 @@ def _cases(tmp: Path) -> dict[str, tuple[list[str], str]]:
         "study with missing spec": (["sweep", str(tmp / "study_missing_spec.toml"), "--out", str(tmp / "o")], "nowhere.toml"),
         "study with unknown path": (["sweep", str(tmp / "study_bad_path.toml"), "--out", str(tmp / "o"), "--quiet"], "actuator.volts"),
         "malformed study": (["sweep", str(tmp / "malformed.toml")], "TOML"),
+        # Every file the CLI reads is named with what it should hold (the fuzz, seed 34: a study
+        # that was not UTF-8 gave "not a UTF-8 text file" without its path).
+        "binary study": (["sweep", str(tmp / "binary.toml")], f"`study` = {tmp / 'binary.toml'}: must be a UTF-8 text file holding a sweep study"),
+        "directory as study": (["sweep", str(tmp / "a_directory.toml")], f"`study` = {tmp / 'a_directory.toml'}: must be a readable file holding a sweep study"),
+        "malformed study names the file": (["sweep", str(tmp / "malformed.toml")], f"`study` = {tmp / 'malformed.toml'}: must be a sweep study in valid TOML"),
+        "binary continuation study": (["continue", str(tmp / "binary.toml")], f"`study` = {tmp / 'binary.toml'}: must be a UTF-8 text file holding a continuation study"),
+        "missing continuation study": (["continue", str(tmp / "nope.toml")], f"`study` = {tmp / 'nope.toml'}: must be a readable file holding a continuation study"),
+        "malformed continuation study": (["continue", str(tmp / "malformed.toml")], f"`study` = {tmp / 'malformed.toml'}: must be a continuation study in valid TOML"),
     }
 
 
@@ -60,6 +68,12 @@ CASE_NAMES = [
     "study with missing spec",
     "study with unknown path",
     "malformed study",
+    "binary study",
+    "directory as study",
+    "malformed study names the file",
+    "binary continuation study",
+    "missing continuation study",
+    "malformed continuation study",
 ]
 
 

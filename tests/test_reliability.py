@@ -555,3 +555,67 @@ def test_a_grid_of_python_objects_is_refused_naming_its_column(tmp_path: Any) ->
     ComputeError (an Object column cannot be written); refused up front, naming the column."""
     hmf = ps.load_spec(EXAMPLES / "hmf.toml")
     _named(lambda: ps.sweep(hmf, {"actuator.frequency_hz": [100.0, object()]}, checkpoint=tmp_path / "s.parquet", progress=False), "actuator.frequency_hz")
+
+
+def test_an_absolute_tolerance_below_1e_30_is_refused_naming_it() -> None:
+    """Found by the fuzz (seed 37): ``options.atol = 5e-324`` (down to about 1e-200) was accepted
+    and every step was rejected until 'step size underflow' at t = 0, naming no field."""
+    parity = ps.load_spec(EXAMPLES / "drag_parity.toml")
+    for tiny in (5e-324, 1e-200, 1e-31):
+        with pytest.raises(ps.InvalidParameterError, match=r"options\.atol.*1e-30") as info:
+            ps.simulate(parity, atol=tiny, max_cycles=2)
+        assert info.value.field == "options.atol"
+    assert ps.simulate(parity, atol=1e-30, max_cycles=2, min_cycles=1).cycles_run == 2
+
+
+def test_more_array_paths_hold_their_output_not_a_hundred_times_it() -> None:
+    """Found by the fuzz (seed 37): ``Planform.chord`` / ``leading_edge`` held ~200 bytes per
+    point (2 GB for 1e7 points: an abort under a memory limit) and ``hill_solution`` ~700 bytes
+    per time against 32 of output. Chunked, each peaks near its output; values unchanged."""
+    import subprocess
+    import sys
+
+    script = r"""
+import resource, numpy as np, paritysim as ps
+from paritysim import _core
+p = ps.Planform.hmf_like()
+z = np.linspace(-1.0, 17.0, 2 * 10**6)
+t = np.linspace(0.0, 10.0, 2 * 10**5)
+small = _core.aero_planform_chord(p.points, z[:5000])
+hill = np.asarray(_core.stability_hill_solution(1.0, 0.2, -np.pi / 2, t[:5000], None))
+def peak(call):
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+    out = call()
+    return out, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024 - before
+chord, chord_peak = peak(lambda: p.chord(z))
+assert np.array_equal(chord[:5000], small["chord"], equal_nan=True)
+edge, edge_peak = peak(lambda: p.leading_edge(z))
+assert np.array_equal(edge[:5000], small["leading_edge"], equal_nan=True)
+m, hill_peak = peak(lambda: ps.stability.hill_solution(1.0, 0.2, t))
+assert m.shape == (t.size, 2, 2) and np.array_equal(m[:5000], hill)
+print(chord_peak, edge_peak, hill_peak)
+"""
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-1500:]
+    chord_peak, edge_peak, hill_peak = (int(v) for v in proc.stdout.split())
+    assert chord_peak < 4 * 16e6 and edge_peak < 4 * 16e6, (chord_peak, edge_peak)  # 16 MB each (was ~400 MB)
+    assert hill_peak < 6 * 6.4e6, hill_peak  # 6.4 MB (was ~140 MB)
+
+
+def test_a_chart_with_brockett_stays_within_the_charts_cost_and_budget() -> None:
+    """Found by the fuzz (seed 38): ``stability_chart(..., brockett=True)`` ran Brockett's test
+    point by point through Python (49 µs each: 98 s for 2M points, past ``max_wall_ms``). Now in
+    the chart's native call and budget: the column equals `brockett_hill` point by point, and
+    costs a fraction of the chart."""
+    beta0, kappa = np.linspace(-0.5, 3.0, 9), np.linspace(-1.0, 30.0, 11)
+    df = ps.stability.stability_chart(beta0, kappa)
+    expected = [k > 0 and r > 0 and ps.stability.brockett_hill(b, k)["bounded"] for b, k, r in df.select("beta0", "kappa", "region").iter_rows()]
+    assert df["brockett_bounded"].to_list() == expected and any(expected) and not all(expected)
+    big_b, big_k = np.linspace(0.0, 3.0, 300), np.linspace(0.1, 30.0, 300)
+    start = time.perf_counter()
+    ps.stability.stability_chart(big_b, big_k, brockett=False)
+    plain = time.perf_counter() - start
+    start = time.perf_counter()
+    ps.stability.stability_chart(big_b, big_k, brockett=True)
+    with_brockett = time.perf_counter() - start
+    assert with_brockett < 1.5 * plain + 0.2, (plain, with_brockett)  # was plain + 4.4 s

@@ -170,7 +170,7 @@ def test_every_invalid_field_is_reported_at_once() -> None:
         ps.Simulation.from_dict(d)
     problems = {p[0]: p[2] for p in e.value.problems}
     assert sorted(problems) == ["drivetrain.rod_mm", "options.max_cycles", "wings[1].aero.omega1"]
-    assert "[0.000001, 100] mm" in problems["drivetrain.rod_mm"] and "integer" in problems["options.max_cycles"]
+    assert "[1e-6, 100] mm" in problems["drivetrain.rod_mm"] and "integer" in problems["options.max_cycles"]
     assert e.value.field in problems
 
 

@@ -7,6 +7,7 @@ import re
 from collections.abc import Iterable
 from typing import Any
 
+from . import _core
 from ._core import InvalidParameterError
 
 
@@ -66,6 +67,31 @@ def finite_reals(field: str, value: Any) -> Any:
         name = field + "".join(f"[{i}]" for i in where)
         raise invalid(name, repr(value) if a.ndim == 0 else a[where], "a finite real number")
     return a
+
+
+def read_toml(field: str, path: Any, what: str) -> dict[str, Any]:
+    """The table of the TOML file ``path`` (``what`` it should hold, e.g. ``"a sweep study"``),
+    or an ``InvalidParameterError`` naming ``field``, the path and what was expected: a missing
+    file, a directory, an unreadable file, bytes that are not UTF-8, malformed TOML."""
+    import os
+    import tomllib
+    from pathlib import Path
+
+    if isinstance(path, bytes) or not isinstance(path, str | os.PathLike):
+        raise invalid(field, repr(path)[:60], f"the path of {what} (a UTF-8 TOML file)")
+    file = Path(path)
+    try:
+        raw = file.read_bytes()
+    except OSError as exc:
+        raise invalid(field, str(file), f"a readable file holding {what} ({exc.strerror or exc})") from exc
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise invalid(field, str(file), f"a UTF-8 text file holding {what} ({exc.reason} at byte {exc.start})") from exc
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise invalid(field, str(file), f"{what} in valid TOML ({exc})") from exc
 
 
 #: Environment variable bounding the bytes one call may allocate (see `memory_limit`).
@@ -128,68 +154,30 @@ def sized(field: str, value: Any, count: int, bytes_each: float, what: str) -> N
         )
 
 
-def _edit_distance(a: str, b: str) -> int:
-    """Levenshtein distance (the Rust core's `schema::nearest` uses the same measure)."""
-    if len(a) < len(b):
-        a, b = b, a
-    previous = list(range(len(b) + 1))
-    for i, ca in enumerate(a, 1):
-        current = [i]
-        for j, cb in enumerate(b, 1):
-            current.append(min(previous[j] + 1, current[j - 1] + 1, previous[j - 1] + (ca != cb)))
-        previous = current
-    return previous[-1]
-
-
-def _typo(a: str, b: str) -> int | None:
-    """The edit distance of ``a`` and ``b`` when it is a plausible typo (the Rust core's rule:
-    at most 2, or a third of the longer), else ``None``."""
-    if not a or not b:
-        return None
-    d = _edit_distance(a, b)
-    return d if d <= max(2, max(len(a), len(b)) // 3) else None
-
-
 def close_names(name: str, valid: Iterable[str], limit: int = 5) -> list[str]:
     """At most ``limit`` names of ``valid`` close to ``name``, nearest first: a typo of the whole
     name or of its last path segment (``balance_spring`` in ``drivetrain.balance_spring``), then
-    names that contain ``name``'s last segment, then names sharing a word with it."""
-    word = str(name).lower()
-    tail = word.rsplit(".", 1)[-1]
-    words = set(re.split(r"[._\[\]]+", tail)) - {""}
-    ranked: list[tuple[int, int, str]] = []
-    for order, candidate in enumerate(dict.fromkeys(valid)):
-        text = candidate.lower()
-        last = text.rsplit(".", 1)[-1]
-        scores = [d for d in (_typo(word, text), _typo(tail, last)) if d is not None]
-        if scores:
-            score = min(scores)
-        elif len(tail) >= 3 and tail in text:
-            score = 50  # containment ranks after every typo
-        elif shared := len(words & set(re.split(r"[._\[\]]+", last)) - {"", "of", "per"}):
-            score = 60 - shared  # shares a word of the last segment: `balance` of `balance_stiffness`
-        else:
-            continue
-        ranked.append((score, order, candidate))
-    return [c for _, _, c in sorted(ranked)[:limit]]
+    names that contain ``name``'s last segment, then names sharing a word with it. The Rust
+    core's ranking (``paritysim_spec::schema::close``), the one of every "did you mean"."""
+    return list(_core.spec_close_names(str(name), [str(v) for v in valid], int(limit)))
 
 
-def suggest(name: str, valid: Iterable[str], limit: int = 5, listed_by: str | None = None) -> str:
+def suggest(name: str, valid: Iterable[str], listed_by: str | None = None, what: str = "a known name") -> str:
     """The ``allowed`` text for an unknown ``name`` among ``valid`` (paths, metrics, knobs,
-    settings): the nearest name and at most ``limit`` close ones, never the whole list unless it
-    is short. ``listed_by`` tells where the full list is (e.g. ``"ps.spec_paths(spec)"``).
+    settings, columns): ``what`` it must be, the nearest name and at most five close ones, never
+    the whole list unless it is that short. ``listed_by`` tells where the full list is (e.g.
+    ``"ps.spec_paths(spec)"``).
 
-    The one "did you mean" of the Python facade: every argument that takes a name uses it."""
-    names = list(dict.fromkeys(valid))
-    close = close_names(name, names, limit)
-    if len(names) <= limit:
-        listing = "one of: " + ", ".join(f"`{n}`" for n in names)
-        return f"did you mean `{close[0]}`? ({listing})" if close else listing
-    where = f"{listed_by} lists all {len(names)}" if listed_by else f"{len(names)} names, e.g. " + ", ".join(f"`{n}`" for n in names[:3])
-    if close:
-        others = f"also close: {', '.join(f'`{c}`' for c in close[1:])}; " if len(close) > 1 else ""
-        return f"a known name: did you mean `{close[0]}`? ({others}{where})"
-    return f"a known name (none close to `{name}`; {where})"
+    The one "did you mean" of paritysim: the Rust core's text (``schema::suggestion_for``) that
+    the spec's own checks use; every argument that takes a name uses it."""
+    names = [str(v) for v in dict.fromkeys(valid)]
+    where = f"{listed_by} lists all {len(names)}" if listed_by else None
+    return str(_core.spec_suggestion(str(name), names, what, where))
+
+
+def unknown_name(field: str, name: Any, valid: Iterable[str], listed_by: str | None = None, what: str = "a known name") -> InvalidParameterError:
+    """The ``InvalidParameterError`` of an unknown ``name`` given as ``field`` (`suggest`)."""
+    return invalid(field, repr(name), suggest(str(name), valid, listed_by, what))
 
 
 #: Points per call of an array path that is evaluated in chunks (`chunked`): the native call

@@ -21,6 +21,7 @@ from scipy.optimize import least_squares
 from ._budget import Deadline
 from ._errors import invalid, real, suggest, whole
 from ._exceptions import ParitysimError
+from ._progress import LongRun
 from .simulation import simulate
 from .spec import Simulation
 
@@ -66,6 +67,7 @@ def calibrate(
     xtol: float = 1e-10,
     diff_step: float = 1e-4,
     max_wall_ms: float = 600_000.0,
+    progress: bool = True,
 ) -> CalibrationResult:
     """Least-squares fit of the ``free`` parameters (name -> (low, high)).
 
@@ -84,6 +86,9 @@ def calibrate(
     ``max_wall_ms`` (default 10 min) bounds the whole fit: each simulation gets what is left as
     its ``options.max_wall_ms`` (a callable model is checked between evaluations); when it is
     spent, ``IntegrationError`` naming ``max_wall_ms``.
+
+    ``progress`` (default True): a fit that takes more than a few seconds shows a bar on stderr
+    (wall time against ``max_wall_ms``, runs done); ``False`` turns it off.
     """
     diff_step = real("diff_step", diff_step)
     if not (math.isfinite(diff_step) and 0 < diff_step < 0.5):
@@ -129,7 +134,7 @@ def calibrate(
         base.with_paths({n: float(v) for n, v in zip(names, start, strict=True)})
 
         def outputs(values: dict[str, float]) -> dict[str, Any]:
-            result = deadline.run(simulate, base.with_paths(values))
+            result = deadline.run(simulate, base.with_paths(values), progress=False)
             out: dict[str, Any] = dict(result.metrics)
             if trajectory_target:
                 out["__trajectory__"] = result.trajectory
@@ -152,6 +157,8 @@ def calibrate(
             t = traj["time_ms"].to_numpy() - traj["time_ms"][0]
             res = []
             for c in columns:
+                if c not in traj.columns:  # polars' ColumnNotFoundError otherwise
+                    raise invalid(f"targets.{c}", "<unknown column>", suggest(c, traj.columns, what="a trajectory column"))
                 sim = np.interp(t_target, t, traj[c].to_numpy())
                 res.append((sim - targets[c].to_numpy()) / max(float(np.abs(targets[c].to_numpy()).max()), 1e-12))
             return np.concatenate(res)
@@ -185,9 +192,11 @@ def calibrate(
         r = residual_of(outputs(values))
         with lock:
             log.append({**values, "cost": 0.5 * float(r @ r)})
+            bar.done()
         return r
 
     pool = ThreadPoolExecutor(max_workers=max(1, workers))
+    bar = LongRun("calibrate", progress, deadline.ms)
 
     def jacobian(x: np.ndarray, *_: Any) -> np.ndarray:
         steps = diff_step * (hi - lo)
@@ -198,7 +207,8 @@ def calibrate(
         return np.column_stack([(c - f0) / s for c, s in zip(columns, signed, strict=True)])
 
     try:
-        fit = least_squares(evaluate, start, jac=jacobian, bounds=(lo, hi), x_scale="jac", max_nfev=max_nfev, xtol=xtol)
+        with bar:
+            fit = least_squares(evaluate, start, jac=jacobian, bounds=(lo, hi), x_scale="jac", max_nfev=max_nfev, xtol=xtol)
     except ValueError as exc:
         if isinstance(exc, ParitysimError):
             raise

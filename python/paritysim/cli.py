@@ -32,7 +32,9 @@ def _reproduce(args: argparse.Namespace) -> int:
         return 2
     unknown = [n for n in names if n not in trials]
     if unknown:
-        print(f"unknown trial(s) {unknown}; available: {', '.join(trials)}", file=sys.stderr)
+        from ._errors import suggest
+
+        print(f"paritysim: error: unknown trial `{unknown[0]}`: must be " + suggest(unknown[0], trials, listed_by="`paritysim reproduce --list`", what="a trial"), file=sys.stderr)
         return 2
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -173,8 +175,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     matplotlib.use("Agg")  # the CLI only writes files
     args = build_parser().parse_args(argv)
     debug = bool(getattr(args, "debug", False))
+    from contextlib import nullcontext
+
+    from ._progress import quiet
+
     try:
-        return int(args.func(args))
+        with quiet() if getattr(args, "quiet", False) else nullcontext():  # no bar of a long run either
+            return int(args.func(args))
     except KeyboardInterrupt:
         if debug:
             raise

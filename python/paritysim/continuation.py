@@ -35,7 +35,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from . import _core
-from ._errors import invalid, real
+from ._errors import invalid, real, suggest
 from .spec import Simulation
 
 if TYPE_CHECKING:
@@ -109,7 +109,7 @@ class ContinuationResult:
         from .plots import label_with_unit
 
         if y not in self.branch.columns:
-            raise invalid("y", repr(y), "a column of the branch: " + ", ".join(self.branch.columns))
+            raise invalid("y", repr(y), suggest(str(y), self.branch.columns, what="a column of the branch"))
         if ax is None:
             fig, ax = plt.subplots(figsize=(7, 4.2), constrained_layout=True)
         else:
@@ -160,7 +160,12 @@ def _current(spec: Simulation, path: str) -> float:
     table = spec_paths(spec)
     match = table.filter(table["path"] == path)
     if match.height == 0:
-        raise invalid("start", "None", f"a number: `{path}` is an alias or not a canonical path, so its current value is not known")
+        try:  # an unknown path: the core names it with the nearest valid ones
+            spec.with_paths({path: 1.0})
+        except _core.InvalidParameterError as exc:
+            if "<unknown parameter path>" in str(exc):
+                raise
+        raise invalid("start", "None", f"a number: `{path}` is an alias, not a canonical path, so its current value is not known")
     value = json.loads(match["value"][0])
     if not isinstance(value, int | float) or isinstance(value, bool):
         raise invalid("start", "None", f"a number: `{path}` holds {value!r}")
@@ -201,7 +206,7 @@ def continuation(spec: Simulation, path: str, stop: float, *, start: float | Non
         raise invalid("path", repr(path), "a parameter path (see paritysim.spec_paths)")
     unknown = sorted(set(settings) - set(SETTINGS))
     if unknown:
-        raise invalid(unknown[0], "<unknown setting>", _core.spec_suggestion(unknown[0], list(SETTINGS)) or "one of: " + ", ".join(SETTINGS))
+        raise invalid(unknown[0], "<unknown setting>", suggest(unknown[0], SETTINGS, what="a setting of paritysim.continuation"))
     first = _current(spec, path) if start is None else real("start", start)
     settings_json = json.dumps(settings, default=lambda o: o.item() if hasattr(o, "item") else repr(o))  # Rust names a bad value
     try:

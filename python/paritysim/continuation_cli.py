@@ -20,11 +20,10 @@ from __future__ import annotations
 
 import argparse
 import time
-import tomllib
 from pathlib import Path
 from typing import Any
 
-from ._errors import invalid
+from ._errors import invalid, read_toml, suggest
 
 __all__ = ["add_parser", "run_study"]
 
@@ -37,14 +36,11 @@ def run_study(study: str | Path, out: str | Path) -> dict[str, Any]:
     from .continuation import continuation
     from .spec import load_spec
 
+    data = read_toml("study", study, "a continuation study")
     study = Path(study)
-    with open(study, "rb") as f:
-        data = tomllib.load(f)
     unknown = sorted(set(data) - set(_KEYS))
     if unknown:
-        from . import _core
-
-        raise invalid(unknown[0], "<unknown key>", _core.spec_suggestion(unknown[0], list(_KEYS)))
+        raise invalid(unknown[0], "<unknown key>", suggest(unknown[0], _KEYS, what="a key of the study file"))
     for key in ("spec", "path", "stop"):
         if key not in data:
             raise invalid(key, "<missing>", "given (see `paritysim continue --help`)")

@@ -14,7 +14,8 @@ import polars as pl
 from matplotlib.figure import Figure
 
 from . import _core, _slow_drive
-from ._errors import invalid, real
+from ._errors import invalid, real, suggest
+from ._progress import LongRun
 from .spec import Simulation
 
 __all__ = ["SimulationResult", "simulate"]
@@ -116,7 +117,7 @@ def _control_call(controller: Controller) -> Callable[[float, list[tuple[str, fl
         checked = []
         for name in out:
             if name not in CONTROL_INPUTS:
-                raise invalid(f"controller[{name!r}]", out[name], f"one of {', '.join(CONTROL_INPUTS)}")
+                raise invalid(f"controller[{name!r}]", out[name], suggest(str(name), CONTROL_INPUTS, what="a control input"))
             v = real(f"controller[{name!r}]", out[name])
             if not math.isfinite(v):
                 raise invalid(f"controller[{name!r}]", v, "a finite number")
@@ -148,6 +149,7 @@ def simulate(
     control_rate_hz: float | None = None,
     columns: Sequence[str] | None = None,
     metrics: Sequence[str] | None = None,
+    progress: bool = True,
     **option_overrides: Any,
 ) -> SimulationResult:
     """Run ``spec`` to periodic steady state (or for ``options.duration_ms``) in Rust.
@@ -173,6 +175,9 @@ def simulate(
     and restarts the integrator, so keep the rate low (100-1000 Hz); the Rust PD controller
     (``[body.control]``) is the fast path. An exception raised by ``controller`` stops the run
     and propagates as is.
+
+    ``progress`` (default True): a run that takes more than a few seconds shows a bar on
+    stderr (wall time against ``options.max_wall_ms``); ``False`` turns it off.
 
     Raises
     ------
@@ -200,15 +205,17 @@ def simulate(
     if controller is None:
         if control_rate_hz is not None:
             raise invalid("control_rate_hz", control_rate_hz, "given only with a controller")
-        # A drive typed in kHz runs for its whole wall budget: probed first, refused by field.
-        raw = _slow_drive.guarded(spec, lambda s: _core.simulate(s.to_json(), _names(columns, "columns"), _names(metrics, "metrics")))
+        with LongRun("simulate", progress, spec.options.max_wall_ms):
+            # A drive typed in kHz runs for its whole wall budget: probed first, refused by field.
+            raw = _slow_drive.guarded(spec, lambda s: _core.simulate(s.to_json(), _names(columns, "columns"), _names(metrics, "metrics")))
     else:
         if not callable(controller):
             raise invalid("controller", type(controller).__name__, "a callable (t_ms, body) -> dict")
         if control_rate_hz is None:
             raise invalid("control_rate_hz", None, "a positive control rate (Hz) with a controller")
         rate = real("control_rate_hz", control_rate_hz)
-        raw = _core.simulate_controlled(spec.to_json(), _control_call(controller), rate, _names(columns, "columns"), _names(metrics, "metrics"))
+        with LongRun("simulate", progress, spec.options.max_wall_ms):
+            raw = _core.simulate_controlled(spec.to_json(), _control_call(controller), rate, _names(columns, "columns"), _names(metrics, "metrics"))
     return SimulationResult(
         metrics={k: (v if math.isfinite(v) else None) for k, v in raw.metrics},
         cycles_run=raw.cycles_run,

@@ -137,9 +137,9 @@ def _from_core(cls: type) -> type:
     def checked_init(self: Any, *args: Any, **kwargs: Any) -> None:
         for key in kwargs:
             if key not in names:  # a typed error with the nearest field, not a bare TypeError
-                from ._errors import invalid
+                from ._errors import invalid, suggest
 
-                raise invalid(f"{cls.__name__}.{key}", "<unknown field>", _core.spec_suggestion(key, names))
+                raise invalid(f"{cls.__name__}.{key}", "<unknown field>", suggest(key, names))
         init(self, *args, **kwargs)
 
     built.__init__ = checked_init  # type: ignore[method-assign]
@@ -183,9 +183,9 @@ class _Node:
         names = [f.name for f in dataclasses.fields(self)]  # type: ignore[arg-type]
         for key in changes:
             if key not in names:
-                from ._errors import invalid
+                from ._errors import invalid, suggest
 
-                raise invalid(f"{path}.{key}", "<unknown field>", _core.spec_suggestion(key, names))
+                raise invalid(f"{path}.{key}", "<unknown field>", suggest(key, names))
         return dataclasses.replace(self, **changes)  # type: ignore[type-var]
 
     def to_dict(self) -> dict[str, Any]:

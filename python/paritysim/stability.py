@@ -34,7 +34,7 @@ import polars as pl
 from matplotlib.figure import Figure
 
 from . import _core
-from ._errors import invalid, real, reals, sized, whole
+from ._errors import chunked, invalid, real, reals, sized, whole
 from .spec import Simulation
 
 __all__ = [
@@ -96,9 +96,21 @@ def hill_solution(beta0: float, kappa: float, t: Any, t0: float = -math.pi / 2, 
     Ctrl-C stops the call between two of them and ``max_wall_ms`` (default 60 s) bounds it
     (``IntegrationError`` naming ``max_wall_ms``).
     """
+    from ._budget import Deadline, exceeded
+
     times = _f64(t, "t")
+    b, k, start = real("beta0", beta0), real("kappa", kappa), real("t0", t0)
+    deadline = Deadline("max_wall_ms", max_wall_ms)
     sized("t", f"{times.size} times", times.size, 32, "the solution matrices")
-    return _core.stability_hill_solution(real("beta0", beta0), real("kappa", kappa), real("t0", t0), times, real("max_wall_ms", max_wall_ms))
+    # A chunk of times per native call (its nested output holds ~700 bytes per time while it
+    # runs: 7 GB for 1e7 times), each within what is left of the one budget.
+    try:
+        out = chunked(lambda x: {"m": _core.stability_hill_solution(b, k, start, x, deadline.remaining_ms())}, [times], ("t",))
+    except _core.IntegrationError as exc:
+        if getattr(exc, "field", None) == "max_wall_ms":
+            raise exceeded("max_wall_ms", deadline.ms) from exc
+        raise
+    return np.asarray(out["m"], dtype=np.float64).reshape(times.size, 2, 2)
 
 
 def hill_floquet(beta0: float, kappa: float) -> dict[str, Any]:
@@ -145,8 +157,9 @@ def stability_chart(beta0: Any, kappa: Any, *, brockett: bool = True, max_wall_m
     Up to 4M points; Ctrl-C stops it and ``max_wall_ms`` (default 10 min) bounds it
     (``IntegrationError`` naming ``max_wall_ms``).
     """
-    raw = _core.stability_chart(_f64(beta0, "beta0"), _f64(kappa, "kappa"), real("max_wall_ms", max_wall_ms))
+    raw = _core.stability_chart(_f64(beta0, "beta0"), _f64(kappa, "kappa"), real("max_wall_ms", max_wall_ms), bool(brockett))
     error_index, messages = raw.pop("error_index"), raw.pop("error")
+    bounded = raw.pop("brockett_bounded", None)  # eqs. 2.57-2.58 at every point, in the chart's budget
     errors = pl.Series("error", [], dtype=pl.String).extend_constant(None, raw["beta0"].size)
     if messages:
         errors = errors.scatter(error_index, messages)
@@ -159,13 +172,8 @@ def stability_chart(beta0: Any, kappa: Any, *, brockett: bool = True, max_wall_m
         .otherwise(pl.col("region").replace_strict(REGIONS, default=None, return_dtype=pl.String))
         .alias("region_name"),
     )
-    if brockett:
-        beta = raw["beta0"]
-        kap = raw["kappa"]
-        guaranteed = np.zeros(beta.size, dtype=bool)
-        for i in np.flatnonzero((kap > 0) & (raw["region"] > 0)):
-            guaranteed[i] = _core.stability_brockett_hill(float(beta[i]), float(kap[i]))["bounded"]
-        df = df.with_columns(pl.Series("brockett_bounded", guaranteed))
+    if bounded is not None:
+        df = df.with_columns(pl.Series("brockett_bounded", bounded))
     return df
 
 

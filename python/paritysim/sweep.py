@@ -92,7 +92,7 @@ import numpy as np
 import polars as pl
 
 from . import _core
-from ._errors import invalid, whole
+from ._errors import invalid, suggest, whole
 from ._sweep_checkpoint import _Checkpoint, _fingerprint, _reuse
 from .spec import Simulation, _dumps
 
@@ -415,7 +415,7 @@ def sweep(
         threads = whole("threads", threads, 1, 4096)
     for name in label_names:
         if name not in table.columns:
-            raise invalid("labels", repr(name), "columns of the grid: " + ", ".join(table.columns))
+            raise invalid("labels", repr(name), suggest(str(name), table.columns, what="a column of the grid"))
     param_table = table.drop(label_names) if label_names else table
     spec_json = spec.to_json()
     _core.validate_spec(spec_json)  # the base design must be valid (typed error naming the field)
@@ -600,7 +600,7 @@ def _cycle_columns(spec_json: str, keep_cycle: bool | Sequence[str]) -> list[str
     wanted = ["time_ms", *[c for c in keep_cycle if c != "time_ms"]]
     for c in wanted:
         if c not in available:
-            raise invalid("keep_cycle", repr(c), "True or trajectory column names: " + ", ".join(available))
+            raise invalid("keep_cycle", repr(c), "True or trajectory column names; " + suggest(c, available, what="a trajectory column"))
     return wanted
 
 
@@ -778,7 +778,7 @@ def plot(df: pl.DataFrame, x: str, y: str | Sequence[str], hue: str | None = Non
     ys = [y] if isinstance(y, str) else list(y)
     for c in [x, *ys, *([hue] if hue else [])]:
         if c not in df.columns:
-            raise invalid("plot", repr(c), "a column of the sweep result: " + ", ".join(df.columns))
+            raise invalid("plot", repr(c), suggest(str(c), df.columns, what="a column of the sweep result"))
     ok = df.filter(pl.col("status") == "ok") if "status" in df.columns else df
     if ax is None:
         fig, ax = plt.subplots(figsize=(6, 4), layout="constrained")

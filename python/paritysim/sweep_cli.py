@@ -28,7 +28,6 @@ import argparse
 import shutil
 import sys
 import time
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -36,8 +35,7 @@ from typing import Any
 import numpy as np
 import polars as pl
 
-from . import _core
-from ._errors import invalid
+from ._errors import invalid, read_toml, suggest
 from .spec import Simulation, load_spec
 
 __all__ = ["Study", "add_parser", "load_study", "run_study"]
@@ -79,12 +77,11 @@ def _axis(name: str, value: Any) -> list[Any]:
 
 def load_study(path: str | Path) -> Study:
     """Parses a study TOML (see the module docstring)."""
+    data = read_toml("study", path, "a sweep study")
     path = Path(path)
-    with open(path, "rb") as f:
-        data = tomllib.load(f)
     unknown = sorted(set(data) - set(_KEYS))
     if unknown:
-        raise invalid(unknown[0], "<unknown key>", _core.spec_suggestion(unknown[0], list(_KEYS)))
+        raise invalid(unknown[0], "<unknown key>", suggest(unknown[0], _KEYS, what="a key of the study file"))
     raw_spec = data.get("spec")
     if isinstance(raw_spec, str):
         spec = load_spec(path.parent / raw_spec)

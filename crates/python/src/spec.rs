@@ -75,9 +75,19 @@ bindings! {
         Ok((out.to_json(), notes))
     }
 
-    /// "a known name: did you mean `x`? (valid: ...)" for `word` among `valid`.
-    fn spec_suggestion(word: &str, valid: Vec<String>) -> String {
-        Ok(schema::suggestion(word, valid.iter().map(String::as_str)))
+    /// The allowed text of an unknown `word` among `valid` (`schema::suggestion_for`): `what`
+    /// it must be, the nearest name and a handful of close ones; `listed_by` says where the
+    /// whole list is.
+    #[pyo3(signature = (word, valid, what = "a known name", listed_by = None))]
+    fn spec_suggestion(word: &str, valid: Vec<String>, what: &str, listed_by: Option<String>) -> String {
+        let valid = valid.iter().map(String::as_str);
+        Ok(schema::suggestion_for(word, valid, what, listed_by.as_deref()))
+    }
+
+    /// At most `limit` names of `valid` close to `word`, nearest first (`schema::close`).
+    fn spec_close_names(word: &str, valid: Vec<String>, limit: usize) -> Vec<String> {
+        let near = schema::close(word, valid.iter().map(String::as_str), limit);
+        Ok(near.into_iter().map(str::to_string).collect())
     }
 
     /// Validates a JSON spec and builds its model: `(n_wings, n_dof)`.

@@ -178,18 +178,37 @@ bindings! {
 /// `beta0, kappa, a, b, spectral_radius, region` (int 1-4; 0 for a failed point, whose numbers
 /// are NaN), `multiplier_error`, `marginal` and `stable` (Region I and not marginal), and the
 /// failed points as `error_index` (flat indices) with their messages `error`.
+/// With `brockett`, also `brockett_bounded` (`floquet::brockett_hill` at every computed point
+/// with κ > 0; false elsewhere), inside the same budget.
 /// `max_wall_ms` bounds the whole chart (None: no budget of its own).
 #[pyfunction]
-#[pyo3(signature = (beta0, kappa, max_wall_ms = None))]
+#[pyo3(signature = (beta0, kappa, max_wall_ms = None, brockett = false))]
 fn stability_chart<'py>(
     py: Python<'py>,
     beta0: PyReadonlyArray1<'py, f64>,
     kappa: PyReadonlyArray1<'py, f64>,
     max_wall_ms: Option<f64>,
+    brockett: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (beta0, kappa) = (to_vec(&beta0), to_vec(&kappa));
-    let c = cancellable(py, || {
-        within(max_wall_ms, || floquet::stability_chart(&beta0, &kappa))
+    let (c, bounded) = cancellable(py, || {
+        within(max_wall_ms, || {
+            let c = floquet::stability_chart(&beta0, &kappa)?;
+            if !brockett {
+                return Ok((c, None));
+            }
+            let mut bounded = vec![false; c.beta0.len()];
+            for (i, (slot, r)) in bounded.iter_mut().zip(&c.region).enumerate() {
+                if i % 4096 == 0 {
+                    budget::check(f64::NAN)?;
+                }
+                let (b, k) = (c.beta0[i], c.kappa[i]);
+                if k > 0.0 && r.is_some() {
+                    *slot = floquet::brockett_hill(b, k)?.bounded;
+                }
+            }
+            Ok((c, Some(bounded)))
+        })
     })?;
     // Up to 4M points: numpy columns straight from the vectors, not the generic converter.
     let (stable, region) = (c.stable(), c.region_numbers());
@@ -217,6 +236,9 @@ fn stability_chart<'py>(
         .unzip();
     out.set_item("error_index", PyArray1::from_vec(py, index))?;
     out.set_item("error", messages)?;
+    if let Some(bounded) = bounded {
+        out.set_item("brockett_bounded", PyArray1::from_vec(py, bounded))?;
+    }
     Ok(out)
 }
 

@@ -257,19 +257,11 @@ impl Simulation {
         let mut options = options.clone();
         if let Some(c) = columns {
             let valid = self.column_names(device)?;
-            options.columns = Some(paritysim_dynamics::sweep::select(
-                "columns",
-                Some(c),
-                &valid,
-            )?);
+            options.columns = Some(crate::schema::select("columns", Some(c), &valid)?);
         }
         if let Some(m) = metrics {
             let valid = self.metric_names(device)?;
-            options.metrics = Some(paritysim_dynamics::sweep::select(
-                "metrics",
-                Some(m),
-                &valid,
-            )?);
+            options.metrics = Some(crate::schema::select("metrics", Some(m), &valid)?);
         }
         Ok(options)
     }

@@ -97,8 +97,9 @@ pub struct Options {
     /// Relative tolerance, in (0, 0.1].
     #[schemars(range(max = 0.1), extend("exclusiveMinimum" = 0.0, "x-unit" = "1"))]
     pub rtol: f64,
-    /// Absolute tolerance, in (0, 0.1].
-    #[schemars(range(max = 0.1), extend("exclusiveMinimum" = 0.0, "x-unit" = "1"))]
+    /// Absolute tolerance, in [1e-30, 0.1] (a smaller one makes the error norm of a state at
+    /// rest overflow: every step is rejected until the step size underflows).
+    #[schemars(range(min = 1e-30, max = 0.1), extend("x-unit" = "1"))]
     pub atol: f64,
     /// Step limit per integration call, in [1, 1e9].
     #[schemars(range(min = 1, max = 1_000_000_000), extend("x-unit" = "steps"))]

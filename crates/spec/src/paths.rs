@@ -17,9 +17,7 @@ use serde::Serialize;
 use serde_json::Value;
 
 use crate::migrate::migrate_path;
-use crate::schema::{
-    Branch, SHOWN_NAMES, classify, describe, join, node, schema, suggestion, unit,
-};
+use crate::schema::{Branch, classify, describe, join, node, schema, suggestion_for, unit};
 use crate::spec::Simulation;
 
 /// One settable path of a spec.
@@ -249,50 +247,22 @@ fn aliases(paths: &[PathInfo]) -> Vec<String> {
     out
 }
 
-/// An unknown path: the nearest valid spelling, looked for first among the siblings of its
-/// last segment (`drivetrain.crank` -> `drivetrain.crank_mm`), then among all paths.
+/// An unknown path: the nearest valid spellings (canonical paths and their aliases; siblings
+/// of its last segment first on a tie), a handful at most (`schema::suggestion_for`).
 fn unknown(name: &str, paths: &[PathInfo]) -> Error {
     let aliases = aliases(paths);
-    let valid: Vec<&str> = paths.iter().map(|p| p.path.as_str()).collect();
-    let spellings: Vec<&str> = valid
+    let spellings = paths
         .iter()
-        .copied()
-        .chain(aliases.iter().map(String::as_str))
-        .collect();
-    let (parent, last) = name.rsplit_once('.').unwrap_or(("", name));
-    let siblings = spellings.iter().filter_map(|s| {
-        s.rsplit_once('.')
-            .filter(|(p, _)| *p == parent)
-            .map(|(_, l)| l)
-    });
-    let best = crate::schema::nearest(last, siblings)
-        .map(|l| format!("{parent}.{l}"))
-        .or_else(|| crate::schema::nearest(name, spellings.iter().copied()).map(String::from));
+        .map(|p| p.path.as_str())
+        .chain(aliases.iter().map(String::as_str));
     // A handful of close names, never the whole list: `ps.spec_paths(spec)` prints that.
-    let allowed = match best {
-        Some(best) => {
-            let others: Vec<String> =
-                crate::schema::close(name, spellings.iter().copied(), SHOWN_NAMES)
-                    .into_iter()
-                    .filter(|c| *c != best)
-                    .take(SHOWN_NAMES - 1)
-                    .map(|c| format!("`{c}`"))
-                    .collect();
-            let also = if others.is_empty() {
-                String::new()
-            } else {
-                format!("also close: {}; ", others.join(", "))
-            };
-            format!(
-                "a parameter path of this spec; did you mean `{best}`? ({also}ps.spec_paths(spec) lists all {})",
-                valid.len()
-            )
-        }
-        None => format!(
-            "a parameter path of this spec; {} (ps.spec_paths(spec) lists them)",
-            suggestion(name, valid.iter().copied())
-        ),
-    };
+    let listed = format!("ps.spec_paths(spec) lists all {}", paths.len());
+    let allowed = suggestion_for(
+        name,
+        spellings,
+        "a parameter path of this spec",
+        Some(&listed),
+    );
     Error::invalid(name.to_string(), "<unknown parameter path>", allowed)
 }
 

@@ -80,7 +80,7 @@ impl SweepPlan {
         }
         let device = base.device()?;
         let valid = base.metric_names(&device)?;
-        let metrics = engine::select(
+        let metrics = crate::schema::select(
             "metrics",
             metrics.map(<[String]>::to_vec).as_deref(),
             &valid,

@@ -105,7 +105,7 @@ fn every_problem_is_reported_with_path_and_range() {
             "wings[1].aero.omegaa2"
         ]
     );
-    assert!(found[0].1.contains("[0.000001, 10] mm"), "{:?}", found[0]);
+    assert!(found[0].1.contains("[1e-6, 10] mm"), "{:?}", found[0]);
     assert!(found[1].1.contains("integer"), "{:?}", found[1]);
     // stroke_drag has omega1 and coefficient: the nearest is omega1.
     assert!(

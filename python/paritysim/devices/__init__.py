@@ -68,9 +68,9 @@ def list() -> builtins.list[str]:  # noqa: A001  (the PyBaMM-style name is the p
 
 def _check(name: str) -> str:
     if not isinstance(name, str) or name not in _index():
-        from .._errors import invalid
+        from .._errors import invalid, suggest
 
-        raise invalid("name", repr(name), "a shipped device: " + ", ".join(list()))
+        raise invalid("name", repr(name), suggest(str(name), list(), listed_by="ps.devices.list()", what="a shipped device"))
     return name
 
 

@@ -106,9 +106,9 @@ def _metrics(spec: Simulation, deadline: Any = None) -> dict[str, float]:
     # of 5.6e-10 on the §3.4 PARITY trim; each run re-picks its frozen step grid, so the
     # metrics are not smooth at that scale). Measured when shooting became the default.
     if deadline is not None:
-        m = deadline.run(simulate, spec, record_cycles=1, steady_state="transient").metrics
+        m = deadline.run(simulate, spec, record_cycles=1, steady_state="transient", progress=False).metrics
     else:
-        m = simulate(spec, record_cycles=1, steady_state="transient").metrics
+        m = simulate(spec, record_cycles=1, steady_state="transient", progress=False).metrics
     return {name: float(m[metric]) if m[metric] is not None else math.nan for name, metric in EQUATIONS.items()}
 
 
@@ -121,6 +121,7 @@ def trim(
     tol: float = 1e-4,
     max_evaluations: int = 80,
     max_wall_ms: float = 600_000.0,
+    progress: bool = True,
 ) -> Trim:
     """Finds the drive of ``spec`` for which cycle-averaged lift equals weight and the
     cycle-averaged body torques ``equations`` vanish (the spec's ``body`` section gives mass,
@@ -145,6 +146,9 @@ def trim(
     max_wall_ms:
         Wall-time budget of the whole trim (default 10 min): each run gets what is left as its
         ``options.max_wall_ms``; when it is spent, ``IntegrationError`` naming ``max_wall_ms``.
+    progress:
+        A trim that takes more than a few seconds shows a bar on stderr (wall time against
+        ``max_wall_ms``, runs done); ``False`` turns it off.
 
     Raises
     ------
@@ -178,7 +182,7 @@ def trim(
     equations = tuple(equations) if equations is not None else order[: len(knobs)]
     for e in equations:
         if e not in EQUATIONS:
-            raise invalid("equations", e, f"one of {', '.join(EQUATIONS)}")
+            raise invalid("equations", repr(e), suggest(str(e), EQUATIONS, what="an equation"))
     if not knobs or len(equations) < len(knobs):
         raise invalid("equations", len(equations), f"at least one equation per knob ({len(knobs)} knobs)")
     clamped, body = _clamped(spec)
@@ -187,7 +191,7 @@ def trim(
     paths = {row[0]: row[3] for row in _path_values(clamped)}
     for k in knobs:
         if k not in paths:
-            raise invalid("knobs", k, "a spec path; " + suggest(k, paths, listed_by="ps.spec_paths(spec)"))
+            raise invalid("knobs", repr(k), suggest(k, paths, listed_by="ps.spec_paths(spec)", what="a parameter path of this spec"))
     if initial is not None:
         x0 = np.atleast_1d(finite_reals("initial", initial))
         if x0.shape != (len(knobs),):
@@ -198,6 +202,9 @@ def trim(
     hi = np.array([_BOUNDS.get(k, (-np.inf, np.inf))[1] for k in knobs])
     x0 = np.clip(x0, lo + 1e-12, hi - 1e-12)
     cache: dict[tuple[float, ...], dict[str, float]] = {}
+    from .._progress import LongRun
+
+    bar = LongRun("trim", progress, deadline.ms)
 
     def evaluate(x: np.ndarray) -> dict[str, float]:
         key = tuple(float(v) for v in x)
@@ -205,6 +212,7 @@ def trim(
             r = _metrics(clamped.with_paths(dict(zip(knobs, key, strict=True))), deadline)
             r["lift"] -= weight
             cache[key] = r
+            bar.done()
         return cache[key]
 
     def scaled(x: np.ndarray) -> np.ndarray:
@@ -213,21 +221,22 @@ def trim(
 
     from scipy.optimize import least_squares
 
-    x = x0
-    if len(equations) == len(knobs):
-        # Square system: MINPACK's hybrid method (one finite-difference Jacobian, then Broyden
-        # updates) needs far fewer steady states than a least-squares search.
-        from scipy.optimize import root
+    with bar:
+        x = x0
+        if len(equations) == len(knobs):
+            # Square system: MINPACK's hybrid method (one finite-difference Jacobian, then
+            # Broyden updates) needs far fewer steady states than a least-squares search.
+            from scipy.optimize import root
 
-        fit = root(lambda v: scaled(np.clip(v, lo, hi)), x0, method="hybr", options={"xtol": 1e-10, "maxfev": max_evaluations, "eps": 1e-6})
-        x = np.clip(fit.x, lo, hi)
-    if len(equations) != len(knobs) or not np.all(np.abs(scaled(x)) < tol):
-        try:
-            fit = least_squares(scaled, x, bounds=(lo, hi), x_scale=np.maximum(np.abs(x0), 1.0), diff_step=1e-5, xtol=1e-10, ftol=1e-12, max_nfev=max_evaluations)
-        except ValueError as exc:  # scipy's: residuals not finite at the start (an undefined metric)
-            raise invalid("initial", [float(v) for v in x], f"a drive where every residual ({', '.join(equations)}) is defined ({exc})") from exc
-        x = fit.x
-    r = evaluate(x)
+            fit = root(lambda v: scaled(np.clip(v, lo, hi)), x0, method="hybr", options={"xtol": 1e-10, "maxfev": max_evaluations, "eps": 1e-6})
+            x = np.clip(fit.x, lo, hi)
+        if len(equations) != len(knobs) or not np.all(np.abs(scaled(x)) < tol):
+            try:
+                fit = least_squares(scaled, x, bounds=(lo, hi), x_scale=np.maximum(np.abs(x0), 1.0), diff_step=1e-5, xtol=1e-10, ftol=1e-12, max_nfev=max_evaluations)
+            except ValueError as exc:  # scipy's: residuals not finite at the start (an undefined metric)
+                raise invalid("initial", [float(v) for v in x], f"a drive where every residual ({', '.join(equations)}) is defined ({exc})") from exc
+            x = fit.x
+        r = evaluate(x)
     values = dict(zip(knobs, (float(v) for v in x), strict=True))
     trimmed = spec.with_paths(values)
     s = {e: r[e] / scales[e] for e in EQUATIONS}

@@ -70,9 +70,9 @@ def params(**overrides: Any) -> Params:
     names = {f.name for f in dataclasses.fields(Params)}
     unknown = sorted(set(overrides) - names)
     if unknown:
-        from .._errors import invalid
+        from .._errors import invalid, suggest
 
-        raise invalid(unknown[0], overrides[unknown[0]], f"one of {', '.join(sorted(names))}")
+        raise invalid(unknown[0], overrides[unknown[0]], suggest(unknown[0], sorted(names), what="a parameter of this trial"))
     return Params(**overrides)
 
 

@@ -135,6 +135,16 @@ fn num(s: &Map<String, Value>, key: &str) -> Option<f64> {
     s.get(key).and_then(Value::as_f64)
 }
 
+/// A bound as a person writes it: `1e-30`, not thirty digits (`{}` of an f64 never uses an
+/// exponent); `0.1`, `86400000` as they are.
+fn bound(v: f64) -> String {
+    if v != 0.0 && (v.abs() < 1e-4 || v.abs() >= 1e16) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
 /// The unit of a field (`x-unit`), if any.
 pub(crate) fn unit(s: &Map<String, Value>) -> Option<String> {
     s.get("x-unit").and_then(Value::as_str).map(str::to_string)
@@ -143,11 +153,11 @@ pub(crate) fn unit(s: &Map<String, Value>) -> Option<String> {
 /// Human-readable range of a numeric node, e.g. `in (0, 10] mm`.
 pub(crate) fn range_text(s: &Map<String, Value>) -> String {
     let lo = num(s, "exclusiveMinimum")
-        .map(|v| format!("({v}"))
-        .or_else(|| num(s, "minimum").map(|v| format!("[{v}")));
+        .map(|v| format!("({}", bound(v)))
+        .or_else(|| num(s, "minimum").map(|v| format!("[{}", bound(v))));
     let hi = num(s, "exclusiveMaximum")
-        .map(|v| format!("{v})"))
-        .or_else(|| num(s, "maximum").map(|v| format!("{v}]")));
+        .map(|v| format!("{})", bound(v)))
+        .or_else(|| num(s, "maximum").map(|v| format!("{}]", bound(v))));
     let range = match (lo, hi) {
         (Some(lo), Some(hi)) => format!("in {lo}, {hi}"),
         (Some(lo), None) => format!("in {lo}, inf)"),
@@ -220,36 +230,108 @@ pub(crate) fn join(path: &str, key: &str) -> String {
     }
 }
 
-/// The nearest candidate by edit distance, when it is close enough to be a typo.
+/// The nearest candidate ([`close`]), when one is close enough.
 pub fn nearest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
     close(word, candidates, 1).into_iter().next()
 }
 
-/// At most `limit` candidates close enough to `word` to be a typo, nearest first.
+/// The last segment of a dotted name (`balance_spring` of `drivetrain.balance_spring`).
+fn last_segment(name: &str) -> &str {
+    name.rsplit_once('.').map_or(name, |(_, last)| last)
+}
+
+/// The words of a name's segment (`balance`, `spring`; `of` and `per` carry no meaning).
+fn words(segment: &str) -> impl Iterator<Item = &str> {
+    segment
+        .split(['.', '_', '[', ']'])
+        .filter(|w| !w.is_empty() && !matches!(*w, "of" | "per"))
+}
+
+/// The edit distance of `a` and `b` when it is a plausible typo: at most 2, or a third of the
+/// longer (in characters), and less than the shorter (`k3` is no typo of `c0`: nothing of it
+/// is left).
+fn typo(a: &str, b: &str) -> Option<usize> {
+    if a.is_empty() || b.is_empty() {
+        return None;
+    }
+    let d = strsim::levenshtein(a, b);
+    let (a, b) = (a.chars().count(), b.chars().count());
+    (d <= 2.max(a.max(b) / 3) && d < a.min(b)).then_some(d)
+}
+
+/// At most `limit` candidates close to `word`, nearest first (case-insensitive): a typo of the
+/// whole name or of its last path segment (ranked by edit distance; on a tie the siblings of
+/// `word`'s parent path, then the candidates' order), then candidates that contain `word`'s
+/// last segment, then those sharing a word with it (`balance_spring` for the deprecated
+/// `balance_stiffness`).
+///
+/// The one "did you mean" ranking of paritysim: the spec's checks, [`crate::paths`] and the
+/// Python facade (`paritysim._errors.close_names`, through the bindings) all use it.
 pub fn close<'a>(
     word: &str,
     candidates: impl IntoIterator<Item = &'a str>,
     limit: usize,
 ) -> Vec<&'a str> {
-    let mut ranked: Vec<(usize, &str)> = candidates
-        .into_iter()
-        .map(|c| (strsim::levenshtein(word, c), c))
-        .filter(|(d, c)| *d <= 2.max(word.len().max(c.len()) / 3))
-        .collect();
-    ranked.sort_by_key(|(d, _)| *d); // stable: equal distances keep the candidates' order
-    ranked.dedup_by(|a, b| a.1 == b.1);
-    ranked.into_iter().take(limit).map(|(_, c)| c).collect()
+    let word = word.to_lowercase();
+    let tail = last_segment(&word);
+    let parent = word.rsplit_once('.').map(|(p, _)| p);
+    let tail_words: Vec<&str> = words(tail).collect();
+    let mut seen = std::collections::HashSet::new();
+    let mut ranked: Vec<(usize, bool, usize, &str)> = Vec::new();
+    for (order, candidate) in candidates.into_iter().enumerate() {
+        if !seen.insert(candidate) {
+            continue;
+        }
+        let text = candidate.to_lowercase();
+        let last = last_segment(&text);
+        let score = match (typo(&word, &text), typo(tail, last)) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
+        .or_else(|| (tail.chars().count() >= 3 && text.contains(tail)).then_some(50))
+        .or_else(|| {
+            let mut shared: Vec<&str> = words(last).filter(|w| tail_words.contains(w)).collect();
+            shared.sort_unstable();
+            shared.dedup();
+            (!shared.is_empty()).then(|| 60 - shared.len().min(9))
+        });
+        if let Some(score) = score {
+            let sibling = parent.is_some() && text.rsplit_once('.').map(|(p, _)| p) == parent;
+            ranked.push((score, !sibling, order, candidate));
+        }
+    }
+    ranked.sort_unstable();
+    ranked.into_iter().take(limit).map(|r| r.3).collect()
 }
 
 /// Names a message shows at most: a handful of close ones, never a list of a hundred.
 pub const SHOWN_NAMES: usize = 5;
 
-/// "a known name: did you mean `x`? (also close: ...)": the allowed text of an unknown name,
-/// with the whole list only when it is short (the Python facade's `_errors.suggest` words its
-/// own arguments the same way).
-pub fn suggestion<'a>(word: &str, valid: impl IntoIterator<Item = &'a str> + Clone) -> String {
-    let list: Vec<&str> = valid.clone().into_iter().collect();
-    let near = close(word, valid, SHOWN_NAMES);
+/// "a known name: did you mean `x`? (also close: ...; 57 names)": the allowed text of an
+/// unknown name, with the whole list only when it is short ([`suggestion_for`]).
+pub fn suggestion<'a>(word: &str, valid: impl IntoIterator<Item = &'a str>) -> String {
+    suggestion_for(word, valid, "a known name", None)
+}
+
+/// The allowed text of an unknown `word` among `valid`: `what` it must be (e.g. "a known
+/// name"), the nearest name and at most [`SHOWN_NAMES`] close ones ([`close`]), never the whole
+/// list unless it is that short. `listed_by` says where the full list is (e.g.
+/// "ps.spec_paths(spec) lists all 120"); without it the count, and a few names when none is
+/// close. The one "did you mean" text of paritysim (the Python facade's
+/// `paritysim._errors.suggest` calls it through the bindings).
+pub fn suggestion_for<'a>(
+    word: &str,
+    valid: impl IntoIterator<Item = &'a str>,
+    what: &str,
+    listed_by: Option<&str>,
+) -> String {
+    let mut list: Vec<&str> = Vec::new();
+    for name in valid {
+        if !list.contains(&name) {
+            list.push(name);
+        }
+    }
+    let near = close(word, list.iter().copied(), SHOWN_NAMES);
     let quoted = |names: &[&str]| {
         names
             .iter()
@@ -263,22 +345,46 @@ pub fn suggestion<'a>(word: &str, valid: impl IntoIterator<Item = &'a str> + Clo
             None => format!("one of: {}", quoted(&list)),
         };
     }
+    let count = format!("{} names", list.len());
+    let listed = listed_by.unwrap_or(&count);
     match near.split_first() {
-        Some((best, [])) => format!(
-            "a known name: did you mean `{best}`? ({} names)",
-            list.len()
-        ),
+        Some((best, [])) => format!("{what}: did you mean `{best}`? ({listed})"),
         Some((best, others)) => format!(
-            "a known name: did you mean `{best}`? (also close: {}; {} names)",
-            quoted(others),
-            list.len()
+            "{what}: did you mean `{best}`? (also close: {}; {listed})",
+            quoted(others)
         ),
-        None => format!(
-            "a known name (none close to `{word}`; {} names, e.g. {})",
-            list.len(),
-            quoted(&list[..3])
-        ),
+        None => match listed_by {
+            Some(listed) => format!("{what} (none close to `{word}`; {listed})"),
+            None => format!(
+                "{what} (none close to `{word}`; {count}, e.g. {})",
+                quoted(&list[..3])
+            ),
+        },
     }
+}
+
+/// `requested` names (`None`: all of `valid`) checked against `valid`: an unknown one is an
+/// [`Error::InvalidParameter`](paritysim_error::Error::InvalidParameter) naming `field`, the
+/// name and a handful of close valid names ([`suggestion`]), not the whole list.
+///
+/// # Errors
+/// The first unknown name.
+pub fn select(
+    field: &str,
+    requested: Option<&[String]>,
+    valid: &[String],
+) -> paritysim_error::Result<Vec<String>> {
+    let Some(requested) = requested else {
+        return Ok(valid.to_vec());
+    };
+    if let Some(name) = requested.iter().find(|n| !valid.contains(n)) {
+        return Err(paritysim_error::Error::invalid(
+            field.to_string(),
+            format!("{name:?}"),
+            suggestion(name, valid.iter().map(String::as_str)),
+        ));
+    }
+    Ok(requested.to_vec())
 }
 
 fn short(v: &Value) -> String {
@@ -299,4 +405,106 @@ pub fn tagged_defaults_json() -> String {
         "Waveform": crate::Waveform::default(),
     })
     .to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const PATHS: [&str; 8] = [
+        "drivetrain.crank_mm",
+        "drivetrain.rod_mm",
+        "drivetrain.balance_spring",
+        "actuator.force_per_volt",
+        "options.max_wall_ms",
+        "options.max_cycles",
+        "wings[0].aero.omega1",
+        "wings[1].aero.omega1",
+    ];
+
+    #[test]
+    fn close_ranks_typos_then_containment_then_shared_words() {
+        // A typo of the whole name, of its last segment, case-insensitive.
+        assert_eq!(close("drivetrain.crank", PATHS, 1), ["drivetrain.crank_mm"]);
+        assert_eq!(
+            close("ACTUATOR.Force_Per_Vol", PATHS, 1),
+            ["actuator.force_per_volt"]
+        );
+        // On a tie, the sibling of the word's parent path first.
+        assert_eq!(
+            close("wings[1].aero.omega2", PATHS, 1),
+            ["wings[1].aero.omega1"]
+        );
+        // Containment: `max_wall` is in `options.max_wall_ms`.
+        assert_eq!(close("max_wall", PATHS, 1), ["options.max_wall_ms"]);
+        // A shared word: the deprecated `balance_stiffness` finds `balance_spring`.
+        assert_eq!(
+            close("balance_stiffness", PATHS, 5),
+            ["drivetrain.balance_spring"]
+        );
+        assert!(close("zzz", PATHS, 5).is_empty());
+        // A segment with nothing left of it is no typo (`k3` of `omega1`, of a `c0`), but the
+        // whole name still is one of a sibling.
+        assert_eq!(
+            close("drivetrain.k3", ["configuration.c0", "drivetrain.kind"], 5),
+            ["drivetrain.kind"]
+        );
+        assert_eq!(close("options.max", PATHS, 5).len(), 2);
+    }
+
+    #[test]
+    fn a_range_reads_as_written() {
+        let range = |v: Value| range_text(v.as_object().unwrap());
+        let atol = serde_json::json!({"minimum": 1e-30, "maximum": 0.1});
+        assert_eq!(range(atol), "in [1e-30, 0.1]");
+        let wall =
+            serde_json::json!({"exclusiveMinimum": 0.0, "maximum": 86_400_000.0, "x-unit": "ms"});
+        assert_eq!(range(wall), "in (0, 86400000] ms");
+    }
+
+    #[test]
+    fn suggestion_shows_a_handful_never_the_list() {
+        let many: Vec<String> = (0..100).map(|i| format!("name_{i:03}")).collect();
+        let text = suggestion_for(
+            "name_0",
+            many.iter().map(String::as_str),
+            "a name",
+            Some("x lists all 100"),
+        );
+        assert!(
+            text.starts_with("a name: did you mean `name_000`?"),
+            "{text}"
+        );
+        assert_eq!(text.matches('`').count(), 2 * SHOWN_NAMES, "{text}");
+        assert!(text.ends_with("x lists all 100)"), "{text}");
+        let none = suggestion("qqqq", many.iter().map(String::as_str));
+        assert_eq!(
+            none,
+            "a known name (none close to `qqqq`; 100 names, e.g. `name_000`, `name_001`, `name_002`)"
+        );
+        assert_eq!(
+            suggestion("lfit", ["lift", "drag"]),
+            "did you mean `lift`? (one of: `lift`, `drag`)"
+        );
+        assert_eq!(
+            suggestion("qqq", ["lift", "drag"]),
+            "one of: `lift`, `drag`"
+        );
+    }
+
+    #[test]
+    fn select_names_the_field_and_the_nearest_name() {
+        let valid: Vec<String> = PATHS.iter().map(|s| s.to_string()).collect();
+        assert_eq!(select("metrics", None, &valid).unwrap(), valid);
+        let asked = vec!["options.max_cycles".to_string()];
+        assert_eq!(select("metrics", Some(&asked), &valid).unwrap(), asked);
+        let err = select("metrics", Some(&["options.max_cycle".to_string()]), &valid).unwrap_err();
+        assert_eq!(err.field(), Some("metrics"));
+        assert!(
+            err.to_string()
+                .contains("did you mean `options.max_cycles`?"),
+            "{err}"
+        );
+        assert!(!err.to_string().contains("crank_mm"), "{err}");
+    }
 }

@@ -1,0 +1,97 @@
+"""A progress bar for one long call: ``simulate``, ``calibrate`` and ``trim`` (issue 33).
+
+A single run has no count of work done that the engine reports while it integrates, so the bar
+shows the wall time spent against the call's wall budget (``max_wall_ms``: where it would stop),
+and the runs finished so far for the loops (``calibrate``, ``trim``). It appears only once the
+call has taken `DELAY_S` (a run of a second shows nothing), on stderr, drawn by tqdm as in
+``ps.sweep`` (the same ``progress=True`` argument: ``False`` turns it off). ``paritysim ...
+--quiet`` turns every bar off (`quiet`). The bar lives on a daemon thread: the engine releases
+the GIL while it runs, so the bar moves while the run does.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from types import TracebackType
+from typing import Any
+
+#: A call shows its bar once it has run this long (s).
+DELAY_S = 3.0
+#: Refresh period of a shown bar (s).
+REFRESH_S = 0.5
+_quiet = False
+
+
+@contextmanager
+def quiet() -> Iterator[None]:
+    """No bar inside this block (the CLI's ``--quiet``)."""
+    global _quiet
+    before, _quiet = _quiet, True
+    try:
+        yield
+    finally:
+        _quiet = before
+
+
+def _seconds(budget_ms: Any) -> float | None:
+    """The budget in seconds for the bar, or None (no budget, or a value the call itself will
+    refuse by name: a bar is drawn before the spec is checked)."""
+    try:
+        ms = float(budget_ms)
+    except (TypeError, ValueError):
+        return None
+    return ms / 1e3 if math.isfinite(ms) and ms > 0 else None
+
+
+class LongRun:
+    """``with LongRun("simulate", progress, budget_ms) as bar: ...``; ``bar.done()`` counts a
+    finished run of a loop."""
+
+    def __init__(self, desc: str, progress: bool, budget_ms: float | None, unit: str = "run") -> None:
+        self.desc, self.unit = desc, unit
+        self.enabled = bool(progress) and not _quiet
+        self.budget_s = _seconds(budget_ms)
+        self.runs = 0
+        self.shown = False
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    def done(self, n: int = 1) -> None:
+        self.runs += n
+
+    def __enter__(self) -> LongRun:
+        self._start = time.monotonic()
+        if self.enabled:
+            self._thread = threading.Thread(target=self._draw, name=f"paritysim-progress-{self.desc}", daemon=True)
+            self._thread.start()
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, value: BaseException | None, tb: TracebackType | None) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+
+    def _draw(self) -> None:
+        if self._stop.wait(DELAY_S):
+            return
+        from tqdm.auto import tqdm  # type: ignore[import-untyped]
+
+        elapsed = "{n:.0f}/{total:.0f} s of the wall budget" if self.budget_s else "{n:.0f} s"
+        fmt = "{desc}: " + ("{percentage:3.0f}%|{bar}| " if self.budget_s else "") + elapsed + "{postfix}"
+        bar: Any = tqdm(total=self.budget_s, desc=self.desc, file=sys.stderr, bar_format=fmt, dynamic_ncols=True, leave=False)
+        self.shown = True
+        try:
+            while True:
+                bar.n = time.monotonic() - self._start
+                if self.runs:
+                    bar.set_postfix_str(f"{self.runs} {self.unit}s done", refresh=False)
+                bar.refresh()
+                if self._stop.wait(REFRESH_S):
+                    break
+        finally:
+            bar.close()
