@@ -190,6 +190,29 @@ def test_spec_paths_list_units_and_ranges_and_with_paths_uses_them() -> None:
     assert changed.wings[1] == SPECS[0].wings[1]
 
 
+def test_the_whippletree_preload_is_a_field_of_both_differentials() -> None:
+    linear = ps.Drivetrain.linear_differential(2.5, 2.5, balance_spring=40.0, balance_preload=2.0)
+    linkage = ps.Drivetrain.linkage_differential(balance_spring=400.0, balance_preload=-1.5)
+    assert (linear.balance_preload, linkage.balance_preload) == (2.0, -1.5)
+    assert ps.Drivetrain.linear_differential(2.5, 2.5).balance_preload == 0.0
+    paths = ps.spec_paths(SPECS[0])
+    row = paths.filter(paths["path"] == "drivetrain.balance_preload").row(0, named=True)
+    assert row["unit"] == "mN mm" and "[-100, 100]" in row["allowed"]
+    with pytest.raises(ps.InvalidParameterError, match=r"drivetrain\.balance_preload"):
+        SPECS[0].with_paths({"drivetrain.balance_preload": 500.0})
+
+
+def test_a_preload_shifts_the_strokes_by_the_closed_form() -> None:
+    # §3.3 Control trial (equal wings, eq. 2.15): the whippletree holds q2 = P / K2, so the
+    # mean strokes are ±T L P / K2 (crates/spec/tests/preload.rs derives it).
+    spec = ps.devices.load("sreetharan2012_3_3_parity").with_paths({"drivetrain.balance_spring": 40.0, "drivetrain.balance_preload": 2.0})
+    r = ps.simulate(spec, metrics=["left_stroke_mean", "right_stroke_mean", "q2_amplitude"])
+    shift = spec.drivetrain.transmission_ratio * spec.drivetrain.arm_length_mm * 2.0 / 40.0
+    assert r.metrics["left_stroke_mean"] == pytest.approx(shift, abs=1e-7)
+    assert r.metrics["right_stroke_mean"] == pytest.approx(-shift, abs=1e-7)
+    assert r.metrics["q2_amplitude"] < 1e-7
+
+
 def test_old_spellings_still_load_with_a_deprecation_warning() -> None:
     with pytest.warns(DeprecationWarning, match="balance_spring"):
         old = ps.Simulation.from_dict({**SPECS[0].to_dict(), "drivetrain": {"kind": "linkage_differential", "balance_stiffness": 1.0}})

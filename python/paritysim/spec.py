@@ -293,7 +293,8 @@ class Drivetrain(_Tagged):
     """A planar drivetrain (§2.3-2.4), tagged by ``kind`` (the kinds registered in Rust:
     ``hmf_four_bar``, ``linear_differential``, ``linkage_differential``, ``dual_four_bar``: one
     four-bar and one drive per wing, beyond the thesis), with the balance-beam
-    spring ``balance_spring`` K2 (mN·mm/rad) of the 2-DOF kinds. ``.evaluate`` maps actuator
+    spring ``balance_spring`` K2 (mN·mm/rad) and its preload ``balance_preload`` P (mN·mm; the
+    whippletree settles at ``q2 = P / K2``) of the two differentials. ``.evaluate`` maps actuator
     coordinates to stroke angles through the Rust kinematics.
     """
 
@@ -315,10 +316,11 @@ class Drivetrain(_Tagged):
         return cls(kind="dual_four_bar", crank_mm=crank_mm, rod_mm=rod_mm)  # type: ignore[call-arg]
 
     @classmethod
-    def linear_differential(cls, transmission_ratio: float, arm_length_mm: float, arm_ratio: float | None = None, balance_spring: float | None = None, **deprecated: float) -> Drivetrain:
-        """Eq. 2.15 with ratio T (rad/mm), mean arm L (mm), arm ratio hL/hR, spring K2."""
+    def linear_differential(cls, transmission_ratio: float, arm_length_mm: float, arm_ratio: float | None = None, balance_spring: float | None = None, balance_preload: float | None = None, **deprecated: float) -> Drivetrain:
+        """Eq. 2.15 with ratio T (rad/mm), mean arm L (mm), arm ratio hL/hR, spring K2 and a
+        preload torque P (mN·mm) on the whippletree."""
         balance_spring = _balance(balance_spring, deprecated)
-        return cls(kind="linear_differential", transmission_ratio=transmission_ratio, arm_length_mm=arm_length_mm, arm_ratio=arm_ratio, balance_spring=balance_spring)  # type: ignore[call-arg]
+        return cls(kind="linear_differential", transmission_ratio=transmission_ratio, arm_length_mm=arm_length_mm, arm_ratio=arm_ratio, balance_spring=balance_spring, balance_preload=balance_preload)  # type: ignore[call-arg]
 
     @classmethod
     def linkage_differential(
@@ -328,12 +330,13 @@ class Drivetrain(_Tagged):
         whippletree_length_mm: float | None = None,
         arm_ratio: float | None = None,
         balance_spring: float | None = None,
+        balance_preload: float | None = None,
         **deprecated: float,
     ) -> Drivetrain:
         """The Drag PARITY linkage (§3.3.2 lengths by default; arm ratio hL/hR of §2.4.2). ``None``
         takes the Rust core's default."""
         balance_spring = _balance(balance_spring, deprecated)
-        return cls(kind="linkage_differential", crank_mm=crank_mm, rod_mm=rod_mm, whippletree_length_mm=whippletree_length_mm, arm_ratio=arm_ratio, balance_spring=balance_spring)  # type: ignore[call-arg]
+        return cls(kind="linkage_differential", crank_mm=crank_mm, rod_mm=rod_mm, whippletree_length_mm=whippletree_length_mm, arm_ratio=arm_ratio, balance_spring=balance_spring, balance_preload=balance_preload)  # type: ignore[call-arg]
 
     def kinematics(self) -> _core.Drivetrain:
         """The native kinematic object, built in Rust from this spec (validates the kind and

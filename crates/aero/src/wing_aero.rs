@@ -4,7 +4,7 @@
 //! the wrench on a shoulder that moves with a flying body ([`wrench`], [`switching`]).
 //!
 //! Adding an aero model is a variant here with its arms in this file, its law in a file of
-//! its own in this crate, and a spec variant (ARCHITECTURE.md, "Add an aero model").
+//! its own in this crate, and a spec variant (docs/recipes.md, "Add an aero model").
 //!
 //! # The wrench on a moving shoulder
 //!

@@ -10,7 +10,8 @@
 //! conditions.
 //!
 //! Dependency direction: this crate depends on `paritysim-dynamics` (and the kinematics,
-//! aero and constraints crates), never the reverse, so the engine stays free of serde.
+//! aero and constraints crates), never the reverse, so the engine never parses a file or knows
+//! a format (it derives serde traits on its options and result records only).
 
 pub mod actuator;
 pub mod attribute;

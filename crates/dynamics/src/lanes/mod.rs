@@ -12,21 +12,18 @@
 //!
 //! * **Which points.** A shooting point qualifies when it records one plain cycle, uses DOP853
 //!   and its device has a lane model ([`has_lane_model`]): drivetrain coordinates of the linear
-//!   differential map with stroke drag (stroke metrics only; `point`), or a switched device
-//!   with blade elements on both wings: the §3.4 stroke-plane model on a single drive, the §2.5
-//!   free-deviation models (Lift PARITY, four coordinates; Dual PARITY, five, in a twelve-entry
-//!   layout), continued points reading metrics without work integrals (`plane_point`). Every
-//!   other point runs the scalar path in place, in its chain's order.
-//! * **Switches.** The switched lanes hold the branch of their blade elements' switching
-//!   functions and replay a step that crosses one on the scalar path (`plane_rhs`), so their
-//!   periods stay the scalar ones bit for bit.
+//!   differential map with an actuator and stroke drag (or no aerodynamics) on both wings
+//!   (`linear_stroke`; stroke metrics only). The switched devices (§3.4 stroke plane, §2.5 free
+//!   deviation) have no lanes (theirs did not pay, docs/findings.md §24), so no lane holds a
+//!   switching function. Every other point runs the scalar path in place, in its chain's order.
 //! * **Same results.** The lanes perform the scalar path's floating-point operations in its
-//!   order, and the Newton logic here (`LanePoint`) is that of `shooting::grid::shoot` and
-//!   `simulate::shooting_steady_state`. The branches it does not follow (a failing period, a
-//!   singular Newton step, no convergence, an unstable orbit: `shoot`'s `Ok(None)` and errors)
-//!   rerun the point on the scalar path from the same start, so every point's result is
-//!   bit-identical to the scalar sweep (`PARITYSIM_LANES=1`; tested for lane widths 1 to 4 and
-//!   thread counts).
+//!   order (the right-hand side is the scalar form's own generic `linear_map::accelerations`),
+//!   and each lane point (`point::LanePoint`) is an executor of the one shooting machine
+//!   (`shooting::machine`), as `shooting::grid::shoot` is. The branches it does not follow (a
+//!   failing period, a singular Newton step, no convergence, an unstable orbit: `shoot`'s
+//!   `Ok(None)` and errors) rerun the point on the scalar path from the same start, so every
+//!   point's result is bit-identical to the scalar sweep (`PARITYSIM_LANES=1`; tested for lane
+//!   widths 1 to 4 and thread counts).
 //! * **Failures are rows**: a failing point fails on the scalar rerun, with the scalar error.
 //!   A panic (an engine bug) fails the chains its worker had taken and not completed (up to
 //!   `LANES` chains) rather than only its chain.

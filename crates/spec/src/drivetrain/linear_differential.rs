@@ -24,6 +24,10 @@ pub struct LinearDifferential {
     /// Balance-beam spring K2 on `q2` (mN·mm/rad), in [0, 1e4] (docs/errata.md#14).
     #[schemars(range(min = 0.0, max = 1e4), extend("x-unit" = "mN mm/rad"))]
     pub balance_spring: f64,
+    /// Preload torque P on the whippletree `q2` (mN·mm), in [-100, 100]: the drive load on `q2`
+    /// is `P − K2 q2`, so a whippletree at rest settles at `q2 = P / K2` (needs K2 > 0 to hold).
+    #[schemars(range(min = -100.0, max = 100.0), extend("x-unit" = "mN mm"))]
+    pub balance_preload: f64,
 }
 
 impl Default for LinearDifferential {
@@ -33,6 +37,7 @@ impl Default for LinearDifferential {
             arm_length_mm: 2.5,
             arm_ratio: 1.0,
             balance_spring: 0.0,
+            balance_preload: 0.0,
         }
     }
 }
@@ -48,5 +53,9 @@ impl DrivetrainConfig for LinearDifferential {
 
     fn balance_spring(&self) -> f64 {
         self.balance_spring
+    }
+
+    fn balance_preload(&self) -> f64 {
+        self.balance_preload
     }
 }
