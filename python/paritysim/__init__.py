@@ -46,18 +46,21 @@ if TYPE_CHECKING:  # what type checkers see; at run time the names below load la
     from . import aero, claims, devices, dynamics, flight, kinematics, laminate, planform, plots, spec, stability, trials
     from .calibration import CalibrationResult, calibrate
     from .continuation import ContinuationResult
+    from .gradients import SensitivityResult, sensitivity
     from .planform import Planform
     from .simulation import SimulationResult, simulate
     from .spec import Actuator, Aero, Body, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, Springs, TunableHinge, Waveform, Wing, load_spec, spec_paths
     from .sweep import grid, sweep
 
 #: Lazily loaded submodules.
-_SUBMODULES = ("aero", "calibration", "claims", "continuation", "devices", "dynamics", "flight", "kinematics", "laminate", "planform", "plots", "simulation", "spec", "stability", "sweep", "trials")
+_SUBMODULES = ("aero", "calibration", "claims", "continuation", "devices", "dynamics", "flight", "gradients", "kinematics", "laminate", "planform", "plots", "simulation", "spec", "stability", "sweep", "trials")
 #: Lazily loaded names -> the submodule defining them.
 _NAMES = {
     "CalibrationResult": "calibration",
     "calibrate": "calibration",
     "ContinuationResult": "continuation",
+    "SensitivityResult": "gradients",
+    "sensitivity": "gradients",
     "Planform": "planform",
     "SimulationResult": "simulation",
     "simulate": "simulation",
@@ -103,6 +106,7 @@ __all__ = [
     "ShapeError",
     "Shoulder",
     "Simulation",
+    "SensitivityResult",
     "SimulationResult",
     "SingularError",
     "Spring",
@@ -123,6 +127,7 @@ __all__ = [
     "load_spec",
     "planform",
     "plots",
+    "sensitivity",
     "simulate",
     "spec",
     "spec_paths",

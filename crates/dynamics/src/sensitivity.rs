@@ -150,13 +150,21 @@ pub fn steady_sensitivity(
     let window = |point: &Point, y: &State| -> Result<Vec<(String, f64)>> {
         crate::simulate::grid_window(&point.device, &rk, &point.grid, point.period, y, options)
     };
-    let base_metrics = crate::simulate::grid_window(&device, &rk, &grid, period, &x_star, options)?;
+    let mut base_metrics =
+        crate::simulate::grid_window(&device, &rk, &grid, period, &x_star, options)?;
+    if let Some(asked) = &options.metrics {
+        // The window computes what the asked metrics need (and may compute more).
+        base_metrics = asked
+            .iter()
+            .filter_map(|name| base_metrics.iter().find(|(m, _)| m == name).cloned())
+            .collect();
+    }
     let n_params = p0.len();
     let base_map = mapped.without_work().compact(n);
     // Per parameter: dx*/dp_j, and the metrics along (dx*/dp_j, 1): central differences at
     // p0 ± h, or the second-order one-sided formula at p0 + h, p0 + 2h where p0 − h is outside
     // the parameter's range (K2 = 0).
-    let columns = crate::stability::rows::run_parts(n_params, |j| {
+    let column = |j: usize| {
         let h = steps[j];
         let at = |offset: f64| -> Result<Option<Point>> {
             let mut p = p0.to_vec();
@@ -209,7 +217,8 @@ pub fn steady_sensitivity(
         let m_near = window(&near, &moved(o_near))?;
         let m_far = window(&far, &moved(o_far))?;
         Ok((dx, m_near, m_far, central))
-    })?;
+    };
+    let columns = crate::stability::rows::run_parts(n_params, column)?;
     let n_metrics = base_metrics.len();
     let mut jacobian = DMatrix::zeros(n_metrics, n_params);
     let mut state_jacobian = DMatrix::zeros(2 * n, n_params);

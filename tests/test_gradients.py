@@ -1,0 +1,110 @@
+"""ps.sensitivity (issue 31): derivatives of steady-state metrics against central differences
+of whole ps.simulate runs, on the §3.4 blade-element device (passive rotation) and the §3.3
+device; neutral families flagged; bad paths named."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import paritysim as ps
+from paritysim import InvalidParameterError
+
+TIGHT = {"rtol": 1e-10, "atol": 1e-12, "steady_tol": 1e-10}
+
+
+def _metrics(spec: ps.Simulation, values: dict[str, float]) -> dict[str, float]:
+    r = ps.simulate(_set(spec, values), columns=[], progress=False, **TIGHT)
+    assert r.converged
+    return dict(r.metrics)
+
+
+def _set(spec: ps.Simulation, values: dict[str, float]) -> ps.Simulation:
+    d = spec.to_dict()
+    for path, v in values.items():
+        node = d
+        keys = path.replace("]", "").replace("[", ".").split(".")
+        for k in keys[:-1]:
+            node = node[int(k)] if k.isdigit() else node[k]
+        node[keys[-1]] = v
+    return ps.Simulation.from_dict(d)
+
+
+def _check_against_whole_runs(spec: ps.Simulation, paths: list[str], base: list[float], rel_step: float) -> int:
+    s = ps.sensitivity(spec, paths, progress=False, **TIGHT)
+    checked = 0
+    for path, p0 in zip(paths, base, strict=True):
+        h = rel_step * abs(p0)
+
+        def reference(step: float) -> dict[str, float]:
+            plus, minus = _metrics(spec, {path: p0 + step}), _metrics(spec, {path: p0 - step})
+            return {m: (plus[m] - minus[m]) / (2 * step) for m in plus if plus[m] is not None and minus[m] is not None}
+
+        coarse, fine = reference(h), reference(h / 2)
+        for row in s.jacobian.iter_rows(named=True):
+            m, m0 = row["metric"], row["value"]
+            if not row["differentiable"] or not np.isfinite(m0) or m not in fine:
+                continue
+            # What whole runs resolve: their own error (~1e-8 of the metric here) over the step.
+            resolved = 1e-8 * (1 + abs(m0)) / (h / 2)
+            if abs(coarse[m] - fine[m]) > 1e-4 * abs(fine[m]) + resolved:
+                continue  # the metric is not smooth over the reference's step
+            ours = row[f"d/d({path})"]
+            assert abs(ours - fine[m]) <= 1e-4 * abs(fine[m]) + resolved, (path, m, ours, fine[m])
+            checked += 1
+    return checked
+
+
+def test_blade_element_device_derivatives_equal_whole_run_differences():
+    spec = ps.devices.load("sreetharan2012_3_4_parity_1cut")
+    spec = _set(spec, {"drivetrain.balance_spring": 30.0})  # K2 > 0: an isolated orbit
+    paths = ["wings[0].springs.hinge.stiffness", "actuator.waveform.amplitude_v", "drivetrain.balance_spring"]
+    d = spec.to_dict()
+    base = [d["wings"][0]["springs"]["hinge"]["stiffness"], d["actuator"]["waveform"]["amplitude_v"], 30.0]
+    assert _check_against_whole_runs(spec, paths, base, 1e-3) >= 15
+
+
+def test_the_frequency_derivative_scales_the_period():
+    spec = _set(ps.devices.load("sreetharan2012_3_3_parity"), {"drivetrain.balance_spring": 5.0})
+    assert _check_against_whole_runs(spec, ["actuator.waveform.frequency_hz"], [110.0], 1e-3) >= 5
+
+
+def test_a_neutral_family_is_reported_and_flagged_not_divided_by():
+    spec = ps.devices.load("sreetharan2012_3_3_parity_1cut")  # K2 = 0: a whippletree family
+    s = ps.sensitivity(spec, ["actuator.waveform.amplitude_v"], progress=False)
+    assert s.neutral_directions == 1
+    assert np.min(np.abs(s.multipliers - 1)) < 1e-6
+    defined = s.jacobian.filter(s.jacobian["value"].is_finite())
+    assert defined["d/d(actuator.waveform.amplitude_v)"].is_finite().all()
+    assert not s.jacobian["differentiable"].all(), "the stroke means move along the family"
+    assert "family" in " ".join(r for r in s.jacobian["reason"].drop_nulls())
+    assert "1 neutral direction" in repr(s) and "\n" not in repr(s)
+
+
+def test_metric_selection_elasticities_and_plot():
+    spec = _set(ps.devices.load("sreetharan2012_3_3_parity"), {"drivetrain.balance_spring": 5.0})
+    s = ps.sensitivity(spec, "actuator.amplitude_v", metrics=["right_stroke_amplitude"], progress=False)
+    assert s.jacobian["metric"].to_list() == ["right_stroke_amplitude"]
+    # A stroke amplitude grows about in proportion to the drive: elasticity near 1 (drag
+    # makes it sublinear), and d/d(amplitude) > 0.
+    e = s.elasticities()["actuator.amplitude_v"][0]
+    assert 0.3 < e < 1.0
+    assert s.derivative("right_stroke_amplitude", "actuator.amplitude_v") > 0
+    assert s.plot().axes
+
+
+@pytest.mark.parametrize(
+    ("params", "named"),
+    [
+        (["drivetrain.balanse_spring"], "balance_spring"),
+        (["drivetrain.kind"], "drivetrain.kind"),
+        (["options.samples_per_cycle"], "options.samples_per_cycle"),
+        ([], "params"),
+        ([3.0], "params"),
+    ],
+)
+def test_bad_parameters_are_named(params, named):
+    spec = ps.devices.load("sreetharan2012_3_3_parity")
+    with pytest.raises(InvalidParameterError) as e:
+        ps.sensitivity(spec, params, progress=False)
+    assert named in str(e.value)
