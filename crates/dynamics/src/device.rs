@@ -58,13 +58,22 @@ impl Transmission {
     ///
     /// # Errors
     /// [`paritysim_error::Error::InvalidParameter`] naming `balance_preload` when it is not
-    /// finite, or nonzero on a drivetrain without a whippletree (1 DOF).
+    /// finite, or nonzero on a drivetrain without a whippletree (1 DOF) or without a balance
+    /// spring (`P − 0·q2` has no equilibrium: the whippletree runs to its stop).
     pub fn with_preload(mut self, preload: f64) -> Result<Self> {
         if !preload.is_finite() || (preload != 0.0 && self.kinematics.dof() != 2) {
             return Err(paritysim_error::Error::invalid(
                 "balance_preload",
                 preload,
                 "a finite torque (mN·mm), and 0 on a 1-DOF drivetrain",
+            ));
+        }
+        if preload != 0.0 && self.balance_stiffness() == 0.0 {
+            return Err(paritysim_error::Error::invalid(
+                "balance_preload",
+                preload,
+                "0 without a balance spring (balance_spring > 0 gives the preload its \
+                 equilibrium q2 = P / K2)",
             ));
         }
         self.preload = preload;

@@ -82,6 +82,13 @@ fn the_preload_is_validated_and_named() {
         .replace("balance_spring = 0.0\n", "");
     let err = from_toml(&hmf).unwrap_err().to_string();
     assert!(err.contains("balance_preload"), "{err}");
+    // Without a balance spring a preload has no equilibrium (q2 would run to its stop).
+    let err = from_toml(&control_trial(0.0, 2.0))
+        .and_then(|(spec, _)| spec.model())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("drivetrain.balance_preload"), "{err}");
+    assert!(err.contains("balance spring"), "{err}");
 }
 
 /// The SIMD lanes carry the preload per lane: a sweep over it gives the scalar sweep's bits at
