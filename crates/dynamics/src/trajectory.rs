@@ -13,6 +13,7 @@ use paritysim_error::{Error, Result};
 
 use crate::device::{Device, Evaluation};
 use crate::integrate::State;
+use crate::metrics::forces;
 use crate::metrics::needs::StrokeNeeds;
 pub use crate::metrics::plane_sample::PlaneSample;
 
@@ -31,6 +32,11 @@ pub struct Sample {
     pub inertial: [Vector3<f64>; 2],
     /// Sum over wings of aerodynamic + inertial (mN·mm).
     pub total: Vector3<f64>,
+    /// Aerodynamic force on each wing (mN), in the body frame (the left wing mirrored,
+    /// `crate::metrics::forces`); zero for wings without a force model.
+    pub force: [Vector3<f64>; 2],
+    /// Power the wings give to the air (mW = µJ/ms; the rate of `−work_aero`).
+    pub aero_power: f64,
     /// Drive voltage (V).
     pub voltage: f64,
     /// Mechanical energy (µJ).
@@ -60,6 +66,8 @@ impl Sample {
             time,
             state: *state,
             energy: device.energy(&eval),
+            force: forces::of_evaluation(device, &eval),
+            aero_power: forces::aero_power(device, &eval),
             eval,
             aero,
             inertial,
@@ -277,7 +285,7 @@ const PER_WING: [WingGetter; 23] = [
     ("kinetic_energy", "uJ", |s, w| s.eval.wings[w].kinetic),
 ];
 
-const PER_DEVICE: [DeviceGetter; 13] = [
+const PER_DEVICE: [DeviceGetter; 14] = [
     ("q1", "mm", |s| s.eval.drive.q.x),
     ("q2", "rad", |s| s.eval.drive.q.y),
     ("q1_dot", "mm/ms", |s| s.eval.drive.q_dot.x),
@@ -293,6 +301,15 @@ const PER_DEVICE: [DeviceGetter; 13] = [
     ("roll_total", "mN*mm", |s| s.total.x),
     ("yaw_total", "mN*mm", |s| s.total.y),
     ("pitch_total", "mN*mm", |s| s.total.z),
+    ("aero_power", "uJ/ms", |s| s.aero_power),
+];
+
+/// Per-wing force columns (body frame), where the device offers forces
+/// ([`forces::offers_forces`]).
+const PER_WING_FORCE: [WingGetter; 3] = [
+    ("lift", "mN", |s, w| s.force[w].x),
+    ("aero_force_y", "mN", |s, w| s.force[w].y),
+    ("aero_force_z", "mN", |s, w| s.force[w].z),
 ];
 
 /// Wing name prefixes: `left`, `right` for two wings, `wing` for one.
@@ -322,6 +339,17 @@ pub fn column_table(device: &Device) -> Vec<Column> {
             unit,
             getter: Getter::Device(g),
         });
+    }
+    if forces::offers_forces(device) {
+        for (w, prefix) in wing_prefixes(device).iter().enumerate() {
+            for (name, unit, g) in PER_WING_FORCE {
+                out.push(Column {
+                    name: format!("{prefix}_{name}"),
+                    unit,
+                    getter: Getter::Wing(w, g),
+                });
+            }
+        }
     }
     out
 }

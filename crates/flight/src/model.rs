@@ -162,6 +162,8 @@ pub struct FlightEval {
     pub inertial_torque: [Vector3<f64>; 2],
     /// Total aerodynamic force on the wings (body frame, mN).
     pub aero_force: Vector3<f64>,
+    /// Per wing: aerodynamic force (body frame, mN; the left wing's mirrored back).
+    pub wing_aero_force: [Vector3<f64>; 2],
     /// Force the wings exert on the airframe (body frame, mN): aerodynamic + gravity on the
     /// wings − their inertial forces.
     pub wing_force: Vector3<f64>,
@@ -692,6 +694,7 @@ impl FlightModel {
         let mut aero_power = 0.0;
         let mut potential = drive.potential;
         let mut aero_force = Vector3::zeros();
+        let mut wing_aero_force = [Vector3::zeros(); 2];
         for k in 0..self.n_wings {
             let o = 3 * k;
             let pw = Vector3::new(p[o], p[o + 1], p[o + 2]);
@@ -809,6 +812,7 @@ impl FlightModel {
             let f_body = wr.force.component_mul(ps);
             let tau_body = wr.torque.component_mul(sa);
             aero_force += f_body;
+            wing_aero_force[k] = f_body;
             force.fixed_rows_mut::<3>(0).add_assign(&(r_b * f_body));
             force
                 .fixed_rows_mut::<3>(3)
@@ -892,6 +896,7 @@ impl FlightModel {
             aero_torque,
             inertial_torque,
             aero_force,
+            wing_aero_force,
             wing_force,
             wing_torque,
             kinetic,

@@ -120,6 +120,9 @@ impl FlightSample {
             aero: f.aero_torque,
             inertial: f.inertial_torque,
             total,
+            force: f.wing_aero_force,
+            // The power the wings give to the air (the flight's is that of the air on them).
+            aero_power: -f.aero_power,
             voltage,
             energy: f.kinetic + f.potential + f.gravity_potential,
         };
@@ -140,7 +143,9 @@ impl FlightSample {
         })
     }
 
-    /// Lift: the aerodynamic force along "up" (world, mN).
+    /// Lift in the world: the aerodynamic force along "up" (against gravity, mN). The device
+    /// metric `lift_mean` is along the body's lift axis `x̂` instead (the same on a clamped
+    /// body under the default gravity).
     pub fn lift(&self) -> f64 {
         (self.flight.attitude * self.flight.aero_force).dot(&self.up)
     }
@@ -193,8 +198,10 @@ pub const BODY_COLUMNS: [BodyGetter; 32] = [
     }),
 ];
 
-/// The body metrics, means over the recorded window's whole wingbeats.
-pub const BODY_METRICS: [&str; 15] = [
+/// The body metrics, means over the recorded window's whole wingbeats (`lift_world_mean`:
+/// the aerodynamic force along "up" in the world; `lift_mean` and `lift_to_weight`, along the
+/// body's lift axis, are device metrics).
+pub const BODY_METRICS: [&str; 14] = [
     "body_omega_roll_mean",
     "body_omega_yaw_mean",
     "body_omega_pitch_mean",
@@ -207,8 +214,7 @@ pub const BODY_METRICS: [&str; 15] = [
     "body_torque_roll_mean",
     "body_torque_yaw_mean",
     "body_torque_pitch_mean",
-    "lift_mean",
-    "lift_to_weight",
+    "lift_world_mean",
     "body_displacement",
 ];
 
@@ -235,7 +241,8 @@ impl FlightColumn {
 }
 
 fn all_columns(model: &FlightModel) -> Vec<FlightColumn> {
-    column_table(model.device())
+    // The source device: its wings' aero laws say which force columns exist.
+    column_table(model.source())
         .into_iter()
         .map(FlightColumn::Device)
         .chain(BODY_COLUMNS.iter().copied().map(FlightColumn::Body))
@@ -249,7 +256,7 @@ pub fn flight_columns(model: &FlightModel) -> Vec<String> {
 
 /// Every metric name of a flight run (the device's, then [`BODY_METRICS`]).
 pub fn flight_metrics(model: &FlightModel) -> Vec<String> {
-    paritysim_dynamics::metrics::names(model.device())
+    paritysim_dynamics::metrics::names_weighed(model.source(), true)
         .into_iter()
         .chain(BODY_METRICS.iter().map(|s| s.to_string()))
         .collect()
@@ -293,7 +300,6 @@ struct BodyAccumulator {
     force: Vector3<f64>,
     torque: Vector3<f64>,
     lift: f64,
-    weight: f64,
     last_angles: Vector3<f64>,
     start: Option<Vector3<f64>>,
     last_position: Vector3<f64>,
@@ -314,18 +320,12 @@ impl BodyAccumulator {
         self.force += s.flight.wing_force;
         self.torque += s.flight.wing_torque;
         self.lift += s.lift();
-        self.weight = s.weight;
     }
 
     fn finish(&self) -> Vec<(String, f64)> {
         let n = self.n.max(1) as f64;
         let (o, f, t) = (self.omega / n, self.force / n, self.torque / n);
         let lift = self.lift / n;
-        let ratio = if self.weight > 0.0 {
-            lift / self.weight
-        } else {
-            f64::NAN
-        };
         let moved = (self.last_position - self.start.unwrap_or_default()).norm();
         let values = [
             o.x,
@@ -341,7 +341,6 @@ impl BodyAccumulator {
             t.y,
             t.z,
             lift,
-            ratio,
             moved,
         ];
         BODY_METRICS
@@ -564,7 +563,8 @@ pub fn fly_controlled(
         options.cancel.clone(),
     )
     .enter();
-    let mut metrics = MetricsAccumulator::new(device, period);
+    let weight = model.total_mass() * model.body().gravity.norm();
+    let mut metrics = MetricsAccumulator::new(model.source(), period).with_weight(Some(weight));
     let mut body = BodyAccumulator::default();
     let mut trajectory = Trajectory {
         time: Vec::with_capacity(if columns.is_empty() { 0 } else { times.len() }),

@@ -28,8 +28,30 @@ impl Simulation {
         let device = self.device()?;
         // A flying spec's body is checked here too (its errors name `body.` fields).
         self.flight(&device)?;
-        let options = options(&self.options, device.n_coords())?;
+        let mut options = options(&self.options, device.n_coords())?;
+        options.weight_mn = self.weight_mn();
         Ok((device, options))
+    }
+
+    /// The weight of body and wings (mN) when the spec has a `body` section (any mode, the
+    /// torque stand's `fixed` included): what `lift_to_weight` divides by.
+    pub fn weight_mn(&self) -> Option<f64> {
+        self.body.as_ref().map(|b| {
+            let g = b.gravity_mm_per_ms2;
+            let mass = b.mass_mg + b.wing_mass_mg.iter().sum::<f64>();
+            mass * (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt()
+        })
+    }
+
+    /// The radius (mm) that gives blade-element wings their force parameter `Ω1 / r`:
+    /// `body.force_radius_mm`, or its default without a `body` section (the torque stand's
+    /// force metrics and free flight use the same).
+    pub fn force_radius_mm(&self) -> f64 {
+        self.body
+            .as_ref()
+            .map_or(crate::body::Body::default().force_radius_mm, |b| {
+                b.force_radius_mm
+            })
     }
 
     /// The validated dynamics model.
@@ -37,11 +59,12 @@ impl Simulation {
     /// # Errors
     /// See [`Simulation::model`].
     pub fn device(&self) -> Result<Device> {
+        let force_radius = self.force_radius_mm();
         let wings = self
             .wings
             .iter()
             .enumerate()
-            .map(|(i, w)| wing(w).map_err(|e| e.in_field(&format!("wings[{i}]"))))
+            .map(|(i, w)| wing(w, force_radius).map_err(|e| e.in_field(&format!("wings[{i}]"))))
             .collect::<Result<Vec<_>>>()?;
         let constraints = constraints(&self.configuration, 3 * wings.len())?;
         let transmission = match &self.drivetrain {
@@ -100,7 +123,9 @@ impl Simulation {
     }
 }
 
-fn wing(w: &Wing) -> Result<EngineWing> {
+/// The engine wing of a spec wing; a blade element gets the force parameter
+/// `Ω1 / force_radius` (mg·mm), so its lift and drag forces are defined on every body mode.
+fn wing(w: &Wing, force_radius: f64) -> Result<EngineWing> {
     let shoulder = SphericalShoulder::new(w.shoulder.alpha2, w.shoulder.alpha3)
         .map_err(|e| e.in_field("shoulder"))?;
     let inertia = Matrix3::from_fn(|i, j| w.inertia[i][j]);
@@ -116,7 +141,9 @@ fn wing(w: &Wing) -> Result<EngineWing> {
         }
         Some(Aero::BladeElement(a)) => {
             let at = |e: Error| e.in_field("aero");
-            let omegas = Omegas::new(a.omega1, a.omega2, a.omega3, a.omega4).map_err(at)?;
+            let omegas = Omegas::new(a.omega1, a.omega2, a.omega3, a.omega4)
+                .and_then(|o| o.with_force(a.omega1 / force_radius))
+                .map_err(at)?;
             let coefficients = CoefficientSet::from_name(match a.model {
                 CoefficientModel::Dickinson1999 => "dickinson1999",
                 CoefficientModel::WhitneyWood2010 => "whitney_wood2010",

@@ -331,7 +331,7 @@ impl Simulation {
     /// As [`Simulation::flight`].
     pub fn metric_names(&self, device: &Device) -> Result<Vec<String>> {
         Ok(match self.flight(device)? {
-            None => paritysim_dynamics::sweep::metric_names(device),
+            None => paritysim_dynamics::metrics::names_weighed(device, self.body.is_some()),
             Some(f) => paritysim_flight::flight_metrics(&f.model),
         })
     }

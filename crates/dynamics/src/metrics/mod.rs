@@ -16,13 +16,38 @@
 //! `imbalance_instantaneous_pct = 100 Δτ_peak / τR_peak`,
 //! `imbalance_peak_pct = 100 (τR_peak − τL_peak) / τR_peak`.
 //!
+//! Forces and power (every device; docs/reference/metrics.md). The wings' aerodynamic force
+//! in the body frame ([`forces`]: `x̂` the lift axis, `ŷ` fore-aft, `ẑ` spanwise toward the
+//! right wing), where every wing has a force model ([`forces::offers_forces`]: blade
+//! elements, not the stroke drag of eq. 2.16), per wing `{p}_{lift,aero_force_y,aero_force_z}`
+//! and net `{lift,aero_force_y,aero_force_z}`, each `_mean`, `_rms`, `_peak` (mN), and
+//! `aero_force_peak = max |F|` of the net force; `aero_power_mean` (mW: power given to the
+//! air, `−work_aero` over the window's duration) and `actuator_power_mean` (mW, the same as
+//! `mean_actuator_power`) on every device; `lift_per_power = lift_mean / actuator_power_mean`
+//! (mN/mW); `lift_to_weight = lift_mean / weight` when a weight is given
+//! ([`MetricsAccumulator::with_weight`]: a spec's `body` section), and on every device given a
+//! weight `actuator_power_per_weight = actuator_power_mean / weight` (mW/mN = W/N).
+//!
+//! The thesis' aerodynamics (§3.2.4) gives moments only (eqs. 3.8–3.11, with `Ω1 = ½ρ∬z³dA`,
+//! eq. 3.12); the force of the same strips is `½ρ∬z²dA · W² (C_L ℓ̂ − C_D û)` with `C_L`, `C_D`
+//! of eqs. 3.5–3.6 at the α of eq. 3.4 (sign convention: docs/errata.md#5). On a stroke-plane
+//! wing (θ ≡ 0) the lift is `½ρ∬z²dA · φ̇² C_L(α)` along the stroke axis and the drag lies in
+//! the stroke plane. The actuator power is the mechanical power the actuator's force gives the
+//! drivetrain (`F_a q̇1`; the piezo's electrical side is not modelled); on a periodic orbit
+//! `actuator_power_mean = aero_power_mean` (the springs and the inertia return their energy,
+//! and the one dissipation, rotational damping eq. 3.10, is part of the aerodynamic power).
+//!
 //! Undefined metrics are NaN (Python turns them into `None` / null): the phase lag of a wing
-//! that does not rotate, the imbalance percentages when `τR_peak = 0`.
+//! that does not rotate, the imbalance percentages when `τR_peak = 0`, `lift_per_power`
+//! without actuator power, `lift_to_weight` at zero weight.
 
+pub mod forces;
 pub mod needs;
 pub mod plane_sample;
-pub use needs::{StrokeNeeds, is_stroke_metric};
+pub use needs::{StrokeNeeds, is_force_metric, is_stroke_metric};
 use std::f64::consts::{PI, TAU};
+
+use nalgebra::Vector3;
 
 use crate::device::Device;
 use crate::trajectory::{Sample, StrokeSample};
@@ -139,6 +164,18 @@ pub struct MetricsAccumulator {
     work_aero: f64,
     /// Fed with [`StrokeSample`]s computing this much: the metrics they do not provide are NaN.
     lean: Option<StrokeNeeds>,
+    /// The force metrics, when the device offers them ([`forces::offers_forces`]).
+    forces: Option<ForceAcc>,
+    /// Weight (mN) for `lift_to_weight`.
+    weight: Option<f64>,
+}
+
+/// Force statistics: per wing and net, per body axis (lift, y, z), and the net magnitude.
+#[derive(Clone, Copy, Debug, Default)]
+struct ForceAcc {
+    wings: [[Stats; 3]; 2],
+    net: [Stats; 3],
+    magnitude: Range,
 }
 
 /// The per-sample values every metric path shares.
@@ -169,7 +206,37 @@ impl MetricsAccumulator {
             work_actuator: 0.0,
             work_aero: 0.0,
             lean: None,
+            forces: forces::offers_forces(device).then(ForceAcc::default),
+            weight: None,
         }
+    }
+
+    /// The same accumulator reporting `lift_to_weight` against `weight` (mN; a body's weight
+    /// with its wings). A device without force metrics ignores it.
+    pub fn with_weight(mut self, weight: Option<f64>) -> Self {
+        self.weight = weight;
+        self
+    }
+
+    /// Adds the wings' aerodynamic forces of a sample (body frame, as [`Sample::force`]);
+    /// `closing` as in [`Self::add`]. Ignored when the device offers no force metric.
+    #[inline]
+    pub fn add_forces(&mut self, force: &[Vector3<f64>; 2], closing: bool) {
+        let Some(acc) = &mut self.forces else {
+            return;
+        };
+        let body = !closing;
+        let mut net = Vector3::zeros();
+        for (stats, f) in acc.wings.iter_mut().zip(force).take(self.n_wings) {
+            for (k, st) in stats.iter_mut().enumerate() {
+                st.add(f[k], body);
+            }
+            net += f;
+        }
+        for (k, st) in acc.net.iter_mut().enumerate() {
+            st.add(net[k], body);
+        }
+        acc.magnitude.add(net.norm());
     }
 
     fn add_core(&mut self, c: &Core, body: bool) {
@@ -222,6 +289,7 @@ impl MetricsAccumulator {
         for (k, stats) in self.total.iter_mut().enumerate() {
             stats.add(s.total[k], body);
         }
+        self.add_forces(&s.force, closing);
         self.work_actuator = s.state.work_actuator;
         self.work_aero = s.state.work_aero;
     }
@@ -329,6 +397,7 @@ impl MetricsAccumulator {
                 force: true,
                 torques: false,
                 work: false,
+                forces: false,
             });
             self.first_time = Some(b.time[0]);
             for acc in &mut self.wings {
@@ -440,6 +509,46 @@ impl MetricsAccumulator {
             out.push(("imbalance_instantaneous_pct".into(), percent(delta)));
             out.push(("imbalance_peak_pct".into(), percent(tau_r - tau_l)));
         }
+        let per_time = |work: f64| {
+            if duration > 0.0 { work / duration } else { 0.0 }
+        };
+        let actuator_power = per_time(self.work_actuator);
+        let mut lift = f64::NAN;
+        if let Some(acc) = &self.forces {
+            for (w, p) in prefixes.iter().enumerate() {
+                for (k, axis) in forces::FORCE_AXES.iter().enumerate() {
+                    let f = &acc.wings[w][k];
+                    out.push((format!("{p}_{axis}_mean"), f.mean(n)));
+                    out.push((format!("{p}_{axis}_rms"), f.rms(n)));
+                    out.push((format!("{p}_{axis}_peak"), f.range.abs_max()));
+                }
+            }
+            for (k, axis) in forces::FORCE_AXES.iter().enumerate() {
+                let f = &acc.net[k];
+                out.push((format!("{axis}_mean"), f.mean(n)));
+                out.push((format!("{axis}_rms"), f.rms(n)));
+                out.push((format!("{axis}_peak"), f.range.abs_max()));
+            }
+            out.push(("aero_force_peak".into(), acc.magnitude.hi.max(0.0)));
+            lift = acc.net[0].mean(n);
+        }
+        // −work_aero: the power the wings give to the air is positive.
+        out.push(("aero_power_mean".into(), -per_time(self.work_aero)));
+        out.push(("actuator_power_mean".into(), actuator_power));
+        let ratio = |x: f64, by: f64| if by != 0.0 { x / by } else { f64::NAN };
+        if self.forces.is_some() {
+            out.push(("lift_per_power".into(), ratio(lift, actuator_power)));
+            if let Some(weight) = self.weight {
+                out.push(("lift_to_weight".into(), ratio(lift, weight)));
+            }
+        }
+        if let Some(weight) = self.weight {
+            // mW/mN = W/N: the input power per newton carried.
+            out.push((
+                "actuator_power_per_weight".into(),
+                ratio(actuator_power, weight),
+            ));
+        }
         if let Some(needs) = self.lean {
             for (name, value) in &mut out {
                 if !needs.provides(name) {
@@ -453,7 +562,14 @@ impl MetricsAccumulator {
 
 /// The metric names for `device`, in order.
 pub fn names(device: &Device) -> Vec<String> {
+    names_weighed(device, false)
+}
+
+/// [`names`] of an accumulator given a weight (`weighed`: `lift_to_weight` too, where the
+/// device offers forces).
+pub fn names_weighed(device: &Device, weighed: bool) -> Vec<String> {
     MetricsAccumulator::new(device, device.period())
+        .with_weight(weighed.then_some(1.0))
         .finish()
         .into_iter()
         .map(|(name, _)| name)

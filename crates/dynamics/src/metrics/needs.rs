@@ -2,11 +2,15 @@
 //! [`crate::trajectory::StrokeSample`] and the accumulator share (its own file so neither
 //! imports the other for it).
 
-/// Metrics read from the work integrals.
-const WORK_METRICS: [&str; 3] = [
+/// Metrics read from the work integrals (`lift_per_power` reads the forces too).
+const WORK_METRICS: [&str; 7] = [
     "work_actuator_per_cycle",
     "work_aero_per_cycle",
     "mean_actuator_power",
+    "aero_power_mean",
+    "actuator_power_mean",
+    "actuator_power_per_weight",
+    "lift_per_power",
 ];
 
 /// What a [`crate::trajectory::StrokeSample`] computes beyond the stroke kinematics, as the
@@ -18,9 +22,12 @@ pub struct StrokeNeeds {
     /// The body reaction torques: per-wing and net `{roll,yaw,pitch}_{mean,rms,peak}` (the
     /// stroke accelerations, so one drivetrain solve per sample; the force comes with them).
     pub torques: bool,
-    /// The work integrals (`work_*_per_cycle`, `mean_actuator_power`): the recorded window
-    /// integrates them.
+    /// The work integrals (`work_*_per_cycle`, `mean_actuator_power`, `*_power_mean`,
+    /// `lift_per_power`): the recorded window integrates them.
     pub work: bool,
+    /// The wings' aerodynamic forces ([`is_force_metric`]: `lift_mean`, ...; `lift_per_power`,
+    /// `lift_to_weight`): evaluated from the sample's `(p, ṗ)`.
+    pub forces: bool,
 }
 
 impl StrokeNeeds {
@@ -29,6 +36,7 @@ impl StrokeNeeds {
         force: true,
         torques: true,
         work: true,
+        forces: true,
     };
 
     /// What the metrics `names` need (`None`: all of them). Unknown names count as torque
@@ -41,13 +49,17 @@ impl StrokeNeeds {
             force: false,
             torques: false,
             work: false,
+            forces: false,
         };
         for name in names {
+            if is_force_metric(name) {
+                needs.forces = true;
+            }
             if name == "actuator_force_peak" {
                 needs.force = true;
             } else if WORK_METRICS.contains(&name.as_str()) {
                 needs.work = true;
-            } else if !is_stroke_metric(name) {
+            } else if !is_stroke_metric(name) && !is_force_metric(name) {
                 needs.torques = true;
             }
         }
@@ -60,8 +72,12 @@ impl StrokeNeeds {
     pub fn provides(&self, name: &str) -> bool {
         if name == "actuator_force_peak" {
             self.force
+        } else if name == "lift_per_power" {
+            self.work && self.forces
         } else if WORK_METRICS.contains(&name) {
             self.work
+        } else if is_force_metric(name) {
+            self.forces
         } else {
             is_stroke_metric(name) || self.torques
         }
@@ -98,4 +114,25 @@ pub fn is_stroke_metric(name: &str) -> bool {
         Some(rest) => WING.contains(&rest),
         None => DEVICE.contains(&name),
     }
+}
+
+/// Force metrics (the wings' aerodynamic force in the body frame, `crate::metrics::forces`):
+/// `{left,right,wing}_{lift,aero_force_y,aero_force_z}_{mean,rms,peak}`, their net
+/// `{lift,aero_force_y,aero_force_z}_{mean,rms,peak}`, `aero_force_peak`, `lift_per_power`
+/// and `lift_to_weight`.
+pub fn is_force_metric(name: &str) -> bool {
+    if matches!(
+        name,
+        "aero_force_peak" | "lift_per_power" | "lift_to_weight"
+    ) {
+        return true;
+    }
+    let rest = ["left_", "right_", "wing_"]
+        .iter()
+        .find_map(|p| name.strip_prefix(p))
+        .unwrap_or(name);
+    ["lift_", "aero_force_y_", "aero_force_z_"]
+        .iter()
+        .find_map(|a| rest.strip_prefix(a))
+        .is_some_and(|stat| matches!(stat, "mean" | "rms" | "peak"))
 }

@@ -289,6 +289,7 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
                 columns,
                 stroke,
                 None,
+                options.weight_mn,
             )?;
             (trajectory, metrics)
         }

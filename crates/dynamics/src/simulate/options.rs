@@ -2,7 +2,7 @@
 //! its validation, and what it returns ([`SimulationResult`]).
 
 use paritysim_constraints::Vec6;
-use paritysim_error::{Result, bail, check_positive};
+use paritysim_error::{Result, bail, check_non_negative, check_positive};
 
 use crate::integrate::budget::CancelFlag;
 use crate::integrate::{Method, State};
@@ -101,6 +101,9 @@ pub struct SimulationOptions {
     /// Stops the run at the next budget check with [`Error::Cancelled`](paritysim_error::Error::Cancelled) once set (not part of
     /// the spec: a sweep's or a caller's flag).
     pub cancel: Option<CancelFlag>,
+    /// Weight (mN) the metric `lift_to_weight` divides the mean lift by (`None`: no such
+    /// metric); the spec sets it from its `body` section (body and wing masses times `|g|`).
+    pub weight_mn: Option<f64>,
 }
 
 /// Default wall-clock budget of one run (ms): a minute.
@@ -128,6 +131,7 @@ impl Default for SimulationOptions {
             shooting_grid: None,
             max_wall_ms: Some(DEFAULT_MAX_WALL_MS),
             cancel: None,
+            weight_mn: None,
         }
     }
 }
@@ -191,6 +195,9 @@ pub const SHOOTING_RETRY_APART: f64 = 1e-2;
 
 pub(crate) fn validate(options: &SimulationOptions) -> Result<()> {
     check_positive("steady_tol", options.steady_tol)?;
+    if let Some(weight) = options.weight_mn {
+        check_non_negative("weight_mn", weight)?;
+    }
     if let Some(ms) = options.max_wall_ms {
         check_positive("max_wall_ms", ms)?;
     }

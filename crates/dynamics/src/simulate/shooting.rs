@@ -142,6 +142,7 @@ pub(crate) fn shooting_steady_state(
             columns.to_vec(),
             stroke,
             Some(grid),
+            options.weight_mn,
         )?;
         recorded = Some((trajectory, metrics));
         Ok((end, None))

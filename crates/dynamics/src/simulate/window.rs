@@ -6,7 +6,7 @@ use paritysim_error::{Result, bail};
 use crate::device::Device;
 use crate::integrate::budget::Budget;
 use crate::integrate::{Integrator, RungeKutta, State};
-use crate::metrics::{MetricsAccumulator, StrokeNeeds};
+use crate::metrics::{MetricsAccumulator, StrokeNeeds, forces};
 use crate::trajectory::Trajectory;
 use crate::trajectory::{PlaneSample, Recorder, Sample, StrokeSample};
 
@@ -47,6 +47,7 @@ pub fn orbit_metrics(
         Vec::new(),
         stroke,
         None,
+        options.weight_mn,
     )?;
     Ok(metrics)
 }
@@ -81,6 +82,7 @@ pub(crate) fn grid_window(
         Vec::new(),
         stroke,
         Some(grid),
+        options.weight_mn,
     )?;
     Ok(metrics)
 }
@@ -134,25 +136,33 @@ pub(super) fn record_window(
     columns: Vec<crate::trajectory::Column>,
     stroke: Option<StrokeNeeds>,
     grid: Option<&[f64]>,
+    weight: Option<f64>,
 ) -> Result<Recorded> {
     let t_end = t_start + window;
     let times: Vec<f64> = window_times(t_start, window, n_samples).collect();
-    let mut metrics = MetricsAccumulator::new(device, period);
+    let mut metrics = MetricsAccumulator::new(device, period).with_weight(weight);
     let plane = device.formulation() != crate::device::Formulation::DrivetrainCoordinates;
     let mut recorder = Recorder::new(columns, times.len());
     let mut sink = |i: usize, t: f64, y: &State| -> Result<()> {
         // `stroke` is only set for drivetrain-coordinate and stroke-plane devices (see
         // `stroke_sampling`).
         if let Some(needs) = stroke {
+            let closing = i == n_samples;
             if plane {
                 if let Some(sample) = PlaneSample::new(device, t, y, needs) {
-                    metrics.add_plane(&sample?, i == n_samples);
+                    metrics.add_plane(&sample?, closing);
+                    if needs.forces {
+                        metrics.add_forces(&forces::of_state(device, y)?, closing);
+                    }
                     return Ok(());
                 }
                 // Outside the closed form: the general sample (which reports why).
             } else {
                 let sample = StrokeSample::of_stroke_device(device, t, y, needs)?;
-                metrics.add_stroke(&sample, i == n_samples);
+                metrics.add_stroke(&sample, closing);
+                if needs.forces {
+                    metrics.add_forces(&forces::of_state(device, y)?, closing);
+                }
                 return Ok(());
             }
         }
