@@ -42,6 +42,10 @@ def test_fixed_body_section_changes_nothing() -> None:
     plain = plain.replace(options=dataclasses.replace(plain.options, max_cycles=5, samples_per_cycle=40))
     fixed = plain.replace(body=ps.spec.Body(mode="fixed", mass_mg=90.0))
     a, b = ps.simulate(plain), ps.simulate(fixed)
+    # The body's mass only adds the ratio to its weight (stroke drag: no lift, so power only).
+    weight = 90.0 * 9.81e-3
+    extra = b.metrics.pop("actuator_power_per_weight")
+    assert extra == pytest.approx(a.metrics["actuator_power_mean"] / weight, rel=1e-14)
     assert a.metrics == b.metrics
     assert a.trajectory.equals(b.trajectory)
 
