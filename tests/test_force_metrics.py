@@ -64,7 +64,9 @@ def test_force_metrics_are_listed_and_documented(parity: ps.Simulation) -> None:
     reference = (Path(__file__).resolve().parents[1] / "docs" / "reference" / "metrics.md").read_text()
     for name in ("lift_mean", "aero_power_mean", "actuator_power_mean", "lift_per_power", "lift_to_weight", "actuator_power_per_weight"):
         assert f"`{name}`" in reference, name
-    # Stroke-drag wings have no force model: asking for lift is an error naming `metrics`.
+    # Stroke-drag wings have no force model: asking for lift is an error saying so.
     drag = ps.devices.load("sreetharan2012_3_3_parity")
-    with pytest.raises(ps.InvalidParameterError, match="metrics"):
+    with pytest.raises(ps.InvalidParameterError, match="metrics.*blade_element"):
         ps.simulate(drag, columns=[], metrics=["lift_mean"])
+    with pytest.raises(ps.InvalidParameterError, match="body"):
+        ps.simulate(drag, columns=[], metrics=["actuator_power_per_weight"])

@@ -242,6 +242,26 @@ fn stroke_drag_devices_offer_power_but_no_force() {
     let names = spec.metric_names(&device).unwrap();
     assert!(names.iter().any(|n| n == "aero_power_mean"));
     assert!(!names.iter().any(|n| n == "lift_mean"));
+    let options = paritysim_dynamics::SimulationOptions::default();
+    let err = spec
+        .with_outputs(&device, &options, None, Some(&["lift_mean".into()]))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("metrics") && err.contains("blade_element"),
+        "{err}"
+    );
+    let err = spec
+        .with_outputs(
+            &device,
+            &options,
+            None,
+            Some(&["actuator_power_per_weight".into()]),
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("body"), "{err}");
+    // The engine's own selection says the same.
     let err = paritysim_dynamics::sweep::select("metrics", Some(&["lift_mean".into()]), &names)
         .unwrap_err()
         .to_string();

@@ -44,7 +44,7 @@
 pub mod forces;
 pub mod needs;
 pub mod plane_sample;
-pub use needs::{StrokeNeeds, is_force_metric, is_stroke_metric};
+pub use needs::{StrokeNeeds, is_force_metric, is_stroke_metric, unavailable_reason};
 use std::f64::consts::{PI, TAU};
 
 use nalgebra::Vector3;

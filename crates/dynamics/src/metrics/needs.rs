@@ -136,3 +136,19 @@ pub fn is_force_metric(name: &str) -> bool {
         .find_map(|a| rest.strip_prefix(a))
         .is_some_and(|stat| matches!(stat, "mean" | "rms" | "peak"))
 }
+
+/// Why a device does not offer the force or weight metric `name` (`valid`: the metrics it
+/// offers), as the start of an error's "must be" text, or `None` for any other name.
+pub fn unavailable_reason(name: &str, valid: &[String]) -> Option<&'static str> {
+    let weighed = matches!(name, "lift_to_weight" | "actuator_power_per_weight");
+    if weighed && (name == "actuator_power_per_weight" || valid.iter().any(|v| v == "lift_mean")) {
+        Some("a weight: the ratios to the weight need a `body` section (its mass_mg); otherwise ")
+    } else if is_force_metric(name) {
+        Some(
+            "blade-element wings (wings[*].aero.kind = \"blade_element\"): the force metrics \
+             need a force model, and stroke drag (eq. 2.16) is a torque only; otherwise ",
+        )
+    } else {
+        None
+    }
+}

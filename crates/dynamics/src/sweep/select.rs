@@ -27,18 +27,8 @@ pub fn select(field: &str, requested: Option<&[String]>, valid: &[String]) -> Re
     };
     for name in requested {
         if !valid.contains(name) {
-            // A force metric the device does not offer: say why before listing the others.
-            let why = if field == "metrics" && name == "actuator_power_per_weight" {
-                "a weight: actuator_power_per_weight needs a `body` section (its mass_mg); \
-                 otherwise "
-            } else if field == "metrics" && metrics::is_force_metric(name) {
-                if name == "lift_to_weight" && valid.iter().any(|v| v == "lift_mean") {
-                    "a weight: lift_to_weight needs a `body` section (its mass_mg); otherwise "
-                } else {
-                    "blade-element wings (wings[*].aero.kind = \"blade_element\"): the force \
-                     metrics need a force model, and stroke drag (eq. 2.16) is a torque only; \
-                     otherwise "
-                }
+            let why = if field == "metrics" {
+                metrics::unavailable_reason(name, valid).unwrap_or("")
             } else {
                 ""
             };

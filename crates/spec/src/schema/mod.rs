@@ -378,10 +378,19 @@ pub fn select(
         return Ok(valid.to_vec());
     };
     if let Some(name) = requested.iter().find(|n| !valid.contains(n)) {
+        // A force or weight metric the device does not have: say why first.
+        let why = match field {
+            "metrics" => paritysim_dynamics::metrics::unavailable_reason(name, valid),
+            _ => None,
+        };
         return Err(paritysim_error::Error::invalid(
             field.to_string(),
             format!("{name:?}"),
-            suggestion(name, valid.iter().map(String::as_str)),
+            format!(
+                "{}{}",
+                why.unwrap_or(""),
+                suggestion(name, valid.iter().map(String::as_str))
+            ),
         ));
     }
     Ok(requested.to_vec())
