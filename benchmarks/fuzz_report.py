@@ -299,6 +299,14 @@ class Cases:
         kwargs = {"max_nfev": 3, **kwargs}
         return lambda: self.ps.calibrate(spec, targets, free, **kwargs)
 
+    def gradients(self, g: Gen) -> Callable[[], Any]:
+        spec = self.specs["hmf"]
+        valid = ["actuator.waveform.amplitude_v", "actuator.frequency_hz", "actuator.stiffness", "wings[*].aero.omega1"]
+        params = g.rng.choice([[g.name(valid)], [g.name(valid), g.name(valid)], "actuator.stiffness", [], 3, [None], ["drivetrain.kind"], ["options.samples_per_cycle"]])
+        metrics = g.rng.choice([None, ["left_stroke_amplitude"], ["bogus"], "lift_mean", 3, []])
+        kwargs = g.rng.choice([{}, {"rtol": g.num(1e-9)}, {"max_wall_ms": g.num(5000.0)}, {"samples_per_cycle": g.int(100)}, {"progress": g.rng.choice([True, "no", None])}])
+        return lambda: self.ps.sensitivity(spec, params, metrics=metrics, **{"progress": False, **kwargs})
+
     def flight(self, g: Gen) -> Callable[[], Any]:
         spec = self.specs["flight"]
         k = g.rng.randrange(3)
@@ -466,6 +474,7 @@ class Cases:
             "chart": lambda: st.stability_chart(np.linspace(0, 3, 2000), np.linspace(-1, 30, 2000), brockett=False),
             "continuation": lambda: self.ps.continuation(slow_hmf, "actuator.waveform.frequency_hz", 2e-3, start=1e-3),
             "trim": lambda: self.ps.flight.trim(self.specs["flight"].with_paths({"options.max_cycles": 200, "options.max_wall_ms": 600_000.0})),
+            "sensitivity": lambda: self.ps.sensitivity(slow_hmf, ["actuator.waveform.amplitude_v"], progress=False),
         }
         name = g.rng.choice(sorted(calls))
         call = calls[name]
@@ -494,11 +503,11 @@ class Cases:
 
 FAMILIES: dict[str, float] = {
     "spec_mutation": 0.09, "spec_file": 0.05, "spec_dict": 0.04, "spec_misc": 0.03, "simulate": 0.06, "controller": 0.02,
-    "sweep": 0.06, "sweep_executor": 0.005, "shared_checkpoint": 0.01, "calibrate": 0.02, "flight": 0.02, "continuation": 0.015,
+    "sweep": 0.06, "sweep_executor": 0.005, "shared_checkpoint": 0.01, "calibrate": 0.02, "gradients": 0.02, "flight": 0.02, "continuation": 0.015,
     "stability": 0.1, "aero": 0.1, "kinematics": 0.09, "planform": 0.1, "laminate": 0.07, "dynamics": 0.04, "cli": 0.025, "ctrl_c": 0.015,
 }  # fmt: skip
 #: Families cheap enough for the CI sample (no subprocess of their own, sub-second cases).
-FAST = ("spec_mutation", "spec_dict", "spec_misc", "simulate", "stability", "aero", "kinematics", "planform", "laminate", "dynamics", "sweep")
+FAST = ("spec_mutation", "spec_dict", "spec_misc", "simulate", "gradients", "stability", "aero", "kinematics", "planform", "laminate", "dynamics", "sweep")
 
 
 def plan(n: int, seed: int, families: tuple[str, ...]) -> list[str]:

@@ -101,6 +101,7 @@ def test_metric_selection_elasticities_and_plot():
         (["options.samples_per_cycle"], "options.samples_per_cycle"),
         ([], "params"),
         ([3.0], "params"),
+        ([""], "params"),
     ],
 )
 def test_bad_parameters_are_named(params, named):

@@ -175,6 +175,6 @@ def _names(field: str, value: Any) -> list[str]:
         raise invalid(field, repr(value)[:60], "a path or a list of paths (str)")
     out = list(value)
     for v in out:
-        if not isinstance(v, str):
-            raise invalid(field, repr(v)[:60], "paths (str)")
+        if not isinstance(v, str) or not v.strip():
+            raise invalid(field, repr(v)[:60], "non-empty names (str)")
     return out
