@@ -190,15 +190,65 @@ class Planform:
         flat = np.ascontiguousarray(zz, dtype=np.float64).ravel()
         return chunked(lambda x: _core.aero_planform_chord(self.points, x), [flat], ("z",))
 
-    def scaled(self, factor: float) -> Planform:
-        """Uniformly scaled about the spherical centre (Ω scale as ``factor**5``)."""
-        f = real("factor", factor)
-        if not (math.isfinite(f) and f > 0):
-            raise invalid("factor", factor, "finite and > 0")
-        reach = float(np.abs(self.points).max())
-        if reach * f > _MAX_COORDINATE:  # the outline's bound (|z|, |x| <= 1e3 mm), named here
-            raise invalid("factor", factor, f"in (0, {_MAX_COORDINATE / reach:.6g}] (the outline must stay within {_MAX_COORDINATE:g} mm)")
-        return Planform(self.points * f)
+    def scaled(self, factor: float | None = None, *, span_mm: float | None = None, area_mm2: float | None = None) -> Planform:
+        """This outline scaled about the spherical centre: uniformly by ``factor``, or to a
+        target spanwise extent ``span_mm`` (mm) and/or membrane area ``area_mm2`` (mm²).
+
+        With both targets the two directions scale apart: ``z -> s_z z`` with
+        ``s_z = span_mm / span`` (the spanwise extent :attr:`span`, so the root offset scales
+        with it) and ``x -> s_x x`` with ``s_x = area_mm2 / (area s_z)`` (the chordwise scale
+        that leaves the area at its target; the hinge line stays at ``x = 0``). With one target
+        the scale is uniform (the shape and aspect ratio are kept): ``s = span_mm / span`` or
+        ``s = sqrt(area_mm2 / area)``.
+
+        Under ``(s_z, s_x)`` the parameters scale as (eqs. 3.12-3.15; :meth:`omegas`):
+        ``Ω1 ∝ s_z⁴ s_x``, ``Ω2 ∝ s_z s_x⁴``, ``Ω3, Ω4 ∝ s_z³ s_x²``, ``force ∝ s_z³ s_x``,
+        and at a fixed mass ``Ixx ∝ s_z²``, ``Izz ∝ s_x²``, ``Ixz ∝ s_z s_x``; uniform scaling
+        gives ``s⁵`` for every Ω.
+
+        Raises ``InvalidParameterError`` naming ``factor``, ``span_mm`` or ``area_mm2``: each
+        finite and > 0, ``factor`` not together with a target, and the scaled outline within
+        1e3 mm of the spherical centre.
+        """
+        if factor is not None and (span_mm is not None or area_mm2 is not None):
+            raise invalid("factor", factor, "None when span_mm or area_mm2 is given (one or the other)")
+        targets = {}
+        for name, value in (("factor", factor), ("span_mm", span_mm), ("area_mm2", area_mm2)):
+            if value is None:
+                continue
+            v = real(name, value)
+            if not (math.isfinite(v) and v > 0):
+                raise invalid(name, value, "finite and > 0" + {"factor": "", "span_mm": " (mm)", "area_mm2": " (mm^2)"}[name])
+            targets[name] = v
+        if not targets:
+            raise invalid("factor", None, "a scale factor > 0, or a target span_mm and/or area_mm2")
+        if "factor" in targets:
+            sz = sx = targets["factor"]
+        elif "span_mm" in targets and "area_mm2" in targets:
+            sz = targets["span_mm"] / self.span
+            sx = targets["area_mm2"] / (self.area * sz)
+        elif "span_mm" in targets:
+            sz = sx = targets["span_mm"] / self.span
+        else:
+            sz = sx = math.sqrt(targets["area_mm2"] / self.area)
+        reach_z = float(np.abs(self.points[:, 0]).max())
+        reach_x = float(np.abs(self.points[:, 1]).max())
+        # The outline's bound (|z|, |x| <= 1e3 mm), named by the argument that sets each scale.
+        if max(reach_z * sz, reach_x * sx) > _MAX_COORDINATE:
+            uniform = _MAX_COORDINATE / max(reach_z, reach_x)  # the largest uniform scale
+            if "factor" in targets:
+                name, top = "factor", uniform
+            elif "area_mm2" not in targets:
+                name, top = "span_mm", uniform * self.span
+            elif "span_mm" not in targets:
+                name, top = "area_mm2", uniform**2 * self.area
+            elif reach_z * sz > _MAX_COORDINATE:
+                name, top = "span_mm", _MAX_COORDINATE / reach_z * self.span
+            else:
+                name, top = "area_mm2", _MAX_COORDINATE / reach_x * self.area * sz
+            unit = {"factor": "", "span_mm": " mm", "area_mm2": " mm^2"}[name]
+            raise invalid(name, targets[name], f"in (0, {top:.6g}]{unit} (the outline must stay within {_MAX_COORDINATE:g} mm)")
+        return Planform(self.points * np.array([sz, sx]))
 
     def translated(self, dz: float = 0.0, dx: float = 0.0) -> Planform:
         """Shifted by ``dz`` (spanwise) and ``dx`` (toward the leading edge; moves the hinge line by ``-dx``)."""
@@ -305,6 +355,18 @@ class Planform:
             name = max((k for k in inputs if inputs[k].size), key=lambda k: float(np.abs(inputs[k]).max()))
             raise invalid(name, float(np.abs(inputs[name]).max()), "small enough that the mass properties are finite (they overflow here)")
         return out
+
+    def _leading_edge_segments(self) -> FloatArray:
+        """The outline's edges facing the leading edge, rows ``[z0, x0, z1, x1]`` (mm): the edges
+        whose outward normal points toward ``+x`` (run with decreasing ``z`` in the
+        counter-clockwise outline), i.e. the boundary ``x = l(z)`` from root to tip. Root and
+        tip edges running along ``x`` belong to neither edge and are left out."""
+        v = self.points
+        w = np.roll(v, -1, axis=0)
+        if float(np.sum(v[:, 0] * w[:, 1] - w[:, 0] * v[:, 1])) < 0:  # clockwise: the other way round
+            v, w = w, v
+        upper = w[:, 0] < v[:, 0]
+        return np.ascontiguousarray(np.hstack([v[upper], w[upper]]))
 
     # ------------------------------------------------------------------ display
     def plot(self, ax: Axes | None = None, *, hinge: bool = True, **kwargs: Any) -> Axes:

@@ -287,6 +287,162 @@ class Wing(_Node):
         inertia = ((ixx, 0.0, ixz), (0.0, iyy, 0.0), (ixz, 0.0, izz))
         return cls(inertia=inertia, **kwargs)  # type: ignore[call-arg]
 
+    @classmethod
+    def from_planform(
+        cls,
+        planform: Any,
+        *,
+        mass_mg: float,
+        line_masses: Any = (),
+        point_masses: Any = (),
+        hinge: Any = None,
+        aero_model: Any = _core.AERO_DEFAULT_MODEL,
+        air_density_mg_per_mm3: float = _core.AERO_AIR_DENSITY,
+        **fields: Any,
+    ) -> Wing:
+        """A wing from its outline: inertia tensor and Ω1..Ω4 in one call.
+
+        The inertia is :meth:`Planform.inertia` (about the spherical centre, frame of Fig. 3.10:
+        ``Ixx = ∫z² dm``, ``Izz = ∫x² dm``, ``Iyy = Ixx + Izz``, ``Ixz = -∫xz dm``) and the
+        aerodynamic parameters are :meth:`Planform.omegas` (eqs. 3.12-3.15), both exact for the
+        polygon.
+
+        Parameters
+        ----------
+        planform:
+            A :class:`~paritysim.planform.Planform` (``[z, x]`` in mm, hinge line ``x = 0``).
+        mass_mg:
+            Mass of the membrane (mg, >= 0), spread uniformly over the planform: areal density
+            ``mass_mg / planform.area``. Spars, veins and point masses come on top of it; the
+            wing's total mass is the sum.
+        line_masses:
+            Spars and veins, each of uniform mass per length: rows
+            ``[z0_mm, x0_mm, z1_mm, x1_mm, mass_mg]`` (a straight segment and its total mass), or
+            ``("leading_edge", mass_mg)``: a spar along the membrane's leading edge ``x = l(z)``
+            from root to tip (the outline edges facing ``+x``, centreline on the edge), its mass
+            spread uniformly along that edge's length. A mapping ``{"leading_edge": mass_mg}``
+            is the same as ``[("leading_edge", mass_mg)]``.
+        point_masses:
+            Rows ``[z_mm, x_mm, mass_mg]`` (glue, hinge parts).
+        hinge:
+            The ψ hinge: a stiffness (mN·mm/rad) or a :class:`Spring` for ``springs.hinge``
+            (joint 6), or a :class:`TunableHinge` for ``tunable_hinge``; None keeps the
+            ``springs`` given (default: no hinge spring).
+        aero_model:
+            A coefficient model of :data:`paritysim.aero.MODELS` (blade elements, eqs. 3.8-3.11,
+            with the planform's Ω1..Ω4), ``"stroke_drag"`` (eq. 2.16 with its Ω1), an
+            :class:`Aero` whose other fields are kept and whose Ω's are replaced, or None
+            (vacuum).
+        air_density_mg_per_mm3:
+            Air density of the Ω's (1.2e-3 mg/mm³ = 1.2 kg/m³).
+        fields:
+            Other :class:`Wing` fields (``shoulder``, ``springs``, ``tunable_hinge``).
+
+        Raises ``InvalidParameterError`` naming the argument (``mass_mg``, ``line_masses[i]``,
+        ``point_masses``, ``hinge``, ``aero_model``, ``air_density_mg_per_mm3``) and its range.
+        """
+        from ._errors import invalid, real
+        from .aero import MODELS
+        from .planform import Planform
+
+        if not isinstance(planform, Planform):
+            raise invalid("planform", type(planform).__name__, "a paritysim.Planform")
+        for key in ("inertia", "aero"):
+            if key in fields:
+                raise invalid(f"Wing.from_planform.{key}", "<given>", "left out: it comes from the planform (use .replace afterwards)")
+        m = real("mass_mg", mass_mg)
+        if not (math.isfinite(m) and m >= 0):
+            raise invalid("mass_mg", mass_mg, "finite and >= 0 (mg, the membrane's mass)")
+        lines = _line_mass_rows(planform, line_masses)
+        try:
+            inertia = planform.inertia(m / planform.area, lines, point_masses)
+        except _core.InvalidParameterError as exc:
+            if getattr(exc, "field", None) == "mass":  # nothing has mass
+                raise invalid("mass_mg", mass_mg, "> 0 when line_masses and point_masses add no mass (a wing needs mass)") from exc
+            raise
+        tensor = _tuples(np.asarray(inertia["tensor"], dtype=float).tolist())
+
+        rho = real("air_density_mg_per_mm3", air_density_mg_per_mm3)
+        if not (math.isfinite(rho) and rho > 0):
+            raise invalid("air_density_mg_per_mm3", air_density_mg_per_mm3, "finite and > 0 (mg/mm^3; air is 1.2e-3)")
+        aero: Aero | None
+        if aero_model is None:
+            aero = None
+        else:
+            omegas = planform.omegas(rho)
+            if isinstance(aero_model, Aero):
+                base = aero_model
+            elif isinstance(aero_model, str) and aero_model in MODELS:
+                base = Aero(kind="blade_element", model=aero_model)  # type: ignore[call-arg]
+            elif aero_model == "stroke_drag":
+                base = Aero(kind="stroke_drag")  # type: ignore[call-arg]
+            else:
+                allowed = ", ".join(repr(n) for n in (*MODELS, "stroke_drag"))
+                raise invalid("aero_model", repr(aero_model)[:60], f"one of {allowed}, an Aero or None")
+            names = ("omega1", "omega2", "omega3", "omega4") if base.kind == "blade_element" else ("omega1",)  # type: ignore[attr-defined]
+            aero = base.replace(**{k: omegas[k] for k in names})
+
+        if hinge is not None:
+            if isinstance(hinge, TunableHinge):
+                if fields.get("tunable_hinge") is not None:
+                    raise invalid("hinge", repr(hinge), "left out when tunable_hinge is given (one hinge)")
+                fields["tunable_hinge"] = hinge
+            else:
+                if isinstance(hinge, Spring):
+                    spring = hinge
+                elif isinstance(hinge, numbers.Real) and not isinstance(hinge, bool):
+                    k = float(hinge)
+                    if not (math.isfinite(k) and k >= 0):
+                        raise invalid("hinge", hinge, "a stiffness >= 0 (mN·mm/rad), a Spring or a TunableHinge")
+                    spring = Spring(stiffness=k)  # type: ignore[call-arg]
+                else:
+                    raise invalid("hinge", repr(hinge)[:60], "a stiffness >= 0 (mN·mm/rad), a Spring or a TunableHinge")
+                springs = fields.get("springs")
+                if springs is None:
+                    springs = Springs()
+                elif isinstance(springs, Mapping):
+                    springs = _build_known("Springs", dict(springs))
+                elif isinstance(springs, list | tuple):
+                    springs = Springs.from_joints(springs)
+                fields["springs"] = springs.replace(hinge=spring)
+        return cls(inertia=tensor, aero=aero, **fields)  # type: ignore[call-arg]
+
+
+def _line_mass_rows(planform: Any, line_masses: Any) -> Any:
+    """``line_masses`` of :meth:`Wing.from_planform` as rows ``[z0, x0, z1, x1, mg/mm]`` of
+    :meth:`Planform.inertia` (each segment's mass spread uniformly along its length)."""
+    from ._errors import finite_reals, invalid
+
+    if isinstance(line_masses, Mapping):
+        line_masses = list(line_masses.items())
+    elif isinstance(line_masses, np.ndarray):
+        line_masses = list(line_masses.reshape(-1, line_masses.shape[-1]) if line_masses.size else [])
+    elif isinstance(line_masses, str) or not isinstance(line_masses, list | tuple):
+        raise invalid("line_masses", repr(line_masses)[:60], 'rows [z0_mm, x0_mm, z1_mm, x1_mm, mass_mg] or ("leading_edge", mass_mg) pairs')
+    rows: list[list[float]] = []
+    for i, item in enumerate(line_masses):
+        name = f"line_masses[{i}]"
+        if isinstance(item, tuple | list) and len(item) == 2 and isinstance(item[0], str):
+            if item[0] != "leading_edge":
+                raise invalid(name, repr(item[0]), '"leading_edge" (or a row [z0_mm, x0_mm, z1_mm, x1_mm, mass_mg])')
+            segments = planform._leading_edge_segments()
+            mass = float(finite_reals(name, item[1]))
+        else:
+            row = finite_reals(name, item)
+            if row.shape != (5,):
+                raise invalid(name, repr(item)[:60], 'a row [z0_mm, x0_mm, z1_mm, x1_mm, mass_mg] or ("leading_edge", mass_mg)')
+            segments, mass = row[None, :4], float(row[4])
+        if mass < 0:
+            raise invalid(name, mass, "a mass_mg >= 0")
+        lengths = np.hypot(segments[:, 2] - segments[:, 0], segments[:, 3] - segments[:, 1])
+        total = float(lengths.sum())
+        if mass == 0:
+            continue
+        if not (math.isfinite(total) and total > 0):
+            raise invalid(name, repr(item)[:60], "a segment of nonzero length (a point mass belongs in point_masses)")
+        rows.extend([*seg, mass / total] for seg in segments.tolist())
+    return np.array(rows, dtype=float).reshape(-1, 5)
+
 
 @_from_core
 class Drivetrain(_Tagged):
