@@ -78,5 +78,8 @@ class _no_warning:
 
 
 def test_unknown_device_names_the_shipped_ones() -> None:
+    # A typo finds the device; a name close to none points to the list (not 17 names inline).
     with pytest.raises(ps.InvalidParameterError, match="sreetharan2012_3_3_parity"):
+        ps.devices.load("sreetharan2012_3_3_parit")
+    with pytest.raises(ps.InvalidParameterError, match=r"ps\.devices\.list\(\) lists all"):
         ps.devices.load("no_such_device")
