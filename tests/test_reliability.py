@@ -325,6 +325,8 @@ SIZE_REPRODUCERS = {
     "ps.kinematics.drivetrain_map(ps.Drivetrain.linkage_differential(), np.zeros(10**7))": "q1",
     "ps.aero.moments(ps.aero.TABLE_3_3['left'], phi_dot=np.zeros(10**7))": "phi_dot",
     "stability.hill_solution(1.0, 0.2, np.zeros(10**8))": "t",
+    # The fuzz (seed 34, case 1909): 10^7 frequencies held ~11.5 GB of rows; SIGABRT.
+    "stability.disturbance_response(parity, np.zeros(10**7), 0.1, samples_per_cycle=32)": "frequency_hz",
 }
 
 

@@ -522,6 +522,8 @@ _BYTES_PER_ORBIT_SAMPLE = 256
 #: Bytes `disturbance_response` holds per sample of a measurement window (two windows, two
 #: signs of the disturbance, a state and its time each), with a margin.
 _BYTES_PER_WINDOW_SAMPLE = 512
+#: Peak bytes per frequency of `disturbance_response` (10^6 failing frequencies: 1.15 GB).
+_BYTES_PER_RESPONSE_ROW = 1200
 
 
 def linearise(spec: Simulation | dict[str, Any], samples: int = _LINEARISE_SAMPLES, **options: Any) -> dict[str, Any]:
@@ -564,6 +566,8 @@ def disturbance_response(
     nulls elsewhere; the others are kept).
     """
     freqs = _f64(frequency_hz, "frequency_hz")
+    # One row per frequency (its result or error text): measured 1.15 kB each at peak.
+    sized("frequency_hz", f"<{freqs.size} frequencies>", freqs.size, _BYTES_PER_RESPONSE_ROW, "the response rows")
     if settle_cycles is not None:
         settle_cycles = whole("settle_cycles", settle_cycles, 0, 100_000)
     if max_window_cycles is not None:
