@@ -36,6 +36,17 @@ bindings! {
     extra stability_region;
     extra stability_lti_transfer;
 
+    /// The continuous spec paths `params` of a JSON spec resolved: their names, units and
+    /// values (`paritysim_spec::sensitivity::parameters`).
+    fn sensitivity_parameters(json: &str, params: Vec<String>) {
+        let spec = crate::spec::parse(json)?;
+        paritysim_spec::sensitivity::parameters(&spec, &params)
+            .map(|(p, units, values)| {
+                let names: Vec<String> = p.into_iter().map(|p| p.name).collect();
+                (names, units, values)
+            })
+    }
+
     /// Derivatives of a JSON spec's steady-state metrics (`metrics`, or all) by the continuous
     /// spec paths `params` (`paritysim_spec::sensitivity`), as plain columns.
     #[pyo3(signature = (json, params, metrics = None))]

@@ -52,6 +52,37 @@ pub fn sensitivity(
         ));
     }
     let options = spec.with_outputs(&device, &options, Some(&[]), metrics)?;
+    let (parameters, units, values) = parameters(spec, params)?;
+    let device_at = |p: &[f64]| -> Result<paritysim_dynamics::Device> {
+        let numbers: Vec<Value> = p.iter().map(|&x| Value::from(x)).collect();
+        let pairs: Vec<(&Parameter, &Value)> = parameters.iter().zip(&numbers).collect();
+        apply(spec, &pairs)?.device()
+    };
+    let result = steady_sensitivity(&device_at, &values, None, &options)?;
+    Ok(Sensitivity {
+        parameters,
+        units,
+        values,
+        result,
+    })
+}
+
+/// The parameters `params` of `spec` resolved, with their units and values: what
+/// [`sensitivity`] differentiates by (a sweep checks its `gradients` with it before running).
+///
+/// # Errors
+/// As [`sensitivity`] for the paths.
+pub fn parameters(
+    spec: &Simulation,
+    params: &[String],
+) -> Result<(Vec<Parameter>, Vec<String>, Vec<f64>)> {
+    if params.is_empty() {
+        return Err(Error::invalid(
+            "params",
+            "[]",
+            "at least one continuous spec path (see ps.spec_paths)",
+        ));
+    }
     let listed = spec_paths(spec);
     let mut parameters = Vec::new();
     let mut units = Vec::new();
@@ -93,18 +124,7 @@ pub fn sensitivity(
         values.push(base.expect("a resolved parameter has a target"));
         parameters.push(param);
     }
-    let device_at = |p: &[f64]| -> Result<paritysim_dynamics::Device> {
-        let numbers: Vec<Value> = p.iter().map(|&x| Value::from(x)).collect();
-        let pairs: Vec<(&Parameter, &Value)> = parameters.iter().zip(&numbers).collect();
-        apply(spec, &pairs)?.device()
-    };
-    let result = steady_sensitivity(&device_at, &values, None, &options)?;
-    Ok(Sensitivity {
-        parameters,
-        units,
-        values,
-        result,
-    })
+    Ok((parameters, units, values))
 }
 
 /// [`Sensitivity`] as plain columns for the bindings (`ps.sensitivity`'s table).

@@ -1,0 +1,60 @@
+"""ps.sweep(..., gradients=[paths]) (issue 31): every converged row carries the derivatives
+ps.sensitivity gives at that point; rows that did not converge carry none."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+import paritysim as ps
+from paritysim import InvalidParameterError
+
+METRICS = ["left_stroke_amplitude", "right_stroke_amplitude", "yaw_total_mean"]
+
+
+def _spec() -> ps.Simulation:
+    d = ps.devices.load("sreetharan2012_3_3_parity").to_dict()
+    d["drivetrain"]["balance_spring"] = 5.0  # an isolated orbit
+    return ps.Simulation.from_dict(d)
+
+
+def test_gradient_columns_equal_sensitivity_at_each_point():
+    spec = _spec()
+    paths = ["actuator.amplitude_v", "wings[0].aero.omega1"]
+    df = ps.sweep(spec, {"actuator.amplitude_v": [80.0, 100.0], "wings.left.omega_ratio": [1.0, 0.6]}, metrics=METRICS, gradients=paths, progress=False)
+    assert (df["status"] == "ok").all()
+    for row in df.iter_rows(named=True):
+        point = spec.with_paths({"actuator.amplitude_v": row["actuator.amplitude_v"], "wings.left.omega_ratio": row["wings.left.omega_ratio"]})
+        s = ps.sensitivity(point, paths, metrics=METRICS, progress=False)
+        for m in METRICS:
+            for p in paths:
+                assert row[f"d({m})/d({p})"] == pytest.approx(s.derivative(m, p), rel=1e-12, abs=1e-15)
+    # The stroke amplitude grows with the drive at every point.
+    assert (df["d(left_stroke_amplitude)/d(actuator.amplitude_v)"] > 0).all()
+
+
+def test_rows_without_a_steady_state_have_no_gradients():
+    spec = _spec()
+    df = ps.sweep(spec, {"actuator.amplitude_v": [100.0, 1e9]}, metrics=METRICS, gradients=["actuator.amplitude_v"], progress=False)
+    bad = df.filter(df["status"] != "ok")
+    assert bad.height == 1
+    assert bad["d(left_stroke_amplitude)/d(actuator.amplitude_v)"].is_null().all()
+    good = df.filter(df["status"] == "ok")
+    assert math.isfinite(good["d(left_stroke_amplitude)/d(actuator.amplitude_v)"][0])
+
+
+@pytest.mark.parametrize(("gradients", "named"), [(["drivetrain.balanse_spring"], "balance_spring"), (["drivetrain.kind"], "drivetrain.kind"), ([""], "gradients")])
+def test_bad_gradient_paths_are_named_before_running(gradients, named):
+    with pytest.raises(InvalidParameterError) as e:
+        ps.sweep(_spec(), {"actuator.amplitude_v": [100.0]}, gradients=gradients, progress=False)
+    assert named in str(e.value)
+
+
+def test_a_checkpoint_of_a_sweep_without_gradients_is_not_reused(tmp_path):
+    spec = _spec()
+    path = tmp_path / "study.parquet"
+    grid = {"actuator.amplitude_v": [90.0, 100.0]}
+    ps.sweep(spec, grid, metrics=METRICS, checkpoint=path, progress=False)
+    with pytest.raises(InvalidParameterError):
+        ps.sweep(spec, grid, metrics=METRICS, checkpoint=path, gradients=["actuator.amplitude_v"], progress=False)
