@@ -46,7 +46,7 @@ if TYPE_CHECKING:  # what type checkers see; at run time the names below load la
     from . import aero, claims, devices, dynamics, flight, kinematics, laminate, planform, plots, spec, stability, trials
     from .calibration import CalibrationResult, calibrate
     from .continuation import ContinuationResult
-    from .gradients import SensitivityResult, sensitivity
+    from .gradients import OptimizationResult, SensitivityResult, optimize, sensitivity
     from .planform import Planform
     from .simulation import SimulationResult, simulate
     from .spec import Actuator, Aero, Body, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, Springs, TunableHinge, Waveform, Wing, load_spec, spec_paths
@@ -59,7 +59,9 @@ _NAMES = {
     "CalibrationResult": "calibration",
     "calibrate": "calibration",
     "ContinuationResult": "continuation",
+    "OptimizationResult": "gradients",
     "SensitivityResult": "gradients",
+    "optimize": "gradients",
     "sensitivity": "gradients",
     "Planform": "planform",
     "SimulationResult": "simulation",
@@ -100,6 +102,7 @@ __all__ = [
     "IntegrationError",
     "InvalidParameterError",
     "Options",
+    "OptimizationResult",
     "OutOfDomainError",
     "ParitysimError",
     "Planform",
@@ -126,6 +129,7 @@ __all__ = [
     "laminate",
     "load_spec",
     "planform",
+    "optimize",
     "plots",
     "sensitivity",
     "simulate",
