@@ -305,6 +305,14 @@ class Cases:
         params = g.rng.choice([[g.name(valid)], [g.name(valid), g.name(valid)], "actuator.stiffness", [], 3, [None], ["drivetrain.kind"], ["options.samples_per_cycle"]])
         metrics = g.rng.choice([None, ["left_stroke_amplitude"], ["bogus"], "lift_mean", 3, []])
         kwargs = g.rng.choice([{}, {"rtol": g.num(1e-9)}, {"max_wall_ms": g.num(5000.0)}, {"samples_per_cycle": g.int(100)}, {"progress": g.rng.choice([True, "no", None])}])
+        k = g.rng.randrange(3)
+        if k == 1:
+            bounds = g.rng.choice([{"actuator.waveform.amplitude_v": (g.num(60.0), g.num(120.0))}, {"actuator.stiffness": (1, 0)}, {"bogus": (0, 1)}, {}, 3])
+            constraints = g.rng.choice([[], ["left_stroke_amplitude >= 0.5"], ["bogus <= 1"], ["left_stroke_amplitude >="], "abs(yaw_total_mean) <= 0.1", [3], ["__import__('os') <= 1"]])
+            objective = g.rng.choice(["actuator_power_mean", "bogus", 3, None, "left_stroke_amplitude"])
+            return lambda: self.ps.optimize(spec, objective=objective, params=bounds, constraints=constraints, max_iterations=g.int(3), progress=False)
+        if k == 2:
+            return lambda: self.ps.sweep(spec, {"actuator.waveform.amplitude_v": [80.0, 100.0]}, metrics=["left_stroke_amplitude"], gradients=params, progress=False)
         return lambda: self.ps.sensitivity(spec, params, metrics=metrics, **{"progress": False, **kwargs})
 
     def flight(self, g: Gen) -> Callable[[], Any]:
