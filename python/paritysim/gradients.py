@@ -263,6 +263,10 @@ class OptimizationResult:
     ``violation``, ``active``); ``active``: the texts of the active ones. ``multipliers``: the
     orbit's Floquet multipliers there, largest modulus first. ``history``: one row per iteration
     (``iteration``, ``objective``, ``max_violation``, one column per parameter).
+    ``evaluations``: the distinct points evaluated (objective, constraints and gradients);
+    ``sensitivities``: every `sensitivity` run, those points' and the stability constraint's
+    one-sided differences (one more per parameter and point): the search's cost, each about
+    one steady-state solve plus two periods per parameter.
     """
 
     success: bool
@@ -279,6 +283,7 @@ class OptimizationResult:
     iterations: int
     evaluations: int
     bounds: dict[str, tuple[float, float]] = field(repr=False)
+    sensitivities: int = 0
 
     @property
     def constraint_values(self) -> dict[str, float]:
@@ -435,7 +440,11 @@ def optimize(
 
     cache: dict[bytes, _Eval] = {}
     warned: dict[str, str] = {}  # metric -> its warning, issued once after the search
-    counts = {"evaluations": 0}
+    counts = {"evaluations": 0, "sensitivities": 0}
+
+    def solve(spec_: Simulation, wanted: list[str]) -> SensitivityResult:
+        counts["sensitivities"] += 1
+        return _sensitivity_or_params(spec_, paths, wanted)
 
     def x_of(z: np.ndarray) -> np.ndarray:
         return low + np.clip(z, 0.0, 1.0) * width
@@ -444,7 +453,7 @@ def optimize(
         return run_spec.with_paths({p: float(v) for p, v in zip(paths, x, strict=True)})
 
     def rho_at(z: np.ndarray) -> float:
-        s = _sensitivity_or_params(at(x_of(z)), paths, metrics[:1])
+        s = solve(at(x_of(z)), metrics[:1])
         return _largest_non_neutral(s.multipliers)
 
     def evaluate(z: np.ndarray) -> _Eval:
@@ -455,7 +464,7 @@ def optimize(
         x = x_of(z)
         shown = ", ".join(f"{p} = {v:.10g}" for p, v in zip(paths, x, strict=True))
         try:
-            s = _sensitivity_or_params(at(x), paths, metrics)
+            s = solve(at(x), metrics)
         except InvalidParameterError:
             raise
         except ParitysimError as exc:
@@ -631,6 +640,7 @@ def optimize(
         history=pl.DataFrame(rows, schema={"iteration": pl.Int64, "objective": pl.Float64, "max_violation": pl.Float64, **{p: pl.Float64 for p in paths}}),
         iterations=iterations,
         evaluations=counts["evaluations"],
+        sensitivities=counts["sensitivities"],
         bounds={p: (float(lo), float(hi)) for p, lo, hi in zip(paths, low, high, strict=True)},
     )
 
