@@ -127,6 +127,9 @@ def build_parser() -> argparse.ArgumentParser:
     from .continuation_cli import add_parser as add_continue_parser
 
     add_continue_parser(sub, parents=[_common()])
+    from .optimize_cli import add_parser as add_optimize_parser
+
+    add_optimize_parser(sub, parents=[_common()])
     try:  # `paritysim sweep` lives with the sweep engine (issue 8)
         from .sweep_cli import add_parser as add_sweep_parser
     except ImportError:
