@@ -12,6 +12,38 @@ use super::{
 /// Safety factor of the step-size controller.
 pub(super) const SAFE: f64 = 0.9;
 
+/// Hairer's step-size control after an attempt of size `h` with scaled error `err`, written
+/// once for the scalar loop ([`AdaptiveRun::attempt`]) and the SIMD lanes
+/// (`lane_control::Adaptive`): `Some(h_new)` when the step is accepted (`fac_old` updated; the
+/// caller then caps `h_new`), `None` when it is rejected (`h` shrunk, `rejected_last` set; a
+/// non-finite error shrinks hard).
+#[inline]
+pub(super) fn step_size<const M: usize, S: Stepper<M>>(
+    err: f64,
+    h: &mut f64,
+    fac_old: &mut f64,
+    rejected_last: &mut bool,
+) -> Option<f64> {
+    let fac_lo = 1.0 / S::FAC_MAX;
+    let fac_hi = 1.0 / S::FAC_MIN;
+    if !err.is_finite() {
+        *rejected_last = true;
+        *h *= S::FAC_MIN;
+        return None;
+    }
+    let fac11 = err.powf(S::EXPONENT);
+    if err <= 1.0 {
+        // Lund stabilisation (PI control): divide by the previous error's factor.
+        let fac = (fac11 / fac_old.powf(S::BETA) / SAFE).clamp(fac_lo, fac_hi);
+        *fac_old = err.max(1e-4);
+        Some(*h / fac)
+    } else {
+        *rejected_last = true;
+        *h /= fac_hi.min(fac11 / SAFE);
+        None
+    }
+}
+
 /// Hairer's initial step size (`HINIT`): one extra evaluation.
 pub(super) fn initial_step<const M: usize>(
     rhs: &mut dyn Rhs<M>,
@@ -174,8 +206,6 @@ impl<const M: usize> AdaptiveRun<M> {
         (times, next, sink): (&[f64], &mut usize, &mut Sink<'_>),
         on_step: &mut dyn FnMut(f64, &State),
     ) -> Result<Attempt> {
-        let fac_lo = 1.0 / S::FAC_MAX;
-        let fac_hi = 1.0 / S::FAC_MIN;
         let Self {
             t,
             y,
@@ -212,19 +242,8 @@ impl<const M: usize> AdaptiveRun<M> {
             *h = t_end - *t;
         }
         let err = stepper.attempt(rhs, *t, y, f0, *h, tol)?;
-        if !err.is_finite() {
-            // A non-finite trial (e.g. a state thrown out of range): shrink hard and retry.
-            stats.rejected += 1;
-            *rejected_last = true;
-            *h *= S::FAC_MIN;
-            return Ok(Attempt::Retry);
-        }
-        let fac11 = err.powf(S::EXPONENT);
-        if err <= 1.0 {
-            // Lund stabilisation (PI control): divide by the previous error's factor.
-            let fac = (fac11 / fac_old.powf(S::BETA) / SAFE).clamp(fac_lo, fac_hi);
-            let mut h_new = *h / fac;
-            *fac_old = err.max(1e-4);
+        // A non-finite trial (e.g. a state thrown out of range) shrinks hard and retries.
+        if let Some(mut h_new) = step_size::<M, S>(err, h, fac_old, rejected_last) {
             let t_new = if last { t_end } else { *t + *h };
             stepper.new_derivative(rhs, t_new, &mut f1)?;
             let y1 = *stepper.y1();
@@ -276,8 +295,6 @@ impl<const M: usize> AdaptiveRun<M> {
             Ok(Attempt::Accepted)
         } else {
             stats.rejected += 1;
-            *rejected_last = true;
-            *h /= fac_hi.min(fac11 / SAFE);
             Ok(Attempt::Retry)
         }
     }

@@ -3,7 +3,6 @@
 //! run's), for `dop853_lanes`.
 
 use super::dop853::Dop853;
-use super::{SAFE, Stepper};
 
 /// The step control of an adaptive lane (`drive` in integrate/adaptive.rs, per lane).
 #[derive(Clone, Debug, Default)]
@@ -46,19 +45,13 @@ impl Adaptive {
             return Control::Failed;
         }
         self.attempts += 1;
-        let fac_lo = 1.0 / <Dop853<4> as Stepper<4>>::FAC_MAX;
-        let fac_hi = 1.0 / <Dop853<4> as Stepper<4>>::FAC_MIN;
-        if !err.is_finite() {
-            self.rejected_last = true;
-            self.h *= <Dop853<4> as Stepper<4>>::FAC_MIN;
-            return Control::Rejected;
-        }
-        let fac11 = err.powf(<Dop853<4> as Stepper<4>>::EXPONENT);
-        if err <= 1.0 {
-            let fac = (fac11 / self.fac_old.powf(<Dop853<4> as Stepper<4>>::BETA) / SAFE)
-                .clamp(fac_lo, fac_hi);
-            let mut h_new = self.h / fac;
-            self.fac_old = err.max(1e-4);
+        let controlled = super::adaptive::step_size::<4, Dop853<4>>(
+            err,
+            &mut self.h,
+            &mut self.fac_old,
+            &mut self.rejected_last,
+        );
+        if let Some(mut h_new) = controlled {
             if !completes() {
                 return Control::Failed;
             }
@@ -80,8 +73,6 @@ impl Adaptive {
             self.h = h_new;
             Control::Accepted
         } else {
-            self.rejected_last = true;
-            self.h /= fac_hi.min(fac11 / SAFE);
             Control::Rejected
         }
     }

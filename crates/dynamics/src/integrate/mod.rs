@@ -48,7 +48,7 @@ pub(crate) use dop853::lanes;
 
 use paritysim_error::{Error, Result};
 
-use adaptive::{SAFE, drive_method, initial_step};
+use adaptive::{drive_method, initial_step};
 pub use array::{ArrayRhs, ArraySink, ArraySystem, integrate_array, integrate_system};
 pub(crate) use events::WithoutEvents;
 pub use events::{MAX_SWITCHES, Sides};
