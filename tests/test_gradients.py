@@ -30,7 +30,7 @@ def _set(spec: ps.Simulation, values: dict[str, float]) -> ps.Simulation:
     return ps.Simulation.from_dict(d)
 
 
-def _check_against_whole_runs(spec: ps.Simulation, paths: list[str], base: list[float], rel_step: float) -> int:
+def _check_against_whole_runs(spec: ps.Simulation, paths: list[str], base: list[float], rel_step: float, rel: float = 1e-4) -> int:
     s = ps.sensitivity(spec, paths, progress=False, **TIGHT)
     checked = 0
     for path, p0 in zip(paths, base, strict=True):
@@ -50,7 +50,7 @@ def _check_against_whole_runs(spec: ps.Simulation, paths: list[str], base: list[
             if abs(coarse[m] - fine[m]) > 1e-4 * abs(fine[m]) + resolved:
                 continue  # the metric is not smooth over the reference's step
             ours = row[f"d/d({path})"]
-            assert abs(ours - fine[m]) <= 1e-4 * abs(fine[m]) + resolved, (path, m, ours, fine[m])
+            assert abs(ours - fine[m]) <= rel * abs(fine[m]) + resolved, (path, m, ours, fine[m])
             checked += 1
     return checked
 
@@ -62,6 +62,22 @@ def test_blade_element_device_derivatives_equal_whole_run_differences():
     d = spec.to_dict()
     base = [d["wings"][0]["springs"]["hinge"]["stiffness"], d["actuator"]["waveform"]["amplitude_v"], 30.0]
     assert _check_against_whole_runs(spec, paths, base, 1e-3) >= 15
+
+
+def test_linkage_drivetrain_derivatives_equal_whole_run_differences():
+    linkage = ps.devices.load("sreetharan2012_3_3_parity_linkage")
+    d = linkage.to_dict()
+    assert _check_against_whole_runs(linkage, ["actuator.waveform.amplitude_v", "drivetrain.balance_spring"], [d["actuator"]["waveform"]["amplitude_v"], d["drivetrain"]["balance_spring"]], 1e-3) >= 20
+
+
+def test_lift_parity_derivatives_equal_whole_run_differences():
+    # The §2.5 Lift PARITY: free deviation, switched blade elements, a period-2 orbit at K2 = 30.
+    # Its variational monodromy missed the jumps at the switches (d left_stroke_amplitude /
+    # d amplitude 3.3 % off); from differences of the fixed-grid map the derivatives agree with
+    # whole runs to 2e-5 (strokes, lift) and 3.5e-4 (roll torque mean), a residual whose cause
+    # is not established (docs/findings.md §30): checked at 1e-3.
+    lift = _set(ps.devices.load("sreetharan2012_2_5_lift_parity_1cut"), {"drivetrain.balance_spring": 30.0})
+    assert _check_against_whole_runs(lift, ["actuator.waveform.amplitude_v"], [100.0], 1e-3, rel=1e-3) >= 5
 
 
 def test_the_frequency_derivative_scales_the_period():
