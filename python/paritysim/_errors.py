@@ -94,6 +94,21 @@ def read_toml(field: str, path: Any, what: str) -> dict[str, Any]:
         raise invalid(field, str(file), f"{what} in valid TOML ({exc})") from exc
 
 
+def read_study(path: Any, what: str, keys: Iterable[str], required: Iterable[str] = (), command: str = "") -> dict[str, Any]:
+    """The table of a CLI study file (`read_toml`, ``field`` ``study``) with its keys checked:
+    an unknown key is an ``InvalidParameterError`` naming it and the nearest ones, a missing
+    ``required`` key one naming it."""
+    data = read_toml("study", path, what)
+    keys = list(keys)
+    unknown = sorted(set(data) - set(keys))
+    if unknown:
+        raise invalid(unknown[0], "<unknown key>", suggest(unknown[0], keys, what="a key of the study file"))
+    for key in required:
+        if key not in data:
+            raise invalid(key, "<missing>", f"given (see `paritysim {command} --help`)")
+    return data
+
+
 #: Environment variable bounding the bytes one call may allocate (see `memory_limit`).
 MAX_BYTES_ENV = "PARITYSIM_MAX_BYTES"
 

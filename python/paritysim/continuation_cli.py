@@ -23,7 +23,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from ._errors import invalid, read_toml, suggest
+from ._errors import invalid, read_study
 
 __all__ = ["add_parser", "run_study"]
 
@@ -36,14 +36,8 @@ def run_study(study: str | Path, out: str | Path) -> dict[str, Any]:
     from .continuation import continuation
     from .spec import load_spec
 
-    data = read_toml("study", study, "a continuation study")
+    data = read_study(study, "a continuation study", _KEYS, ("spec", "path", "stop"), "continue")
     study = Path(study)
-    unknown = sorted(set(data) - set(_KEYS))
-    if unknown:
-        raise invalid(unknown[0], "<unknown key>", suggest(unknown[0], _KEYS, what="a key of the study file"))
-    for key in ("spec", "path", "stop"):
-        if key not in data:
-            raise invalid(key, "<missing>", "given (see `paritysim continue --help`)")
     source = data["spec"]
     if not isinstance(source, str):
         raise invalid("spec", repr(source), "a spec file (relative to the study) or a named device")

@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ._errors import invalid, read_toml, suggest
+from ._errors import invalid, read_study
 from .spec import Simulation, load_spec
 
 __all__ = ["OptimizeStudy", "add_parser", "load_study", "run_study"]
@@ -82,14 +82,8 @@ def load_study(path: str | Path) -> OptimizeStudy:
     the key (the values themselves are checked by `paritysim.optimize`, naming its argument)."""
     from . import devices
 
-    data = read_toml("study", path, "an optimisation study")
+    data = read_study(path, "an optimisation study", _KEYS, ("spec", "objective", "params"), "optimize")
     path = Path(path)
-    unknown = sorted(set(data) - set(_KEYS))
-    if unknown:
-        raise invalid(unknown[0], "<unknown key>", suggest(unknown[0], _KEYS, what="a key of the study file"))
-    for key in ("spec", "objective", "params"):
-        if key not in data:
-            raise invalid(key, "<missing>", "given (see `paritysim optimize --help` and the docs' Getting started)")
     source = data["spec"]
     if not isinstance(source, str) or not source.strip():
         raise invalid("spec", repr(source)[:60], "a named device (`paritysim devices`) or a spec file relative to the study")

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 import polars as pl
 
-from ._errors import invalid, read_toml, suggest
+from ._errors import invalid, read_study
 from .spec import Simulation, load_spec
 
 __all__ = ["Study", "add_parser", "load_study", "run_study"]
@@ -77,11 +77,8 @@ def _axis(name: str, value: Any) -> list[Any]:
 
 def load_study(path: str | Path) -> Study:
     """Parses a study TOML (see the module docstring)."""
-    data = read_toml("study", path, "a sweep study")
+    data = read_study(path, "a sweep study", _KEYS)
     path = Path(path)
-    unknown = sorted(set(data) - set(_KEYS))
-    if unknown:
-        raise invalid(unknown[0], "<unknown key>", suggest(unknown[0], _KEYS, what="a key of the study file"))
     raw_spec = data.get("spec")
     if isinstance(raw_spec, str):
         spec = load_spec(path.parent / raw_spec)
