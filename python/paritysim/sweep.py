@@ -559,21 +559,19 @@ def _with_gradients(df: pl.DataFrame, spec_json: str, names: list[str], paths: l
     errors: list[str | None] = [None] * df.height
     status = df["status"].to_list()
     rows = df.select(names).rows() if names else [()] * df.height
-    for i, (state, row) in enumerate(zip(status, rows, strict=True)):
-        if state != "ok":
+    converged = [i for i, state in enumerate(status) if state == "ok"]
+    # One native call for the chunk's converged points, run on the sweep engine's threads.
+    raw = _core.sensitivity_rows(spec_json, [_dumps(dict(zip(names, rows[i], strict=True))) for i in converged], paths, metrics)
+    for i, point, kind, error in zip(converged, raw["rows"], raw["error_kind"], raw["error"], strict=True):
+        if point is None:
+            errors[i] = f"{kind}Error: {error}"
             continue
-        try:
-            point = _core.spec_apply(spec_json, _dumps(dict(zip(names, row, strict=True))))[0] if names else spec_json
-            raw = _core.sensitivity(point, paths, metrics)
-        except ParitysimError as exc:
-            errors[i] = f"{type(exc).__name__}: {exc}"
-            continue
-        index = {m: k for k, m in enumerate(raw["metric"])}
+        index = {m: k for k, m in enumerate(point["metric"])}
         for j, path in enumerate(paths):
-            column = raw["jacobian"][j]
+            column = point["jacobian"][j]
             for m in metrics:
                 k = index.get(m)
-                if k is not None and not raw["not_differentiable"][k]:
+                if k is not None and not point["not_differentiable"][k]:
                     v = float(column[k])
                     values[f"d({m})/d({path})"][i] = v if math.isfinite(v) else None
     return df.with_columns([pl.Series(c, v, dtype=pl.Float64) for c, v in values.items()] + [pl.Series("gradient_error", errors, dtype=pl.String)])

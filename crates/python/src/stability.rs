@@ -56,6 +56,14 @@ bindings! {
             .map(|s| s.record())
     }
 
+    /// `sensitivity` at each point `rows[i]` (a JSON object of spec paths and values) of a
+    /// JSON spec, on the sweep engine's threads (`paritysim_spec::sensitivity::sensitivities`).
+    #[pyo3(signature = (json, rows, params, metrics = None))]
+    fn sensitivity_rows(json: &str, rows: Vec<String>, params: Vec<String>, metrics: Option<Vec<String>>) {
+        let spec = crate::spec::parse(json)?;
+        paritysim_spec::sensitivity::sensitivities(&spec, &rows, &params, metrics.as_deref())
+    }
+
     /// Monodromy matrix `M(t0)` of eq. 2.25 (`x'' + β0|cos t| x' + κ x = 0`, period π), 2×2.
     fn stability_hill_monodromy(beta0: f64, kappa: f64, t0: f64) {
         Ok(rows2(&floquet::hill_monodromy(beta0, kappa, t0)?))

@@ -6,7 +6,7 @@ use paritysim_dynamics::sensitivity::{SteadySensitivity, steady_sensitivity};
 use paritysim_error::{Error, Result};
 use serde_json::Value;
 
-use crate::paths::{Parameter, apply, resolve_in, spec_paths};
+use crate::paths::{Parameter, apply, apply_json, resolve_in, spec_paths};
 use crate::spec::Simulation;
 
 /// What [`sensitivity`] returns: the resolved parameters with their units and base values,
@@ -65,6 +65,46 @@ pub fn sensitivity(
         values,
         result,
     })
+}
+
+/// The sensitivities at the points `rows` of `spec` (each a JSON object of spec paths and
+/// values, as a sweep's rows apply them), one row per point, on the sweep engine's thread
+/// pool: `ps.sweep(..., gradients=...)`. A point that fails is its row's error.
+///
+/// # Errors
+/// [`Error::Cancelled`] when the caller's budget is cancelled; the rest are per row.
+pub fn sensitivities(
+    spec: &Simulation,
+    rows: &[String],
+    params: &[String],
+    metrics: Option<&[String]>,
+) -> Result<SensitivityRows> {
+    let runs = paritysim_dynamics::stability::rows::run_rows(rows.len(), None, |i| {
+        let (point, _) = apply_json(spec, &rows[i])?;
+        sensitivity(&point, params, metrics).map(|s| s.record())
+    })?;
+    Ok(SensitivityRows {
+        error: runs
+            .iter()
+            .map(|r| r.as_ref().err().map(ToString::to_string))
+            .collect(),
+        error_kind: runs
+            .iter()
+            .map(|r| r.as_ref().err().map(|e| e.kind()))
+            .collect(),
+        rows: runs.into_iter().map(Result::ok).collect(),
+    })
+}
+
+/// [`sensitivities`] for the bindings: per point its record, or its error and the error's kind.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SensitivityRows {
+    /// Each point's derivatives (None where it failed).
+    pub rows: Vec<Option<SensitivityRecord>>,
+    /// Each failed point's error message.
+    pub error: Vec<Option<String>>,
+    /// Each failed point's error kind (`Integration`, `InvalidParameter`, ...).
+    pub error_kind: Vec<Option<&'static str>>,
 }
 
 /// The parameters `params` of `spec` resolved, with their units and values: what

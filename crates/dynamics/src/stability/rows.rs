@@ -18,7 +18,7 @@ pub type Rows<T> = Vec<Result<T>>;
 /// # Errors
 /// [`Error::Cancelled`] when the caller's budget is cancelled (no new point starts once a
 /// running one saw it); [`Error::InvalidParameter`] for a bad `PARITYSIM_THREADS`.
-pub(crate) fn run_rows<T, F>(n: usize, array: Option<&str>, point: F) -> Result<Rows<T>>
+pub fn run_rows<T, F>(n: usize, array: Option<&str>, point: F) -> Result<Rows<T>>
 where
     T: Send,
     F: Fn(usize) -> Result<T> + Sync,
