@@ -44,7 +44,7 @@ logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 if TYPE_CHECKING:  # what type checkers see; at run time the names below load lazily
     from . import aero, claims, devices, dynamics, flight, kinematics, laminate, planform, plots, spec, stability, trials
-    from .calibration import CalibrationResult, calibrate
+    from .calibration import CalibrationResult, Measured, TableCalibrationResult, calibrate, measured
     from .continuation import ContinuationResult
     from .gradients import OptimizationResult, SensitivityResult, optimize, sensitivity
     from .planform import Planform
@@ -58,6 +58,9 @@ _SUBMODULES = ("aero", "calibration", "claims", "continuation", "devices", "dyna
 _NAMES = {
     "CalibrationResult": "calibration",
     "calibrate": "calibration",
+    "Measured": "calibration",
+    "TableCalibrationResult": "calibration",
+    "measured": "calibration",
     "ContinuationResult": "continuation",
     "OptimizationResult": "gradients",
     "SensitivityResult": "gradients",
@@ -101,6 +104,7 @@ __all__ = [
     "GeometryError",
     "IntegrationError",
     "InvalidParameterError",
+    "Measured",
     "Options",
     "OptimizationResult",
     "OutOfDomainError",
@@ -112,6 +116,7 @@ __all__ = [
     "SensitivityResult",
     "SimulationResult",
     "SingularError",
+    "TableCalibrationResult",
     "Spring",
     "Springs",
     "TunableHinge",
@@ -128,6 +133,7 @@ __all__ = [
     "kinematics",
     "laminate",
     "load_spec",
+    "measured",
     "planform",
     "optimize",
     "plots",

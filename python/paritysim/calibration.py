@@ -1,4 +1,5 @@
-"""``paritysim.calibrate``: fit model parameters to target metrics or a measured trajectory.
+"""``paritysim.calibrate``: fit model parameters to target metrics, a measured trajectory, or a
+measured table of operating points (``data=``, ``params=``: `TableCalibrationResult`).
 
 The thesis fitted its model to high-speed video (§3.3.3); this is the same workflow. Each
 residual evaluation runs simulations in Rust with the GIL released, so the finite-difference
@@ -19,13 +20,14 @@ import polars as pl
 from scipy.optimize import least_squares
 
 from ._budget import Deadline
+from ._calibrate_table import Measured, TableCalibrationResult, calibrate_table, measured
 from ._errors import invalid, real, suggest, whole
 from ._exceptions import ParitysimError
 from ._progress import LongRun
 from .simulation import simulate
 from .spec import Simulation
 
-__all__ = ["CalibrationResult", "calibrate"]
+__all__ = ["CalibrationResult", "Measured", "TableCalibrationResult", "calibrate", "measured"]
 
 @dataclass(frozen=True)
 class CalibrationResult:
@@ -57,23 +59,58 @@ class CalibrationResult:
 
 def calibrate(
     model: Simulation | Callable[..., Mapping[str, float]],
-    targets: Mapping[str, float] | pl.DataFrame,
-    free: Mapping[str, tuple[float, float]],
+    targets: Mapping[str, float] | pl.DataFrame | None = None,
+    free: Mapping[str, tuple[float, float]] | None = None,
     *,
+    data: Any = None,
+    params: Mapping[str, tuple[float, float]] | None = None,
+    measured: Mapping[str, Measured | str] | None = None,
+    holdout: float | None = None,
+    seed: int = 0,
+    labels: Sequence[str] = (),
+    jacobian: str = "auto",
+    threads: int | None = None,
     x0: Mapping[str, float] | None = None,
     scale: Mapping[str, float] | None = None,
     workers: int = 2,
     max_nfev: int = 100,
-    xtol: float = 1e-10,
+    xtol: float | None = None,
     diff_step: float = 1e-4,
     max_wall_ms: float = 600_000.0,
     progress: bool = True,
-) -> CalibrationResult:
+) -> CalibrationResult | TableCalibrationResult:
     """Least-squares fit of the ``free`` parameters (name -> (low, high)).
+
+    Two forms. ``calibrate(model, targets, free)`` fits one operating point (target metrics or
+    a measured trajectory; `CalibrationResult`). ``calibrate(spec, data=table, params={path:
+    (low, high)})`` fits a measured table of operating points (`TableCalibrationResult`):
+
+    ``data``: a polars DataFrame (or a pandas DataFrame, or a mapping of columns) whose columns
+    are spec paths giving each row's operating point (``actuator.waveform.amplitude_v``,
+    ``actuator.waveform.frequency_hz``, ...), measured columns, and the ``labels`` columns to
+    carry along. ``measured``: ``{column: ps.measured(metric, peak_to_peak=..., unit=...,
+    sigma=...)}`` states each measured column's convention (a bench's peak-to-peak degrees are
+    ``ps.measured("left_stroke_amplitude", peak_to_peak=True, unit="deg")``); a plain metric
+    name is that metric in its own unit; None takes the columns named after metrics, as they
+    are. Any other column must be a spec path (unknown: the nearest names). ``params``: the
+    fitted spec paths with bounds inside the spec's ranges; the start is the spec's own value
+    when it lies within the bounds (else the middle), or ``x0``. ``holdout``: a fraction in
+    (0, 1) of the rows held out of the fit (chosen by ``seed``) and predicted at the end.
+
+    Each residual evaluation is one `paritysim.sweep` of the fitted rows (``threads`` engine
+    threads); ``jacobian="auto"`` takes the derivatives from the same sweep's ``gradients=``
+    (`paritysim.sensitivity` at every point) when every parameter is differentiable, else
+    (``"differences"``) from one sweep of forward differences of ``diff_step`` × the bound
+    range. The result reports the fitted values, standard errors and correlations (linearised
+    least squares at the optimum, ``s² (JᵀJ)⁻¹`` with the residual variance ``s²``), RMS and
+    max errors on the fitted and held-out rows, scipy's convergence status, and plots the
+    measured against the predicted values per operating line (:meth:`TableCalibrationResult.plot`).
 
     ``model``: a :class:`Simulation` (names are the spec paths of :func:`paritysim.spec_paths`,
     the same language as :func:`paritysim.sweep`; outputs are the simulation metrics) or a callable ``f(**values)``
     returning a mapping of outputs.
+
+    ``xtol``: scipy's step tolerance (default 1e-10, 1e-8 with ``data=``).
 
     ``diff_step``: finite-difference step as a fraction of each parameter's bound range.
     Simulation outputs (sampled peaks, steady-state detection) carry small discontinuities,
@@ -90,10 +127,44 @@ def calibrate(
     ``progress`` (default True): a fit that takes more than a few seconds shows a bar on stderr
     (wall time against ``max_wall_ms``, runs done); ``False`` turns it off.
     """
+    if data is not None:
+        if targets is not None:
+            raise invalid("targets", type(targets).__name__, "None when data= is given (the measured columns of data are the targets)")
+        if free is not None and params is not None:
+            raise invalid("free", "given with params", "None when params= is given (one or the other)")
+        return calibrate_table(
+            model,  # type: ignore[arg-type]
+            data,
+            params if params is not None else free,
+            measured=measured,
+            holdout=holdout,
+            seed=seed,
+            labels=labels,
+            x0=x0,
+            jacobian=jacobian,
+            diff_step=diff_step,
+            max_nfev=max_nfev,
+            xtol=1e-8 if xtol is None else xtol,
+            max_wall_ms=max_wall_ms,
+            threads=threads,
+            progress=progress,
+        )
+    for field_name, extra in (("measured", measured), ("holdout", holdout)):
+        if extra is not None:
+            raise invalid(field_name, type(extra).__name__, "None unless data= is given (a measured table)")
+    if params is not None:
+        if free is not None:
+            raise invalid("free", "given with params", "None when params= is given (one or the other)")
+        free = params
+    if targets is None:
+        raise invalid("targets", "None", "target metrics {output: value}, a trajectory DataFrame, or data= (a measured table)")
+    goal_table: Mapping[str, float] | pl.DataFrame = targets
+    if free is None:
+        raise invalid("free", "None", "a mapping {name: (low, high)}")
     diff_step = real("diff_step", diff_step)
     if not (math.isfinite(diff_step) and 0 < diff_step < 0.5):
         raise invalid("diff_step", diff_step, "in (0, 0.5)")
-    xtol = real("xtol", xtol)
+    xtol = real("xtol", 1e-10 if xtol is None else xtol)
     if not (math.isfinite(xtol) and 0 < xtol < 1):
         raise invalid("xtol", xtol, "in (0, 1)")
     max_nfev = whole("max_nfev", max_nfev, 1, 1_000_000)
@@ -124,9 +195,9 @@ def calibrate(
     for n, v, a, b in zip(names, start, lo, hi, strict=True):
         if not (math.isfinite(v) and a <= v <= b):
             raise invalid(f"x0.{n}", float(v), f"within the bounds [{a}, {b}]")
-    trajectory_target = isinstance(targets, pl.DataFrame)
-    if not trajectory_target and not isinstance(targets, Mapping):
-        raise invalid("targets", type(targets).__name__, "a mapping {output: value} or a DataFrame with time_ms and trajectory columns")
+    trajectory_target = isinstance(goal_table, pl.DataFrame)
+    if not trajectory_target and not isinstance(goal_table, Mapping):
+        raise invalid("targets", type(goal_table).__name__, "a mapping {output: value} or a DataFrame with time_ms and trajectory columns")
 
     if isinstance(model, Simulation):
         base = model
@@ -149,8 +220,8 @@ def calibrate(
             return dict(out)
 
     if trajectory_target:
-        columns = [c for c in targets.columns if c != "time_ms"]
-        t_target = targets["time_ms"].to_numpy() - targets["time_ms"][0]
+        columns = [c for c in goal_table.columns if c != "time_ms"]
+        t_target = goal_table["time_ms"].to_numpy() - goal_table["time_ms"][0]
 
         def residual_of(out: dict[str, Any]) -> np.ndarray:
             traj = out["__trajectory__"]
@@ -160,13 +231,13 @@ def calibrate(
                 if c not in traj.columns:  # polars' ColumnNotFoundError otherwise
                     raise invalid(f"targets.{c}", "<unknown column>", suggest(c, traj.columns, what="a trajectory column"))
                 sim = np.interp(t_target, t, traj[c].to_numpy())
-                res.append((sim - targets[c].to_numpy()) / max(float(np.abs(targets[c].to_numpy()).max()), 1e-12))
+                res.append((sim - goal_table[c].to_numpy()) / max(float(np.abs(goal_table[c].to_numpy()).max()), 1e-12))
             return np.concatenate(res)
     else:
-        keys = list(targets)
+        keys = list(goal_table)
         if not keys:
             raise invalid("targets", "{}", "at least one output to fit")
-        goal = np.array([real(f"targets.{k}", targets[k]) for k in keys])
+        goal = np.array([real(f"targets.{k}", goal_table[k]) for k in keys])
         scales = np.array([real(f"scale.{k}", (scale or {}).get(k, max(abs(g), 1e-12))) for k, g in zip(keys, goal, strict=True)])
         for k, g, sc in zip(keys, goal, scales, strict=True):
             if not math.isfinite(g):
@@ -198,7 +269,7 @@ def calibrate(
     pool = ThreadPoolExecutor(max_workers=max(1, workers))
     bar = LongRun("calibrate", progress, deadline.ms)
 
-    def jacobian(x: np.ndarray, *_: Any) -> np.ndarray:
+    def differences(x: np.ndarray, *_: Any) -> np.ndarray:
         steps = diff_step * (hi - lo)
         # step inwards at the upper bound
         signed = np.where(x + steps > hi, -steps, steps)
@@ -208,7 +279,7 @@ def calibrate(
 
     try:
         with bar:
-            fit = least_squares(evaluate, start, jac=jacobian, bounds=(lo, hi), x_scale="jac", max_nfev=max_nfev, xtol=xtol)
+            fit = least_squares(evaluate, start, jac=differences, bounds=(lo, hi), x_scale="jac", max_nfev=max_nfev, xtol=xtol)
     except ValueError as exc:
         if isinstance(exc, ParitysimError):
             raise

@@ -11,7 +11,7 @@ import polars as pl
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-__all__ = ["COINCIDENCE_TOLERANCE", "fig2_9", "label_with_unit", "pair", "save", "simulation"]
+__all__ = ["COINCIDENCE_TOLERANCE", "calibration_table", "fig2_9", "label_with_unit", "pair", "save", "simulation"]
 
 #: Two curves closer than this fraction of their peak are "coincident" for :func:`pair`.
 COINCIDENCE_TOLERANCE = 0.01
@@ -116,6 +116,58 @@ def simulation(result: object) -> Figure:
     ax_t.legend(ncol=2, fontsize=8)
     name = getattr(getattr(result, "spec", None), "name", "") or "simulation"
     fig.suptitle(f"{name}: wing angles and body torques over the recorded cycles")
+    return fig
+
+
+def calibration_table(result: Any, x: str | None = None, line: str | None = None, path: str | Path | None = None) -> Figure:
+    """Measured against predicted values of a table calibration (`paritysim.calibrate` with
+    ``data=``), one panel per measured column: the measured rows as markers (filled: fitted,
+    open: held out) and the model's prediction at the same operating points as a line, against
+    the operating column ``x`` (default: the one with the most distinct values), one colour per
+    operating line (the distinct values of ``line``, default every other operating column).
+    Saved to ``path`` (PNG) when given."""
+    from ._errors import invalid, suggest
+
+    table: pl.DataFrame = result.table
+    operating: list[str] = list(result.operating)
+    if x is None:
+        x = max(operating, key=lambda c: table[c].n_unique())
+    elif x not in operating:
+        raise invalid("x", repr(x), suggest(str(x), operating, what="an operating-point column of the data"))
+    if line is not None and line not in operating:
+        raise invalid("line", repr(line), suggest(str(line), operating, what="an operating-point column of the data"))
+    groups = [line] if line is not None else [c for c in operating if c != x]
+    columns = list(result.measured)
+    fig, axes = plt.subplots(1, len(columns), figsize=(6.2 * len(columns), 4.2), constrained_layout=True, squeeze=False)
+    keys = table.select(groups).unique(maintain_order=True).sort(groups).rows() if groups else [()]
+    for ax, column in zip(axes[0], columns, strict=True):
+        m = result.measured[column]
+        for k, key in enumerate(keys):
+            sub = table
+            for g, v in zip(groups, key, strict=True):
+                sub = sub.filter(pl.col(g) == v)
+            sub = sub.sort(x)
+            color = f"C{k % 10}"
+            name = ", ".join(f"{g.rsplit('.', 1)[-1]} = {v:g}" for g, v in zip(groups, key, strict=True)) or "model"
+            ax.plot(sub[x].to_numpy(), sub[f"predicted_{column}"].to_numpy(), "-", color=color, lw=1.4, label=name)
+            for part, face in (("fit", color), ("holdout", "none")):
+                s = sub.filter(pl.col("split") == part)
+                ax.plot(s[x].to_numpy(), s[column].to_numpy(), "o", ms=5, mfc=face, mec=color, ls="none")
+        ax.plot([], [], "ko", ms=5, ls="none", label="measured, fitted")
+        ax.plot([], [], "o", mfc="none", mec="k", ms=5, ls="none", label="measured, held out")
+        ax.plot([], [], "k-", lw=1.4, label="predicted")
+        ax.set_xlabel(label_with_unit(x))
+        unit = f" ({m.unit})" if m.unit else ""
+        convention = f"{'2 × ' if m.peak_to_peak else ''}{m.metric}"
+        ax.set_ylabel(f"{column}{unit}")
+        rms = result.holdout_rms.get(column, float("nan"))
+        held = f"held-out RMS {rms:.3g}{unit.strip(' ()') and ' ' + m.unit}" if np.isfinite(rms) else "nothing held out"
+        ax.set_title(f"{column} = {convention}{unit}: {held}", fontsize=9)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, ncol=2)
+    fig.suptitle("Measured (markers) and predicted (lines) per operating line")
+    if path is not None:
+        fig.savefig(Path(path), dpi=150)
     return fig
 
 
