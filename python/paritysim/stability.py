@@ -245,8 +245,12 @@ class FloquetResult:
         ``asymptotic``, ``marginal`` (largest |ρ| within ``max(1e-5, monodromy_uncertainty)``
         of 1) or ``unstable``.
     monodromy_uncertainty:
-        Largest entry of the difference between the monodromies computed with ``fd_step`` and
-        ``4 fd_step``: an estimate of the finite-difference error.
+        Largest entry of the difference between the monodromy and its check (the variational
+        equations' against central differences at ``fd_step``; for switched devices without
+        an analytic Jacobian, differences at ``fd_step`` against ``2 fd_step``): an error
+        estimate.
+    orbit_cycles:
+        Drive cycles per orbit (``period_ms`` covers them): 2 for a period-doubled orbit.
     slowest_decay_ms:
         ``T / -ln|ρ|`` of the slowest decaying multiplier (None if none decays).
     growth_time_ms:
@@ -274,6 +278,7 @@ class FloquetResult:
     growth_time_ms: float | None
     max_exponent_per_ms: float
     period_ms: float
+    orbit_cycles: int
     coordinates: list[str]
     orbit_state: np.ndarray
     monodromy: np.ndarray = field(repr=False)
@@ -344,8 +349,9 @@ class FloquetResult:
         whippletree = ""
         if self.whippletree_multipliers is not None:
             whippletree = ", whippletree |ρ| = " + ", ".join(f"{abs(m):.4g}" for m in self.whippletree_multipliers)
+        doubled = f" ({self.orbit_cycles} drive cycles)" if self.orbit_cycles > 1 else ""
         return (
-            f"FloquetResult({self.stability}: {radius}{extra}{whippletree}; period {self.period_ms:.4g} ms, "
+            f"FloquetResult({self.stability}: {radius}{extra}{whippletree}; period {self.period_ms:.4g} ms{doubled}, "
             f"{len(self.multipliers)} multipliers over {', '.join(self.coordinates)}; .frame for every mode)"
         )
 
@@ -398,11 +404,18 @@ def floquet(spec: Simulation | dict[str, Any], **options: Any) -> FloquetResult:
     """Periodic orbit of a driven device by shooting, and its Floquet multipliers.
 
     Newton on the stroboscopic map over one drive period (cycle-to-cycle simulation as the
-    fallback, which finds stable orbits only), then a central-difference monodromy over the
-    integrated coordinates and rates (work integrals excluded). ``options``: ``rtol`` (1e-12),
+    fallback, which finds stable orbits only), then the monodromy over the integrated
+    coordinates and rates (work integrals excluded): the variational equations', checked by
+    central differences of the map; for a device with blade-element switches and no analytic
+    Jacobian (the §2.5 Lift and Dual PARITY), the central differences, checked at twice the
+    step (the variational equations miss the jumps at the switches: docs/findings.md §30).
+    When the one-cycle orbit is flip-unstable (a multiplier below −1), the orbit of two drive
+    cycles is analysed instead if it is not unstable (``orbit_cycles`` says which; the Lift
+    PARITY settles on such a period-doubled orbit). ``options``: ``rtol`` (1e-12),
     ``atol`` (1e-14), ``method``, ``max_steps``, ``t0`` (section time, ms), ``warmup_cycles``
     (20), ``warmup_tol``, ``max_newton`` (20), ``tol`` (1e-10), ``fd_step`` (1e-5),
-    ``fallback_cycles`` (2000).
+    ``fallback_cycles`` (2000), ``orbit_cycles`` (drive cycles per orbit, 1-8; default: 1, or
+    2 as above).
 
     Raises
     ------
@@ -430,6 +443,7 @@ def floquet(spec: Simulation | dict[str, Any], **options: Any) -> FloquetResult:
         growth_time_ms=raw["growth_time_ms"],
         max_exponent_per_ms=float(raw["max_exponent_per_ms"]),
         period_ms=float(raw["period_ms"]),
+        orbit_cycles=int(raw["orbit_cycles"]),
         coordinates=coordinates,
         orbit_state=raw["orbit_state"],
         monodromy=monodromy,

@@ -28,6 +28,8 @@ pub enum OrbitStability {
 pub struct NonlinearFloquet {
     /// The orbit.
     pub orbit: PeriodicOrbit,
+    /// Drive cycles per orbit (2: a period-doubled orbit; see [`floquet`]).
+    pub orbit_cycles: usize,
     /// Monodromy matrix: Jacobian of the stroboscopic map over `[x (n), ẋ (n)]`.
     pub monodromy: DMatrix<f64>,
     /// Names of the monodromy's rows/columns (`q1, q2, q1_dot, q2_dot` in drivetrain
@@ -42,10 +44,11 @@ pub struct NonlinearFloquet {
     /// Largest entry of the off-diagonal `(q1, q̇1)`–`(q2, q̇2)` blocks of the monodromy
     /// (zero for a symmetric orbit).
     pub whippletree_coupling: Option<f64>,
-    /// Largest entry of `|M_var − M_fd|` between the monodromy of the variational equations
-    /// and the central-difference Jacobian of the map at `fd_step` (two independent
-    /// formulations): an error estimate, larger for piecewise-smooth models such as
-    /// blade-element aerodynamics.
+    /// Largest entry of `|M − M_check|`: the variational equations' monodromy against the
+    /// central-difference Jacobian of the map at `fd_step` (two independent formulations), or,
+    /// for a switched device without an analytic Jacobian, the differences at `fd_step`
+    /// against those at `2 fd_step`. An error estimate, larger for piecewise-smooth models such
+    /// as blade-element aerodynamics.
     pub monodromy_uncertainty: f64,
 }
 
@@ -58,6 +61,15 @@ impl NonlinearFloquet {
     /// Largest Floquet exponent real part `ln(max|ρ|)/T` (1/ms).
     pub fn max_exponent(&self) -> f64 {
         self.spectral_radius().ln() / self.orbit.period
+    }
+
+    /// Unstable through a real multiplier below −1 (a flip: period doubling).
+    pub fn flip_unstable(&self) -> bool {
+        self.stability() == OrbitStability::Unstable
+            && self
+                .multipliers
+                .first()
+                .is_some_and(|r| r.re < 0.0 && r.im.abs() <= self.marginal_tol())
     }
 
     /// Asymptotically stable, marginal or unstable.
@@ -127,10 +139,49 @@ fn eig2(m: &Matrix2<f64>) -> [Complex<f64>; 2] {
 
 /// Periodic orbit and Floquet multipliers of a driven device (see [`periodic_orbit`]; the
 /// monodromy is [`map_jacobian`] at the orbit).
+///
+/// The orbit covers [`ShootingOptions::orbit_cycles`] drive cycles; without it, one, and two
+/// when the one-cycle orbit is flip-unstable (a real multiplier below −1: the device settles
+/// on a period-doubled orbit, as `simulate`'s two-cycle shot finds) and the two-cycle orbit
+/// is not unstable.
+///
+/// The monodromy is the variational equations' at the orbit, checked against central
+/// differences of the map. A device with switches (blade-element branches) whose variational
+/// equations run on a numerical Jacobian (the free-deviation Lift and Dual PARITY) misses the
+/// jumps at the switches there (docs/findings.md §30), so its monodromy is the central
+/// differences of the map (which re-locate the switches), checked against differences at
+/// twice the step.
+///
+/// # Errors
+/// Those of [`periodic_orbit`]; [`Error::Singular`] for a non-finite monodromy.
 pub fn floquet(device: &Device, options: &ShootingOptions) -> Result<NonlinearFloquet> {
-    let orbit = periodic_orbit(device, options)?;
-    let integrator = options.validate(orbit.period)?;
+    let cycles = options.orbit_cycles.unwrap_or(1);
+    let one = floquet_over(device, options, cycles)?;
+    if options.orbit_cycles.is_none() && one.flip_unstable() {
+        match floquet_over(device, options, 2) {
+            Ok(two) if two.stability() != OrbitStability::Unstable => return Ok(two),
+            Err(Error::Cancelled) => return Err(Error::Cancelled),
+            _ => {}
+        }
+    }
+    Ok(one)
+}
+
+/// [`floquet`] of the orbit of `cycles` drive cycles.
+fn floquet_over(
+    device: &Device,
+    options: &ShootingOptions,
+    cycles: usize,
+) -> Result<NonlinearFloquet> {
+    let options = ShootingOptions {
+        orbit_cycles: Some(cycles),
+        ..options.clone()
+    };
+    let orbit = periodic_orbit(device, &options)?;
+    let integrator = options.validate(drive_period(device)?)?;
     let n = device.n_dof();
+    let switched_without_jacobian =
+        crate::integrate::OdeSystem::n_switches(device) > 0 && !device.has_analytic_jacobian();
     // The monodromy from the variational equations (exact derivative of the computed map);
     // its uncertainty from the independent central-difference Jacobian of the map.
     let variational = || -> Result<DMatrix<f64>> {
@@ -146,7 +197,7 @@ pub fn floquet(device: &Device, options: &ShootingOptions) -> Result<NonlinearFl
             .flow_with_sensitivity(device, orbit.t0, &orbit.state, orbit.t0 + orbit.period)
             .map(|(_, m)| m)
     };
-    let differences = || {
+    let differences = |step: f64| {
         map_jacobian(
             device,
             n,
@@ -154,16 +205,18 @@ pub fn floquet(device: &Device, options: &ShootingOptions) -> Result<NonlinearFl
             orbit.t0,
             orbit.period,
             &orbit.state,
-            options.fd_step,
+            step,
         )
     };
-    // Both in parallel on the sweep engine's pool, under the caller's budget.
-    let mut both =
-        super::rows::run_parts(2, |i| if i == 0 { variational() } else { differences() })?;
-    let (coarse, monodromy) = (
-        both.pop().expect("two parts"),
-        both.pop().expect("two parts"),
-    );
+    // The monodromy and its check, in parallel on the sweep engine's pool under the caller's
+    // budget.
+    let mut parts = super::rows::run_parts(2, |i| match (i, switched_without_jacobian) {
+        (0, false) => variational(),
+        (0, true) | (1, false) => differences(options.fd_step),
+        _ => differences(2.0 * options.fd_step),
+    })?;
+    let coarse = parts.pop().expect("two parts");
+    let monodromy = parts.pop().expect("two parts");
     let monodromy_uncertainty = (&monodromy - coarse).amax();
     let multipliers = eigenvalues(&monodromy)?;
     let drivetrain_coords = device.formulation() == Formulation::DrivetrainCoordinates;
@@ -209,6 +262,7 @@ pub fn floquet(device: &Device, options: &ShootingOptions) -> Result<NonlinearFl
     };
     Ok(NonlinearFloquet {
         orbit,
+        orbit_cycles: cycles,
         monodromy,
         coordinates,
         multipliers,

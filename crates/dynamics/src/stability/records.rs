@@ -128,8 +128,10 @@ pub struct FloquetRecord {
     pub coordinates: Vec<String>,
     /// Coordinates then rates at the section.
     pub orbit_state: Vec<f64>,
-    /// Period, ms.
+    /// Period of the orbit, ms (`orbit_cycles` drive periods).
     pub period_ms: f64,
+    /// Drive cycles per orbit (2: period-doubled).
+    pub orbit_cycles: usize,
     /// Section time, ms.
     pub t0_ms: f64,
     /// Residual of the orbit.
@@ -173,6 +175,7 @@ impl From<&NonlinearFloquet> for FloquetRecord {
                 .chain((0..n / 2).map(|i| s.rates[i]))
                 .collect(),
             period_ms: f.orbit.period,
+            orbit_cycles: f.orbit_cycles,
             t0_ms: f.orbit.t0,
             residual: f.orbit.residual,
             newton_iterations: f.orbit.newton_iterations,

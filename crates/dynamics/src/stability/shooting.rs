@@ -40,6 +40,10 @@ pub struct ShootingOptions {
     pub fd_step: f64,
     /// Cycles of the fallback simulation when Newton fails.
     pub fallback_cycles: usize,
+    /// Drive cycles per orbit, in [1, 8]. `None`: one for [`periodic_orbit`];
+    /// [`floquet`](super::floquet) then tries two when the one-cycle orbit is flip-unstable
+    /// (a period-doubled orbit, as `simulate`'s two-cycle shot finds).
+    pub orbit_cycles: Option<usize>,
     /// Initial state (full integrator layout); `None`: rest at the constraints' particular
     /// configuration, as [`crate::simulate()`].
     #[serde(skip)]
@@ -60,6 +64,7 @@ impl Default for ShootingOptions {
             tol: 1e-10,
             fd_step: 1e-5,
             fallback_cycles: 2000,
+            orbit_cycles: None,
             initial: None,
         }
     }
@@ -90,9 +95,18 @@ impl ShootingOptions {
         if let Some(y) = &self.initial {
             paritysim_error::check_all_finite("initial", &y.to_vec())?;
         }
+        if let Some(k) = self
+            .orbit_cycles
+            .filter(|k| !(1..=MAX_ORBIT_CYCLES).contains(k))
+        {
+            bail!(invalid "orbit_cycles", k, format!("an integer in [1, {MAX_ORBIT_CYCLES}]"));
+        }
         RungeKutta::new(self.method, self.rtol, self.atol, self.max_steps)
     }
 }
+
+/// Largest [`ShootingOptions::orbit_cycles`].
+pub const MAX_ORBIT_CYCLES: usize = 8;
 
 /// How the periodic orbit was found.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -110,7 +124,7 @@ pub struct PeriodicOrbit {
     pub state: State,
     /// Section time (ms).
     pub t0: f64,
-    /// Drive period T (ms).
+    /// Orbit period (ms): [`ShootingOptions::orbit_cycles`] drive periods.
     pub period: f64,
     /// `‖P(y) − y‖∞ / (1 + ‖y‖∞)` at the returned state.
     pub residual: f64,
@@ -241,8 +255,10 @@ pub fn periodic_orbit(device: &Device, options: &ShootingOptions) -> Result<Peri
     // The per-point wall budget of `simulate` bounds a pathological orbit search too (an outer
     // run's earlier deadline or cancel flag still applies).
     let _budget = budget::Budget::new(Some(crate::simulate::DEFAULT_MAX_WALL_MS), None).enter();
-    let period = drive_period(device)?;
-    let integrator = options.validate(period)?;
+    let drive = drive_period(device)?;
+    let integrator = options.validate(drive)?;
+    // The section map covers the orbit's cycles.
+    let period = drive * options.orbit_cycles.unwrap_or(1) as f64;
     let n = device.n_dof();
     let t0 = options.t0;
     let mut y = match options.initial {
