@@ -67,11 +67,14 @@ def _trials(spec: ps.Simulation, clean: pl.DataFrame, seeds: range) -> tuple[np.
     return np.array(estimates), np.array(errors), converged
 
 
-def _check_recovery(estimates: np.ndarray, errors: np.ndarray, converged: int, trials: int) -> None:
+def _check_recovery(estimates: np.ndarray, errors: np.ndarray, converged: int, trials: int, joint: float = 0.9) -> None:
     truth = np.array(list(TRUTH.values()))
-    inside = np.all(np.abs(estimates - truth) <= 2.0 * errors, axis=1)
+    each = np.abs(estimates - truth) <= 2.0 * errors
+    inside = np.all(each, axis=1)
     assert converged == trials
-    assert inside.sum() >= math.ceil(0.9 * trials), (inside, estimates, errors)
+    assert inside.sum() >= math.ceil(joint * trials), (inside, estimates, errors)
+    # Each parameter alone: |t| <= 2 has probability 0.94 at these degrees of freedom.
+    assert np.all(each.mean(axis=0) >= 0.85), each.mean(axis=0)
     # Monte Carlo: the spread of the estimates over the trials is what the fits report.
     ratio = estimates.std(axis=0, ddof=1) / np.median(errors, axis=0)
     lo, hi = (0.5, 1.7) if trials < 20 else (0.7, 1.4)
@@ -87,7 +90,9 @@ def test_recovers_the_known_parameters_within_two_standard_errors(spec: ps.Simul
 @pytest.mark.slow
 def test_recovery_and_standard_errors_over_forty_trials(spec: ps.Simulation) -> None:
     clean = _clean(spec, [80.0, 110.0, 140.0, 170.0], [60.0, 80.0, 100.0, 120.0, 140.0, 160.0, 180.0])
-    _check_recovery(*_trials(spec, clean, range(100, 140)), trials=40)
+    # Both parameters at once: about 0.9 for two correlated 95 % intervals with 26 degrees of
+    # freedom, so 40 trials are asked for 80 % (36 of 40 measured).
+    _check_recovery(*_trials(spec, clean, range(100, 140)), trials=40, joint=0.8)
 
 
 def test_standard_errors_are_the_linear_least_squares_formula(spec: ps.Simulation, small: pl.DataFrame) -> None:

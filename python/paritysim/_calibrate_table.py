@@ -264,7 +264,8 @@ def calibrate_table(
     jacobian: str = "auto",
     diff_step: float = 1e-4,
     max_nfev: int = 100,
-    xtol: float = 1e-10,
+    xtol: float = 1e-8,
+    ftol: float = 1e-6,
     max_wall_ms: float = 600_000.0,
     threads: int | None = None,
     progress: bool = True,
@@ -283,6 +284,9 @@ def calibrate_table(
     xtol = real("xtol", xtol)
     if not (math.isfinite(xtol) and 0 < xtol < 1):
         raise invalid("xtol", xtol, "in (0, 1)")
+    ftol = real("ftol", ftol)
+    if not (math.isfinite(ftol) and 0 < ftol < 1):
+        raise invalid("ftol", ftol, "in (0, 1)")
     max_nfev = whole("max_nfev", max_nfev, 1, 1_000_000)
     seed = whole("seed", seed, 0, 2**63 - 1)
     if jacobian not in ("auto", "sensitivity", "differences"):
@@ -476,7 +480,7 @@ def calibrate_table(
     bar = LongRun("calibrate", progress, deadline.ms, unit="sweep")
     with bar:
         try:
-            fit = least_squares(evaluate, np.array(start), jac=jac, bounds=(lower, upper), x_scale="jac", max_nfev=max_nfev, xtol=xtol)
+            fit = least_squares(evaluate, np.array(start), jac=jac, bounds=(lower, upper), x_scale="jac", max_nfev=max_nfev, xtol=xtol, ftol=ftol)
         except ValueError as exc:
             if isinstance(exc, ParitysimError):
                 raise
@@ -503,7 +507,7 @@ def calibrate_table(
     if dof <= 0:
         notes.append(f"no degrees of freedom left ({m_obs} measured values for {p} parameters): no standard errors")
     if state["gradient_failures"]:
-        notes.append(f"{state['gradient_failures']} evaluations took their Jacobian from differences: the sensitivity of some point failed")
+        notes.append(f"{state['gradient_failures']} evaluation(s) took the Jacobian from differences: the sensitivity of some point failed")
     unconverged = int((final["status"] == "unconverged").sum())
     if unconverged:
         notes.append(f"{unconverged} rows did not reach a steady state at the fit (their metrics are those of the last cycles run)")

@@ -75,6 +75,7 @@ def calibrate(
     workers: int = 2,
     max_nfev: int = 100,
     xtol: float | None = None,
+    ftol: float | None = None,
     diff_step: float = 1e-4,
     max_wall_ms: float = 600_000.0,
     progress: bool = True,
@@ -110,7 +111,9 @@ def calibrate(
     the same language as :func:`paritysim.sweep`; outputs are the simulation metrics) or a callable ``f(**values)``
     returning a mapping of outputs.
 
-    ``xtol``: scipy's step tolerance (default 1e-10, 1e-8 with ``data=``).
+    ``xtol``, ``ftol``: scipy's step and cost tolerances (default 1e-10 and 1e-8; with ``data=``
+    1e-8 and 1e-6: a relative cost change of 1e-6 moves the parameters by about 1e-3 of their
+    standard errors, below what the steady states' own tolerances resolve).
 
     ``diff_step``: finite-difference step as a fraction of each parameter's bound range.
     Simulation outputs (sampled peaks, steady-state detection) carry small discontinuities,
@@ -145,6 +148,7 @@ def calibrate(
             diff_step=diff_step,
             max_nfev=max_nfev,
             xtol=1e-8 if xtol is None else xtol,
+            ftol=1e-6 if ftol is None else ftol,
             max_wall_ms=max_wall_ms,
             threads=threads,
             progress=progress,
@@ -167,6 +171,9 @@ def calibrate(
     xtol = real("xtol", 1e-10 if xtol is None else xtol)
     if not (math.isfinite(xtol) and 0 < xtol < 1):
         raise invalid("xtol", xtol, "in (0, 1)")
+    ftol = real("ftol", 1e-8 if ftol is None else ftol)
+    if not (math.isfinite(ftol) and 0 < ftol < 1):
+        raise invalid("ftol", ftol, "in (0, 1)")
     max_nfev = whole("max_nfev", max_nfev, 1, 1_000_000)
     workers = whole("workers", workers, 1, 1024)
     deadline = Deadline("max_wall_ms", max_wall_ms)
@@ -279,7 +286,7 @@ def calibrate(
 
     try:
         with bar:
-            fit = least_squares(evaluate, start, jac=differences, bounds=(lo, hi), x_scale="jac", max_nfev=max_nfev, xtol=xtol)
+            fit = least_squares(evaluate, start, jac=differences, bounds=(lo, hi), x_scale="jac", max_nfev=max_nfev, xtol=xtol, ftol=ftol)
     except ValueError as exc:
         if isinstance(exc, ParitysimError):
             raise
