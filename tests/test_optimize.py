@@ -4,6 +4,8 @@ the active constraint), an infeasible problem, a stability bound, bad input name
 
 from __future__ import annotations
 
+import importlib.util
+import sys
 import warnings
 
 import numpy as np
@@ -38,7 +40,10 @@ def blade_element() -> ps.Simulation:
     return _with(ps.devices.load("sreetharan2012_3_4_parity"), balance_spring=30.0)
 
 
-def test_the_least_power_for_a_stroke_amplitude_is_where_the_constraint_binds(drag_parity):
+@pytest.mark.parametrize("method", ["SLSQP", "ipopt"])
+def test_the_least_power_for_a_stroke_amplitude_is_where_the_constraint_binds(drag_parity, method):
+    if method == "ipopt":
+        pytest.importorskip("cyipopt", reason="the optional ipopt extra (CI installs it)")
     # Power grows with the drive amplitude, so the optimum is the amplitude at which the stroke
     # amplitude is exactly A0: found here by brentq on whole ps.simulate runs.
     a0 = 0.6
@@ -49,11 +54,12 @@ def test_the_least_power_for_a_stroke_amplitude_is_where_the_constraint_binds(dr
         return r.metrics["left_stroke_amplitude"]
 
     volts = brentq(lambda v: stroke(v) - a0, 20.0, 150.0, xtol=1e-12, rtol=1e-14)
-    r = ps.optimize(drag_parity, "actuator_power_mean", {V: (20.0, 150.0)}, [f"left_stroke_amplitude >= {a0}"], progress=False, **TIGHT)
+    r = ps.optimize(drag_parity, "actuator_power_mean", {V: (20.0, 150.0)}, [f"left_stroke_amplitude >= {a0}"], method=method, progress=False, **TIGHT)
     assert r.success, r.message
     assert r.x[V] == pytest.approx(volts, rel=1e-6)
     assert r.active == [f"left_stroke_amplitude >= {a0}"]
-    assert r.constraint_values[f"left_stroke_amplitude >= {a0}"] == pytest.approx(a0, abs=1e-9)
+    # IPOPT (interior point) ends within its tolerance of the bound, SLSQP on it.
+    assert r.constraint_values[f"left_stroke_amplitude >= {a0}"] == pytest.approx(a0, abs=1e-9 if method == "SLSQP" else 1e-7)
     assert r.history["iteration"][0] == 0 and r.history[V][0] == 100.0  # started at the spec's value
     assert r.history["objective"][-1] == pytest.approx(r.objective)
     assert r.objective < r.history["objective"][0]
@@ -94,6 +100,13 @@ def test_the_most_lift_on_a_power_budget_matches_a_grid_and_a_refinement(blade_e
     assert t.success, t.message
     assert t.x[K] == pytest.approx(k_ref, rel=1e-5) and t.x[V] == pytest.approx(volts_ref, rel=1e-5)
     assert t.objective == pytest.approx(lift_ref, rel=1e-5)
+
+    # IPOPT (the optional extra; CI installs it) reaches the same optimum.
+    if importlib.util.find_spec("cyipopt") is not None:
+        i = ps.optimize(blade_element, "lift_mean", {V: (30.0, 200.0), K: (1.0, 5.0)}, [f"actuator_power_mean <= {p0}"], sense="max", method="ipopt", progress=False, **TIGHT)
+        assert i.success, i.message
+        assert i.x[K] == pytest.approx(k_ref, rel=1e-6) and i.x[V] == pytest.approx(volts_ref, rel=1e-6)
+        assert i.objective == pytest.approx(lift_ref, rel=1e-8)
 
 
 def test_a_stability_bound_moves_the_optimum_onto_it(blade_element):
@@ -163,6 +176,13 @@ def test_bad_input_is_refused_naming_the_argument(drag_parity, kwargs, field, te
         ps.optimize(drag_parity, **args)
     assert err.value.field == field, str(err.value)
     assert text in str(err.value)
+
+
+def test_ipopt_without_its_extra_is_refused_naming_the_method(drag_parity, monkeypatch):
+    monkeypatch.setitem(sys.modules, "cyipopt", None)  # as if not installed
+    with pytest.raises(InvalidParameterError, match='paritysim\\[ipopt\\]') as err:
+        ps.optimize(drag_parity, "actuator_power_mean", {V: (20.0, 150.0)}, method="ipopt", progress=False)
+    assert err.value.field == "method"
 
 
 def test_the_result_prints_on_one_line_plots_and_saves_its_spec(drag_parity, tmp_path):

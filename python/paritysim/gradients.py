@@ -364,12 +364,13 @@ def optimize(
 ) -> OptimizationResult:
     """Minimise (``sense="min"``) or maximise a steady-state metric over continuous spec paths,
     subject to constraints on metrics and on stability, with exact gradients
-    (`sensitivity`) under ``scipy.optimize`` (``method`` ``"SLSQP"`` or ``"trust-constr"``).
+    (`sensitivity`) under ``scipy.optimize`` (``method`` ``"SLSQP"`` or ``"trust-constr"``) or
+    IPOPT (``"ipopt"``, the optional ``ipopt`` extra: cyipopt, with a limited-memory Hessian).
 
     ``params``: ``{path: (low, high)}``, any continuous path `sensitivity` takes. The optimiser
     works in parameters scaled to [0, 1] by these bounds and in the objective divided by its
     magnitude at the start, so ``tol`` (SLSQP's ``ftol``, trust-constr's ``gtol`` and ``xtol``)
-    is relative. ``constraints``: texts ``"metric >= number"``, ``"metric <= number"``,
+    is relative (IPOPT's ``tol``). ``constraints``: texts ``"metric >= number"``, ``"metric <= number"``,
     ``"metric == number"``, ``"abs(metric) <= number"``. ``stability``: a bound on the largest
     modulus of the orbit's Floquet multipliers other than neutral ones (within ``1e-3`` of 1);
     its gradient is a one-sided difference of step ``1e-5`` in each scaled parameter (one more
@@ -401,10 +402,15 @@ def optimize(
     run_spec = spec.replace(options=spec.options.with_fields("options", **option_overrides)) if option_overrides else spec
     if sense not in ("min", "max"):
         raise invalid("sense", repr(sense), '"min" or "max"')
-    methods = {"slsqp": "SLSQP", "trust-constr": "trust-constr"}
+    methods = {"slsqp": "SLSQP", "trust-constr": "trust-constr", "ipopt": "ipopt"}
     if not isinstance(method, str) or method.lower() not in methods:
-        raise invalid("method", repr(method), '"SLSQP" or "trust-constr"')
+        raise invalid("method", repr(method), '"SLSQP", "trust-constr" or "ipopt"')
     method = methods[method.lower()]
+    if method == "ipopt":
+        try:
+            import cyipopt  # noqa: F401  (the optional `ipopt` extra)
+        except ImportError:
+            raise invalid("method", '"ipopt"', 'an installed IPOPT: pip install "paritysim[ipopt]" (cyipopt), or "SLSQP"') from None
     max_iterations = whole("max_iterations", max_iterations, 1, 100_000)
     tol = real("tol", tol)
     if not (tol > 0 and math.isfinite(tol)):
@@ -577,6 +583,8 @@ def optimize(
                     fun, z0, jac=jac, method="SLSQP", bounds=Bounds(0.0, 1.0), constraints=scipy_constraints,
                     options={"maxiter": max_iterations, "ftol": tol}, callback=callback,
                 )  # fmt: skip
+            elif method == "ipopt":
+                res = _ipopt(fun, jac, [cons(g) for g in (ineq, eq) if g], [len(ineq)] * bool(ineq) + [0] * bool(eq), z0, max_iterations, tol, callback)
             else:
                 nonlinear = []
                 for group, lb, ub in ((ineq, 0.0, np.inf), (eq, 0.0, 0.0)):
@@ -643,6 +651,50 @@ def optimize(
         sensitivities=counts["sensitivities"],
         bounds={p: (float(lo), float(hi)) for p, lo, hi in zip(paths, low, high, strict=True)},
     )
+
+
+def _ipopt(fun: Any, jac: Any, groups: list[tuple[Any, Any]], inequalities: list[int], z0: np.ndarray, max_iterations: int, tol: float, callback: Any) -> Any:
+    """`optimize`'s search by IPOPT (cyipopt's low-level problem: its ``intermediate`` hook
+    records each iterate) on the scaled box [0, 1] with a limited-memory Hessian (only
+    gradients are exact). ``groups``: (values, Jacobian) of the inequality (>= 0) and equality
+    (= 0) constraints; ``inequalities``: per group, how many of its rows are inequalities (all
+    or none). Returns a scipy-like result (x, success, message, nit)."""
+    from types import SimpleNamespace
+
+    import cyipopt
+
+    sizes = [len(np.atleast_1d(g[0](z0))) for g in groups]
+    lower = np.zeros(sum(sizes))
+    upper = np.concatenate([np.full(n, np.inf) if k else np.zeros(n) for n, k in zip(sizes, inequalities, strict=True)]) if sizes else lower
+    iterations = [0]
+
+    class Problem:
+        def objective(self, z: np.ndarray) -> float:
+            return float(fun(z))
+
+        def gradient(self, z: np.ndarray) -> np.ndarray:
+            return np.asarray(jac(z), dtype=float)
+
+        def constraints(self, z: np.ndarray) -> np.ndarray:
+            return np.concatenate([np.atleast_1d(g[0](z)) for g in groups]) if groups else np.zeros(0)
+
+        def jacobian(self, z: np.ndarray) -> np.ndarray:  # dense, row-major
+            return np.concatenate([np.asarray(g[1](z), dtype=float).ravel() for g in groups]) if groups else np.zeros(0)
+
+        def intermediate(self, alg_mod: int, iter_count: int, *_: Any) -> bool:
+            if iter_count > 0:
+                iterations[0] = iter_count
+                callback(np.clip(problem.get_current_iterate()["x"], 0.0, 1.0))
+            return True
+
+    n = len(z0)
+    problem = cyipopt.Problem(n=n, m=len(lower), problem_obj=Problem(), lb=np.zeros(n), ub=np.ones(n), cl=lower, cu=upper)
+    for key, value in (("hessian_approximation", "limited-memory"), ("max_iter", max_iterations), ("tol", tol), ("print_level", 0), ("sb", "yes")):
+        problem.add_option(key, value)
+    x, info = problem.solve(np.asarray(z0, dtype=float))
+    message = info["status_msg"].decode() if isinstance(info["status_msg"], bytes) else str(info["status_msg"])
+    # IPOPT status 0: solved; 1: solved to the acceptable level.
+    return SimpleNamespace(x=x, success=info["status"] in (0, 1), message=f"IPOPT: {message}", nit=iterations[0])
 
 
 def _sensitivity_or_params(spec: Simulation, paths: list[str], metrics: list[str]) -> SensitivityResult:

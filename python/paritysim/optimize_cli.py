@@ -8,7 +8,7 @@ constraints::
     sense = "min"                          # optional: "min" (default) or "max"
     constraints = ["lift_mean >= 0.5886", "abs(yaw_total_mean) <= 0.05"]   # optional
     stability = 0.98                       # optional: bound on the largest non-neutral |multiplier|
-    method = "SLSQP"                       # optional: "SLSQP" (default) or "trust-constr"
+    method = "SLSQP"                       # optional: "SLSQP" (default), "trust-constr" or "ipopt"
     max_iterations = 100                   # optional
     tol = 1e-6                             # optional (relative, see paritysim.optimize)
     out = "runs"                           # optional: output directory, relative to this file
