@@ -563,7 +563,7 @@ def _with_gradients(df: pl.DataFrame, spec_json: str, names: list[str], paths: l
     # One native call for the chunk's converged points, run on the sweep engine's threads.
     raw = _core.sensitivity_rows(spec_json, [_dumps(dict(zip(names, rows[i], strict=True))) for i in converged], paths, metrics)
     for i, point, kind, error in zip(converged, raw["rows"], raw["error_kind"], raw["error"], strict=True):
-        if point is None:
+        if not isinstance(point, dict):  # the converter hands an all-failed column over as NaN
             errors[i] = f"{kind}Error: {error}"
             continue
         index = {m: k for k, m in enumerate(point["metric"])}
