@@ -13,6 +13,8 @@
 //! * [`blade`]: the blade-element state (wind-relative coordinates, eq. 3.4) and the four moments
 //!   `M_N, M_T, M_rd, M_r` of eqs. 3.8–3.11, plus lift and drag forces and their torques about
 //!   the body axes.
+//! * [`whitney_wood`]: the Whitney & Wood 2010 model: the blade element plus rotational lift
+//!   and added mass (an added inertia tensor), with its planform parameters Ω5..Ω8.
 //!
 //! # Units
 //! mg-mm-ms-rad: lengths mm, mass mg, time ms, density mg/mm³, so the Ω are mg·mm² and
@@ -36,6 +38,7 @@ pub mod inertia;
 pub mod planform;
 pub mod records;
 pub mod stroke_drag;
+pub mod whitney_wood;
 pub mod wing_aero;
 
 pub use blade::{
@@ -52,4 +55,8 @@ pub use inertia::{LineMass, MassDistribution, PointMass, WingInertia};
 pub use paritysim_error::{Error, Result};
 pub use planform::{DEFAULT_AIR_DENSITY, Planform, PlanformIntegrals};
 pub use stroke_drag::{stroke_drag, stroke_drag_constant, stroke_drag_slope, stroke_drag_torque};
+pub use whitney_wood::{
+    DEFAULT_ROTATIONAL_ADDED_MASS, DEFAULT_ROTATIONAL_LIFT, DEFAULT_TRANSLATIONAL_ADDED_MASS,
+    QuasiSteadyOmegas, QuasiSteadyTerms, WhitneyWoodModel,
+};
 pub use wing_aero::WingAero;

@@ -74,6 +74,15 @@ pub struct PlanformIntegrals {
     pub z2_c2: f64,
     /// `∫ z² l(z) c(z) dz` (mm⁵), eq. 3.15 without `½ρ`.
     pub z2_lc: f64,
+    /// `∫ z c² x_m dz` (mm⁵), `x_m = l − c/2` the mid-chord: Ω5 without `½ρ`
+    /// ([`crate::whitney_wood`]).
+    pub z_c2_xm: f64,
+    /// `∫ c² x_m² dz` (mm⁵): Ω6 without `½ρ`.
+    pub c2_xm2: f64,
+    /// `∫ c⁴ dz` (mm⁵): Ω7 without `½ρ`.
+    pub c4: f64,
+    /// `∫ z c (l − c/4)(¾c − l) dz` (mm⁵): Ω8 without `½ρ`.
+    pub z_rotational_lift: f64,
 }
 
 /// A validated wing outline (simple polygon, counter-clockwise in the `(z, x)` plane) with its
@@ -569,6 +578,11 @@ impl Planform {
                 s.x3_abs += wz * m3;
                 s.z2_c2 += wz * z2 * c * c;
                 s.z2_lc += wz * z2 * lead * c;
+                let xm = lead - 0.5 * c;
+                s.z_c2_xm += wz * z * c * c * xm;
+                s.c2_xm2 += wz * c * c * xm * xm;
+                s.c4 += wz * c * c * c * c;
+                s.z_rotational_lift += wz * z * c * (lead - 0.25 * c) * (0.75 * c - lead);
             }
         }
         s
@@ -661,6 +675,31 @@ impl Planform {
             omega3: h * s.z2_c2,
             omega4: h * s.z2_lc,
             force: Some(h * s.z2),
+        })
+    }
+
+    /// Ω5..Ω8 of the Whitney & Wood 2010 model ([`crate::whitney_wood`], mg·mm²) for air of
+    /// `density` mg/mm³, with the mid-chord `x_m = l − c/2`:
+    ///
+    /// ```text
+    /// Ω5 = ½ρ ∫ z c² x_m dz     Ω6 = ½ρ ∫ c² x_m² dz
+    /// Ω7 = ½ρ ∫ c⁴ dz           Ω8 = ½ρ ∫ z c (l − c/4)(¾c − l) dz
+    /// ```
+    ///
+    /// `c` is the membrane's total chord at `z` and `l` its foremost edge, as in Ω3, Ω4; each
+    /// integrand is a polynomial of degree 4 on a slab, so the 3-point Gauss rule is exact.
+    ///
+    /// # Errors
+    /// As [`Self::omegas`].
+    pub fn quasi_steady_omegas(&self, density: f64) -> Result<crate::QuasiSteadyOmegas> {
+        check_positive("density", density)?;
+        let h = 0.5 * density;
+        let s = &self.integrals;
+        Ok(crate::QuasiSteadyOmegas {
+            omega5: h * s.z_c2_xm,
+            omega6: h * s.c2_xm2,
+            omega7: h * s.c4,
+            omega8: h * s.z_rotational_lift,
         })
     }
 }

@@ -49,6 +49,14 @@ pub struct PlanformReport {
     pub omega4: f64,
     /// `½ρ∬z²dA` (mg·mm), 0 when undefined.
     pub force: f64,
+    /// Ω5..Ω8 of the Whitney & Wood 2010 model (mg·mm², [`Planform::quasi_steady_omegas`]).
+    pub omega5: f64,
+    /// Ω6.
+    pub omega6: f64,
+    /// Ω7.
+    pub omega7: f64,
+    /// Ω8.
+    pub omega8: f64,
     /// The density-free integrals.
     pub integrals: PlanformIntegrals,
 }
@@ -60,6 +68,7 @@ impl PlanformReport {
     /// As [`Planform::omegas`].
     pub fn of(p: &Planform, density: f64) -> Result<Self> {
         let o = p.omegas(density)?;
+        let q = p.quasi_steady_omegas(density)?;
         let (x0, x1) = p.x_range();
         Ok(Self {
             vertices: vertices(p),
@@ -75,6 +84,10 @@ impl PlanformReport {
             omega3: o.omega3,
             omega4: o.omega4,
             force: o.force.unwrap_or(0.0),
+            omega5: q.omega5,
+            omega6: q.omega6,
+            omega7: q.omega7,
+            omega8: q.omega8,
             integrals: *p.integrals(),
         })
     }
