@@ -1,5 +1,6 @@
-//! A wing's aerodynamic law, written once: [`WingAero`] (none, the stroke drag of eq. 2.16, or
-//! the blade element of §3.2.4) and everything the engine asks of it: the torque on a wing
+//! A wing's aerodynamic law, written once: [`WingAero`] (none, the stroke drag of eq. 2.16,
+//! the blade element of §3.2.4, or Whitney & Wood 2010 with rotational lift and added mass)
+//! and everything the engine asks of it: the torque on a wing
 //! turning about a fixed shoulder (the fixed-body right-hand sides, [`WingAero::torque`]), and
 //! the wrench on a shoulder that moves with a flying body ([`wrench`], [`switching`]).
 //!
@@ -28,7 +29,7 @@ use nalgebra::{Matrix3, Vector3};
 use paritysim_error::{Result, check_non_negative};
 
 use crate::stroke_drag::{stroke_drag, stroke_drag_constant, stroke_drag_torque};
-use crate::{BladeElementModel, Branch, CoefficientSet};
+use crate::{BladeElementModel, Branch, CoefficientSet, WhitneyWoodModel};
 
 /// Aerodynamic model of a wing, evaluated inside the right-hand side (allocation-free).
 #[derive(Clone, Debug, PartialEq)]
@@ -46,6 +47,10 @@ pub enum WingAero {
     /// The quasi-steady blade-element model of §3.2.4 (crates/aero): `M_N, M_T, M_r, M_rd` of
     /// eqs. 3.8–3.11 from the wing's angular velocity `ω = J6 ṗ`, as a torque in frame 6.
     BladeElement(BladeElementModel<CoefficientSet>),
+    /// Whitney & Wood 2010 (crates/aero/src/whitney_wood.rs): the blade element plus
+    /// rotational lift (in the torques here) and added mass ([`Self::added_inertia`], which
+    /// the wing adds to its inertia tensor).
+    WhitneyWood2010(WhitneyWoodModel),
 }
 
 impl WingAero {
@@ -55,6 +60,26 @@ impl WingAero {
             omega1: check_non_negative("omega1", omega1)?,
             coefficient: check_non_negative("coefficient", coefficient)?,
         })
+    }
+
+    /// The inertia the law adds to the wing's (mg·mm², frame 6, about the shoulder): the
+    /// added mass of a law that has one, else zero. `paritysim_dynamics::Wing::new` adds it,
+    /// so every form and flight run it as inertia.
+    pub fn added_inertia(&self) -> Matrix3<f64> {
+        match self {
+            WingAero::WhitneyWood2010(model) => model.added_inertia(),
+            _ => Matrix3::zeros(),
+        }
+    }
+
+    /// The law's blade element when its switching surfaces are the blade element's (the
+    /// blade element itself, or Whitney & Wood's translational part): event location.
+    pub fn switching_blade(&self) -> Option<&BladeElementModel<CoefficientSet>> {
+        match self {
+            WingAero::BladeElement(model) => Some(model),
+            WingAero::WhitneyWood2010(model) => Some(model.blade()),
+            _ => None,
+        }
     }
 
     /// Torque about the stroke axis of a wing that only strokes (θ = ψ = 0, `ω = φ̇ x̂`).
@@ -68,6 +93,13 @@ impl WingAero {
             } => stroke_drag_torque(stroke_drag_constant(*omega1, *coefficient), phi_dot),
             WingAero::BladeElement(model) => {
                 model.moments_omega(&Vector3::new(phi_dot, 0.0, 0.0)).normal
+            }
+            // ω_z = 0: no rotational lift.
+            WingAero::WhitneyWood2010(model) => {
+                model
+                    .blade()
+                    .moments_omega(&Vector3::new(phi_dot, 0.0, 0.0))
+                    .normal
             }
         }
     }
@@ -101,6 +133,7 @@ impl WingAero {
                 None => model.moments_omega(omega).torque(),
                 Some(b) => model.moments_omega_branch(omega, b).torque(),
             },
+            WingAero::WhitneyWood2010(model) => model.torque(omega, branch),
             WingAero::StrokeDrag {
                 omega1,
                 coefficient,
@@ -144,6 +177,9 @@ pub fn switching(
         WingAero::None => [1.0; 3],
         WingAero::StrokeDrag { .. } => [(r61 * omega6).x, 1.0, 1.0],
         WingAero::BladeElement(model) => model.switching_functions(&effective(omega6, v6, r_f)),
+        WingAero::WhitneyWood2010(model) => model
+            .blade()
+            .switching_functions(&effective(omega6, v6, r_f)),
     }
 }
 
@@ -191,6 +227,18 @@ pub fn wrench(
             Wrench {
                 force: loads.lift + loads.drag,
                 torque: loads.torque(),
+            }
+        }
+        WingAero::WhitneyWood2010(model) => {
+            let eff = effective(omega6, v6, r_f);
+            let blade = model.blade();
+            let loads = match branch {
+                Some(b) => blade.loads_omega_branch(&eff, r61, b)?,
+                None => blade.loads_omega(&eff, r61)?,
+            };
+            Wrench {
+                force: loads.lift + loads.drag + r61 * model.rotational_lift_force(&eff, branch),
+                torque: loads.torque() + r61 * model.rotational_lift_torque(&eff, branch),
             }
         }
     })

@@ -214,9 +214,25 @@ impl FlightModel {
                             .with_normal_force_law(m.normal_force_law()),
                     )
                 }
+                WingAero::WhitneyWood2010(m) if m.blade().omegas().force.is_none() => {
+                    let b = m.blade();
+                    let omegas = b
+                        .omegas()
+                        .with_force(b.omegas().omega1 / body.force_radius)?;
+                    let blade =
+                        paritysim_aero::BladeElementModel::new(omegas, *b.coefficient_model())?
+                            .with_rotational_damping(b.rotational_damping())?
+                            .with_normal_force_law(b.normal_force_law());
+                    WingAero::WhitneyWood2010(paritysim_aero::WhitneyWoodModel::new(
+                        blade,
+                        *m.omegas(),
+                        *m.terms(),
+                    )?)
+                }
                 other => other.clone(),
             };
-            // The flight model evaluates aerodynamics itself (with body motion).
+            // The flight model evaluates aerodynamics itself (with body motion); the inertia
+            // keeps the law's added inertia (`Wing::inertia` includes it).
             let mut bare = Wing::new(*w.shoulder(), *w.inertia(), *w.springs(), WingAero::None)?;
             if let Some(h) = w.tunable_hinge() {
                 bare = bare.with_tunable_hinge(*h);

@@ -76,7 +76,7 @@ impl LinearMapTerms<f64> {
                     omega1,
                     coefficient,
                 } => paritysim_aero::stroke_drag_constant(*omega1, *coefficient),
-                WingAero::BladeElement(_) => {
+                WingAero::BladeElement(_) | WingAero::WhitneyWood2010(_) => {
                     analytic = false;
                     0.0
                 }

@@ -14,7 +14,6 @@ use paritysim_aero::Branch;
 use paritysim_error::Result;
 
 use super::Device;
-use crate::WingAero;
 use crate::integrate::{MAX_SWITCHES, Sides, State};
 
 /// The blade elements' branches named by the sides of the switching functions (three per
@@ -36,7 +35,7 @@ impl Device {
             .spec
             .wings
             .iter()
-            .any(|w| matches!(w.aero(), WingAero::BladeElement(_)));
+            .any(|w| w.aero().switching_blade().is_some());
         if !blade || self.form.stroke_only().is_some() {
             return 0;
         }
@@ -62,7 +61,7 @@ impl Device {
     ) -> Result<()> {
         let (p, p_dot) = self.coordinates(y)?;
         for (w, wing) in self.spec.wings.iter().enumerate() {
-            let WingAero::BladeElement(model) = wing.aero() else {
+            let Some(model) = wing.aero().switching_blade() else {
                 g[3 * w..3 * w + 3].fill(1.0);
                 continue;
             };
@@ -95,7 +94,7 @@ pub(super) mod tests {
     use super::*;
     use crate::device::{DeviceSpec, Formulation, Transmission};
     use crate::integrate::{Method, OdeSystem, RungeKutta};
-    use crate::{Actuator, DcOffset, JointSpring, TunableHinge, Waveform, Wing};
+    use crate::{Actuator, DcOffset, JointSpring, TunableHinge, Waveform, Wing, WingAero};
 
     /// A Table 3.3 wing with the §2.5 free deviation: blade element Ω1..Ω4, deviation spring
     /// 10 mN·mm/rad, tunable hinge `k(θ) = 2.53 + 20 θ²` (as `paritysim.devices`'

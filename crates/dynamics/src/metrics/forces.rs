@@ -28,6 +28,7 @@ pub fn offers_forces(device: &Device) -> bool {
         WingAero::None => true,
         WingAero::StrokeDrag { .. } => false,
         WingAero::BladeElement(m) => m.omegas().force.is_some(),
+        WingAero::WhitneyWood2010(m) => m.blade().omegas().force.is_some(),
     })
 }
 
@@ -38,7 +39,7 @@ pub fn offers_forces(device: &Device) -> bool {
 #[inline]
 pub fn wing_force(aero: &WingAero, omega6: &Vector3<f64>, r61: &Matrix3<f64>) -> Vector3<f64> {
     match aero {
-        WingAero::BladeElement(_) => {
+        WingAero::BladeElement(_) | WingAero::WhitneyWood2010(_) => {
             // At rest the shoulder velocity is zero and the force radius plays no part.
             paritysim_aero::wing_aero::wrench(aero, omega6, &Vector3::zeros(), r61, 1.0, None)
                 .map_or(Vector3::repeat(f64::NAN), |w| w.force)

@@ -76,7 +76,8 @@ pub struct WingTerms {
 }
 
 impl Wing {
-    /// A wing with a full inertia tensor (mg·mm², frame 6, about the spherical centre).
+    /// A wing with a full inertia tensor (mg·mm², frame 6, about the spherical centre); an
+    /// aero law with added mass adds its [`WingAero::added_inertia`] to it.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming `inertia` when an entry is non-finite or beyond
@@ -122,7 +123,8 @@ impl Wing {
         }
         Ok(Self {
             shoulder,
-            inertia,
+            // The law's added mass is inertia (Whitney & Wood 2010, crates/aero/src/whitney_wood.rs).
+            inertia: inertia + aero.added_inertia(),
             springs,
             aero,
             tunable_hinge: None,
@@ -157,9 +159,15 @@ impl Wing {
         &self.shoulder
     }
 
-    /// Inertia tensor (frame 6).
+    /// Inertia tensor (frame 6): the structural one given to [`Self::new`] plus the aero law's
+    /// added inertia ([`WingAero::added_inertia`]), the one every form integrates.
     pub fn inertia(&self) -> &Matrix3<f64> {
         &self.inertia
+    }
+
+    /// The structural inertia given to [`Self::new`] (without the aero law's added inertia).
+    pub fn structural_inertia(&self) -> Matrix3<f64> {
+        self.inertia - self.aero.added_inertia()
     }
 
     /// Joint springs `γ1..γ6`.

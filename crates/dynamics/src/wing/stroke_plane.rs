@@ -97,7 +97,7 @@ impl Wing {
             self.inertia[(1, 0)],
             self.inertia[(2, 0)],
         );
-        let on_axis = !matches!(self.aero, WingAero::BladeElement(_));
+        let on_axis = matches!(self.aero, WingAero::None | WingAero::StrokeDrag { .. });
         if on_axis && inertia_x.y == 0.0 && inertia_x.z == 0.0 {
             // No product of inertia with the stroke axis and a drag torque about it: both
             // torques lie on x̂, which R_x(φ) keeps (the general path's other components are

@@ -80,9 +80,14 @@ fn lift_variant(stiffness: f64, amplitude_v: f64, offset_v: f64) -> Device {
         let mut springs = *w.springs();
         springs[3] = JointSpring::linear(stiffness, 0.0).unwrap();
         let hinge = *w.tunable_hinge().unwrap();
-        *w = Wing::new(*w.shoulder(), *w.inertia(), springs, w.aero().clone())
-            .unwrap()
-            .with_tunable_hinge(hinge);
+        *w = Wing::new(
+            *w.shoulder(),
+            w.structural_inertia(),
+            springs,
+            w.aero().clone(),
+        )
+        .unwrap()
+        .with_tunable_hinge(hinge);
     }
     Device::new(spec).unwrap()
 }

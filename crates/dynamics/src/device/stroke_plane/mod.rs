@@ -109,9 +109,9 @@ impl Device {
             let psi = lean.offset[w][1] + dot(row_psi, x);
             let (s, c) = paritysim_simd::sin_cos(psi);
             let omega = Vector3::new(c * phi_dot, -s * phi_dot, dot(row_psi, x_dot));
-            let values = match wing.aero() {
-                WingAero::BladeElement(model) => model.switching_functions(&omega),
-                _ => [1.0; 3],
+            let values = match wing.aero().switching_blade() {
+                Some(model) => model.switching_functions(&omega),
+                None => [1.0; 3],
             };
             g[3 * w..3 * w + 3].copy_from_slice(&values);
         }
@@ -202,6 +202,15 @@ impl Device {
                 WingAero::BladeElement(model) if c > 0.0 && own_side => model
                     .moments_stroke_plane(phi_dot, psi, (s, c), psi_dot, branch)
                     .torque(),
+                // The same closed form for Whitney & Wood's blade element, plus its rotational
+                // lift (its added mass is in `inertia`).
+                WingAero::WhitneyWood2010(model) if c > 0.0 && own_side => {
+                    model
+                        .blade()
+                        .moments_stroke_plane(phi_dot, psi, (s, c), psi_dot, branch)
+                        .torque()
+                        + model.rotational_lift_torque(&omega, branch)
+                }
                 aero => aero.torque_about(phi_dot, &omega, &a, branch),
             };
             let (spring_phi, spring_psi) = wing.stroke_plane_springs(phi, psi);
@@ -418,6 +427,14 @@ impl Device {
                     [a * slope, a1 * m, Vector3::zeros()]
                 }
                 WingAero::None => [Vector3::zeros(); 3],
+                WingAero::WhitneyWood2010(model) => {
+                    let blade = model
+                        .blade()
+                        .moments_stroke_plane_jacobian(phi_dot, psi, (s, c), psi_dot, branch)?
+                        .1;
+                    let lift = model.rotational_lift_stroke_plane_slopes(phi_dot, &omega, branch);
+                    [0, 1, 2].map(|k| blade[k] + lift[k])
+                }
             };
             let (spring_phi, spring_psi) = wing.stroke_plane_spring_slopes(phi, psi);
             // Rows f_φ = a·τ − a·v − V_φ + τ_drive, f_ψ = τ_z − v_z − V_ψ; columns φ, ψ, φ̇, ψ̇.
