@@ -320,6 +320,20 @@ class Planform:
                 raise invalid("rho", rho, f"small enough that {k} is finite")
         return {k: float(p[k]) for k in ("omega1", "omega2", "omega3", "omega4", "force")}
 
+    def quasi_steady_omegas(self, rho: float = AIR_DENSITY) -> dict[str, float]:
+        """Ω5..Ω8 of the ``whitney_wood2010`` aero model (mg·mm²), with the mid-chord
+        ``x_m = l - c/2``: ``omega5 = ½ρ∫ z c² x_m dz``, ``omega6 = ½ρ∫ c² x_m² dz``,
+        ``omega7 = ½ρ∫ c⁴ dz``, ``omega8 = ½ρ∫ z c (l - c/4)(¾c - l) dz`` (exact for the polygon;
+        docs/concepts.md, Aero models).
+
+        Raises ``InvalidParameterError`` (``rho``) unless ``rho`` is finite and > 0.
+        """
+        r = real("rho", rho)
+        if not (math.isfinite(r) and r > 0):
+            raise invalid("rho", rho, "finite and > 0 (mg/mm^3; air is 1.2e-3)")
+        p = _core.aero_planform_properties(self.points, r, None)
+        return {k: float(p[k]) for k in ("omega5", "omega6", "omega7", "omega8")}
+
     def inertia(
         self,
         areal_density: float = 0.0,

@@ -256,6 +256,10 @@ class Aero(_Tagged):
     ``blade_element``: the quasi-steady model of §3.2.4 (eqs. 3.8-3.11) with ``omega1..omega4``,
     coefficient ``model``, ``rotational_damping`` (None: the aero crate's cited default) and
     ``normal_force_law``.
+    ``whitney_wood2010``: Whitney & Wood 2010: the blade element's fields plus ``omega5..omega8``
+    and the multipliers ``rotational_lift`` (rotational lift), ``translational_added_mass`` and
+    ``rotational_added_mass`` (added mass, run as an added inertia tensor); all three 0 is the
+    blade element (docs/concepts.md, Aero models).
     """
 
 
@@ -331,8 +335,9 @@ class Wing(_Node):
         aero_model:
             A coefficient model of :data:`paritysim.aero.MODELS` (blade elements, eqs. 3.8-3.11,
             with the planform's Ω1..Ω4), ``"stroke_drag"`` (eq. 2.16 with its Ω1), an
-            :class:`Aero` whose other fields are kept and whose Ω's are replaced, or None
-            (vacuum).
+            :class:`Aero` whose other fields are kept and whose Ω's are replaced (an
+            ``Aero(kind="whitney_wood2010")`` gets Ω1..Ω8, :meth:`Planform.quasi_steady_omegas`),
+            or None (vacuum).
         air_density_mg_per_mm3:
             Air density of the Ω's (1.2e-3 mg/mm³ = 1.2 kg/m³).
         fields:
@@ -379,7 +384,14 @@ class Wing(_Node):
             else:
                 allowed = ", ".join(repr(n) for n in (*MODELS, "stroke_drag"))
                 raise invalid("aero_model", repr(aero_model)[:60], f"one of {allowed}, an Aero or None")
-            names = ("omega1", "omega2", "omega3", "omega4") if base.kind == "blade_element" else ("omega1",)  # type: ignore[attr-defined]
+            kind = base.kind  # type: ignore[attr-defined]
+            if kind == "whitney_wood2010":
+                omegas = {**omegas, **planform.quasi_steady_omegas(rho)}
+            names: tuple[str, ...] = ("omega1",)
+            if kind in ("blade_element", "whitney_wood2010"):
+                names = ("omega1", "omega2", "omega3", "omega4")
+            if kind == "whitney_wood2010":
+                names += ("omega5", "omega6", "omega7", "omega8")
             aero = base.replace(**{k: omegas[k] for k in names})
 
         if hinge is not None:

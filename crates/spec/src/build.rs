@@ -1,7 +1,10 @@
 //! From a spec to the dynamics model ([`Device`]) and its [`SimulationOptions`].
 
 use nalgebra::Matrix3;
-use paritysim_aero::{BladeElementModel, CoefficientSet, Omegas};
+use paritysim_aero::{
+    BladeElementModel, CoefficientSet, Omegas, QuasiSteadyOmegas, QuasiSteadyTerms,
+    WhitneyWoodModel,
+};
 use paritysim_constraints::{Constraints, Vec6};
 use paritysim_dynamics::device::{DeviceSpec, Formulation as EngineFormulation, Transmission};
 use paritysim_dynamics::simulate::PerturbTarget as EngineTarget;
@@ -123,6 +126,31 @@ impl Simulation {
     }
 }
 
+/// The §3.2.4 blade element of a spec aero (`omegas` Ω1..Ω4) with the force parameter
+/// `Ω1 / force_radius`.
+fn blade_element(
+    omegas: [f64; 4],
+    model: CoefficientModel,
+    rotational_damping: Option<f64>,
+    normal_force_law: NormalForceLaw,
+    force_radius: f64,
+) -> Result<BladeElementModel<CoefficientSet>> {
+    let [o1, o2, o3, o4] = omegas;
+    let omegas = Omegas::new(o1, o2, o3, o4).and_then(|o| o.with_force(o1 / force_radius))?;
+    let coefficients = CoefficientSet::from_name(match model {
+        CoefficientModel::Dickinson1999 => "dickinson1999",
+        CoefficientModel::WhitneyWood2010 => "whitney_wood2010",
+    })?;
+    let damping = rotational_damping.unwrap_or(paritysim_aero::DEFAULT_ROTATIONAL_DAMPING);
+    let law = match normal_force_law {
+        NormalForceLaw::Coefficient => paritysim_aero::NormalForceLaw::Coefficient,
+        NormalForceLaw::Unit => paritysim_aero::NormalForceLaw::Unit,
+    };
+    Ok(BladeElementModel::new(omegas, coefficients)?
+        .with_rotational_damping(damping)?
+        .with_normal_force_law(law))
+}
+
 /// The engine wing of a spec wing; a blade element gets the force parameter
 /// `Ω1 / force_radius` (mg·mm), so its lift and drag forces are defined on every body mode.
 fn wing(w: &Wing, force_radius: f64) -> Result<EngineWing> {
@@ -139,28 +167,39 @@ fn wing(w: &Wing, force_radius: f64) -> Result<EngineWing> {
         Some(Aero::StrokeDrag(a)) => {
             WingAero::stroke_drag(a.omega1, a.coefficient).map_err(|e| e.in_field("aero"))?
         }
-        Some(Aero::BladeElement(a)) => {
-            let at = |e: Error| e.in_field("aero");
-            let omegas = Omegas::new(a.omega1, a.omega2, a.omega3, a.omega4)
-                .and_then(|o| o.with_force(a.omega1 / force_radius))
-                .map_err(at)?;
-            let coefficients = CoefficientSet::from_name(match a.model {
-                CoefficientModel::Dickinson1999 => "dickinson1999",
-                CoefficientModel::WhitneyWood2010 => "whitney_wood2010",
-            })
-            .map_err(at)?;
-            let damping = a
-                .rotational_damping
-                .unwrap_or(paritysim_aero::DEFAULT_ROTATIONAL_DAMPING);
-            let law = match a.normal_force_law {
-                NormalForceLaw::Coefficient => paritysim_aero::NormalForceLaw::Coefficient,
-                NormalForceLaw::Unit => paritysim_aero::NormalForceLaw::Unit,
+        Some(Aero::BladeElement(a)) => WingAero::BladeElement(
+            blade_element(
+                [a.omega1, a.omega2, a.omega3, a.omega4],
+                a.model,
+                a.rotational_damping,
+                a.normal_force_law,
+                force_radius,
+            )
+            .map_err(|e| e.in_field("aero"))?,
+        ),
+        Some(Aero::WhitneyWood2010(a)) => {
+            let blade = blade_element(
+                [a.omega1, a.omega2, a.omega3, a.omega4],
+                a.model,
+                a.rotational_damping,
+                a.normal_force_law,
+                force_radius,
+            );
+            let omegas = QuasiSteadyOmegas {
+                omega5: a.omega5,
+                omega6: a.omega6,
+                omega7: a.omega7,
+                omega8: a.omega8,
             };
-            WingAero::BladeElement(
-                BladeElementModel::new(omegas, coefficients)
-                    .and_then(|m| m.with_rotational_damping(damping))
-                    .map_err(at)?
-                    .with_normal_force_law(law),
+            let terms = QuasiSteadyTerms {
+                rotational_lift: a.rotational_lift,
+                translational_added_mass: a.translational_added_mass,
+                rotational_added_mass: a.rotational_added_mass,
+            };
+            WingAero::WhitneyWood2010(
+                blade
+                    .and_then(|b| WhitneyWoodModel::new(b, omegas, terms))
+                    .map_err(|e| e.in_field("aero"))?,
             )
         }
     };

@@ -169,6 +169,84 @@ impl Default for BladeElement {
     }
 }
 
+/// The Whitney & Wood 2010 quasi-steady model (J. Fluid Mech. 660, 197-220): the blade element
+/// of §3.2.4 (`omega1..omega4`, `model`, `rotational_damping`, `normal_force_law`, as
+/// [`BladeElement`]) plus rotational lift and translational and rotational added mass, from
+/// `omega5..omega8` (crates/aero/src/whitney_wood.rs). With the three multipliers 0 it is the
+/// blade element.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(default, deny_unknown_fields)]
+pub struct WhitneyWood2010 {
+    /// Ω1 (mg·mm²), in [0, 1e5].
+    #[schemars(range(min = 0.0, max = 1e5), extend("x-unit" = "mg mm^2"))]
+    pub omega1: f64,
+    /// Ω2 (mg·mm), in [-1e6, 1e6].
+    #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm"))]
+    pub omega2: f64,
+    /// Ω3 (mg·mm²), in [-1e6, 1e6].
+    #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
+    pub omega3: f64,
+    /// Ω4 (mg·mm²), in [-1e6, 1e6].
+    #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
+    pub omega4: f64,
+    /// Ω5 = ½ρ∫ z c² x_m dz, `x_m = l − c/2` the mid-chord (mg·mm²), in [-1e6, 1e6], with
+    /// `|Ω5| <= √(Ω3 Ω6)`: the added inertia's stroke-pitch product.
+    #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
+    pub omega5: f64,
+    /// Ω6 = ½ρ∫ c² x_m² dz (mg·mm²), in [0, 1e6]: the normal added mass' pitch inertia.
+    #[schemars(range(min = 0.0, max = 1e6), extend("x-unit" = "mg mm^2"))]
+    pub omega6: f64,
+    /// Ω7 = ½ρ∫ c⁴ dz (mg·mm²), in [0, 1e6]: the pitch added inertia about mid-chord.
+    #[schemars(range(min = 0.0, max = 1e6), extend("x-unit" = "mg mm^2"))]
+    pub omega7: f64,
+    /// Ω8 = ½ρ∫ z c (l − c/4)(¾c − l) dz (mg·mm²), in [-1e6, 1e6]: the rotational lift's
+    /// moment about the hinge.
+    #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
+    pub omega8: f64,
+    /// Translational coefficient model (default: Whitney & Wood 2010's `sin 2α` fit).
+    pub model: CoefficientModel,
+    /// Rotational damping coefficient `C_rd` (dimensionless), in [0, 100]; absent: 5.0 (the
+    /// aero crate's default, cited to Whitney & Wood 2010).
+    #[schemars(range(min = 0.0, max = 100.0), extend("x-unit" = "1"))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rotational_damping: Option<f64>,
+    /// Normal-force law of the translational term.
+    pub normal_force_law: NormalForceLaw,
+    /// Rotational-lift multiplier `k_R` of `C_R = π(¾ − x̂₀)` (Whitney & Wood 2010 §2.2,
+    /// after Sane & Dickinson 2002), in [0, 10]; 1 is the paper's theoretical value.
+    #[schemars(range(min = 0.0, max = 10.0), extend("x-unit" = "1"))]
+    pub rotational_lift: f64,
+    /// Translational added-mass multiplier `k_t` of the flat plate's `ρπc²/4` per span, in
+    /// [0, 10]; 1 is the value Whitney & Wood 2010 use.
+    #[schemars(range(min = 0.0, max = 10.0), extend("x-unit" = "1"))]
+    pub translational_added_mass: f64,
+    /// Rotational added-mass multiplier `k_r` of the flat plate's `ρπc⁴/128` per span (pitch
+    /// about mid-chord), in [0, 10]; 1 is the flat-plate value.
+    #[schemars(range(min = 0.0, max = 10.0), extend("x-unit" = "1"))]
+    pub rotational_added_mass: f64,
+}
+
+impl Default for WhitneyWood2010 {
+    fn default() -> Self {
+        Self {
+            omega1: StrokeDrag::default().omega1,
+            omega2: 0.0,
+            omega3: 0.0,
+            omega4: 0.0,
+            omega5: 0.0,
+            omega6: 0.0,
+            omega7: 0.0,
+            omega8: 0.0,
+            model: CoefficientModel::WhitneyWood2010,
+            rotational_damping: None,
+            normal_force_law: NormalForceLaw::default(),
+            rotational_lift: paritysim_aero::DEFAULT_ROTATIONAL_LIFT,
+            translational_added_mass: paritysim_aero::DEFAULT_TRANSLATIONAL_ADDED_MASS,
+            rotational_added_mass: paritysim_aero::DEFAULT_ROTATIONAL_ADDED_MASS,
+        }
+    }
+}
+
 /// Wing aerodynamics (absent: vacuum).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
@@ -177,6 +255,8 @@ pub enum Aero {
     StrokeDrag(StrokeDrag),
     /// Quasi-steady blade elements.
     BladeElement(BladeElement),
+    /// Whitney & Wood 2010: blade elements plus rotational lift and added mass.
+    WhitneyWood2010(WhitneyWood2010),
 }
 
 /// The tunable hinge of §2.5.1: `V = ½ k(θ) ψ²` with
