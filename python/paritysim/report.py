@@ -17,7 +17,7 @@ from . import __version__
 from . import claims as cl
 
 #: Sections in thesis order; modules not listed follow alphabetically.
-ORDER = ["section_2_3", "section_3_3", "section_2_6", "section_3_4", "section_2_5", "laminate_design"]
+ORDER = ["section_2_3", "section_3_3", "section_2_6", "section_3_4", "aero_models", "section_2_5", "laminate_design"]
 
 
 def _modules() -> list[str]:

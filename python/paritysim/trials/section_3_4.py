@@ -56,6 +56,7 @@ class Params:
     force_per_volt: float = _THESIS_ACTUATOR.force_per_volt  # from the Rust spec
     actuator_stiffness: float = _THESIS_ACTUATOR.stiffness  # from the Rust spec
     model: str = "dickinson1999"
+    aero: str = "blade_element"  # or "whitney_wood2010" (trials.aero_models)
     max_cycles: int = 200
     samples_per_cycle: int = 200
 
@@ -65,11 +66,26 @@ class Params:
         return math.radians(self.stroke_deg_per_200um) / 0.2
 
 
-def _wing(key: str, hinge: float, model: str) -> Wing:
+def whitney_wood_omegas(omega3: float) -> dict[str, float]:
+    """Ω5..Ω8 (mg·mm²) for a Table 3.3 wing of ``omega3``: the thesis gives no outline, so
+    those of the HMF-like planform, scaled by ``omega3`` over its own (all are ½ρ × mm⁵
+    integrals of one shape, so this is the planform scaled uniformly to the wing's Ω3)."""
+    from ..planform import Planform
+
+    shape = Planform.hmf_like()
+    scale = omega3 / shape.omegas()["omega3"]
+    return {k: scale * v for k, v in shape.quasi_steady_omegas().items()}
+
+
+def _wing(key: str, hinge: float, p: Params) -> Wing:
     w = aero.TABLE_3_3[key]
     springs = Springs(hinge=Spring(stiffness=hinge))  # joint 6 = ψ hinge
-    blade = Aero(kind="blade_element", omega1=w["omega1"], omega2=w["omega2"], omega3=w["omega3"], omega4=w["omega4"], model=model)
-    return Wing.from_moments(w["ixx"], w["iyy"], w["izz"], w["ixz"], springs=springs, aero=blade)
+    omegas = {k: w[k] for k in ("omega1", "omega2", "omega3", "omega4")}
+    if p.aero == "whitney_wood2010":
+        law = Aero(kind="whitney_wood2010", **omegas, **whitney_wood_omegas(w["omega3"]), model=p.model)
+    else:
+        law = Aero(kind="blade_element", **omegas, model=p.model)
+    return Wing.from_moments(w["ixx"], w["iyy"], w["izz"], w["ixz"], springs=springs, aero=law)
 
 
 def device(p: Params, drivetrain: str, trial: str, hinge: float | None = None) -> Simulation:
@@ -77,7 +93,7 @@ def device(p: Params, drivetrain: str, trial: str, hinge: float | None = None) -
     k = hinge if hinge is not None else hinge_stiffness(p)
     return Simulation(
         name=f"§3.4 {drivetrain} {trial}",
-        wings=(_wing("left", k, p.model), _wing(TRIALS[trial], k, p.model)),
+        wings=(_wing("left", k, p), _wing(TRIALS[trial], k, p)),
         configuration=Configuration(DRIVETRAINS[drivetrain]),
         drivetrain=Drivetrain.linear_differential(p.transmission_ratio, p.arm_mm, balance_spring=p.balance_stiffness),
         actuator=Actuator(Waveform(amplitude_v=p.amplitude_v, offset_v=p.offset_v, frequency_hz=p.frequency_hz), p.force_per_volt, p.actuator_stiffness, p.dc_offset),
