@@ -205,6 +205,7 @@ pub struct LinearDifferential {
     transmission_ratio: f64,
     left_arm: f64,
     right_arm: f64,
+    polynomial: OddPolynomial,
 }
 
 /// Drag PARITY nonlinear linkage (§2.3.2): whippletree plus two rod-cranks.
@@ -213,6 +214,178 @@ pub struct LinkageDifferential {
     side: RodCrank,
     left_arm: f64,
     right_arm: f64,
+}
+
+/// An odd polynomial transmission (beyond the thesis, issue 35; modified RoboBee-class
+/// transmissions): a side's stroke is `φ = τ1 σ + τ2 σ³/3 + a5 σ⁵ + a7 σ⁷ + a9 σ⁹` of its
+/// actuator-side displacement `σ` (mm). Stored in terms of the linear stroke `ℓ = τ1 σ` (what the
+/// linear map gives): `φ = P(ℓ) = ℓ (1 + ℓ² (b3 + ℓ² (b5 + ℓ² (b7 + ℓ² b9))))` with
+/// `b3 = τ2 / (3 τ1³)`, `b5 = a5 / τ1⁵`, ..., so that zero higher terms give `φ = ℓ` bit for
+/// bit (the linear map's numbers).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct OddPolynomial {
+    b: [f64; 4],
+}
+
+/// Most higher odd terms (`σ⁵, σ⁷, σ⁹`) an [`OddPolynomial`] takes.
+pub const MAX_HIGHER_ODD: usize = 3;
+
+/// What a polynomial transmission's fold-over error names (`what`).
+pub const POLYNOMIAL: &str = "polynomial transmission";
+
+impl OddPolynomial {
+    /// The linear map (`φ = ℓ`).
+    pub const LINEAR: OddPolynomial = OddPolynomial { b: [0.0; 4] };
+
+    /// `φ = τ1 σ + τ2 σ³/3 + Σ_j higher[j] σ^(2j+5)` with `τ1 = transmission_ratio` (rad/mm, > 0),
+    /// `τ2 = cubic_ratio` (rad/mm³) and `higher` the coefficients of `σ⁵, σ⁷, σ⁹` (rad/mm⁵, ...).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `cubic_ratio` or `higher_odd_ratios[j]` when not
+    /// finite, or `higher_odd_ratios` when it has more than [`MAX_HIGHER_ODD`] entries.
+    pub fn new(transmission_ratio: f64, cubic_ratio: f64, higher: &[f64]) -> Result<Self> {
+        let t = check_positive("transmission_ratio", transmission_ratio)?;
+        let tau2 = paritysim_error::check_finite("cubic_ratio", cubic_ratio)?;
+        if higher.len() > MAX_HIGHER_ODD {
+            bail!(invalid "higher_odd_ratios", higher.len(), format!(
+                "at most {MAX_HIGHER_ODD} coefficients (of sigma^5, sigma^7, sigma^9)"
+            ));
+        }
+        let mut b = [tau2 / (3.0 * t.powi(3)), 0.0, 0.0, 0.0];
+        for (j, &a) in higher.iter().enumerate() {
+            if !a.is_finite() {
+                bail!(invalid format!("higher_odd_ratios[{j}]"), a, "a finite number");
+            }
+            b[j + 1] = a / t.powi(2 * j as i32 + 5);
+        }
+        if !b.iter().all(|x| x.is_finite()) {
+            bail!(invalid "cubic_ratio", cubic_ratio, "such that the coefficients over powers of transmission_ratio stay finite");
+        }
+        Ok(Self { b })
+    }
+
+    /// The coefficients `(b3, b5, b7, b9)` of `ℓ³, ℓ⁵, ℓ⁷, ℓ⁹` (see the type).
+    pub fn coefficients(&self) -> [f64; 4] {
+        self.b
+    }
+
+    /// Whether this is the linear map (`φ = ℓ`).
+    pub fn is_linear(&self) -> bool {
+        self.b == [0.0; 4]
+    }
+
+    /// `(P, P', P'')` at the linear stroke `ℓ` (rad).
+    ///
+    /// # Errors
+    /// [`Error::OutOfDomain`] where `P'(ℓ) <= 0`: the transmission folds over (a softening
+    /// polynomial beyond its turning point).
+    #[inline]
+    pub fn evaluate(&self, l: f64) -> Result<(f64, f64, f64)> {
+        let [b3, b5, b7, b9] = self.b;
+        let l2 = l * l;
+        let p = l * (1.0 + l2 * (b3 + l2 * (b5 + l2 * (b7 + l2 * b9))));
+        let p1 = 1.0 + l2 * (3.0 * b3 + l2 * (5.0 * b5 + l2 * (7.0 * b7 + l2 * (9.0 * b9))));
+        let p2 = l * (6.0 * b3 + l2 * (20.0 * b5 + l2 * (42.0 * b7 + l2 * (72.0 * b9))));
+        if !(p1 > 0.0) || !p.is_finite() {
+            return Err(Error::OutOfDomain {
+                what: POLYNOMIAL.into(),
+                detail: format!(
+                    "the stroke map folds over (d phi / d sigma = {p1} <= 0) at a linear stroke of {l} rad"
+                ),
+            });
+        }
+        Ok((p, p1, p2))
+    }
+}
+
+/// One actuator on a linear (or polynomial) transmission (beyond the thesis, issue 35): the
+/// RoboBee-class single drive, `φ = P(−T q1)` for one wing, or for two wings tied `φL = φR`
+/// (the linearised HMF). 1 DOF.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SingleLinear {
+    transmission_ratio: f64,
+    polynomial: OddPolynomial,
+}
+
+/// One actuator per wing on linear (or polynomial) transmissions (beyond the thesis, issue 35:
+/// every RoboBee since 2013): `φL = P(−T q1)`, `φR = P(−T q2)`, 2 DOF, diagonal Jacobian.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DualLinear {
+    transmission_ratio: f64,
+    polynomial: OddPolynomial,
+}
+
+/// The rows `J_k` of a linear map with a polynomial on each side: `φ_k = P(J_k q)`.
+#[inline]
+fn polynomial_map(
+    rows: [[f64; 2]; 2],
+    polynomial: &OddPolynomial,
+    q1: f64,
+    q2: f64,
+) -> Result<DrivetrainEval> {
+    let mut stroke = Vector2::zeros();
+    let mut jacobian = Matrix2::zeros();
+    let mut hessian = [Matrix2::zeros(); 2];
+    for (k, [a, b]) in rows.into_iter().enumerate() {
+        let (p, p1, p2) = polynomial.evaluate(a * q1 + b * q2)?;
+        stroke[k] = p;
+        jacobian[(k, 0)] = p1 * a;
+        jacobian[(k, 1)] = p1 * b;
+        hessian[k] = Matrix2::new(p2 * a * a, p2 * a * b, p2 * a * b, p2 * b * b);
+    }
+    Ok(DrivetrainEval {
+        stroke,
+        jacobian,
+        hessian,
+    })
+}
+
+impl SingleLinear {
+    /// `φ = P(−T q1)` with `T = transmission_ratio` (rad/mm) in [1e-6, 1e3].
+    pub fn new(transmission_ratio: f64, polynomial: OddPolynomial) -> Result<Self> {
+        check_in_closed("transmission_ratio", transmission_ratio, 1e-6, 1e3)?;
+        Ok(Self {
+            transmission_ratio,
+            polynomial,
+        })
+    }
+
+    /// `T` (rad/mm).
+    pub fn transmission_ratio(&self) -> f64 {
+        self.transmission_ratio
+    }
+
+    /// The polynomial of the transmission.
+    pub fn polynomial(&self) -> OddPolynomial {
+        self.polynomial
+    }
+}
+
+impl DualLinear {
+    /// `φL = P(−T q1)`, `φR = P(−T q2)` with `T = transmission_ratio` (rad/mm) in [1e-6, 1e3].
+    pub fn new(transmission_ratio: f64, polynomial: OddPolynomial) -> Result<Self> {
+        check_in_closed("transmission_ratio", transmission_ratio, 1e-6, 1e3)?;
+        Ok(Self {
+            transmission_ratio,
+            polynomial,
+        })
+    }
+
+    /// `T` (rad/mm).
+    pub fn transmission_ratio(&self) -> f64 {
+        self.transmission_ratio
+    }
+
+    /// The polynomial of the transmission (both sides).
+    pub fn polynomial(&self) -> OddPolynomial {
+        self.polynomial
+    }
+
+    /// The linear rows `J_k` (`ℓ_k = J_k q`).
+    pub fn rows(&self) -> [[f64; 2]; 2] {
+        let t = self.transmission_ratio;
+        [[-t, 0.0], [0.0, -t]]
+    }
 }
 
 /// Splits a whippletree of `length` (mm) into `(left, right)` arms with `ratio = left/right`.
@@ -272,10 +445,30 @@ impl LinearDifferential {
             transmission_ratio,
             left_arm,
             right_arm,
+            polynomial: OddPolynomial::LINEAR,
         })
     }
 
-    /// Eq. 2.15 at `(q1, q2)`: constant Jacobian, no second derivatives.
+    /// With a polynomial transmission on each side: `φ_k = P(ℓ_k)` where `ℓ_k` is the stroke of
+    /// eq. 2.15 (the rod-top displacement times `T`).
+    pub fn with_polynomial(mut self, polynomial: OddPolynomial) -> Self {
+        self.polynomial = polynomial;
+        self
+    }
+
+    /// The polynomial of the transmission (both sides; linear for eq. 2.15).
+    pub fn polynomial(&self) -> OddPolynomial {
+        self.polynomial
+    }
+
+    /// The rows of eq. 2.15's Jacobian (`ℓ_k = J_k q`).
+    pub fn rows(&self) -> [[f64; 2]; 2] {
+        let t = self.transmission_ratio;
+        [[-t, t * self.left_arm], [-t, -t * self.right_arm]]
+    }
+
+    /// Eq. 2.15 at `(q1, q2)`, ignoring any polynomial: constant Jacobian, no second
+    /// derivatives.
     #[inline]
     pub fn evaluate(&self, q1: f64, q2: f64) -> DrivetrainEval {
         let t = self.transmission_ratio;
@@ -343,13 +536,17 @@ pub enum Drivetrain {
     LinkageDifferential(LinkageDifferential),
     /// Two four-bars, one actuator per wing (`q1` left, `q2` right), 2 DOF.
     DualFourBar(DualFourBar),
+    /// One actuator on a linear or polynomial transmission, 1 DOF.
+    SingleLinear(SingleLinear),
+    /// One actuator per wing on linear or polynomial transmissions, 2 DOF.
+    DualLinear(DualLinear),
 }
 
 impl Drivetrain {
     /// Number of kinematic degrees of freedom (1 for the HMF, 2 for Drag PARITY).
     pub fn dof(&self) -> usize {
         match self {
-            Drivetrain::HmfFourBar(_) => 1,
+            Drivetrain::HmfFourBar(_) | Drivetrain::SingleLinear(_) => 1,
             _ => 2,
         }
     }
@@ -360,17 +557,36 @@ impl Drivetrain {
             Drivetrain::HmfFourBar(d) => Some(d.side),
             Drivetrain::LinkageDifferential(d) => Some(d.side),
             Drivetrain::DualFourBar(d) => Some(d.side),
-            Drivetrain::LinearDifferential(_) => None,
+            Drivetrain::LinearDifferential(_)
+            | Drivetrain::SingleLinear(_)
+            | Drivetrain::DualLinear(_) => None,
         }
     }
 
-    /// Short name (`hmf_four_bar`, `linear_differential`, `linkage_differential`).
+    /// Whether each wing has its own drive (`q1` left, `q2` right: the dual drivetrains).
+    pub fn is_dual(&self) -> bool {
+        matches!(self, Drivetrain::DualFourBar(_) | Drivetrain::DualLinear(_))
+    }
+
+    /// The polynomial of a linear-map drivetrain's transmission (None for the linkages).
+    pub fn polynomial(&self) -> Option<OddPolynomial> {
+        match self {
+            Drivetrain::LinearDifferential(d) => Some(d.polynomial),
+            Drivetrain::SingleLinear(d) => Some(d.polynomial),
+            Drivetrain::DualLinear(d) => Some(d.polynomial),
+            _ => None,
+        }
+    }
+
+    /// Short name (`hmf_four_bar`, `linear_differential`, `linkage_differential`, ...).
     pub fn name(&self) -> &'static str {
         match self {
             Drivetrain::HmfFourBar(_) => "hmf_four_bar",
             Drivetrain::LinearDifferential(_) => "linear_differential",
             Drivetrain::LinkageDifferential(_) => "linkage_differential",
             Drivetrain::DualFourBar(_) => "dual_four_bar",
+            Drivetrain::SingleLinear(_) => "single_linear",
+            Drivetrain::DualLinear(_) => "dual_linear",
         }
     }
 
@@ -392,7 +608,7 @@ impl Drivetrain {
         // The linear map inline (it sits in every right-hand side and sample); the linkages,
         // with their trigonometry and Newton solves, out of line.
         match self {
-            Drivetrain::LinearDifferential(d) => Ok(d.evaluate(q1, q2)),
+            Drivetrain::LinearDifferential(d) if d.polynomial.is_linear() => Ok(d.evaluate(q1, q2)),
             _ => self.evaluate_linkage(q1, q2),
         }
     }
@@ -436,7 +652,21 @@ impl Drivetrain {
                     ],
                 })
             }
-            Drivetrain::LinearDifferential(d) => Ok(d.evaluate(q1, q2)),
+            Drivetrain::LinearDifferential(d) if d.polynomial.is_linear() => Ok(d.evaluate(q1, q2)),
+            Drivetrain::LinearDifferential(d) => polynomial_map(d.rows(), &d.polynomial, q1, q2),
+            Drivetrain::DualLinear(d) => polynomial_map(d.rows(), &d.polynomial, q1, q2),
+            Drivetrain::SingleLinear(d) => {
+                let t = d.transmission_ratio;
+                let (p, p1, p2) = d.polynomial.evaluate(-t * q1)?;
+                // q2 is not a coordinate: zero column, both wings on the one drive.
+                let j = Matrix2::new(-t * p1, 0.0, -t * p1, 0.0);
+                let h = Matrix2::new(p2 * t * t, 0.0, 0.0, 0.0);
+                Ok(DrivetrainEval {
+                    stroke: Vector2::new(p, p),
+                    jacobian: j,
+                    hessian: [h, h],
+                })
+            }
         }
     }
 }

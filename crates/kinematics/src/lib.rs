@@ -18,6 +18,6 @@ pub mod records;
 pub mod rotation;
 pub mod shoulder;
 
-pub use drivetrain::{Drivetrain, DrivetrainEval, RodCrank};
+pub use drivetrain::{Drivetrain, DrivetrainEval, OddPolynomial, RodCrank};
 pub use paritysim_error::{Error, Result};
 pub use shoulder::{ShoulderPartials, ShoulderPose, SphericalShoulder};

@@ -3,7 +3,8 @@
 use approx::assert_relative_eq;
 use nalgebra::{Matrix3, Vector2, Vector3};
 use paritysim_kinematics::drivetrain::{
-    DualFourBar, HmfFourBar, LinearDifferential, LinkageDifferential,
+    DualFourBar, DualLinear, HmfFourBar, LinearDifferential, LinkageDifferential, OddPolynomial,
+    SingleLinear,
 };
 use paritysim_kinematics::rotation::{rot_axis, rot_x, rot_y, rot_z, skew};
 use paritysim_kinematics::{Drivetrain, Error, RodCrank, SphericalShoulder};
@@ -376,7 +377,112 @@ fn all_drivetrains() -> Vec<Drivetrain> {
             LinkageDifferential::new(RodCrank::new(0.35, 1.0).unwrap(), 5.0, 0.5).unwrap(),
         ),
         Drivetrain::DualFourBar(DualFourBar::new(RodCrank::THESIS)),
+        // Polynomial transmissions (issue 35): stiffening and softening cubics, a quintic.
+        Drivetrain::SingleLinear(
+            SingleLinear::new(2.67, OddPolynomial::new(2.67, 40.0, &[]).unwrap()).unwrap(),
+        ),
+        Drivetrain::DualLinear(
+            DualLinear::new(2.67, OddPolynomial::new(2.67, -20.0, &[150.0]).unwrap()).unwrap(),
+        ),
+        Drivetrain::LinearDifferential(
+            LinearDifferential::new(2.5, 2.5, 0.7)
+                .unwrap()
+                .with_polynomial(OddPolynomial::new(2.5, 30.0, &[-40.0, 90.0]).unwrap()),
+        ),
     ]
+}
+
+/// `φ = τ1 σ + τ2 σ³/3 + a5 σ⁵ + a7 σ⁷` of the rod-top displacement σ (closed form), whatever
+/// the internal scaling by powers of τ1; τ2 = 0 is eq. 2.15's map bit for bit; a softening
+/// cubic is refused beyond its turning point σ* = √(τ1/|τ2|) and the coefficients are named.
+#[test]
+fn polynomial_transmissions_are_the_odd_polynomial_of_the_rod_displacement() {
+    let (t1, t2, a5, a7) = (2.67, 35.0, -60.0, 400.0);
+    let poly = OddPolynomial::new(t1, t2, &[a5, a7]).unwrap();
+    let closed = |s: f64| t1 * s + t2 * s.powi(3) / 3.0 + a5 * s.powi(5) + a7 * s.powi(7);
+    let slope = |s: f64| t1 + t2 * s * s + 5.0 * a5 * s.powi(4) + 7.0 * a7 * s.powi(6);
+    let single = Drivetrain::SingleLinear(SingleLinear::new(t1, poly).unwrap());
+    let dual = Drivetrain::DualLinear(DualLinear::new(t1, poly).unwrap());
+    let (hl, hr) = (2.0 * 2.5 * 0.7 / 1.7, 2.0 * 2.5 / 1.7);
+    let diff = Drivetrain::LinearDifferential(
+        LinearDifferential::new(t1, 2.5, 0.7)
+            .unwrap()
+            .with_polynomial(poly),
+    );
+    for &(q1, q2) in &[(0.0, 0.0), (0.11, -0.02), (-0.17, 0.04)] {
+        // σ = −q1 (+ hL q2 left, − hR q2 right): positive q1 strokes both wings negative.
+        let e = single.evaluate(q1, 0.0).unwrap();
+        assert_relative_eq!(
+            e.stroke.x,
+            closed(-q1),
+            max_relative = 1e-14,
+            epsilon = 1e-16
+        );
+        assert_relative_eq!(e.jacobian[(0, 0)], -slope(-q1), max_relative = 1e-14);
+        let e = dual.evaluate(q1, q2).unwrap();
+        assert_relative_eq!(
+            e.stroke.x,
+            closed(-q1),
+            max_relative = 1e-14,
+            epsilon = 1e-16
+        );
+        assert_relative_eq!(
+            e.stroke.y,
+            closed(-q2),
+            max_relative = 1e-14,
+            epsilon = 1e-16
+        );
+        let e = diff.evaluate(q1, q2).unwrap();
+        let (sl, sr) = (-q1 + hl * q2, -q1 - hr * q2);
+        assert_relative_eq!(
+            e.stroke.x,
+            closed(sl),
+            max_relative = 1e-13,
+            epsilon = 1e-16
+        );
+        assert_relative_eq!(
+            e.stroke.y,
+            closed(sr),
+            max_relative = 1e-13,
+            epsilon = 1e-16
+        );
+        assert_relative_eq!(e.jacobian[(1, 1)], -hr * slope(sr), max_relative = 1e-13);
+        // τ2 = 0: the linear map's own numbers.
+        let linear = LinearDifferential::new(t1, 2.5, 0.7).unwrap();
+        let zero = Drivetrain::LinearDifferential(
+            linear.with_polynomial(OddPolynomial::new(t1, 0.0, &[]).unwrap()),
+        );
+        assert_eq!(zero.evaluate(q1, q2).unwrap(), linear.evaluate(q1, q2));
+        let via_map = Drivetrain::DualLinear(
+            DualLinear::new(t1, OddPolynomial::new(t1, 0.0, &[]).unwrap()).unwrap(),
+        )
+        .evaluate(q1, q2)
+        .unwrap();
+        assert_eq!(via_map.stroke, Vector2::new(-t1 * q1, -t1 * q2));
+        assert_eq!(via_map.hessian, [nalgebra::Matrix2::zeros(); 2]);
+    }
+    // Softening: P'(σ) = τ1 − 20 σ² vanishes at σ* = √(2.67/20) = 0.365 mm.
+    let soft = Drivetrain::SingleLinear(
+        SingleLinear::new(t1, OddPolynomial::new(t1, -20.0, &[]).unwrap()).unwrap(),
+    );
+    assert!(soft.evaluate(-0.36, 0.0).is_ok());
+    assert!(matches!(
+        soft.evaluate(-0.37, 0.0),
+        Err(Error::OutOfDomain { .. })
+    ));
+    for (bad, field) in [
+        (OddPolynomial::new(t1, f64::NAN, &[]), "cubic_ratio"),
+        (
+            OddPolynomial::new(t1, 0.0, &[1.0, f64::INFINITY]),
+            "higher_odd_ratios[1]",
+        ),
+        (OddPolynomial::new(t1, 0.0, &[1.0; 4]), "higher_odd_ratios"),
+    ] {
+        match bad {
+            Err(Error::InvalidParameter { field: f, .. }) => assert_eq!(f, field),
+            other => panic!("{other:?}"),
+        }
+    }
 }
 
 #[test]
@@ -448,7 +554,7 @@ fn drivetrain_derivatives_match_finite_differences() {
                 let qq = q(t);
                 d.evaluate(qq[0], qq[1]).unwrap().stroke
             };
-            let hh = 1e-4;
+            let hh = 2e-5; // the polynomials have large fourth derivatives along this path
             let phi_dd = (phi(hh) - 2.0 * phi(0.0) + phi(-hh)) / (hh * hh);
             let (v, a) = if d.dof() == 1 {
                 (Vector2::new(v[0], 0.0), Vector2::new(a[0], 0.0))
