@@ -287,7 +287,9 @@ impl Device {
             free_deviation[w] = !stroke_plane[w] && wing.has_closed_form_free_deviation();
         }
         let linear_jacobian = match spec.transmission.as_ref().map(|tr| &tr.kinematics) {
-            Some(Drivetrain::LinearDifferential(map)) => Some(map.evaluate(0.0, 0.0).jacobian),
+            Some(Drivetrain::LinearDifferential(map)) if map.polynomial().is_linear() => {
+                Some(map.evaluate(0.0, 0.0).jacobian)
+            }
             _ => None,
         };
         let mut device = Self {
@@ -413,7 +415,7 @@ impl Device {
             .form
             .stroke_only()
             .expect("only called for drivetrain-coordinate devices");
-        if let Some(terms) = &fast.linear {
+        if let Some(terms) = fast.linear.as_ref().filter(|t| !t.polynomial) {
             // φ̈ = J q̈: the linear map has no velocity product.
             let (q_dot, q_ddot, force, _) = self.linear_map_step(terms, t, y)?;
             let (q, _) = self.drive_coordinates(y);
@@ -486,7 +488,7 @@ impl Device {
         self.spec
             .transmission
             .as_ref()
-            .is_some_and(|tr| matches!(tr.kinematics, Drivetrain::DualFourBar(_)))
+            .is_some_and(|tr| tr.kinematics.is_dual())
     }
 
     /// Actuator power `F q̇1` (plus `F_R q̇2` on a dual drivetrain) for a drive at `t` whose

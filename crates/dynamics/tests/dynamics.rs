@@ -15,6 +15,8 @@ mod lean;
 mod linear_jacobian;
 #[path = "dynamics/metrics.rs"]
 mod metrics;
+#[path = "dynamics/polynomial.rs"]
+mod polynomial;
 #[path = "dynamics/sensitivity.rs"]
 mod sensitivity;
 #[path = "dynamics/steady_state.rs"]

@@ -179,8 +179,9 @@ impl Device {
     }
 
     /// [`Self::drivetrain_step`] for the linear map (eq. 2.15): `φ = J q`, `φ̇ = J q̇`, no
-    /// velocity product, the constant `M_q` ([`linear_map::accelerations`], the lanes' code):
-    /// `(q̇, q̈, F, aerodynamic power)`.
+    /// velocity product, the constant `M_q` ([`linear_map::accelerations`], the lanes' code),
+    /// or a polynomial transmission on it: `(q̇, q̈, F (the left side's on a dual drive),
+    /// aerodynamic power)`.
     #[inline(always)]
     pub(super) fn linear_map_step(
         &self,
@@ -195,16 +196,19 @@ impl Device {
             // The drivetrain names the implausible coordinate.
             self.drivetrain().evaluate(q.x, q.y)?;
         }
-        if terms.det == 0.0 || !terms.det.is_finite() {
+        if terms.polynomial {
+            // A softening polynomial folds over: the drivetrain names where.
+            self.drivetrain().evaluate(q.x, q.y)?;
+        } else if terms.det == 0.0 || !terms.det.is_finite() {
             return Err(singular_drive(&q));
         }
-        let force = self.drive_forces(t)[0];
+        let forces = self.drive_forces(t);
         let y = [q.x, q.y, q_dot.x, q_dot.y];
         let wings = &self.spec.wings;
-        let (q_ddot, aero_power) = linear_map::accelerations(terms, force, &y, |k, rate| {
+        let (q_ddot, aero_power) = linear_map::accelerations(terms, forces, &y, |k, rate| {
             wings[k].aero().stroke_torque(rate)
         });
-        Ok((q_dot, q_ddot.into(), force, aero_power))
+        Ok((q_dot, q_ddot.into(), forces[0], aero_power))
     }
 }
 
@@ -223,8 +227,8 @@ impl Equations for StrokeOnly {
 
     fn variational(
         &self,
-        _device: &Device,
-        _t: f64,
+        device: &Device,
+        t: f64,
         y: &State,
         _branches: Option<[Branch; 2]>,
         n: usize,
@@ -234,7 +238,7 @@ impl Equations for StrokeOnly {
     ) -> Option<Result<()>> {
         let terms = (self.linear.as_ref()).filter(|t| t.analytic && n == 2 && rhs.is_none())?;
         let y = [y.coords[0], y.coords[1], y.rates[0], y.rates[1]];
-        linear_map::variational(terms, &y, phi, dphi);
+        linear_map::variational(terms, device.drive_forces(t), &y, phi, dphi);
         Some(Ok(()))
     }
 }

@@ -36,6 +36,11 @@ impl<'a> LinearStroke<'a> {
             return None;
         }
         let terms = *device.linear_map_terms()?;
+        // Polynomial transmissions and dual drives run scalar (their state-dependent mass matrix
+        // and per-side forces are not in the lane gathers).
+        if terms.polynomial || terms.drive.dual {
+            return None;
+        }
         if terms.det == 0.0 || !terms.det.is_finite() {
             return None; // the scalar path reports the singular drivetrain
         }
@@ -129,6 +134,9 @@ impl<'a> LinearStrokeLanes<'a> {
                 cubic: [z; 2],
                 rest: [z; 2],
                 drive: DriveSprings::single(z, z),
+                polynomial: false,
+                poly: [z; 4],
+                inertia: [one; 2],
             },
         }
     }
@@ -187,7 +195,7 @@ impl LinearStrokeLanes<'_> {
         let failed = !inside.to_bitmask() & ((1 << LANES) - 1);
         let drag = self.terms.drag;
         let ([q1_ddot, q2_ddot], _) =
-            linear_map::accelerations(&self.terms, force, y, |k, rate| {
+            linear_map::accelerations(&self.terms, [force, V::splat(0.0)], y, |k, rate| {
                 paritysim_aero::stroke_drag_torque(drag[k], rate)
             });
         *dydt = [q1_dot, q2_dot, q1_ddot, q2_ddot];
@@ -214,9 +222,11 @@ impl LaneRhs<20> for VariationalLanes<'_, '_> {
         let rhs = self.0;
         let y: [V; 4] = std::array::from_fn(|i| c[i]);
         let mut f = [V::splat(0.0); 4];
-        let failed = rhs.eval_with(rhs.force(t, stage), &y, &mut f);
+        let force = rhs.force(t, stage);
+        let failed = rhs.eval_with(force, &y, &mut f);
         dc[..4].copy_from_slice(&f);
-        linear_map::variational(&rhs.terms, &y, &c[4..], &mut dc[4..]);
+        let forces = [force, V::splat(0.0)];
+        linear_map::variational(&rhs.terms, forces, &y, &c[4..], &mut dc[4..]);
         failed
     }
 }

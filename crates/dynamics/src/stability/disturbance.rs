@@ -277,8 +277,8 @@ pub fn linearise(
 ) -> Result<DeviceLinearisation> {
     let stroke = StrokeDevice::new(device)?;
     let tr = stroke.transmission();
-    if tr.kinematics().dof() != 2 || stroke.n_wings != 2 {
-        bail!(Constraint "the §2.6–2.7 linearisation needs a 2-DOF (Drag PARITY) drivetrain and two wings");
+    if tr.kinematics().dof() != 2 || stroke.n_wings != 2 || tr.kinematics().is_dual() {
+        bail!(Constraint "the §2.6–2.7 linearisation needs a 2-DOF (Drag PARITY) drivetrain with a whippletree and two wings (not a drive per wing: {})", tr.kinematics().name());
     }
     if samples < 8 {
         bail!(invalid "samples", samples, ">= 8");

@@ -236,7 +236,7 @@ fn floquet_over(
             }
         }))
         .collect();
-    let (whippletree, whippletree_coupling) = if drivetrain_coords && n == 2 {
+    let (whippletree, whippletree_coupling) = if drivetrain_coords && n == 2 && !device.is_dual() {
         let block = Matrix2::new(
             monodromy[(1, 1)],
             monodromy[(1, 3)],
