@@ -28,7 +28,7 @@ import math
 import numbers
 import os
 import warnings
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -460,7 +460,9 @@ def _line_mass_rows(planform: Any, line_masses: Any) -> Any:
 class Drivetrain(_Tagged):
     """A planar drivetrain (§2.3-2.4), tagged by ``kind`` (the kinds registered in Rust:
     ``hmf_four_bar``, ``linear_differential``, ``linkage_differential``, ``dual_four_bar``: one
-    four-bar and one drive per wing, beyond the thesis), with the balance-beam
+    four-bar and one drive per wing, beyond the thesis; ``single_linear`` and ``dual_linear``: one
+    actuator, or one per wing, on a linear or odd-polynomial transmission
+    ``φ = τ1 σ + τ2 σ³/3 + ...``, beyond the thesis), with the balance-beam
     spring ``balance_spring`` K2 (mN·mm/rad) and its preload ``balance_preload`` P (mN·mm; the
     whippletree settles at ``q2 = P / K2``) of the two differentials. ``.evaluate`` maps actuator
     coordinates to stroke angles through the Rust kinematics.
@@ -484,11 +486,29 @@ class Drivetrain(_Tagged):
         return cls(kind="dual_four_bar", crank_mm=crank_mm, rod_mm=rod_mm)  # type: ignore[call-arg]
 
     @classmethod
-    def linear_differential(cls, transmission_ratio: float, arm_length_mm: float, arm_ratio: float | None = None, balance_spring: float | None = None, balance_preload: float | None = None, **deprecated: float) -> Drivetrain:
+    def single_linear(cls, transmission_ratio: float, cubic_ratio: float | None = None, higher_odd_ratios: Sequence[float] | None = None) -> Drivetrain:
+        """One actuator, ``φ = τ1 σ + τ2 σ³/3 + a5 σ⁵ + ...`` with ``σ = −q1`` (τ1
+        ``transmission_ratio`` in rad/mm, τ2 ``cubic_ratio`` in rad/mm³, ``higher_odd_ratios``
+        the coefficients of σ⁵, σ⁷, σ⁹): a one-wing device (``configuration = "single_wing_fixed"``)
+        or two tied wings (``hmf``, ``hmf_fixed``)."""
+        return cls(kind="single_linear", transmission_ratio=transmission_ratio, cubic_ratio=cubic_ratio, higher_odd_ratios=None if higher_odd_ratios is None else list(higher_odd_ratios))  # type: ignore[call-arg]
+
+    @classmethod
+    def dual_linear(cls, transmission_ratio: float, cubic_ratio: float | None = None, higher_odd_ratios: Sequence[float] | None = None) -> Drivetrain:
+        """A linear (or polynomial, as :meth:`single_linear`) drive per wing, ``φL = P(−q1)``,
+        ``φR = P(−q2)`` (RoboBee-class): use with ``configuration = "drag_parity_fixed"`` or
+        ``"drag_parity"``; ``actuator.side_gain`` and ``actuator.side_offset_v`` scale each side's
+        drive."""
+        return cls(kind="dual_linear", transmission_ratio=transmission_ratio, cubic_ratio=cubic_ratio, higher_odd_ratios=None if higher_odd_ratios is None else list(higher_odd_ratios))  # type: ignore[call-arg]
+
+    @classmethod
+    def linear_differential(cls, transmission_ratio: float, arm_length_mm: float, arm_ratio: float | None = None, balance_spring: float | None = None, balance_preload: float | None = None, cubic_ratio: float | None = None, higher_odd_ratios: Sequence[float] | None = None, **deprecated: float) -> Drivetrain:
         """Eq. 2.15 with ratio T (rad/mm), mean arm L (mm), arm ratio hL/hR, spring K2 and a
-        preload torque P (mN·mm) on the whippletree."""
+        preload torque P (mN·mm) on the whippletree; ``cubic_ratio`` τ2 (rad/mm³) and
+        ``higher_odd_ratios`` make each side's transmission an odd polynomial of its rod-top
+        displacement (0 and none: eq. 2.15)."""
         balance_spring = _balance(balance_spring, deprecated)
-        return cls(kind="linear_differential", transmission_ratio=transmission_ratio, arm_length_mm=arm_length_mm, arm_ratio=arm_ratio, balance_spring=balance_spring, balance_preload=balance_preload)  # type: ignore[call-arg]
+        return cls(kind="linear_differential", transmission_ratio=transmission_ratio, arm_length_mm=arm_length_mm, arm_ratio=arm_ratio, balance_spring=balance_spring, balance_preload=balance_preload, cubic_ratio=cubic_ratio, higher_odd_ratios=None if higher_odd_ratios is None else list(higher_odd_ratios))  # type: ignore[call-arg]
 
     @classmethod
     def linkage_differential(

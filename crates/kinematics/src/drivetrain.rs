@@ -290,7 +290,8 @@ impl OddPolynomial {
             return Err(Error::OutOfDomain {
                 what: POLYNOMIAL.into(),
                 detail: format!(
-                    "the stroke map folds over (d phi / d sigma = {p1} <= 0) at a linear stroke of {l} rad"
+                    "the stroke map folds over (d phi / d sigma = {p1} <= 0) at a linear stroke of {l} rad \
+                     (a softening drivetrain.cubic_ratio: keep sigma below sqrt(tau1 / |tau2|))"
                 ),
             });
         }

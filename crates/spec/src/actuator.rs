@@ -90,11 +90,11 @@ pub struct Actuator {
     pub stiffness: f64,
     /// DC offset law.
     pub dc_offset: DcOffset,
-    /// Per side (left, right) of a `dual_four_bar` drivetrain (one drive per wing): scale of
+    /// Per side (left, right) of a `dual_four_bar` or `dual_linear` drivetrain (one drive per wing): scale of
     /// the drive force, each in [0, 1e3]; [1, 1] for any other drivetrain.
     #[schemars(inner(range(min = 0.0, max = 1e3)), extend("x-unit" = "1"))]
     pub side_gain: [f64; 2],
-    /// Per side of a `dual_four_bar` drivetrain: added DC voltage (V, a static force
+    /// Per side of a `dual_four_bar` or `dual_linear` drivetrain: added DC voltage (V, a static force
     /// `force_per_volt × side_offset_v`), each in [-1e4, 1e4]; [0, 0] for any other drivetrain.
     #[schemars(inner(range(min = -1e4, max = 1e4)), extend("x-unit" = "V"))]
     pub side_offset_v: [f64; 2],

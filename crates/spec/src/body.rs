@@ -122,17 +122,17 @@ pub enum ControlInput {
     /// `ln q3` of eq. 5.1 (1): the whippletree holds the torque ratio `τL/τR = q3` (a
     /// "virtual moving pivot"; a 2-DOF differential drivetrain).
     LogQ3,
-    /// `dual_four_bar`: relative change of the left drive's force (1 = +100 %).
+    /// `dual_four_bar`, `dual_linear`: relative change of the left drive's force (1 = +100 %).
     SideGainLeft,
-    /// `dual_four_bar`: relative change of the right drive's force.
+    /// `dual_four_bar`, `dual_linear`: relative change of the right drive's force.
     SideGainRight,
-    /// `dual_four_bar`: added force on the left drive (mN).
+    /// `dual_four_bar`, `dual_linear`: added force on the left drive (mN).
     SideOffsetLeft,
-    /// `dual_four_bar`: added force on the right drive (mN).
+    /// `dual_four_bar`, `dual_linear`: added force on the right drive (mN).
     SideOffsetRight,
-    /// `dual_four_bar`: +u on the left drive's relative force, −u on the right's.
+    /// `dual_four_bar`, `dual_linear`: +u on the left drive's relative force, −u on the right's.
     SideGainDifference,
-    /// `dual_four_bar`: +u mN on the left drive, −u on the right.
+    /// `dual_four_bar`, `dual_linear`: +u mN on the left drive, −u on the right.
     SideOffsetDifference,
 }
 

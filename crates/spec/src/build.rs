@@ -86,12 +86,20 @@ impl Simulation {
             .map(actuator)
             .transpose()
             .map_err(|e| e.in_field("actuator"))?;
+        // A 2-DOF drivetrain drives two wings.
+        if let Some(t) = &transmission
+            && t.kinematics().dof() == 2
+            && wings.len() == 1
+        {
+            return Err(Error::invalid(
+                "drivetrain.kind",
+                t.kinematics().name(),
+                "a 1-DOF drivetrain (single_linear, hmf_four_bar) for a device with one wing",
+            ));
+        }
         // Per-side drives need one drive per wing.
         if let (Some(a), Some(t), Some(spec)) = (&actuator, &transmission, &self.actuator) {
-            let dual = matches!(
-                t.kinematics(),
-                paritysim_kinematics::Drivetrain::DualFourBar(_)
-            );
+            let dual = t.kinematics().is_dual();
             if a.has_sides() && !dual {
                 let (field, value) = if spec.side_gain != [1.0, 1.0] {
                     ("actuator.side_gain", format!("{:?}", spec.side_gain))
@@ -105,7 +113,7 @@ impl Simulation {
                     field,
                     value,
                     format!(
-                        "[1, 1] (gain) and [0, 0] (offset) unless drivetrain.kind = \"dual_four_bar\" (one drive per wing; this drivetrain is {})",
+                        "[1, 1] (gain) and [0, 0] (offset) unless drivetrain.kind is \"dual_four_bar\" or \"dual_linear\" (one drive per wing; this drivetrain is {})",
                         t.kinematics().name()
                     ),
                 ));
@@ -253,6 +261,11 @@ fn rename_hinge(e: Error) -> Error {
     }
 }
 
+/// The named configurations of a one-wing device (`wings` of length 1): `single_wing` (the
+/// deviation θ held at 0, the rotation ψ free) and `single_wing_fixed` (θ and ψ held: the wing
+/// only strokes).
+pub const SINGLE_WING_CONFIGURATIONS: [&str; 2] = ["single_wing", "single_wing_fixed"];
+
 fn constraints(c: &Configuration, n_coords: usize) -> Result<Constraints> {
     match (&c.name, &c.rows) {
         (Some(_), Some(_)) => Err(Error::invalid(
@@ -260,10 +273,37 @@ fn constraints(c: &Configuration, n_coords: usize) -> Result<Constraints> {
             "both name and rows",
             "a Table 3.1 name or explicit rows, not both",
         )),
-        (Some(name), None) => Constraints::configuration(name).map_err(|e| match e {
-            Error::InvalidParameter { value, allowed, .. } => {
-                Error::invalid("configuration.name", value, allowed)
+        // One wing (issue 35): the stroke free, the deviation held, the rotation free or held.
+        (Some(name), None) if SINGLE_WING_CONFIGURATIONS.contains(&name.as_str()) => {
+            if n_coords != 3 {
+                return Err(Error::invalid(
+                    "configuration.name",
+                    name,
+                    "a Table 3.1 name for two wings (single_wing and single_wing_fixed need \
+                     `wings` of length 1)",
+                ));
             }
+            let rows: &[Vec<f64>] = if name == "single_wing" {
+                &[vec![0.0, 1.0, 0.0]]
+            } else {
+                &[vec![0.0, 1.0, 0.0], vec![0.0, 0.0, 1.0]]
+            };
+            Constraints::new(3, rows, &vec![0.0; rows.len()])
+        }
+        (Some(name), None) if n_coords == 3 => Err(Error::invalid(
+            "configuration.name",
+            name,
+            "single_wing (theta held) or single_wing_fixed (theta and psi held) for one wing",
+        )),
+        (Some(name), None) => Constraints::configuration(name).map_err(|e| match e {
+            Error::InvalidParameter { value, allowed, .. } => Error::invalid(
+                "configuration.name",
+                value,
+                format!(
+                    "{allowed}, or for one wing {}",
+                    SINGLE_WING_CONFIGURATIONS.join(", ")
+                ),
+            ),
             other => other,
         }),
         (None, Some(rows)) => {

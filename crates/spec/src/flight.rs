@@ -67,7 +67,7 @@ fn check_input(device: &Device, i: ControlInput, field: &str) -> Result<()> {
             field.clone(),
             value,
             format!(
-                "an input of this drivetrain ({name}): side_* inputs need drivetrain.kind = \"dual_four_bar\" (one drive per wing)"
+                "an input of this drivetrain ({name}): side_* inputs need drivetrain.kind = \"dual_four_bar\" or \"dual_linear\" (one drive per wing)"
             ),
         ));
     }

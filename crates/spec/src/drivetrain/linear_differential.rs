@@ -7,6 +7,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use super::DrivetrainConfig;
+use super::polynomial::polynomial;
 
 /// `φ_{L,R} = T (q1 ± h_{L,R} q2)`-type linear differential (eq. 2.15), 2 DOF.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -28,6 +29,18 @@ pub struct LinearDifferential {
     /// is `P − K2 q2`, so a whippletree at rest settles at `q2 = P / K2` (needs K2 > 0 to hold).
     #[schemars(range(min = -100.0, max = 100.0), extend("x-unit" = "mN mm"))]
     pub balance_preload: f64,
+    /// Cubic transmission term τ2 (rad/mm³), in [-1e4, 1e4]: each wing's stroke is
+    /// `τ1 σ + τ2 σ³/3` of its rod-top displacement `σ` (eq. 2.15's stroke over τ1); 0 is
+    /// eq. 2.15. A negative τ2 folds over at `σ = √(τ1/|τ2|)` (refused there).
+    #[schemars(range(min = -1e4, max = 1e4), extend("x-unit" = "rad/mm^3"))]
+    pub cubic_ratio: f64,
+    /// Coefficients of `σ⁵, σ⁷, σ⁹` (rad/mm⁵, rad/mm⁷, rad/mm⁹), at most 3, each in [-1e6, 1e6].
+    #[schemars(
+        inner(range(min = -1e6, max = 1e6)),
+        length(max = 3),
+        extend("x-unit" = "rad/mm^(2j+5)")
+    )]
+    pub higher_odd_ratios: Vec<f64>,
 }
 
 impl Default for LinearDifferential {
@@ -38,17 +51,23 @@ impl Default for LinearDifferential {
             arm_ratio: 1.0,
             balance_spring: 0.0,
             balance_preload: 0.0,
+            cubic_ratio: 0.0,
+            higher_odd_ratios: Vec::new(),
         }
     }
 }
 
 impl DrivetrainConfig for LinearDifferential {
     fn kinematics(&self) -> Result<Kinematics> {
-        Ok(Kinematics::LinearDifferential(Linear::new(
+        let p = polynomial(
             self.transmission_ratio,
-            self.arm_length_mm,
-            self.arm_ratio,
-        )?))
+            self.cubic_ratio,
+            &self.higher_odd_ratios,
+        )?;
+        Ok(Kinematics::LinearDifferential(
+            Linear::new(self.transmission_ratio, self.arm_length_mm, self.arm_ratio)?
+                .with_polynomial(p),
+        ))
     }
 
     fn balance_spring(&self) -> f64 {

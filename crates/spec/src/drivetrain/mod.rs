@@ -9,14 +9,19 @@ use paritysim_error::Result;
 use paritysim_kinematics::Drivetrain as Kinematics;
 
 mod dual_four_bar;
+mod dual_linear;
 mod hmf_four_bar;
 mod linear_differential;
 mod linkage_differential;
+mod polynomial;
+mod single_linear;
 
 pub use dual_four_bar::DualFourBar;
+pub use dual_linear::DualLinear;
 pub use hmf_four_bar::HmfFourBar;
 pub use linear_differential::LinearDifferential;
 pub use linkage_differential::LinkageDifferential;
+pub use single_linear::SingleLinear;
 
 /// What a drivetrain configuration provides to the model.
 pub trait DrivetrainConfig {
@@ -74,6 +79,11 @@ registry! {
     LinkageDifferential,
     /// Two four-bars, one drive per wing (beyond the thesis), 2 DOF.
     DualFourBar,
+    /// One actuator on a linear or polynomial transmission (beyond the thesis: a one-wing
+    /// device, or two tied wings), 1 DOF.
+    SingleLinear,
+    /// A linear or polynomial drive per wing (beyond the thesis: RoboBee-class), 2 DOF.
+    DualLinear,
 }
 
 impl Drivetrain {
