@@ -286,7 +286,7 @@ impl OddPolynomial {
         let p = l * (1.0 + l2 * (b3 + l2 * (b5 + l2 * (b7 + l2 * b9))));
         let p1 = 1.0 + l2 * (3.0 * b3 + l2 * (5.0 * b5 + l2 * (7.0 * b7 + l2 * (9.0 * b9))));
         let p2 = l * (6.0 * b3 + l2 * (20.0 * b5 + l2 * (42.0 * b7 + l2 * (72.0 * b9))));
-        if !(p1 > 0.0) || !p.is_finite() {
+        if p1.is_nan() || p1 <= 0.0 || !p.is_finite() {
             return Err(Error::OutOfDomain {
                 what: POLYNOMIAL.into(),
                 detail: format!(
