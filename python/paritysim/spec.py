@@ -581,6 +581,28 @@ class Actuator(_Node):
         # The sign of d31 only sets the direction of q1; the engine takes the magnitude.
         return cls(waveform=waveform or Waveform(), force_per_volt=abs(float(force)), stiffness=float(stiffness), **({} if dc_offset is None else {"dc_offset": dc_offset}))  # type: ignore[arg-type]
 
+    @classmethod
+    def from_blocked_force(
+        cls,
+        blocked_force_mn: float,
+        free_deflection_mm: float,
+        voltage_v: float,
+        waveform: Waveform | None = None,
+        **fields: Any,
+    ) -> Actuator:
+        """An actuator from its datasheet numbers: the blocked force ``F_b`` (mN) and the free
+        deflection ``δ`` (mm) at the voltage ``V`` (V). A linear piezo is a force source in
+        parallel with a spring, so ``stiffness = F_b / δ`` (mN/mm) and ``force_per_volt = F_b /
+        V`` (mN/V); the §3.3.1 actuator is 120 mN blocked and 0.257 mm free at 100 V. Other
+        fields (``mass_mg``, ``damping``, ``cubic_stiffness``, ``dc_offset``, ...) pass through.
+        """
+        from ._errors import invalid
+
+        for name, value in (("blocked_force_mn", blocked_force_mn), ("free_deflection_mm", free_deflection_mm), ("voltage_v", voltage_v)):
+            if not (isinstance(value, numbers.Real) and math.isfinite(value) and value > 0):
+                raise invalid(name, value, "a finite number > 0")
+        return cls(waveform=waveform or Waveform(), force_per_volt=float(blocked_force_mn) / float(voltage_v), stiffness=float(blocked_force_mn) / float(free_deflection_mm), **fields)
+
 
 @_from_core
 class Configuration(_Node):

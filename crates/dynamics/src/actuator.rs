@@ -175,6 +175,10 @@ pub struct Actuator {
     dc_offset: DcOffset,
     /// Per side (left, right) of a dual drivetrain: force scale and added force (mN).
     sides: [(f64, f64); 2],
+    /// Effective mass on `q1` (mg), viscous damping (mN·ms/mm), cubic stiffness (mN/mm³).
+    mass: f64,
+    damping: f64,
+    cubic_stiffness: f64,
 }
 
 impl Actuator {
@@ -191,7 +195,40 @@ impl Actuator {
             waveform,
             dc_offset,
             sides: [(1.0, 0.0); 2],
+            mass: 0.0,
+            damping: 0.0,
+            cubic_stiffness: 0.0,
         })
+    }
+
+    /// With an effective mass `mass` (mg) on `q1` (the actuator and linkage inertia reflected to
+    /// the actuator tip: kinetic energy `½ m q̇1²`), viscous damping `damping` (mN·ms/mm: a
+    /// force `−b1 q̇1`) and a cubic stiffness `cubic_stiffness` (mN/mm³: a force `−K1c q1³`,
+    /// hardening when positive). All zero by default.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `mass_mg`, `damping` or `cubic_stiffness` when
+    /// negative or not finite.
+    pub fn with_dynamics(mut self, mass: f64, damping: f64, cubic_stiffness: f64) -> Result<Self> {
+        self.mass = check_non_negative("mass_mg", mass)?;
+        self.damping = check_non_negative("damping", damping)?;
+        self.cubic_stiffness = check_non_negative("cubic_stiffness", cubic_stiffness)?;
+        Ok(self)
+    }
+
+    /// Effective mass on `q1` (mg).
+    pub fn mass(&self) -> f64 {
+        self.mass
+    }
+
+    /// Viscous damping on `q1` (mN·ms/mm).
+    pub fn damping(&self) -> f64 {
+        self.damping
+    }
+
+    /// Cubic stiffness on `q1` (mN/mm³).
+    pub fn cubic_stiffness(&self) -> f64 {
+        self.cubic_stiffness
     }
 
     /// The same actuator driving each side of a dual drivetrain
@@ -234,6 +271,9 @@ impl Actuator {
             waveform,
             dc_offset: DcOffset::AsForce,
             sides: [(1.0, 0.0); 2],
+            mass: 0.0,
+            damping: 0.0,
+            cubic_stiffness: 0.0,
         }
     }
 

@@ -40,6 +40,8 @@ pub struct Transmission {
     kinematics: Drivetrain,
     balance_stiffness: f64,
     preload: f64,
+    balance_damping: f64,
+    balance_cubic: f64,
 }
 
 impl Transmission {
@@ -50,7 +52,45 @@ impl Transmission {
             kinematics,
             balance_stiffness: check_non_negative("balance_stiffness", balance_stiffness)?,
             preload: 0.0,
+            balance_damping: 0.0,
+            balance_cubic: 0.0,
         })
+    }
+
+    /// With viscous damping `damping` (mN·mm·ms/rad: a torque `−b2 q̇2`) and a cubic stiffness
+    /// `cubic` (mN·mm/rad³: a torque `−K2c q2³`) on the whippletree `q2` (the stroke flexure /
+    /// balance spring). Both zero by default.
+    ///
+    /// # Errors
+    /// [`paritysim_error::Error::InvalidParameter`] naming `balance_damping` or
+    /// `balance_cubic` when negative, not finite, or nonzero on a drivetrain without a
+    /// whippletree (1 DOF) or a dual one (`q2` is the right drive there: the actuator's terms
+    /// act on it).
+    pub fn with_balance_losses(mut self, damping: f64, cubic: f64) -> Result<Self> {
+        let whippletree = self.kinematics.dof() == 2 && !self.kinematics.is_dual();
+        for (name, value) in [("balance_damping", damping), ("balance_cubic", cubic)] {
+            check_non_negative(name, value)?;
+            if value != 0.0 && !whippletree {
+                return Err(paritysim_error::Error::invalid(
+                    name,
+                    value,
+                    "0 on a drivetrain without a whippletree (1 DOF, or dual: one drive per wing)",
+                ));
+            }
+        }
+        self.balance_damping = damping;
+        self.balance_cubic = cubic;
+        Ok(self)
+    }
+
+    /// Damping on the whippletree `q2` (mN·mm·ms/rad).
+    pub fn balance_damping(&self) -> f64 {
+        self.balance_damping
+    }
+
+    /// Cubic stiffness on the whippletree `q2` (mN·mm/rad³).
+    pub fn balance_cubic(&self) -> f64 {
+        self.balance_cubic
     }
 
     /// With a constant torque `preload` (mN·mm) on the whippletree `q2` (a preloaded centring
@@ -444,10 +484,15 @@ impl Device {
     /// ([`drive::DriveSprings::load`]) and the drive springs' energy.
     // Always inlined: every right-hand side calls it (a call and its spills cost more than it).
     #[inline(always)]
-    fn drive_load(&self, t: f64, q: &Vector2<f64>) -> (f64, Vector2<f64>, f64) {
+    fn drive_load(
+        &self,
+        t: f64,
+        q: &Vector2<f64>,
+        q_dot: &Vector2<f64>,
+    ) -> (f64, Vector2<f64>, f64) {
         let forces = self.drive_forces(t);
         let [q1, q2] = [q.x, q.y];
-        let [l1, l2] = self.drive.load(forces, [q1, q2]);
+        let [l1, l2] = self.drive.load(forces, [q1, q2], [q_dot.x, q_dot.y]);
         (forces[0], Vector2::new(l1, l2), self.drive.energy([q1, q2]))
     }
 
@@ -476,9 +521,10 @@ impl Device {
         }
     }
 
-    /// `∂Q/∂q` of [`Self::drive_load`] ([`drive::DriveSprings::slope`]).
+    /// `∂Q/∂q` of [`Self::drive_load`] at `q = 0` ([`drive::DriveSprings::slope`]; the
+    /// constant slope of a drive without cubic springs).
     pub(crate) fn drive_load_slope(&self) -> nalgebra::Matrix2<f64> {
-        let [s1, s2] = self.drive.slope();
+        let [s1, s2] = self.drive.slope([0.0, 0.0]);
         nalgebra::Matrix2::new(s1, 0.0, 0.0, s2)
     }
 
@@ -539,10 +585,11 @@ impl Device {
         if dt.dof() == 1 {
             let (q1, slope) = invert_1dof(dt, p[0])?;
             let q = Vector2::new(q1, 0.0);
-            let (force, load, potential) = self.drive_load(t, &q);
+            let q_dot = Vector2::new(p_dot[0] / slope, 0.0);
+            let (force, load, potential) = self.drive_load(t, &q, &q_dot);
             return Ok(DriveState {
                 q,
-                q_dot: Vector2::new(p_dot[0] / slope, 0.0),
+                q_dot,
                 actuator_force: force,
                 load,
                 stroke_torque: stroke_torque(1, &Matrix2::new(slope, 0.0, slope, 0.0), &q, &load)?,
@@ -582,7 +629,7 @@ impl Device {
             let q_dot = lu
                 .solve(&Vector2::new(p_dot[0], p_dot[3]))
                 .ok_or_else(|| singular_drive(&q))?;
-            let (force, load, potential) = self.drive_load(t, &q);
+            let (force, load, potential) = self.drive_load(t, &q, &q_dot);
             return Ok(DriveState {
                 q,
                 q_dot,
@@ -597,7 +644,7 @@ impl Device {
             .lu()
             .solve(&Vector2::new(p_dot[0], p_dot[3]))
             .ok_or_else(|| singular_drive(&q))?;
-        let (force, load, potential) = self.drive_load(t, &q);
+        let (force, load, potential) = self.drive_load(t, &q, &q_dot);
         Ok(DriveState {
             q,
             q_dot,
@@ -655,7 +702,8 @@ impl Device {
         })
     }
 
-    /// Mechanical energy: kinetic + joint springs + drivetrain springs (µJ).
+    /// Mechanical energy: kinetic + joint springs + drivetrain springs + the actuator mass's
+    /// kinetic energy (µJ).
     pub fn energy(&self, e: &Evaluation) -> f64 {
         e.wings
             .iter()
@@ -663,6 +711,50 @@ impl Device {
             .map(|w| w.kinetic + w.potential)
             .sum::<f64>()
             + e.drive.potential
+            + self.drive.kinetic([e.drive.q_dot.x, e.drive.q_dot.y])
+    }
+
+    /// The power the drive's dampers and the wings' hinge dampers dissipate at `e` (mW):
+    /// `b1 q̇1² + b2 q̇2² + Σ_w bψ ψ̇_w²`.
+    pub fn damping_power(&self, e: &Evaluation) -> f64 {
+        let hinges: f64 = (self.spec.wings.iter().enumerate())
+            .map(|(w, wing)| wing.hinge_damping() * e.p_dot[3 * w + 2] * e.p_dot[3 * w + 2])
+            .sum();
+        self.drive.dissipation([e.drive.q_dot.x, e.drive.q_dot.y]) + hinges
+    }
+
+    /// The actuator's effective mass seen on the strokes `(φL, φR)` at the drive state `drive`
+    /// and the force its velocity product applies: with `φ̈ = J q̈ + h`, the mass `m` on `q1`
+    /// (and `q2` of a dual drive) adds `A = J⁻ᵀ diag(m) J⁻¹` to the mass matrix and `A h` to
+    /// the generalised force; `None` without actuator mass. A 1-DOF drivetrain acts through
+    /// φL only (`A = m / J²`).
+    ///
+    /// # Errors
+    /// A drivetrain evaluation outside the linkage's domain; a singular drivetrain Jacobian.
+    pub(crate) fn actuator_inertia(
+        &self,
+        drive: &DriveState,
+    ) -> Result<Option<(Matrix2<f64>, Vector2<f64>)>> {
+        let [m1, m2] = self.drive.masses();
+        if m1 == 0.0 {
+            return Ok(None);
+        }
+        let e = self.drivetrain().evaluate(drive.q.x, drive.q.y)?;
+        let h = e.velocity_product(&drive.q_dot);
+        if self.drivetrain().dof() == 1 {
+            let j = e.jacobian[(0, 0)];
+            let a = m1 / (j * j);
+            return Ok(Some((
+                Matrix2::new(a, 0.0, 0.0, 0.0),
+                Vector2::new(a * h.x, 0.0),
+            )));
+        }
+        let inverse = e
+            .jacobian
+            .try_inverse()
+            .ok_or_else(|| singular_drive(&drive.q))?;
+        let a = inverse.transpose() * Matrix2::new(m1, 0.0, 0.0, m2) * inverse;
+        Ok(Some((a, a * h)))
     }
 }
 

@@ -237,7 +237,15 @@ impl FlightModel {
             if let Some(h) = w.tunable_hinge() {
                 bare = bare.with_tunable_hinge(*h);
             }
-            wings.push(bare);
+            wings.push(bare.with_hinge_damping(w.hinge_damping())?);
+        }
+        // The actuator's effective mass is in the fixed-body forms' mass matrices only.
+        if let Some(a) = spec.actuator.as_ref().filter(|a| a.mass() != 0.0) {
+            return Err(Error::invalid(
+                "actuator.mass_mg",
+                a.mass(),
+                "0 with a moving body (free flight does not take the actuator's mass yet)",
+            ));
         }
         for m in &mechanisms {
             let two = spec
@@ -727,6 +735,10 @@ impl FlightModel {
             potential += terms.potential;
             for i in 0..3 {
                 generalized_p[o + i] -= terms.spring[i];
+            }
+            let hinge_damping = wing.hinge_damping();
+            if hinge_damping != 0.0 {
+                generalized_p[o + 2] -= hinge_damping * vw.z;
             }
             let r = terms.rotation;
             let w = terms.omega;

@@ -76,7 +76,9 @@ pub enum DcOffset {
     Ignore,
 }
 
-/// Zeroth-order piezo actuator: force = `force_per_volt` × V(t), in parallel with `stiffness`.
+/// Piezo actuator: force = `force_per_volt` × V(t), in parallel with `stiffness` (and, when set,
+/// a cubic stiffness, viscous damping and an effective mass on `q1`): the drive load on `q1` is
+/// `F(t) − K1 q1 − K1c q1³ − b1 q̇1`, with `m q̈1` added to the drivetrain's inertia.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct Actuator {
@@ -98,6 +100,21 @@ pub struct Actuator {
     /// `force_per_volt × side_offset_v`), each in [-1e4, 1e4]; [0, 0] for any other drivetrain.
     #[schemars(inner(range(min = -1e4, max = 1e4)), extend("x-unit" = "V"))]
     pub side_offset_v: [f64; 2],
+    /// Effective mass `m` on `q1` (mg), in [0, 1e3]: the actuator's and linkage's inertia
+    /// reflected to the actuator tip (kinetic energy `½ m q̇1²`; through the transmission it
+    /// adds `m / T²` to the stroke inertia of a linear map). 0 (the default): massless (§3.2.2
+    /// item 5). Taken by the drivetrain-coordinate and general forms (others decline).
+    #[schemars(range(min = 0.0, max = 1e3), extend("x-unit" = "mg"))]
+    pub mass_mg: f64,
+    /// Viscous damping `b1` on `q1` (mN·ms/mm), in [0, 1e4]: a force `−b1 q̇1` (structural
+    /// loss of the actuator). 0 (the default) adds nothing.
+    #[schemars(range(min = 0.0, max = 1e4), extend("x-unit" = "mN ms/mm"))]
+    pub damping: f64,
+    /// Cubic (hardening) stiffness `K1c` on `q1` (mN/mm³), in [0, 1e8]: a force `−K1c q1³`, so
+    /// the resonance rises with amplitude (ω² ≈ ω0² + ¾ (K_c / m) A² at amplitude A). 0 (the
+    /// default) adds nothing.
+    #[schemars(range(min = 0.0, max = 1e8), extend("x-unit" = "mN/mm^3"))]
+    pub cubic_stiffness: f64,
 }
 
 /// §3.3.1 actuator stiffness (mN/mm), defined by the engine.
@@ -114,6 +131,9 @@ impl Default for Actuator {
             dc_offset: DcOffset::default(),
             side_gain: [1.0, 1.0],
             side_offset_v: [0.0, 0.0],
+            mass_mg: 0.0,
+            damping: 0.0,
+            cubic_stiffness: 0.0,
         }
     }
 }

@@ -76,6 +76,7 @@ impl Simulation {
                 d.kinematics()
                     .and_then(|k| Transmission::new(k, d.balance_spring()))
                     .and_then(|t| t.with_preload(d.balance_preload()))
+                    .and_then(|t| t.with_balance_losses(d.balance_damping(), d.balance_cubic()))
                     .map_err(|e| rename_field(e, "balance_stiffness", "balance_spring"))
                     .map_err(|e| e.in_field("drivetrain"))?,
             ),
@@ -211,7 +212,9 @@ fn wing(w: &Wing, force_radius: f64) -> Result<EngineWing> {
             )
         }
     };
-    let built = EngineWing::new(shoulder, inertia, springs, aero)?;
+    let built = EngineWing::new(shoulder, inertia, springs, aero)?
+        .with_hinge_damping(w.springs.hinge_damping)
+        .map_err(|e| rename_field(e, "damping", "hinge_damping").in_field("springs"))?;
     Ok(match &w.tunable_hinge {
         None => built,
         Some(h) => built.with_tunable_hinge(
@@ -345,7 +348,9 @@ fn actuator(a: &Actuator) -> Result<EngineActuator> {
             ));
         }
     }
-    engine.with_sides(a.side_gain, a.side_offset_v.map(|v| v * a.force_per_volt))
+    engine
+        .with_sides(a.side_gain, a.side_offset_v.map(|v| v * a.force_per_volt))?
+        .with_dynamics(a.mass_mg, a.damping, a.cubic_stiffness)
 }
 
 fn vec6(field: &str, v: &Option<Vec<f64>>, n_coords: usize) -> Result<Option<Vec6>> {

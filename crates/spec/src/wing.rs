@@ -58,6 +58,11 @@ pub struct Springs {
     pub wing_deviation: Spring,
     /// Joint 6, the wing hinge (rotation ψ).
     pub hinge: Spring,
+    /// Viscous damping `bψ` of the wing hinge (mN·mm·ms/rad), in [0, 1e3]: a torque `−bψ ψ̇`
+    /// on ψ. 0 (the default) adds nothing. Taken by the general form and free flight (the
+    /// closed stroke-plane and free-deviation forms decline it).
+    #[schemars(range(min = 0.0, max = 1e3), extend("x-unit" = "mN mm ms/rad"))]
+    pub hinge_damping: f64,
 }
 
 /// The names of [`Springs`] in joint order (joint 1 first).

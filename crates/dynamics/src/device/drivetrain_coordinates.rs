@@ -111,11 +111,13 @@ impl Device {
         let eval = self.drivetrain().evaluate(q.x, q.y)?;
         let phi_dot = eval.jacobian * q_dot;
         let h = eval.velocity_product(&q_dot);
-        let (force, load, potential) = self.drive_load(t, &q);
+        let (force, load, potential) = self.drive_load(t, &q, &q_dot);
         // M_q = Σ_k I_k J_kᵀ J_k and Q = load + Σ_k J_kᵀ τ_k in scalars (J_k = row k of J):
         // the nalgebra 2×2 temporaries cost more than the arithmetic here.
         let j = &eval.jacobian;
-        let (mut m00, mut m01, mut m11) = (0.0, 0.0, 0.0);
+        // The actuator's effective mass on q1 (and on q2 of a dual drive; 0 by default).
+        let [mass1, mass2] = self.drive.masses();
+        let (mut m00, mut m01, mut m11) = (mass1, 0.0, mass2);
         let (mut g0, mut g1) = (load.x, load.y);
         let mut aero_power = 0.0;
         for k in 0..2 {

@@ -84,9 +84,13 @@ impl FreeDeviation {
     /// The lean model when `device` applies: null-space coordinates, two wings with the
     /// closed-form free deviation, the 2-DOF linear map.
     pub(super) fn of(device: &Device) -> Option<Self> {
+        // No actuator mass (it couples the wings' blocks) and no hinge damping: the general
+        // form runs those.
         let applies = device.formulation == Formulation::NullSpace
             && device.n_wings() == 2
-            && device.free_deviation == [true, true];
+            && device.free_deviation == [true, true]
+            && device.drive.mass == 0.0
+            && device.spec.wings.iter().all(|w| w.hinge_damping() == 0.0);
         let jacobian = device.linear_jacobian.filter(|_| applies)?;
         let inverse = jacobian.try_inverse()?;
         let mut lean = Self {
@@ -263,7 +267,7 @@ impl Device {
             return Ok(None);
         }
         let q_dot = lean.inverse * Vector2::new(p_dot[0], p_dot[3]);
-        let (force, load, _) = self.drive_load(t, &q);
+        let (force, load, _) = self.drive_load(t, &q, &q_dot);
         let drive_torque = lean.inverse_transpose * load;
 
         let mut reduced_mass = SMatrix::<f64, N, N>::zeros();

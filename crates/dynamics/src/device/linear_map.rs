@@ -2,13 +2,15 @@
 //! analytic Jacobian, written once for both scalar (`f64`) and SIMD-lane (`wide::f64x4`)
 //! arithmetic.
 //!
-//! With `φ_k = J_k q` constant in `q`, `M_q = Σ_k I_k J_kᵀ J_k` constant and no velocity
-//! product, the equations are `M_q q̈ = g(t, q, q̇)`,
-//! `g = (F(t) − K1 q1, −K2 q2) + Σ_k J_kᵀ τ_k`, `τ_k = τ_aero,k(φ̇_k) − s_k(φ_k)` (the wing's
+//! With `φ_k = J_k q` constant in `q`, `M_q = diag(m) + Σ_k I_k J_kᵀ J_k` constant (`m` the
+//! actuator's effective mass on each drive) and no velocity product, the equations are
+//! `M_q q̈ = g(t, q, q̇)`, `g = Q(t, q, q̇) + Σ_k J_kᵀ τ_k` with the drive load `Q` of `drive.rs`
+//! (`(F − K1 q1 − K1c q1³ − b1 q̇1, P − K2 q2 − K2c q2³ − b2 q̇2)`),
+//! `τ_k = τ_aero,k(φ̇_k) − s_k(φ_k)` (the wing's
 //! stroke torque: the stroke drag of eq. 2.16 `−Ω_k C φ̇_k |φ̇_k|` or a fixed blade element, and
 //! the stroke spring, A.7). So, with stroke drag,
-//! `∂g/∂q = −diag(K1, K2) − Σ_k s_k'(φ_k) J_kᵀ J_k` and
-//! `∂g/∂q̇ = Σ_k (−2 Ω_k C |φ̇_k|) J_kᵀ J_k`, and the variational equations
+//! `∂g/∂q = ∂Q/∂q − Σ_k s_k'(φ_k) J_kᵀ J_k` (`∂Q/∂q = −diag(K1 + 3K1c q1², K2 + 3K2c q2²)`) and
+//! `∂g/∂q̇ = −diag(b1, b2) + Σ_k (−2 Ω_k C |φ̇_k|) J_kᵀ J_k`, and the variational equations
 //! `Φ̇ = J Φ` of the state `(q, q̇)` are, per column `(u, v)` of `Φ`: `u̇ = v`,
 //! `v̇ = M_q⁻¹ (∂g/∂q u + ∂g/∂q̇ v)`.
 //!
@@ -79,7 +81,13 @@ impl LinearMapTerms<f64> {
         // As `LinearDifferential::evaluate` builds it.
         let jacobian = [rows[0][0], rows[0][1], rows[1][0], rows[1][1]];
         let mut inertias = [0.0; 2];
-        let (mut m00, mut m01, mut m11) = (0.0, 0.0, 0.0);
+        let drive = DriveSprings::of(
+            spec,
+            spec.actuator.is_some() && transmission.kinematics().is_dual(),
+        );
+        // The actuator's effective mass on each drive (0 by default: the sums are today's bits).
+        let [mass1, mass2] = drive.masses();
+        let (mut m00, mut m01, mut m11) = (mass1, 0.0, mass2);
         let mut drag = [0.0; 2];
         let mut analytic = true;
         let (mut stiffness, mut cubic, mut rest) = ([0.0; 2], [0.0; 2], [0.0; 2]);
@@ -113,10 +121,7 @@ impl LinearMapTerms<f64> {
             stiffness,
             cubic,
             rest,
-            drive: DriveSprings::of(
-                spec,
-                spec.actuator.is_some() && transmission.kinematics().is_dual(),
-            ),
+            drive,
             polynomial: !polynomial.is_linear(),
             poly: polynomial.coefficients(),
             inertia: inertias,
@@ -157,7 +162,7 @@ pub(crate) fn accelerations<S: Real>(
     }
     let [q1, q2, q1_dot, q2_dot] = *y;
     let [j00, j01, j10, j11] = terms.jacobian;
-    let [mut g0, mut g1] = terms.drive.load(forces, [q1, q2]);
+    let [mut g0, mut g1] = terms.drive.load(forces, [q1, q2], [q1_dot, q2_dot]);
     let mut aero_power = S::splat(0.0);
     for (k, (a, b)) in [(j00, j01), (j10, j11)].into_iter().enumerate() {
         let stroke = a * q1 + b * q2;
@@ -189,9 +194,10 @@ pub(crate) fn polynomial_accelerations<S: Real>(
 ) -> ([S; 2], S, [S; 3], S) {
     let [q1, q2, q1_dot, q2_dot] = *y;
     let [j00, j01, j10, j11] = terms.jacobian;
-    let [mut g0, mut g1] = terms.drive.load(forces, [q1, q2]);
+    let [mut g0, mut g1] = terms.drive.load(forces, [q1, q2], [q1_dot, q2_dot]);
     let zero = S::splat(0.0);
-    let (mut m00, mut m01, mut m11) = (zero, zero, zero);
+    let [mass1, mass2] = terms.drive.lane_masses();
+    let (mut m00, mut m01, mut m11) = (mass1, zero, mass2);
     let mut aero_power = zero;
     for (k, (a, b)) in [(j00, j01), (j10, j11)].into_iter().enumerate() {
         let l = a * q1 + b * q2;
@@ -243,9 +249,10 @@ pub(crate) fn variational<S: Real>(
     let rows = [(j00, j01), (j10, j11)];
     // ∂g/∂q and ∂g/∂q̇, symmetric: entries (00, 01, 11).
     let zero = S::splat(0.0);
-    let [slope1, slope2] = terms.drive.slope();
+    let [slope1, slope2] = terms.drive.slope([q1, q2]);
+    let [damping1, damping2] = terms.drive.damping();
     let (mut gq00, mut gq01, mut gq11) = (slope1, zero, slope2);
-    let (mut gv00, mut gv01, mut gv11) = (zero, zero, zero);
+    let (mut gv00, mut gv01, mut gv11) = (damping1, zero, damping2);
     for (k, (a, b)) in rows.into_iter().enumerate() {
         let stroke = a * q1 + b * q2;
         let rate = a * q1_dot + b * q2_dot;
@@ -296,9 +303,10 @@ fn polynomial_variational<S: Real>(
     let [j00, j01, j10, j11] = terms.jacobian;
     let zero = S::splat(0.0);
     let two = S::splat(2.0);
-    let [slope1, slope2] = terms.drive.slope();
+    let [slope1, slope2] = terms.drive.slope([q1, q2]);
+    let [damping1, damping2] = terms.drive.damping();
     let (mut gq00, mut gq01, mut gq11) = (slope1, zero, slope2);
-    let (mut gv00, mut gv01, mut gv11) = (zero, zero, zero);
+    let (mut gv00, mut gv01, mut gv11) = (damping1, zero, damping2);
     for (k, (a, b)) in [(j00, j01), (j10, j11)].into_iter().enumerate() {
         let l = a * q1 + b * q2;
         let l_dot = a * q1_dot + b * q2_dot;

@@ -43,7 +43,11 @@ impl Device {
                 wing.terms_on(&pw, &vw, branch)?
             };
             mass.fixed_view_mut::<3, 3>(k, k).copy_from(&terms.mass);
-            let f = terms.aero - terms.coriolis - terms.spring;
+            let mut f = terms.aero - terms.coriolis - terms.spring;
+            let hinge_damping = wing.hinge_damping();
+            if hinge_damping != 0.0 {
+                f.z -= hinge_damping * vw.z;
+            }
             force.fixed_view_mut::<3, 1>(k, 0).copy_from(&f);
             wings[w] = terms;
         }
@@ -51,6 +55,18 @@ impl Device {
         force[0] += drive.stroke_torque.x;
         if self.n_wings() == 2 {
             force[3] += drive.stroke_torque.y;
+        }
+        // The actuator's effective mass couples the strokes (the only entries off the wings'
+        // blocks: `solve_reduced` reads (0, 3)).
+        if let Some((inertia, bias)) = self.actuator_inertia(&drive)? {
+            let rows = if self.n_wings() == 2 { [0, 3] } else { [0, 0] };
+            let n = if self.n_wings() == 2 { 2 } else { 1 };
+            for i in 0..n {
+                force[rows[i]] += bias[i];
+                for j in 0..n {
+                    mass[(rows[i], rows[j])] += inertia[(i, j)];
+                }
+            }
         }
         // The null-space solve also serves the drivetrain-coordinate devices here (recording).
         let p_ddot = match self.formulation {
@@ -101,6 +117,19 @@ impl Device {
             let mass_w: nalgebra::Matrix3<f64> = mass.fixed_view::<3, 3>(k, k).into_owned();
             reduced_mass += basis_w.transpose() * (mass_w * basis_w);
             reduced_force += basis_w.transpose() * force.fixed_rows::<3>(k);
+        }
+        // The strokes' coupling by the actuator's mass (zero without one).
+        let coupling = if self.n_wings() == 2 {
+            mass[(0, 3)]
+        } else {
+            0.0
+        };
+        if coupling != 0.0 {
+            let left: nalgebra::SMatrix<f64, 1, N> =
+                self.basis.fixed_view::<1, N>(0, 0).into_owned();
+            let right: nalgebra::SMatrix<f64, 1, N> =
+                self.basis.fixed_view::<1, N>(3, 0).into_owned();
+            reduced_mass += (left.transpose() * right + right.transpose() * left) * coupling;
         }
         let x_ddot = reduced_mass.cholesky()?.solve(&reduced_force);
         Some(self.basis.fixed_columns::<N>(0) * x_ddot)

@@ -166,6 +166,11 @@ impl<'a> LinearStrokeLanes<'a> {
         set(&mut lane.drive.k1, l, device.drive.k1);
         set(&mut lane.drive.k2, l, device.drive.k2);
         set(&mut lane.drive.preload, l, device.drive.preload);
+        set(&mut lane.drive.k1_cubic, l, device.drive.k1_cubic);
+        set(&mut lane.drive.k2_cubic, l, device.drive.k2_cubic);
+        set(&mut lane.drive.b1, l, device.drive.b1);
+        set(&mut lane.drive.b2, l, device.drive.b2);
+        set(&mut lane.drive.mass, l, device.drive.mass);
     }
 }
 

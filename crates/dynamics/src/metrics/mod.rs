@@ -35,7 +35,8 @@
 //! the stroke plane. The actuator power is the mechanical power the actuator's force gives the
 //! drivetrain (`F_a q̇1`; the piezo's electrical side is not modelled); on a periodic orbit
 //! `actuator_power_mean = aero_power_mean` (the springs and the inertia return their energy,
-//! and the one dissipation, rotational damping eq. 3.10, is part of the aerodynamic power).
+//! and the one dissipation, rotational damping eq. 3.10, is part of the aerodynamic power;
+//! with the drive's and hinges' dampers the actuator power also covers their `Σ b q̇²`).
 //!
 //! Undefined metrics are NaN (Python turns them into `None` / null): the phase lag of a wing
 //! that does not rotate, the imbalance percentages when `τR_peak = 0`, `lift_per_power`

@@ -44,6 +44,8 @@ pub struct Wing {
     springs: [JointSpring; 6],
     aero: WingAero,
     tunable_hinge: Option<TunableHinge>,
+    /// Viscous damping of the wing hinge `bψ` (mN·mm·ms/rad): a torque `−bψ ψ̇` on ψ.
+    hinge_damping: f64,
 }
 
 /// Everything the dynamics need from one wing at `(p, ṗ)`.
@@ -128,6 +130,7 @@ impl Wing {
             springs,
             aero,
             tunable_hinge: None,
+            hinge_damping: 0.0,
         })
     }
 
@@ -147,6 +150,23 @@ impl Wing {
     pub fn with_tunable_hinge(mut self, hinge: TunableHinge) -> Self {
         self.tunable_hinge = Some(hinge);
         self
+    }
+
+    /// With viscous damping `bψ` (mN·mm·ms/rad) of the wing hinge: a torque `−bψ ψ̇` on ψ
+    /// (0 by default). The general form and free flight take it; the closed stroke-plane and
+    /// free-deviation forms decline such a wing's device.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `damping` when negative or not finite.
+    pub fn with_hinge_damping(mut self, damping: f64) -> Result<Self> {
+        self.hinge_damping = paritysim_error::check_non_negative("damping", damping)?;
+        Ok(self)
+    }
+
+    /// The hinge's viscous damping `bψ` (mN·mm·ms/rad).
+    #[inline]
+    pub fn hinge_damping(&self) -> f64 {
+        self.hinge_damping
     }
 
     /// The tunable hinge, if any.

@@ -41,6 +41,14 @@ pub struct LinearDifferential {
         extend("x-unit" = "rad/mm^(2j+5)")
     )]
     pub higher_odd_ratios: Vec<f64>,
+    /// Viscous damping `b2` of the whippletree `q2` (the stroke flexure / balance spring;
+    /// mN·mm·ms/rad), in [0, 1e3]: a torque `−b2 q̇2`; 0 (the default) adds nothing.
+    #[schemars(range(min = 0.0, max = 1e3), extend("x-unit" = "mN mm ms/rad"))]
+    pub balance_damping: f64,
+    /// Cubic (hardening) stiffness `K2c` of the balance spring on `q2` (mN·mm/rad³), in
+    /// [0, 1e6]: a torque `−K2c q2³`; 0 (the default) adds nothing.
+    #[schemars(range(min = 0.0, max = 1e6), extend("x-unit" = "mN mm/rad^3"))]
+    pub balance_cubic: f64,
 }
 
 impl Default for LinearDifferential {
@@ -53,6 +61,8 @@ impl Default for LinearDifferential {
             balance_preload: 0.0,
             cubic_ratio: 0.0,
             higher_odd_ratios: Vec::new(),
+            balance_damping: 0.0,
+            balance_cubic: 0.0,
         }
     }
 }
@@ -76,5 +86,13 @@ impl DrivetrainConfig for LinearDifferential {
 
     fn balance_preload(&self) -> f64 {
         self.balance_preload
+    }
+
+    fn balance_damping(&self) -> f64 {
+        self.balance_damping
+    }
+
+    fn balance_cubic(&self) -> f64 {
+        self.balance_cubic
     }
 }

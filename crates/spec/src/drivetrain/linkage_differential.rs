@@ -31,6 +31,14 @@ pub struct LinkageDifferential {
     /// is `P − K2 q2`, so a whippletree at rest settles at `q2 = P / K2` (needs K2 > 0 to hold).
     #[schemars(range(min = -100.0, max = 100.0), extend("x-unit" = "mN mm"))]
     pub balance_preload: f64,
+    /// Viscous damping `b2` of the whippletree `q2` (the stroke flexure / balance spring;
+    /// mN·mm·ms/rad), in [0, 1e3]: a torque `−b2 q̇2`; 0 (the default) adds nothing.
+    #[schemars(range(min = 0.0, max = 1e3), extend("x-unit" = "mN mm ms/rad"))]
+    pub balance_damping: f64,
+    /// Cubic (hardening) stiffness `K2c` of the balance spring on `q2` (mN·mm/rad³), in
+    /// [0, 1e6]: a torque `−K2c q2³`; 0 (the default) adds nothing.
+    #[schemars(range(min = 0.0, max = 1e6), extend("x-unit" = "mN mm/rad^3"))]
+    pub balance_cubic: f64,
 }
 
 impl Default for LinkageDifferential {
@@ -42,6 +50,8 @@ impl Default for LinkageDifferential {
             arm_ratio: 1.0,
             balance_spring: 0.0,
             balance_preload: 0.0,
+            balance_damping: 0.0,
+            balance_cubic: 0.0,
         }
     }
 }
@@ -61,5 +71,13 @@ impl DrivetrainConfig for LinkageDifferential {
 
     fn balance_preload(&self) -> f64 {
         self.balance_preload
+    }
+
+    fn balance_damping(&self) -> f64 {
+        self.balance_damping
+    }
+
+    fn balance_cubic(&self) -> f64 {
+        self.balance_cubic
     }
 }

@@ -43,6 +43,18 @@ pub trait DrivetrainConfig {
     fn balance_preload(&self) -> f64 {
         0.0
     }
+
+    /// Viscous damping of the whippletree `q2` (mN·mm·ms/rad); 0 unless a configuration has
+    /// one.
+    fn balance_damping(&self) -> f64 {
+        0.0
+    }
+
+    /// Cubic stiffness of the balance spring on `q2` (mN·mm/rad³); 0 unless a configuration
+    /// has one.
+    fn balance_cubic(&self) -> f64 {
+        0.0
+    }
 }
 
 macro_rules! registry {
@@ -103,6 +115,16 @@ impl Drivetrain {
     /// The preload torque on `q2` (mN·mm).
     pub fn balance_preload(&self) -> f64 {
         self.config().balance_preload()
+    }
+
+    /// Damping of the whippletree `q2` (mN·mm·ms/rad).
+    pub fn balance_damping(&self) -> f64 {
+        self.config().balance_damping()
+    }
+
+    /// Cubic stiffness of the balance spring (mN·mm/rad³).
+    pub fn balance_cubic(&self) -> f64 {
+        self.config().balance_cubic()
     }
 }
 

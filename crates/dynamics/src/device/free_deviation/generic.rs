@@ -118,6 +118,11 @@ impl<const N: usize> Constants<paritysim_simd::f64x4, N> {
                 k1: v(&|d| d.drive.k1),
                 k2: v(&|d| d.drive.k2),
                 preload: v(&|d| d.drive.preload),
+                k1_cubic: v(&|d| d.drive.k1_cubic),
+                k2_cubic: v(&|d| d.drive.k2_cubic),
+                b1: v(&|d| d.drive.b1),
+                b2: v(&|d| d.drive.b2),
+                mass: v(&|d| d.drive.mass),
                 dual: mask(&|d| d.drive.dual),
             },
             wings: [wing(0), wing(1)],
@@ -315,7 +320,7 @@ pub(crate) fn step<R: Real, const N: usize>(
     let plausible = q[0].abs().le(k(paritysim_error::plausible::OFFSET_MM))
         & q[1].abs().le(k(paritysim_error::plausible::ANGLE_RAD));
     let q_dot = mat2(&c.inverse, [p_dot[0], p_dot[3]]);
-    let load = c.drive.load(forces, q);
+    let load = c.drive.load(forces, q, q_dot);
     let drive_torque = mat2(&c.inverse_transpose, load);
     let mut reduced_mass = [[zero; N]; N];
     let mut reduced_force = [zero; N];

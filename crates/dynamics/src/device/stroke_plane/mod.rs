@@ -55,7 +55,11 @@ impl StrokePlane {
         let applies = device.formulation == super::Formulation::NullSpace
             && device.n_wings() == 2
             && device.stroke_plane == [true, true]
-            && device.n_dof == N;
+            && device.n_dof == N
+            // Its Jacobian takes a constant, undamped drive slope and its blocks no actuator
+            // mass or hinge damping: the general form runs those.
+            && device.drive.is_linear_lossless()
+            && device.spec.wings.iter().all(|w| w.hinge_damping() == 0.0);
         let jacobian = device.linear_jacobian.filter(|_| applies)?;
         let inverse = jacobian.try_inverse()?;
         let row = |i: usize| -> [f64; N] { std::array::from_fn(|k| device.basis[(i, k)]) };
@@ -170,7 +174,7 @@ impl Device {
             return Ok(None);
         }
         let q_dot = lean.inverse * stroke_rate;
-        let (force, load, _) = self.drive_load(t, &q);
+        let (force, load, _) = self.drive_load(t, &q, &q_dot);
         let drive_torque = lean.inverse_transpose * load;
         let mut inverse_blocks = [[0.0; 3]; 2];
         let mut x_ddot = SVector::<f64, N>::zeros();

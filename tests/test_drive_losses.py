@@ -1,0 +1,310 @@
+"""An actuator and drivetrain with mass and losses (issue 35 item 2): actuator damping `b1`,
+whippletree damping `b2`, hinge damping `bψ`, the actuator's effective mass `m` reflected through
+the transmission, cubic actuator stiffness; checked against closed forms (energy dissipated per
+cycle, the driven damped oscillator's resonance curve, `√(K / M_eff)`, the harmonic-balance
+backbone of a hardening spring), not against the code's own numbers."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+import paritysim as ps
+
+T = 2.5  # transmission ratio (rad/mm)
+INERTIA = 29.0  # stroke inertia of each wing (mg·mm²)
+K1 = 467.0  # actuator stiffness (mN/mm)
+FPV = 1.2  # force per volt (mN/V)
+
+
+def vacuum(
+    *,
+    volts: float = 20.0,
+    freq: float = 150.0,
+    mass: float = 0.0,
+    damping: float = 0.0,
+    cubic: float = 0.0,
+    balance_damping: float = 0.0,
+    balance_spring: float = 0.0,
+    arm_ratio: float = 1.0,
+    formulation: str | None = None,
+) -> ps.Simulation:
+    """Two fixed stroke-only wings without aerodynamics on the linear map (eq. 2.15): with equal
+    arms `q1` is a driven oscillator `M q̈1 + b1 q̇1 + K1 q1 + K1c q1³ = F0 sin ωt` with
+    `M = m + 2 I T²` (φ = −T q1 on both wings), and `q2` stays at rest."""
+    wing = ps.Wing(inertia=((INERTIA, 0, 0), (0, INERTIA, 0), (0, 0, 1.0)), aero=None)
+    spec = ps.Simulation(
+        wings=(wing, wing),
+        configuration=ps.Configuration("drag_parity_fixed"),
+        drivetrain=dataclasses.replace(
+            ps.Drivetrain.linear_differential(T, 2.5, arm_ratio=arm_ratio, balance_spring=balance_spring),
+            balance_damping=balance_damping,
+        ),
+        actuator=ps.Actuator(
+            ps.Waveform(amplitude_v=volts, frequency_hz=freq),
+            FPV,
+            K1,
+            mass_mg=mass,
+            damping=damping,
+            cubic_stiffness=cubic,
+        ),
+        options=ps.Options(samples_per_cycle=400),
+    )
+    if formulation is not None:
+        spec = spec.replace(formulation=formulation)
+    return spec
+
+
+def one_cycle_integral(result: ps.SimulationResult, integrand: np.ndarray) -> float:
+    """`∮ integrand dt` over the last recorded period (rectangle rule on the uniform samples of
+    one period: exact to round-off for a smooth periodic integrand)."""
+    t = result.trajectory["time_ms"].to_numpy()
+    period = 1.0 / (result.spec.actuator.waveform.frequency_hz * 1e-3)
+    last = t >= t[-1] - period - 1e-9
+    dt = np.diff(t[last])
+    return float(np.sum(integrand[last][:-1] * dt))
+
+
+@pytest.mark.parametrize(
+    "which",
+    ["actuator", "balance", "hinge"],
+)
+def test_each_damper_dissipates_its_closed_form_per_cycle(which: str) -> None:
+    """The actuator's work per cycle less the air's is what the damper dissipates, `∮ b q̇² dt`
+    from the recorded rates (springs and inertia return their energy; in vacuum the air takes
+    nothing)."""
+    if which == "actuator":
+        spec = vacuum(damping=15.0, volts=40.0)
+        rates = ["q1_dot"]
+        b = 15.0
+    elif which == "balance":
+        # Unequal arms couple q2 to the drive; b2 is the only loss.
+        spec = vacuum(balance_damping=0.4, balance_spring=20.0, arm_ratio=1.6, volts=40.0)
+        rates = ["q2_dot"]
+        b = 0.4
+    else:
+        # The §3.4 PARITY's rotating wings with bψ on both hinges: the aerodynamic work is a
+        # metric of its own, so the balance is W_actuator + W_aero = ∮ bψ (ψ̇L² + ψ̇R²) dt.
+        base = ps.devices.load("sreetharan2012_3_4_parity")
+        b = 0.5
+        wings = tuple(dataclasses.replace(w, springs=dataclasses.replace(w.springs, hinge_damping=b)) for w in base.wings)
+        spec = base.replace(wings=wings)
+        rates = ["left_psi_dot", "right_psi_dot"]
+    result = ps.simulate(spec, max_cycles=400, columns=[*rates])
+    df = result.trajectory
+    dissipated = sum(one_cycle_integral(result, b * df[c].to_numpy() ** 2) for c in rates)
+    work = result.metrics["work_actuator_per_cycle"] + result.metrics["work_aero_per_cycle"]
+    assert dissipated > 1e-2 * result.metrics["work_actuator_per_cycle"]
+    assert work == pytest.approx(dissipated, rel=1e-6)
+
+
+def resonance_amplitude(omega: np.ndarray, force: float, stiffness: float, mass: float, damping: float) -> np.ndarray:
+    """`|q1|` of `M q̈ + b q̇ + K q = F sin ωt`: `F / √((K − M ω²)² + (b ω)²)`."""
+    return force / np.sqrt((stiffness - mass * omega**2) ** 2 + (damping * omega) ** 2)
+
+
+@pytest.mark.parametrize("formulation", [None, "null_space"])
+def test_damped_device_follows_the_analytic_resonance_curve(formulation: str | None) -> None:
+    """A linear damped vacuum device with an actuator mass: stroke amplitude over frequency is
+    `T F0 / √((K1 − M ω²)² + (b1 ω)²)` with `M = m + 2 I T²`, on the drivetrain-coordinate
+    (lanes) and the general form."""
+    mass, b1, volts = 40.0, 30.0, 10.0
+    freqs = np.linspace(80.0, 260.0, 10)
+    # 4000 samples per cycle: the sampled peak-to-peak is within (π/4000)²/2 = 3e-7 of the
+    # sinusoid's.
+    spec = vacuum(mass=mass, damping=b1, volts=volts, formulation=formulation)
+    spec = spec.replace(options=dataclasses.replace(spec.options, samples_per_cycle=4000))
+    df = ps.sweep(spec, {"actuator.waveform.frequency_hz": freqs}, metrics=["left_stroke_amplitude"], progress=False)
+    assert (df["status"] == "ok").all()
+    omega = 2 * math.pi * freqs * 1e-3
+    expected = T * resonance_amplitude(omega, FPV * volts, K1, mass + 2 * INERTIA * T**2, b1)
+    np.testing.assert_allclose(df["left_stroke_amplitude"].to_numpy(), expected, rtol=1e-6)
+
+
+def peak_frequency(spec: ps.Simulation, freqs: np.ndarray) -> tuple[float, float]:
+    """The frequency (Hz) and stroke amplitude of the largest response: a parabola through the
+    sweep's three points around its maximum."""
+    df = ps.sweep(spec, {"actuator.waveform.frequency_hz": freqs}, metrics=["left_stroke_amplitude"], progress=False)
+    assert (df["status"] == "ok").all()
+    a = df["left_stroke_amplitude"].to_numpy()
+    i = int(np.clip(np.argmax(a), 1, len(a) - 2))
+    c = np.polyfit(freqs[i - 1 : i + 2], a[i - 1 : i + 2], 2)
+    f = -c[1] / (2 * c[0])
+    return float(f), float(np.polyval(c, f))
+
+
+def test_reflected_actuator_mass_shifts_the_natural_frequency() -> None:
+    """The resonance of a lightly damped device moves as `√(K1 / (m + 2 I T²))` predicts when the
+    actuator gains a mass `m` (the mass reflected through the transmission: `m / T²` per
+    radian of stroke), on both forms that take it."""
+    b1 = 2.0
+    for formulation in (None, "null_space"):
+        for mass in (0.0, 150.0):
+            m_eff = mass + 2 * INERTIA * T**2
+            f0 = math.sqrt(K1 / m_eff) / (2 * math.pi) * 1e3
+            zeta = b1 / (2 * math.sqrt(K1 * m_eff))
+            f_peak = f0 * math.sqrt(1 - 2 * zeta**2)  # displacement resonance of a damped oscillator
+            freqs = f_peak * np.linspace(0.985, 1.015, 7)
+            f, _ = peak_frequency(vacuum(mass=mass, damping=b1, volts=2.0, formulation=formulation), freqs)
+            assert f == pytest.approx(f_peak, rel=2e-4), (formulation, mass)
+
+
+def harmonic_balance_peak(volts: float, cubic: float, b1: float, m_eff: float) -> tuple[float, float]:
+    """The peak of the harmonic-balance (first-harmonic) response of
+    `M q̈ + b q̇ + K q + Kc q³ = F sin ωt`: the amplitude `A` at ω solves
+    `A² ((K + ¾ Kc A² − M ω²)² + (b ω)²) = F²` (a cubic in `A²`, one positive root when the
+    curve does not fold); its maximum lies near the backbone `M ω² = K + ¾ Kc A²`. Returns
+    (peak frequency in Hz, peak amplitude A in mm) from a fine grid and a parabola."""
+    force = FPV * volts
+    omega0 = math.sqrt(K1 / m_eff)
+    omegas = omega0 * np.linspace(0.9, 1.3, 4001)
+    amplitude = np.empty_like(omegas)
+    for i, w in enumerate(omegas):
+        d = K1 - m_eff * w**2
+        # x ((d + c x)² + (b w)²) = F² with c = ¾ Kc: c² x³ + 2 c d x² + (d² + b²w²) x − F² = 0.
+        c = 0.75 * cubic
+        roots = np.roots([c * c, 2 * c * d, d * d + (b1 * w) ** 2, -(force**2)])
+        real = roots[(abs(roots.imag) < 1e-12 * abs(roots).max()) & (roots.real > 0)].real
+        assert len(real) == 1, "the harmonic-balance curve folds: pick more damping"
+        amplitude[i] = math.sqrt(real[0])
+    k = int(np.argmax(amplitude))
+    cfit = np.polyfit(omegas[k - 2 : k + 3], amplitude[k - 2 : k + 3], 2)
+    w_peak = -cfit[1] / (2 * cfit[0])
+    return w_peak / (2 * math.pi) * 1e3, float(np.polyval(cfit, w_peak))
+
+
+def test_cubic_stiffness_raises_the_peak_frequency_with_voltage_as_the_backbone_predicts() -> None:
+    """A hardening actuator (`K1c > 0`): the resonance rises with drive voltage, by the
+    harmonic-balance backbone `ω² ≈ ω0² + ¾ (K1c / M) A²` (sign and size, with the damping's
+    small offset from the backbone); the linear device's peak does not move."""
+    b1, cubic = 40.0, 200.0
+    m_eff = 2 * INERTIA * T**2
+    f0 = math.sqrt(K1 / m_eff) / (2 * math.pi) * 1e3
+    zeta = b1 / (2 * math.sqrt(K1 * m_eff))
+    f_linear = f0 * math.sqrt(1 - 2 * zeta**2)
+    peaks = {}
+    for volts in (8.0, 20.0):
+        f_hb, a_hb = harmonic_balance_peak(volts, cubic, b1, m_eff)
+        freqs = f_hb + np.linspace(-3.0, 3.0, 9)
+        f, stroke = peak_frequency(vacuum(damping=b1, cubic=cubic, volts=volts, freq=f_hb), freqs)
+        peaks[volts] = f
+        # Backbone by hand: ω² − ω_lin² ≈ ¾ (K1c / M) A² at the peak amplitude.
+        backbone = math.sqrt((2 * math.pi * f_linear * 1e-3) ** 2 + 0.75 * cubic / m_eff * a_hb**2) / (2 * math.pi) * 1e3
+        assert f_hb == pytest.approx(backbone, abs=0.02 * (backbone - f_linear) + 0.05)
+        # The simulated shift from the linear peak: positive and harmonic balance's to 5 %.
+        assert f - f_linear > 0
+        assert f - f_linear == pytest.approx(f_hb - f_linear, rel=0.05), (volts, f, f_hb, f_linear)
+        assert stroke / T == pytest.approx(a_hb, rel=0.02)
+    assert peaks[20.0] > peaks[8.0] + 3.0
+    # Linear: the peak stays at ω0 √(1 − 2ζ²) at both voltages.
+    for volts in (8.0, 20.0):
+        f, _ = peak_frequency(vacuum(damping=b1, volts=volts), f_linear + np.linspace(-3.0, 3.0, 9))
+        assert f == pytest.approx(f_linear, rel=2e-4)
+
+
+def test_zero_terms_are_the_default_spec() -> None:
+    """The new fields default to zero and a spec that spells the zeros out is the same spec (the
+    bit-for-bit check against the previous engine is in docs/findings.md)."""
+    spec = ps.devices.load("sreetharan2012_3_3_parity")
+    assert spec.actuator.mass_mg == 0.0 and spec.actuator.damping == 0.0 and spec.actuator.cubic_stiffness == 0.0
+    assert all(w.springs.hinge_damping == 0.0 for w in spec.wings)
+    explicit = spec.replace(actuator=dataclasses.replace(spec.actuator, mass_mg=0.0, damping=0.0, cubic_stiffness=0.0))
+    a = ps.simulate(spec, columns=[]).metrics
+    b = ps.simulate(explicit, columns=[]).metrics
+    assert a == b
+
+
+def test_lanes_are_bit_identical_with_the_new_terms(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A sweep over the new terms on the linear map gives the scalar bits at lane widths 1 and
+    4 (the lanes take the drive load and its Jacobian from the same generic code)."""
+    spec = vacuum(volts=30.0, freq=170.0, balance_spring=15.0, arm_ratio=1.3).replace(
+        wings=tuple(dataclasses.replace(w, aero=ps.Aero(omega1=31.3, coefficient=1.0)) for w in vacuum().wings)
+    )
+    grid = {
+        "actuator.damping": [0.0, 5.0, 20.0],
+        "actuator.mass_mg": [0.0, 60.0],
+        "actuator.cubic_stiffness": [0.0, 3e3],
+        "drivetrain.balance_damping": [0.0, 0.3],
+    }
+    metrics = ["left_stroke_amplitude", "q2_amplitude", "work_actuator_per_cycle"]
+    out = {}
+    for lanes in ("1", "4"):
+        monkeypatch.setenv("PARITYSIM_LANES", lanes)
+        df = ps.sweep(spec, grid, metrics=metrics, threads=1, progress=False)
+        assert (df["status"] == "ok").all()
+        out[lanes] = df.select(metrics).to_numpy()
+    assert out["1"].tobytes() == out["4"].tobytes()
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "field"),
+    [
+        ("actuator.mass_mg", -1.0, "mass_mg"),
+        ("actuator.damping", float("nan"), "damping"),
+        ("actuator.cubic_stiffness", -3.0, "cubic_stiffness"),
+        ("drivetrain.balance_damping", -0.1, "balance_damping"),
+        ("wings[0].springs.hinge_damping", -0.5, "hinge_damping"),
+    ],
+)
+def test_bad_values_are_typed_errors_naming_the_field(path: str, value: float, field: str) -> None:
+    spec = vacuum()
+    data = spec.to_dict()
+    node = data
+    keys = path.replace("[0]", ".0").split(".")
+    for k in keys[:-1]:
+        node = node[int(k)] if k.isdigit() else node[k]
+    node[keys[-1]] = value
+    with pytest.raises(ps.InvalidParameterError, match=field):
+        ps.simulate(ps.Simulation.from_dict(data), columns=[])
+
+
+def test_balance_terms_need_a_whippletree() -> None:
+    spec = ps.devices.load("sreetharan2012_3_3_hmf_four_bar")
+    assert spec.drivetrain.kind == "hmf_four_bar"
+    with pytest.raises(ps.InvalidParameterError, match="balance_damping"):
+        data = spec.to_dict()
+        data["drivetrain"]["balance_damping"] = 0.1
+        ps.simulate(ps.Simulation.from_dict(data), columns=[])
+
+
+def test_actuator_mass_is_refused_in_free_flight() -> None:
+    spec = ps.devices.load("sreetharan2012_3_3_parity")
+    if not hasattr(ps, "Body"):
+        pytest.skip("no body")
+    flying = spec.replace(
+        actuator=dataclasses.replace(spec.actuator, mass_mg=5.0),
+        body=ps.Body(mode="roll"),
+    )
+    with pytest.raises(ps.InvalidParameterError, match="mass_mg"):
+        ps.simulate(flying, max_cycles=2)
+
+
+def test_actuator_from_blocked_force() -> None:
+    """Blocked force F_b at V and free deflection δ: stiffness F_b / δ, force per volt F_b / V;
+    the §3.3.1 actuator is 120 mN blocked at 100 V with 467 mN/mm, δ = 0.257 mm."""
+    a = ps.Actuator.from_blocked_force(blocked_force_mn=120.0, free_deflection_mm=120.0 / 467.0, voltage_v=100.0, damping=3.0)
+    assert a.stiffness == pytest.approx(467.0, rel=1e-12)
+    assert a.force_per_volt == pytest.approx(1.2, rel=1e-12)
+    assert a.damping == 3.0
+    with pytest.raises(ps.InvalidParameterError, match="free_deflection_mm"):
+        ps.Actuator.from_blocked_force(blocked_force_mn=120.0, free_deflection_mm=0.0, voltage_v=100.0)
+
+
+@pytest.mark.parametrize("name", ["sreetharan2012_3_3_hmf_four_bar", "sreetharan2012_3_3_parity_linkage"])
+def test_actuator_mass_through_a_nonlinear_linkage_agrees_between_forms(name: str) -> None:
+    """Through a rod-crank linkage (`φ̈ = J q̈ + h`, `J` varying) the two forms model the mass
+    independently: drivetrain coordinates add `m` to `M_q`; the general form adds
+    `J⁻ᵀ diag(m) J⁻¹` to the strokes' mass matrix and `J⁻ᵀ diag(m) J⁻¹ h` to their forces. Their
+    orbits agree to the integration tolerance, and the mass moves the orbit."""
+    base = ps.devices.load(name)
+    heavy = base.replace(actuator=dataclasses.replace(base.actuator, mass_mg=200.0, damping=4.0))
+    metrics = ["left_stroke_amplitude", "right_stroke_amplitude", "work_actuator_per_cycle", "q2_amplitude"]
+    fast = ps.simulate(heavy, columns=[], metrics=metrics).metrics
+    general = ps.simulate(heavy.replace(formulation="null_space"), columns=[], metrics=metrics).metrics
+    light = ps.simulate(base, columns=[], metrics=metrics).metrics
+    for m in metrics:
+        assert general[m] == pytest.approx(fast[m], rel=1e-6, abs=1e-9), m
+    assert abs(fast["left_stroke_amplitude"] / light["left_stroke_amplitude"] - 1) > 1e-2
