@@ -59,8 +59,8 @@ pub struct Springs {
     /// Joint 6, the wing hinge (rotation ψ).
     pub hinge: Spring,
     /// Viscous damping `bψ` of the wing hinge (mN·mm·ms/rad), in [0, 1e3]: a torque `−bψ ψ̇`
-    /// on ψ. 0 (the default) adds nothing. Taken by the general form and free flight (the
-    /// closed stroke-plane and free-deviation forms decline it).
+    /// on ψ. 0 (the default) adds nothing. Taken by the general and stroke-plane forms and free
+    /// flight (the free-deviation form declines it).
     #[schemars(range(min = 0.0, max = 1e3), extend("x-unit" = "mN mm ms/rad"))]
     pub hinge_damping: f64,
 }

@@ -153,8 +153,8 @@ impl Wing {
     }
 
     /// With viscous damping `bψ` (mN·mm·ms/rad) of the wing hinge: a torque `−bψ ψ̇` on ψ
-    /// (0 by default). The general form and free flight take it; the closed stroke-plane and
-    /// free-deviation forms decline such a wing's device.
+    /// (0 by default). The general and stroke-plane forms and free flight take it; the
+    /// free-deviation form declines such a wing's device.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming `damping` when negative or not finite.

@@ -49,6 +49,27 @@ fn sprung_device() -> Device {
     )
 }
 
+/// The sprung device with an actuator of mass, damping and cubic stiffness and a damped,
+/// hardening whippletree (issue 35): the drive load's slope `∂Q/∂q` varies with `q` and its
+/// damping `∂Q/∂q̇` enters the velocity block.
+fn lossy_device() -> Device {
+    let sprung = sprung_device();
+    let spec = sprung.spec();
+    let actuator = Actuator::thesis(Waveform::sine(50.0, 110.0, 0.0, 0.3).unwrap())
+        .with_dynamics(30.0, 12.0, 4.0e3)
+        .unwrap();
+    let transmission = Transmission::new(linear_map(), 35.0)
+        .unwrap()
+        .with_balance_losses(0.8, 60.0)
+        .unwrap();
+    Device::new(DeviceSpec {
+        actuator: Some(actuator),
+        transmission: Some(transmission),
+        ..spec.clone()
+    })
+    .unwrap()
+}
+
 /// The device with only its right-hand side: the variational equations fall back to central
 /// differences.
 struct WithoutJacobian<'a>(&'a Device);
@@ -87,7 +108,7 @@ fn uniform(seed: &mut u64) -> f64 {
 fn analytic_jacobian_equals_central_differences_on_random_states() {
     let mut seed = 12;
     let eye: Vec<f64> = DMatrix::<f64>::identity(4, 4).iter().copied().collect();
-    for device in [drag_device(), sprung_device()] {
+    for device in [drag_device(), sprung_device(), lossy_device()] {
         let mut checked = 0;
         while checked < 200 {
             let v = [
@@ -168,7 +189,7 @@ fn monodromy_equals_finite_differences_of_the_period_map_and_the_difference_fall
     let rk = RungeKutta::new(Method::Dop853, 1e-10, 1e-12, 100_000)
         .unwrap()
         .with_work(false);
-    for device in [drag_device(), sprung_device()] {
+    for device in [drag_device(), sprung_device(), lossy_device()] {
         let y0 = start(&device, &rk);
         let (_, _, grid) = rk
             .flow_with_sensitivity_and_steps(&device, 0.0, &y0, PERIOD)

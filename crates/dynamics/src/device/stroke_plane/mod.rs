@@ -46,6 +46,9 @@ pub(crate) struct StrokePlane {
     inverse_transpose: Matrix2<f64>,
     /// The drive's part of `∂f_φw/∂x` per wing (constant): `Σ_k (J⁻ᵀ ∂Q/∂q J⁻¹)_wk N_φk`.
     drive_rows: [[f64; N]; 2],
+    /// Whether the drive load is linear and undamped (`drive_rows` is its whole Jacobian);
+    /// else the Jacobian takes `∂Q/∂q` at the state and `∂Q/∂q̇` on `ẋ`.
+    linear_drive: bool,
 }
 
 impl StrokePlane {
@@ -56,10 +59,9 @@ impl StrokePlane {
             && device.n_wings() == 2
             && device.stroke_plane == [true, true]
             && device.n_dof == N
-            // Its Jacobian takes a constant, undamped drive slope and its blocks no actuator
-            // mass or hinge damping: the general form runs those.
-            && device.drive.is_linear_lossless()
-            && device.spec.wings.iter().all(|w| w.hinge_damping() == 0.0);
+            // Its per-wing blocks take no actuator mass (it couples the strokes' inertia): the
+            // general form runs that.
+            && device.drive.mass == 0.0;
         let jacobian = device.linear_jacobian.filter(|_| applies)?;
         let inverse = jacobian.try_inverse()?;
         let row = |i: usize| -> [f64; N] { std::array::from_fn(|k| device.basis[(i, k)]) };
@@ -77,8 +79,11 @@ impl StrokePlane {
         let strokes = [row(0), row(3)];
         let drive_rows = [0, 1]
             .map(|w| std::array::from_fn(|j| (0..2).map(|k| drive[(w, k)] * strokes[k][j]).sum()));
+        // (The mass is zero here.)
+        let linear_drive = device.drive.is_linear_lossless();
         Some(Self {
             drive_rows,
+            linear_drive,
             rows: [[row(0), row(2)], [row(3), row(5)]],
             offset: [
                 [device.offset[0], device.offset[2]],
@@ -220,7 +225,11 @@ impl Device {
             let (spring_phi, spring_psi) = wing.stroke_plane_springs(phi, psi);
             let aero_phi = a.dot(&tau);
             let f_phi = aero_phi - a.dot(&v) - spring_phi + drive_torque[w];
-            let f_psi = tau.z - v.z - spring_psi;
+            let mut f_psi = tau.z - v.z - spring_psi;
+            let hinge_damping = wing.hinge_damping();
+            if hinge_damping != 0.0 {
+                f_psi -= hinge_damping * psi_dot;
+            }
             aero_power += aero_phi * phi_dot + tau.z * psi_dot;
             // B = J6ᵀ I J6 on (φ, ψ): aᵀ I a, aᵀ I ẑ, I_zz; (φ̈, ψ̈) = B⁻¹ f, ẍ += Sᵀ (φ̈, ψ̈).
             let (m_pp, m_ps, m_ss) = (a.dot(&i_a), i_a.z, inertia[(2, 2)]);
@@ -394,6 +403,23 @@ impl Device {
             Err(e) => return Some(Err(e)),
         };
         let x_ddot: [f64; N] = step.x_ddot.into();
+        // The drive's rows on x and ẋ: the constant ones of a linear undamped drive, else
+        // `J⁻ᵀ (∂Q/∂q) J⁻¹` at the state's q and `J⁻ᵀ (∂Q/∂q̇) J⁻¹`.
+        let (drive_rows, drive_rate_rows) = if lean.linear_drive {
+            (lean.drive_rows, [[0.0; N]; 2])
+        } else {
+            let strokes = Vector2::new(step.wings[0].angles.0, step.wings[1].angles.0);
+            let q = lean.inverse * strokes;
+            let [s1, s2] = self.drive.slope([q.x, q.y]);
+            let [d1, d2] = self.drive.damping();
+            let on = |a: f64, b: f64| {
+                let m = lean.inverse_transpose * Matrix2::new(a, 0.0, 0.0, b) * lean.inverse;
+                [0, 1].map(|w| -> [f64; N] {
+                    std::array::from_fn(|j| (0..2).map(|k| m[(w, k)] * lean.rows[k][0][j]).sum())
+                })
+            };
+            (on(s1, s2), on(d1, d2))
+        };
         // ∂ẍ = Sᵀ B⁻¹ [∂f − (∂B) (φ̈, ψ̈)] per wing on [∂x | ∂ẋ] (see the module).
         let mut jacobian = SMatrix::<f64, N, { 2 * N }>::zeros();
         let z = Vector3::z();
@@ -452,7 +478,7 @@ impl Device {
                 0.0,
                 tau_psi.z - v_psi.z - spring_psi,
                 tau_phi_dot.z - v_phi_dot.z,
-                tau_psi_dot.z - v_psi_dot.z,
+                tau_psi_dot.z - v_psi_dot.z - wing.hinge_damping(),
             ];
             let (dm_pp, dm_ps) = (a1.dot(&i_a) + a.dot(&i_a1), i_a1.z);
             let (phi_ddot, psi_ddot) = (dot(row_phi, &x_ddot), dot(row_psi, &x_ddot));
@@ -462,9 +488,12 @@ impl Device {
             let mut local = [[0.0; 2 * N]; 2];
             for j in 0..N {
                 let (rj, sj) = (row_phi[j], row_psi[j]);
-                local[0][j] = f_phi[0] * rj + (f_phi[1] - dm_phi) * sj + lean.drive_rows[w][j];
+                local[0][j] = f_phi[0] * rj + (f_phi[1] - dm_phi) * sj + drive_rows[w][j];
                 local[1][j] = f_psi[0] * rj + (f_psi[1] - dm_psi) * sj;
                 local[0][N + j] = f_phi[2] * rj + f_phi[3] * sj;
+                if !lean.linear_drive {
+                    local[0][N + j] += drive_rate_rows[w][j];
+                }
                 local[1][N + j] = f_psi[2] * rj + f_psi[3] * sj;
             }
             let [b00, b01, b11] = step.inverse_blocks[w];
