@@ -28,6 +28,9 @@ pub(crate) struct DriveSprings<R: Real> {
     /// The actuator's effective mass on `q1` (mg): not a load, the forms add it to `M_q`.
     pub(crate) mass: R,
     pub(crate) dual: R::Mask,
+    /// Whether every cubic and damping term is zero (in every lane): the load skips them (one
+    /// predictable branch; the default path then costs what it did before them).
+    pub(crate) lossless: bool,
 }
 
 impl<R: Real> DriveSprings<R> {
@@ -44,6 +47,7 @@ impl<R: Real> DriveSprings<R> {
             b2: zero,
             mass: zero,
             dual: zero.lt(zero),
+            lossless: true,
         }
     }
 
@@ -54,6 +58,16 @@ impl<R: Real> DriveSprings<R> {
     /// dual drivetrain.
     #[inline(always)]
     pub(crate) fn load(&self, forces: [R; 2], q: [R; 2], q_dot: [R; 2]) -> [R; 2] {
+        if self.lossless {
+            return [
+                forces[0] - self.k1 * q[0],
+                R::select(
+                    self.dual,
+                    forces[1] - self.k1 * q[1],
+                    -self.k2 * q[1] + self.preload,
+                ),
+            ];
+        }
         let extra1 = self.k1_cubic * q[0] * q[0] * q[0] + self.b1 * q_dot[0];
         let cubic2 = R::select(self.dual, self.k1_cubic, self.k2_cubic);
         let b2 = R::select(self.dual, self.b1, self.b2);
@@ -72,6 +86,9 @@ impl<R: Real> DriveSprings<R> {
     /// both drives of a dual drivetrain.
     #[inline(always)]
     pub(crate) fn slope(&self, q: [R; 2]) -> [R; 2] {
+        if self.lossless {
+            return [-self.k1, R::select(self.dual, -self.k1, -self.k2)];
+        }
         let three = R::splat(3.0);
         let k2 = R::select(self.dual, self.k1, self.k2);
         let cubic2 = R::select(self.dual, self.k1_cubic, self.k2_cubic);
@@ -91,6 +108,9 @@ impl<R: Real> DriveSprings<R> {
     /// `∂Q/∂q̇`, diagonal and constant: `(−b1, −b2)`, or `(−b1, −b1)` on a dual drivetrain.
     #[inline(always)]
     pub(crate) fn damping(&self) -> [R; 2] {
+        if self.lossless {
+            return [R::splat(0.0); 2];
+        }
         [-self.b1, R::select(self.dual, -self.b1, -self.b2)]
     }
 }
@@ -112,13 +132,21 @@ impl DriveSprings<f64> {
             b2: transmission(|tr| tr.balance_damping()),
             mass: actuator(|a| a.mass()),
             dual,
+            lossless: true,
         }
+        .with_lossless_flag()
+    }
+
+    /// `self` with [`Self::lossless`] set from its terms.
+    pub(crate) fn with_lossless_flag(mut self) -> Self {
+        self.lossless = [self.k1_cubic, self.k2_cubic, self.b1, self.b2] == [0.0; 4];
+        self
     }
 
     /// Whether every term beyond `K1`, `K2`, `P` is zero (today's drive: the closed forms that
     /// take no actuator mass, drive damping or cubic drive stiffness apply).
     pub(crate) fn is_linear_lossless(&self) -> bool {
-        [self.k1_cubic, self.k2_cubic, self.b1, self.b2, self.mass] == [0.0; 5]
+        self.lossless && self.mass == 0.0
     }
 
     /// The actuator mass on each drive coordinate: `(m, 0)`, or `(m, m)` on a dual drivetrain.
@@ -180,7 +208,8 @@ mod tests {
             b2: 0.02,
             mass: 3.0,
             ..preloaded
-        };
+        }
+        .with_lossless_flag();
         let lossy_dual = DriveSprings {
             dual: true,
             ..lossy

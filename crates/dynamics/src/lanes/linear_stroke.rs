@@ -105,6 +105,8 @@ impl LinearStroke<'_> {
 /// [`LANES`] devices side by side (vectors of their constants).
 pub(crate) struct LinearStrokeLanes<'a> {
     actuators: [Option<&'a Actuator>; LANES],
+    /// Each lane's drive has no cubic or damping term ([`DriveSprings::lossless`]).
+    lossless: [bool; LANES],
     /// Each lane's [`LinearStroke::forcing`] of its current grid.
     forcing: [Option<Rc<[f64]>>; LANES],
     /// Each lane's device constants.
@@ -123,6 +125,7 @@ impl<'a> LinearStrokeLanes<'a> {
         let (z, one) = (V::splat(0.0), V::splat(1.0));
         Self {
             actuators: [None; LANES],
+            lossless: [true; LANES],
             forcing: std::array::from_fn(|_| None),
             terms: LinearMapTerms {
                 jacobian: [one, z, z, one],
@@ -171,6 +174,8 @@ impl<'a> LinearStrokeLanes<'a> {
         set(&mut lane.drive.b1, l, device.drive.b1);
         set(&mut lane.drive.b2, l, device.drive.b2);
         set(&mut lane.drive.mass, l, device.drive.mass);
+        self.lossless[l] = device.drive.lossless;
+        lane.drive.lossless = self.lossless.iter().all(|&x| x);
     }
 }
 

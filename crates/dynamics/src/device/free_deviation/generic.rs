@@ -124,6 +124,7 @@ impl<const N: usize> Constants<paritysim_simd::f64x4, N> {
                 b2: v(&|d| d.drive.b2),
                 mass: v(&|d| d.drive.mass),
                 dual: mask(&|d| d.drive.dual),
+                lossless: devices.iter().all(|d| d.drive.lossless),
             },
             wings: [wing(0), wing(1)],
         }

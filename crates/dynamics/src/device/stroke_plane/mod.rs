@@ -405,9 +405,7 @@ impl Device {
         let x_ddot: [f64; N] = step.x_ddot.into();
         // The drive's rows on x and ẋ: the constant ones of a linear undamped drive, else
         // `J⁻ᵀ (∂Q/∂q) J⁻¹` at the state's q and `J⁻ᵀ (∂Q/∂q̇) J⁻¹`.
-        let (drive_rows, drive_rate_rows) = if lean.linear_drive {
-            (lean.drive_rows, [[0.0; N]; 2])
-        } else {
+        let lossy_rows = (!lean.linear_drive).then(|| {
             let strokes = Vector2::new(step.wings[0].angles.0, step.wings[1].angles.0);
             let q = lean.inverse * strokes;
             let [s1, s2] = self.drive.slope([q.x, q.y]);
@@ -419,7 +417,8 @@ impl Device {
                 })
             };
             (on(s1, s2), on(d1, d2))
-        };
+        });
+        let drive_rows = lossy_rows.as_ref().map_or(&lean.drive_rows, |rows| &rows.0);
         // ∂ẍ = Sᵀ B⁻¹ [∂f − (∂B) (φ̈, ψ̈)] per wing on [∂x | ∂ẋ] (see the module).
         let mut jacobian = SMatrix::<f64, N, { 2 * N }>::zeros();
         let z = Vector3::z();
@@ -491,10 +490,12 @@ impl Device {
                 local[0][j] = f_phi[0] * rj + (f_phi[1] - dm_phi) * sj + drive_rows[w][j];
                 local[1][j] = f_psi[0] * rj + (f_psi[1] - dm_psi) * sj;
                 local[0][N + j] = f_phi[2] * rj + f_phi[3] * sj;
-                if !lean.linear_drive {
-                    local[0][N + j] += drive_rate_rows[w][j];
-                }
                 local[1][N + j] = f_psi[2] * rj + f_psi[3] * sj;
+            }
+            if let Some((_, rate_rows)) = &lossy_rows {
+                for j in 0..N {
+                    local[0][N + j] += rate_rows[w][j];
+                }
             }
             let [b00, b01, b11] = step.inverse_blocks[w];
             for j in 0..2 * N {
