@@ -354,3 +354,28 @@ def test_sensitivities_by_the_new_terms_equal_the_resonance_curve_derivatives() 
     assert derivative("work_actuator_per_cycle", "actuator.damping") == pytest.approx(math.pi * w * force**2 * (d - 2 * (b1 * w) ** 2) / d**2, rel=1e-5)
     assert derivative("work_actuator_per_cycle", "actuator.mass_mg") == pytest.approx(2 * math.pi * b1 * w**3 * force**2 * k / d**2, rel=1e-5)
     assert derivative("left_stroke_amplitude", "actuator.mass_mg") == pytest.approx(a * w * w * k / d, rel=1e-3)
+
+
+def test_bimorph_effective_mass_is_rayleighs() -> None:
+    """A uniform cantilever without extension reflects 33/140 of its mass to its tip (Rayleigh
+    with the static shape w ∝ 3L x² − x³); a rigid extension moves the output point further per
+    unit of beam motion, so less; a taper that thins the tip lowers it too. `from_laminate(mass=True)`
+    puts it in `mass_mg` with the laminate's stiffness and force per volt."""
+    from paritysim import laminate as lam
+
+    uniform = lam.Bimorph(lam.Layup.bimorph_wood(), length=9.0, base_width=2.0)
+    assert uniform.effective_mass == pytest.approx(33 / 140 * uniform.active_mass, rel=1e-6)
+    extended = lam.Bimorph(lam.Layup.bimorph_wood(), length=9.0, extension=4.0, base_width=2.0)
+    # Closed form with extension e: w = (L+e) x²/2 − x³/6, δ = w(L) + w'(L) e.
+    L, e = 9.0, 4.0
+    x = np.linspace(0.0, L, 200001)
+    w = (L + e) * x**2 / 2 - x**3 / 6
+    delta = (L + e) * L**2 / 2 - L**3 / 6 + ((L + e) * L - L**2 / 2) * e
+    expected = extended.active_mass * np.trapezoid((w / delta) ** 2, x) / L
+    assert extended.effective_mass == pytest.approx(expected, rel=1e-6)
+    assert extended.effective_mass < uniform.effective_mass
+    tapered = lam.Bimorph(lam.Layup.bimorph_wood(), length=9.0, base_width=2.0, width_ratio=0.5)
+    assert tapered.effective_mass < 33 / 140 * tapered.active_mass
+    a = ps.Actuator.from_laminate(extended, mass=True, damping=2.0)
+    assert a.mass_mg == extended.effective_mass and a.damping == 2.0
+    assert a.stiffness == pytest.approx(extended.stiffness) and a.force_per_volt == pytest.approx(abs(extended.force_per_volt))

@@ -600,6 +600,27 @@ class Bimorph:
         return float(self._data["active_mass"])
 
     @property
+    def effective_mass(self) -> float:
+        """The active part's mass reflected to the output point (mg): Rayleigh's estimate
+        ``m_eff = ∫ μ(x) (w(x) / δ)² dx`` with the static deflection shape ``w`` under a force at
+        the end of the rigid, massless extension (curvature ``M(x) / (D b(x))``, linear taper
+        ``b(x)``, ``μ ∝ b``), ``δ = w(L) + w'(L) L_ext``. A uniform cantilever without extension
+        gives the classical ``33/140`` of its mass. What ``actuator.mass_mg`` takes
+        (:meth:`paritysim.Actuator.from_laminate` with ``mass=True``)."""
+        n = 4001
+        x = np.linspace(0.0, self.length, n)
+        width = 1.0 + (self.width_ratio - 1.0) * x / self.length  # relative to the base
+        curvature = (self.length + self.extension - x) / width  # M / (D b), D and F cancel
+        dx = x[1] - x[0]
+        slope = np.concatenate(([0.0], np.cumsum(0.5 * (curvature[1:] + curvature[:-1]) * dx)))
+        w = np.concatenate(([0.0], np.cumsum(0.5 * (slope[1:] + slope[:-1]) * dx)))
+        delta = w[-1] + slope[-1] * self.extension
+        shape = width * (w / delta) ** 2
+        mean_width = 0.5 * (1.0 + self.width_ratio)
+        integral = float(np.sum(0.5 * (shape[1:] + shape[:-1]) * dx))
+        return self.active_mass * integral / (mean_width * self.length)
+
+    @property
     def tip_width(self) -> float:
         """Width at the end of the active part, mm."""
         return float(self._data["tip_width"])

@@ -233,12 +233,13 @@ class Spring(_Node):
 @_from_core
 class Springs(_Node):
     """The six shoulder joint springs by joint: ``stroke`` (γ1 = φ), ``passive_s2``, ``passive_s3``,
-    ``deviation`` (γ4 = θ), ``wing_deviation`` (γ5 = θ_w), ``hinge`` (γ6 = ψ)."""
+    ``deviation`` (γ4 = θ), ``wing_deviation`` (γ5 = θ_w), ``hinge`` (γ6 = ψ); and the hinge's
+    viscous damping ``hinge_damping`` bψ (mN·mm·ms/rad)."""
 
     @classmethod
     def from_joints(cls, springs: Any) -> Springs:
         """From six springs in joint order (the old list form)."""
-        names = [f.name for f in dataclasses.fields(cls)]  # type: ignore[arg-type]
+        names = [f.name for f in dataclasses.fields(cls) if f.name != "hinge_damping"]  # type: ignore[arg-type]
         springs = list(springs)
         if len(springs) != len(names):
             from ._errors import invalid
@@ -568,18 +569,22 @@ class Actuator(_Node):
     with ``stiffness`` (mN/mm). ``dc_offset``: ``as_force`` or ``ignore`` (docs/errata.md#14)."""
 
     @classmethod
-    def from_laminate(cls, bimorph: Any, waveform: Waveform | None = None, dc_offset: str | None = None) -> Actuator:
+    def from_laminate(cls, bimorph: Any, waveform: Waveform | None = None, dc_offset: str | None = None, mass: bool = False, **fields: Any) -> Actuator:
         """An actuator whose constants come from laminate plate theory.
 
         ``bimorph`` is a :class:`paritysim.laminate.Bimorph` (or anything with ``stiffness`` in
-        mN/mm and ``force_per_volt`` in mN/V, e.g. ``ActuatorConstants``).
+        mN/mm and ``force_per_volt`` in mN/V, e.g. ``ActuatorConstants``). ``mass=True`` also
+        sets ``mass_mg`` to the bimorph's ``effective_mass`` (its active mass reflected to the
+        output point by Rayleigh's method); other fields (``damping``, ...) pass through.
         """
+        if mass:
+            fields = {"mass_mg": float(bimorph.effective_mass), **fields}
         stiffness = getattr(bimorph, "stiffness", None)
         force = getattr(bimorph, "force_per_volt", None)
         if stiffness is None or force is None:  # ActuatorConstants
             stiffness, force = bimorph.stiffness_mn_per_mm, bimorph.force_per_volt_mn_per_v
         # The sign of d31 only sets the direction of q1; the engine takes the magnitude.
-        return cls(waveform=waveform or Waveform(), force_per_volt=abs(float(force)), stiffness=float(stiffness), **({} if dc_offset is None else {"dc_offset": dc_offset}))  # type: ignore[arg-type]
+        return cls(waveform=waveform or Waveform(), force_per_volt=abs(float(force)), stiffness=float(stiffness), **({} if dc_offset is None else {"dc_offset": dc_offset}), **fields)  # type: ignore[arg-type]
 
     @classmethod
     def from_blocked_force(
