@@ -379,3 +379,60 @@ def test_bimorph_effective_mass_is_rayleighs() -> None:
     a = ps.Actuator.from_laminate(extended, mass=True, damping=2.0)
     assert a.mass_mg == extended.effective_mass and a.damping == 2.0
     assert a.stiffness == pytest.approx(extended.stiffness) and a.force_per_volt == pytest.approx(abs(extended.force_per_volt))
+
+
+@pytest.mark.parametrize(("tau2", "volts", "hz"), [(0.0, 60.0, 120.0), (25.0, 80.0, 150.0)])
+def test_one_wing_with_mass_and_losses_equals_an_independent_scipy_integration(tau2: float, volts: float, hz: float) -> None:
+    """The one-wing device (`single_linear`, φ = P(σ) = τ1 σ + τ2 σ³/3, σ = −q1) with an
+    actuator of mass `m`, damping `b1` and cubic stiffness `K1c`. Lagrange's equation in σ,
+    written here from scratch: `(I P'² + m) σ̈ + I P' P'' σ̇² = −F − K1 σ − K1c σ³ − b1 σ̇
+    + P' (τ_aero − k_s φ)`; solve_ivp (DOP853) from rest against the engine's steady state."""
+    from scipy.integrate import solve_ivp
+
+    inertia, omega_c, k_stroke, fpv, k1, tau1 = 60.0, 10.0 * 3.46, 5.0, 1.2, 300.0, 2.67
+    mass, b1, k1c = 25.0, 6.0, 2.0e3
+    wing = ps.devices.load("sreetharan2012_3_3_parity").to_dict()["wings"][0]
+    wing["inertia"] = [[inertia, 0.0, 0.0], [0.0, inertia, 0.0], [0.0, 0.0, 3.0]]
+    wing["aero"] = {"kind": "stroke_drag", "omega1": 10.0, "coefficient": 3.46}
+    wing["springs"]["stroke"]["stiffness"] = k_stroke
+    spec = ps.Simulation.from_dict(
+        {
+            "wings": [wing],
+            "configuration": {"name": "single_wing_fixed"},
+            "drivetrain": {"kind": "single_linear", "transmission_ratio": tau1, "cubic_ratio": tau2},
+            "actuator": {
+                "force_per_volt": fpv,
+                "stiffness": k1,
+                "mass_mg": mass,
+                "damping": b1,
+                "cubic_stiffness": k1c,
+                "waveform": {"kind": "sine", "amplitude_v": volts, "frequency_hz": hz},
+            },
+            "options": {"rtol": 1e-10, "atol": 1e-12, "steady_tol": 1e-9, "samples_per_cycle": 4000},
+        }
+    )
+    omega = 2.0 * math.pi * hz / 1000.0
+
+    def rhs(t: float, y: np.ndarray) -> list[float]:
+        s, v = y
+        p1, p2 = tau1 + tau2 * s * s, 2.0 * tau2 * s
+        phi = tau1 * s + tau2 * s**3 / 3.0
+        phi_dot = p1 * v
+        aero = -omega_c * phi_dot * abs(phi_dot)
+        force = fpv * volts * math.sin(omega * t)
+        drive = -force - k1 * s - k1c * s**3 - b1 * v
+        return [v, (drive + p1 * (aero - k_stroke * phi) - inertia * p1 * p2 * v * v) / (inertia * p1 * p1 + mass)]
+
+    period = 1000.0 / hz
+    cycles = 60
+    sol = solve_ivp(rhs, (0.0, cycles * period), [0.0, 0.0], method="DOP853", rtol=1e-11, atol=1e-13, dense_output=True)
+    assert sol.success
+    amplitudes = []
+    for k in (cycles - 2, cycles - 1):
+        s = sol.sol(np.linspace(k * period, (k + 1) * period, 20001))[0]
+        phi = tau1 * s + tau2 * s**3 / 3.0
+        amplitudes.append(0.5 * (phi.max() - phi.min()))
+    assert abs(amplitudes[0] - amplitudes[1]) < 1e-8 * amplitudes[1]
+    result = ps.simulate(spec)
+    assert result.converged
+    assert result.metrics["wing_stroke_amplitude"] == pytest.approx(amplitudes[1], rel=1e-6)

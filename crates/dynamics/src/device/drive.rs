@@ -14,8 +14,8 @@ use super::DeviceSpec;
 /// `m` (mg) on `q1`; and whether the drivetrain is dual (one actuator per wing: `K1`, `K1c`,
 /// `b1` and `m` on both drives, no balance spring). One device, or one device per lane.
 ///
-/// Every term beyond `K1`, `K2`, `P` defaults to zero, and then the load is today's to the bit
-/// (the added terms are `±0`).
+/// Every term beyond `K1`, `K2`, `P` defaults to zero, and then the load takes its previous
+/// expression (`lossless`): today's results to the bit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct DriveSprings<R: Real> {
     pub(crate) k1: R,
