@@ -40,7 +40,7 @@ CONFIGURATIONS = [
 def _wing(key: str, hinge_k0: float, hinge_k2: float, deviation_stiffness: float) -> Wing:
     w = aero.TABLE_3_3[key]
     springs = Springs(deviation=Spring(stiffness=deviation_stiffness))  # joint 4 = θ
-    blade = dataclasses.replace(s34._wing(key, hinge_k0, "dickinson1999").aero)  # type: ignore[arg-type]
+    blade = dataclasses.replace(s34._wing(key, hinge_k0, s34.params()).aero)  # type: ignore[arg-type]
     return Wing.from_moments(w["ixx"], w["iyy"], w["izz"], w["ixz"], springs=springs, aero=blade, tunable_hinge=TunableHinge(hinge_k0, 0.0, hinge_k2))
 
 
