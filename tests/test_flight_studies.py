@@ -23,7 +23,7 @@ def _device(drivetrain: str = "PARITY", right: str = "left", left: str = "left",
     """The §3.4 device with Table 3.3 wings by key (``"left"``, ``"right_1cut"``...)."""
     p = s34.params()
     spec = s34.device(p, drivetrain, "Uncut", hinge=HINGE)
-    wings = {w: s34._wing(w, HINGE, p.model) for w in {left, right}}
+    wings = {w: s34._wing(w, HINGE, p) for w in {left, right}}
     spec = spec.replace(wings=(wings[left], wings[right]))
     return spec.with_paths({"drivetrain.arm_ratio": arm_ratio}) if drivetrain == "PARITY" else spec
 
