@@ -32,9 +32,10 @@ import numpy as np
 
 import paritysim as ps
 
-T_RATIO, ARM, INERTIA, C, OMEGA_R = 2.5, 2.5, 29.0, 1.0, 31.3
-K1, FORCE_PER_VOLT, AMPLITUDE_V, FREQUENCY_HZ = 467.0, 1.2, 100.0, 110.0
-METRICS = ("delta_tau_peak", "tau_r_peak", "tau_l_peak", "imbalance_instantaneous_pct", "imbalance_peak_pct")
+# The §3.3 device, its constants and its spec are vs_jax's (one definition of the benchmark device).
+from vs_jax import AMPLITUDE_V, ARM, FORCE_PER_VOLT, FREQUENCY_HZ, INERTIA, K1, METRICS, OMEGA_R, T_RATIO, C
+from vs_jax import spec as _device_spec
+
 PARAMS = (
     "wings[0].aero.omega1",
     "wings[1].aero.omega1",
@@ -48,16 +49,7 @@ PARAMS = (
 
 
 def spec(rtol: float, samples: int) -> ps.Simulation:
-    def wing(omega: float) -> ps.Wing:
-        return ps.Wing(inertia=((INERTIA, 0, 0), (0, INERTIA, 0), (0, 0, 1.0)), aero=ps.Aero(omega1=omega, coefficient=C))
-
-    return ps.Simulation(
-        wings=(wing(OMEGA_R), wing(OMEGA_R)),
-        configuration=ps.Configuration("drag_parity_fixed"),
-        drivetrain=ps.Drivetrain.linear_differential(T_RATIO, ARM, balance_spring=0.0),
-        actuator=ps.Actuator(ps.Waveform(amplitude_v=AMPLITUDE_V, frequency_hz=FREQUENCY_HZ), FORCE_PER_VOLT, K1),
-        options=ps.Options(rtol=rtol, atol=rtol * 1e-2, samples_per_cycle=samples),
-    )
+    return _device_spec(rtol=rtol, atol=rtol * 1e-2, samples=samples)
 
 
 def grid_points(n: int) -> tuple[np.ndarray, np.ndarray]:
