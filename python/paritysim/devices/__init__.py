@@ -9,7 +9,9 @@ spec = ps.devices.load("sreetharan2012_3_3_parity")  # §3.3 Drag PARITY, Contro
 ps.devices.info("sreetharan2012_3_3_parity")         # what the thesis states, what we chose
 ```
 
-Names are ``sreetharan2012_<section>_<drivetrain>[_<trial>]``. Each file is a plain spec
+Names are ``sreetharan2012_<section>_<drivetrain>[_<trial>]`` for the thesis' devices;
+``robobee_dual_linear`` is a RoboBee-class vehicle (one linear drive per wing) whose values cite
+published sources or say they are representative estimates (``info(...).stated_in``). Each file is a plain spec
 (`paritysim.load_spec` reads `path`); its header and `info` list which values
 the thesis states (with § or table) and which are our choices, and why.
 
@@ -45,9 +47,10 @@ class DeviceInfo:
     stated: tuple[str, ...]
     choices: tuple[str, ...]
     cut_wings: bool
+    stated_in: str = "the thesis"
 
     def __str__(self) -> str:
-        lines = [f"{self.name}: {self.title} ({self.section})", "Stated in the thesis:"]
+        lines = [f"{self.name}: {self.title} ({self.section})", f"Stated in {self.stated_in}:"]
         lines += [f"  - {s}" for s in self.stated]
         lines += ["Our choices and why:"]
         lines += [f"  - {c}" for c in self.choices]
@@ -82,7 +85,7 @@ def path(name: str) -> Path:
 def info(name: str) -> DeviceInfo:
     """The provenance of device ``name``: thesis statements, our choices, cut-wing robustness."""
     e = _index()[_check(name)]
-    return DeviceInfo(name, e["title"], e["section"], tuple(e["stated"]), tuple(e["choices"]), bool(e["cut_wings"]))
+    return DeviceInfo(name, e["title"], e["section"], tuple(e["stated"]), tuple(e["choices"]), bool(e["cut_wings"]), e.get("stated_in", "the thesis"))
 
 
 def load(name: str) -> Simulation:
