@@ -15,7 +15,9 @@ offset must act as a force: a spec with ``dc_offset = "ignore"`` (the §3.4 piez
 trimmed with ``dc_offset = "as_force"`` and the offset starting from 0 V, so the trimmed DC is
 the force-producing part of the drive. With a Drag PARITY drivetrain add
 ``"drivetrain.arm_ratio"`` (the whippletree pivot, q3 of eq. 5.1) and the ``"yaw"`` equation to
-trim the lift asymmetry too.
+trim the lift asymmetry too; with a drive per wing (``dual_linear``, ``dual_four_bar``) add
+``"actuator.side_gain[0]"`` (the left drive's gain) instead. Trim needs lift: a wing with
+``stroke_drag`` aerodynamics (eq. 2.16) or none is refused, naming ``wings[i].aero.kind``.
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ EQUATIONS = {"lift": "lift_mean", "roll": "body_torque_roll_mean", "yaw": "body_
 
 #: Knobs the default trim uses, with their bounds.
 AMPLITUDE, OFFSET = "actuator.waveform.amplitude_v", "actuator.waveform.offset_v"
-_BOUNDS = {AMPLITUDE: (1e-3, 1e4), OFFSET: (-1e4, 1e4), "drivetrain.arm_ratio": (0.05, 20.0)}
+_BOUNDS = {AMPLITUDE: (1e-3, 1e4), OFFSET: (-1e4, 1e4), "drivetrain.arm_ratio": (0.05, 20.0), "actuator.side_gain[0]": (0.0, 1e3), "actuator.side_gain[1]": (0.0, 1e3)}
 
 
 @dataclass(frozen=True)
@@ -109,6 +111,11 @@ def _metrics(spec: Simulation, deadline: Any = None) -> dict[str, float]:
         m = deadline.run(simulate, spec, record_cycles=1, steady_state="transient", progress=False).metrics
     else:
         m = simulate(spec, record_cycles=1, steady_state="transient", progress=False).metrics
+    missing = [metric for metric in EQUATIONS.values() if metric not in m]
+    if missing:  # a device whose clamped run reports no lift or body torque
+        from .._errors import invalid
+
+        raise invalid("spec", spec.name, f"a device whose clamped run reports {', '.join(missing)} (trim's residuals)")
     return {name: float(m[metric]) if m[metric] is not None else math.nan for name, metric in EQUATIONS.items()}
 
 
@@ -153,8 +160,9 @@ def trim(
     Raises
     ------
     InvalidParameterError
-        Unknown knob path or equation name, a spec without an actuator, or a drive the model
-        rejects (the message names the field).
+        Unknown knob path or equation name, a spec without an actuator, a wing without lift
+        (``wings[i].aero.kind`` stroke_drag or none), or a drive the model rejects (the message
+        names the field).
     """
     from .._errors import finite_reals, invalid, real, suggest, whole
 
@@ -185,6 +193,16 @@ def trim(
             raise invalid("equations", repr(e), suggest(str(e), EQUATIONS, what="an equation"))
     if not knobs or len(equations) < len(knobs):
         raise invalid("equations", len(equations), f"at least one equation per knob ({len(knobs)} knobs)")
+    for i, wing in enumerate(spec.wings):
+        # Trim balances the cycle-mean lift against the weight: a wing without a lift model
+        # (eq. 2.16's stroke drag, or none) makes no lift, and the clamped run reports none.
+        kind = None if wing.aero is None else wing.aero.kind
+        if kind is None or kind == "stroke_drag":
+            raise invalid(
+                f"wings[{i}].aero.kind",
+                repr(kind),
+                "an aerodynamic model with lift (blade_element, whitney_wood2010, ...): trim balances lift against weight, and a stroke_drag wing (eq. 2.16) or a wing without aero makes no lift",
+            )
     clamped, body = _clamped(spec)
     weight, radius = _weight(body)
     scales = {e: (weight if e == "lift" else weight * radius) for e in EQUATIONS}
