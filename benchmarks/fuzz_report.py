@@ -2,7 +2,11 @@
 
 Every public function of ``paritysim`` (specs and files, simulate with and without a Python
 controller, sweeps with checkpoints and executors, calibrate, flight, continuation, stability,
-aero, kinematics, planform, laminate, devices), every CLI command, file and concurrency faults
+aero, kinematics, planform, laminate, devices; the session 13-14 surface: one-wing and per-wing
+linear drives, polynomial transmissions, the drive's losses, Whitney & Wood aerodynamics,
+datasheet and laminate actuators, planform wings and scaling, ``calibrate(data=...)`` and
+``measured``, sensitivity, optimize with SLSQP/trust-constr/IPOPT, ``floquet(orbit_cycles=)``,
+``paritysim optimize``/``reproduce``), every CLI command, file and concurrency faults
 (two sweeps sharing a checkpoint, a process-pool executor) and Ctrl-C during the long calls.
 Each case runs in a worker process with a memory limit (``RLIMIT_AS``: what the worker maps
 after importing plus ``--memory-gb``) and a time limit (``--time-limit``): a worker that dies
@@ -100,6 +104,17 @@ class Gen:
 
 # ------------------------------------------------------------------ the cases
 
+#: The spec paths of the session 13-14 surface, each with a typical value (a list: valid names).
+NEW_PATHS: list[tuple[str, Any]] = [
+    ("drivetrain.higher_odd_ratios", None), ("drivetrain.transmission_ratio", 2.67), ("drivetrain.cubic_ratio", 5.0),
+    ("drivetrain.balance_damping", 0.3), ("drivetrain.balance_cubic", 10.0), ("actuator.mass_mg", 30.0), ("actuator.damping", 2.0),
+    ("actuator.cubic_stiffness", 1e3), ("wings[*].springs.hinge_damping", 0.2), ("wings[0].springs.hinge_damping", 0.2),
+    ("wings[*].aero.omega5", -3.0), ("wings[*].aero.omega6", 0.6), ("wings[*].aero.omega7", 2.9), ("wings[*].aero.omega8", -1.0),
+    ("wings[*].aero.rotational_lift", 1.0), ("wings[*].aero.translational_added_mass", 1.0), ("wings[*].aero.rotational_added_mass", 1.0),
+    ("wings[*].aero.kind", ["whitney_wood2010", "blade_element", "stroke_drag"]), ("wings[*].aero.model", ["whitney_wood2010", "dickinson1999"]),
+    ("drivetrain.kind", ["single_linear", "dual_linear"]), ("actuator.waveform.amplitude_v", 80.0),
+]  # fmt: skip
+
 SMALL = {"min_cycles": 1, "max_cycles": 4, "samples_per_cycle": 24, "record_cycles": 1, "max_wall_ms": 10_000.0}
 
 
@@ -107,7 +122,25 @@ def _specs(ps: Any) -> dict[str, Any]:
     def small(name: str) -> Any:
         return ps.load_spec(EXAMPLES / name).with_paths({f"options.{k}": v for k, v in SMALL.items()})
 
-    return {"hmf": small("hmf.toml"), "parity": small("drag_parity.toml"), "flight": small("free_flight.toml")}
+    specs = {"hmf": small("hmf.toml"), "parity": small("drag_parity.toml"), "flight": small("free_flight.toml")}
+    opts = {f"options.{k}": v for k, v in SMALL.items()}
+    # The one-wing device (issue 35): a stroke-only wing on one linear drive, cubic transmission.
+    one = ps.devices.load("sreetharan2012_3_3_parity").to_dict()
+    wing = one["wings"][0]
+    wing["aero"] = {"kind": "stroke_drag", "omega1": 10.0, "coefficient": 3.46}
+    one.update(wings=[wing], configuration={"name": "single_wing_fixed"}, drivetrain={"kind": "single_linear", "transmission_ratio": 2.67, "cubic_ratio": 5.0})
+    one["actuator"].update(mass_mg=20.0, damping=1.0, cubic_stiffness=500.0)
+    specs["one_wing"] = ps.Simulation.from_dict(one).with_paths(opts)
+    # One linear drive per wing, with an odd polynomial transmission.
+    dual = specs["hmf"].to_dict()
+    dual["drivetrain"] = {"kind": "dual_linear", "transmission_ratio": 2.67, "cubic_ratio": 5.0, "higher_odd_ratios": [1.0]}
+    specs["dual"] = ps.Simulation.from_dict(dual)
+    # Whitney & Wood 2010 aerodynamics from a planform, and the drive's losses.
+    ww = ps.Wing.from_planform(ps.Planform.hmf_like(), mass_mg=0.5, aero_model=ps.Aero(kind="whitney_wood2010"), hinge=2.0).aero  # type: ignore[call-arg]
+    parity = specs["parity"]
+    specs["ww"] = parity.replace(wings=tuple(w.replace(aero=ww) for w in parity.wings))
+    specs["lossy"] = parity.with_paths({"actuator.mass_mg": 30.0, "actuator.damping": 2.0, "actuator.cubic_stiffness": 1e3, "drivetrain.balance_damping": 0.3, "drivetrain.balance_cubic": 10.0, "wings[*].springs.hinge_damping": 0.2})
+    return specs
 
 
 class Cases:
@@ -300,19 +333,26 @@ class Cases:
         return lambda: self.ps.calibrate(spec, targets, free, **kwargs)
 
     def gradients(self, g: Gen) -> Callable[[], Any]:
-        spec = self.specs["hmf"]
-        valid = ["actuator.waveform.amplitude_v", "actuator.frequency_hz", "actuator.stiffness", "wings[*].aero.omega1"]
+        key = g.rng.choice(["hmf", "hmf", "one_wing", "lossy", "ww"])
+        spec = self.specs[key]
+        valid = ["actuator.waveform.amplitude_v", "actuator.frequency_hz", "actuator.stiffness", "actuator.mass_mg", "actuator.damping", "actuator.cubic_stiffness"]
+        valid += {"hmf": ["wings[*].aero.omega1"], "one_wing": ["drivetrain.cubic_ratio", "drivetrain.transmission_ratio"], "lossy": ["drivetrain.balance_damping", "drivetrain.balance_cubic", "wings[*].springs.hinge_damping"], "ww": ["wings[*].aero.rotational_lift", "wings[*].aero.omega5"]}[key]
         params = g.rng.choice([[g.name(valid)], [g.name(valid), g.name(valid)], "actuator.stiffness", [], 3, [None], ["drivetrain.kind"], ["options.samples_per_cycle"]])
         metrics = g.rng.choice([None, ["left_stroke_amplitude"], ["bogus"], "lift_mean", 3, []])
         kwargs = g.rng.choice([{}, {"rtol": g.num(1e-9)}, {"max_wall_ms": g.num(5000.0)}, {"samples_per_cycle": g.int(100)}, {"progress": g.rng.choice([True, "no", None])}])
-        k = g.rng.randrange(3)
+        k = g.rng.randrange(4)
         if k == 1:
             bounds = g.rng.choice([{"actuator.waveform.amplitude_v": (g.num(60.0), g.num(120.0))}, {"actuator.stiffness": (1, 0)}, {"bogus": (0, 1)}, {}, 3])
             constraints = g.rng.choice([[], ["left_stroke_amplitude >= 0.5"], ["bogus <= 1"], ["left_stroke_amplitude >="], "abs(yaw_total_mean) <= 0.1", [3], ["__import__('os') <= 1"]])
             objective = g.rng.choice(["actuator_power_mean", "bogus", 3, None, "left_stroke_amplitude"])
-            return lambda: self.ps.optimize(spec, objective=objective, params=bounds, constraints=constraints, max_iterations=g.int(3), progress=False)
+            method = g.name(["SLSQP", "trust-constr", "ipopt", "ipopt"])
+            extra = g.rng.choice([{}, {}, {"x0": {"actuator.waveform.amplitude_v": g.num(90.0)}}, {"stability": g.num(0.98)}, {"sense": g.name(["min", "max"])}, {"tol": g.num(1e-6)}, {"rtol": g.num(1e-9)}])
+            return lambda: self.ps.optimize(spec, objective=objective, params=bounds, constraints=constraints, method=method, max_iterations=g.int(3), progress=False, **extra)
         if k == 2:
-            return lambda: self.ps.sweep(spec, {"actuator.waveform.amplitude_v": [80.0, 100.0]}, metrics=["left_stroke_amplitude"], gradients=params, progress=False)
+            metric = "wing_stroke_amplitude" if key == "one_wing" else "left_stroke_amplitude"
+            return lambda: self.ps.sweep(spec, {"actuator.waveform.amplitude_v": [80.0, 100.0]}, metrics=[metric], gradients=params, progress=False)
+        if k == 3:
+            return lambda: self.ps.stability.floquet(spec, orbit_cycles=g.int(1), max_newton=g.int(5))
         return lambda: self.ps.sensitivity(spec, params, metrics=metrics, **{"progress": False, **kwargs})
 
     def flight(self, g: Gen) -> Callable[[], Any]:
@@ -444,6 +484,153 @@ class Cases:
         index = g.rng.choice([0, 1, -1, 2, "a", None, 2.0]) if g._bad() else 0
         return lambda: self.ps.dynamics.wing_terms(spec, g.array(0, 0.3, 3) if g._bad() else [0.2, 0.05, 0.1], [g.num(1.0), 0.0, g.num(0.5)], index=index)
 
+    # -- the surface of sessions 13-14: per-wing drives, polynomial transmissions, drive
+    # losses, Whitney & Wood aerodynamics, datasheet/laminate actuators, planform wings,
+    # table calibration
+    def drive_spec(self, g: Gen) -> Callable[[], Any]:
+        """The new spec fields, mutated by path (or as a drivetrain table), then run."""
+        key = g.rng.choice(["one_wing", "dual", "ww", "lossy"])
+        spec = self.specs[key]
+        values: dict[str, Any] = {}
+        for _ in range(g.rng.choice([1, 1, 2, 3])):
+            path, typical = g.rng.choice(NEW_PATHS)
+            if path == "drivetrain.higher_odd_ratios":
+                values[path] = g.rng.choice([[NAN], "x", [1e308], [], [0.1] * 50, [[1.0]], None, [1.0, -2.0], {"a": 1}, [INF]]) if g._bad() else [g.num(1.0)]
+            elif isinstance(typical, list):
+                values[path] = g.name(typical)
+            else:
+                values[path] = g.num(typical)
+        k = g.rng.randrange(6)
+        if k == 0:
+            d = spec.to_dict()
+            table = g.rng.choice([
+                {"kind": g.name(["single_linear", "dual_linear"])},
+                {"kind": "single_linear", "transmission_ratio": g.num(2.67), "cubic_ratios": 1.0},
+                {"kind": "dual_linear", "transmission_ratio": g.num(2.67), "higher_odd_ratios": g.rng.choice([[g.num(1.0)], "x", 3, [None]])},
+                {"kind": "single_linear", "transmission_ratio": g.num(2.67), "cubic_ratio": g.num(5.0), "balance_damping": g.num(0.3)},
+                None, 3, [],
+            ])  # fmt: skip
+            d["drivetrain"] = table
+            return lambda: self.ps.simulate(self.ps.Simulation.from_dict(d))
+        if k == 1:
+            return lambda: self.ps.stability.floquet(spec.with_paths(values), orbit_cycles=g.int(1), max_newton=5)
+        if k == 2:
+            return lambda: self.ps.sweep(spec, {path: [typical, typical * 1.1] if not isinstance(typical, list) else typical[:2] for path, typical in [g.rng.choice(NEW_PATHS[1:])]}, progress=False, metrics=None)
+        return lambda: self.ps.simulate(spec.with_paths(values))
+
+    def device_ctor(self, g: Gen) -> Callable[[], Any]:
+        """Drivetrain / Actuator / Wing / Planform constructors of the new surface, each checked
+        by a spec that holds it (``validate``) and sometimes run."""
+        ps = self.ps
+        k = g.rng.randrange(9)
+        one, dual = self.specs["one_wing"], self.specs["dual"]
+        odd = lambda: g.rng.choice([None, [g.num(1.0)], "x", [NAN], [[1.0]], 3, [1.0] * 40])  # noqa: E731
+        if k == 0:
+            return lambda: one.replace(drivetrain=ps.Drivetrain.single_linear(g.num(2.67), cubic_ratio=g.num(5.0) if g.rng.random() < 0.6 else None, higher_odd_ratios=odd())).validate().to_dict()["drivetrain"]
+        if k == 1:
+            return lambda: ps.simulate(dual.replace(drivetrain=ps.Drivetrain.dual_linear(g.num(2.67), cubic_ratio=g.num(5.0), higher_odd_ratios=odd()))).metrics
+        if k == 2:
+            fields = g.rng.choice([{}, {"mass_mg": g.num(30.0)}, {"damping": g.num(2.0)}, {"cubic_stiffness": g.num(1e3)}, {"bogus": 1.0}, {"dc_offset": g.name(["as_force", "ignore"])}, {"stiffness": 3.0}])
+            waveform = g.rng.choice([None, None, ps.Waveform(), 3, "x"])
+            return lambda: one.replace(actuator=ps.Actuator.from_blocked_force(g.num(120.0), g.num(0.257), g.num(100.0), waveform=waveform, **fields)).validate().actuator.stiffness
+        if k == 3:
+            from types import SimpleNamespace
+
+            lam = ps.laminate
+            bimorph = g.rng.choice([lam.Bimorph.design_for(), None, 3, "x", SimpleNamespace(stiffness=NAN, force_per_volt=1.0, effective_mass=1.0), SimpleNamespace(stiffness=300.0, force_per_volt="x", effective_mass=-1.0), SimpleNamespace(stiffness_mn_per_mm=300.0, force_per_volt_mn_per_v=1.0)]) if g._bad() else lam.Bimorph.design_for()
+            mass = g.rng.choice([True, False, "yes", None, 1]) if g._bad() else g.rng.choice([True, False])
+            fields = g.rng.choice([{}, {"damping": g.num(2.0)}, {"mass_mg": g.num(5.0)}, {"bogus": 1}])
+            return lambda: one.replace(actuator=ps.Actuator.from_laminate(bimorph, mass=mass, **fields)).validate().actuator.mass_mg
+        if k == 4:
+
+            def effective() -> Any:
+                b = ps.laminate.Bimorph(ps.laminate.Layup.bimorph_mobee(), g.num(10.0), extension=g.num(2.0), base_width=g.num(1.0), width_ratio=g.num(0.5))
+                return {"effective_mass": b.effective_mass, "active_mass": b.active_mass}
+
+            return effective
+        if k == 5:
+            P = ps.Planform
+            planform = g.rng.choice([P.hmf_like(), P.rectangle(15.0, 5.0, 1.0, 0.5), None, 3]) if g._bad() else P.hmf_like()
+            lines = g.rng.choice([(), [("leading_edge", g.num(0.1))], {"leading_edge": g.num(0.1)}, [[0.0, 0.0, 10.0, 0.0, g.num(0.1)]], "x", [[1.0, 2.0]], [("bogus", 1.0)], [[NAN, 0, 1, 0, 1]], self.np.zeros((0, 5))])
+            points = g.rng.choice([(), [[5.0, 0.0, g.num(0.05)]], "x", [[1.0, 2.0]], [[NAN, 0.0, 1.0]], [[1e300, 1e300, 1e300]]])
+            hinge = g.rng.choice([None, g.num(2.0), ps.Spring(stiffness=2.0), ps.TunableHinge(stiffness_at_zero=2.0), "x", -1.0])  # type: ignore[call-arg]
+            model = g.rng.choice([*ps.aero.MODELS, "stroke_drag", ps.Aero(kind="whitney_wood2010"), None, "bogus", 3])  # type: ignore[call-arg]
+            fields = g.rng.choice([{}, {}, {"inertia": 1}, {"bogus": 1}, {"shoulder": 3}, {"aero": None}])
+
+            def wing() -> Any:
+                w = ps.Wing.from_planform(planform, mass_mg=g.num(0.5), line_masses=lines, point_masses=points, hinge=hinge, aero_model=model, air_density_mg_per_mm3=g.num(1.2e-3), **fields)
+                spec = self.specs["parity"]
+                return ps.simulate(spec.replace(wings=(w, w))).metrics if g.rng.random() < 0.3 else w.to_dict()
+
+            return wing
+        if k == 6:
+            p = ps.Planform.hmf_like()
+            kwargs = g.rng.choice([{"factor": g.num(1.2)}, {"span_mm": g.num(16.6)}, {"area_mm2": g.num(40.0)}, {"span_mm": g.num(16.6), "area_mm2": g.num(40.0)}, {"factor": g.num(1.2), "span_mm": 10.0}, {}])
+
+            def scaled() -> Any:
+                q = p.scaled(**kwargs)
+                return {"area": q.area, "span": q.span, **q.omegas(g.num(1.2e-3)), **q.quasi_steady_omegas(g.num(1.2e-3))}
+
+            return scaled
+        if k == 7:
+            fields = {name: g.num(typical) for name, typical in (("omega5", -3.0), ("omega6", 0.6), ("omega7", 2.9), ("omega8", -1.0), ("rotational_lift", 1.0), ("translational_added_mass", 1.0), ("rotational_added_mass", 1.0), ("rotational_damping", 5.0)) if g.rng.random() < 0.4}
+            spec = self.specs["ww"]
+
+            def ww() -> Any:
+                aero = spec.wings[0].aero.replace(**fields)
+                return ps.simulate(spec.replace(wings=(spec.wings[0].replace(aero=aero), spec.wings[1]))).metrics
+
+            return ww
+        return lambda: self.ps.aero.coefficients(g.array(0, 3), model=g.name(["whitney_wood2010", *self.ps.aero.MODELS]))
+
+    def calibrate_table(self, g: Gen) -> Callable[[], Any]:
+        """``ps.calibrate(spec, data=table, params=...)`` and ``ps.measured``."""
+        ps = self.ps
+        if g.rng.random() < 0.2:
+            return lambda: ps.measured(g.name(["left_stroke_amplitude", "lift_mean", "left_rotation_amplitude"]), peak_to_peak=g.rng.choice([True, False, "yes", None]), unit=g.rng.choice([None, "deg", "rad", "bogus", 3]), sigma=g.num(1.0))
+        one = g.rng.random() < 0.5
+        spec = self.specs["one_wing" if one else "hmf"]
+        metric = "wing_stroke_amplitude" if one else "left_stroke_amplitude"
+        volts = [60.0, 80.0, 100.0]
+        data: Any = {"actuator.waveform.amplitude_v": volts, metric: [0.4, 0.5, 0.6]}
+        if g._bad():
+            data = g.rng.choice([
+                {}, {"actuator.waveform.amplitude_v": [], metric: []}, {"actuator.waveform.amplitude_v": volts, metric: [NAN] * 3},
+                {"actuator.waveform.amplitude_v": [60.0, NAN, INF], metric: [0.4, 0.5, 0.6]}, {"actuator.waveform.amplitude_v": volts},
+                {metric: [0.4, 0.5, 0.6]}, {"actuator.waveform.amplitude_v": volts, metric: ["a", "b", "c"]}, {"actuator.waveform.amplitude_v": volts, metric: [0.4]},
+                {"actuator.waveform.amplitude_v": volts, metric: [0.4, None, 0.6]}, {"bogus": volts, metric: [0.4, 0.5, 0.6]}, None, 3, [[1.0, 2.0]], "table.csv",
+                {"actuator.waveform.amplitude_v": [60.0] * 10**5, metric: [0.5] * 10**5}, {"actuator.waveform.amplitude_v": volts, metric: [1e308, -1e308, 0.5]},
+                {"actuator.waveform.amplitude_v": volts, "stroke_pp_deg": [40.0, 50.0, 60.0]}, {"actuator.waveform.amplitude_v": [1e300, 1e300, 1e300], metric: [0.4, 0.5, 0.6]},
+            ])  # fmt: skip
+            if isinstance(data, dict) and g.rng.random() < 0.3:
+                import polars as pl
+
+                try:
+                    data = pl.DataFrame(data, strict=False)
+                except Exception:  # noqa: BLE001 - a table polars itself refuses stays a mapping
+                    pass
+        params: Any = {"actuator.force_per_volt": (g.num(0.5), g.num(2.0))}
+        if g._bad():
+            params = g.rng.choice([{"actuator.force_per_volt": (2.0, 0.5)}, {"actuator.force_per_volt": (NAN, 1.0)}, {"actuator.force_per_volt": 5}, {"bogus": (0, 1)}, {}, [1], None, {"drivetrain.kind": (0, 1)}, {"actuator.waveform.amplitude_v": (10.0, 200.0)}, {"actuator.force_per_volt": (0.5, 2.0, 3.0)}, {"actuator.mass_mg": (-1.0, 1e308)}, {"actuator.damping": (0.0, 5.0), "actuator.mass_mg": (0.0, 50.0)}, {"actuator.force_per_volt": ("a", "b")}])
+        kwargs: dict[str, Any] = {}
+        for name, make in (
+            ("measured", lambda: g.rng.choice([None, {"stroke_pp_deg": ps.measured(metric, peak_to_peak=True, unit="deg")}, {metric: "bogus"}, {metric: 3}, {"missing": metric}, {}, [metric]])),
+            ("holdout", lambda: g.num(0.3)),
+            ("jacobian", lambda: g.name(["auto", "sensitivity", "differences"])),
+            ("x0", lambda: g.rng.choice([{"actuator.force_per_volt": g.num(1.0)}, {"bogus": 1.0}, 3])),
+            ("labels", lambda: g.rng.choice([["bogus"], "x", [3], []])),
+            ("threads", lambda: g.int(1)),
+            ("seed", lambda: g.int(3, 0)),
+            ("diff_step", lambda: g.num(1e-3)),
+            ("xtol", lambda: g.num(1e-6)),
+            ("max_wall_ms", lambda: g.num(20_000.0)),
+        ):
+            if g.rng.random() < 0.15:
+                kwargs[name] = make()
+        kwargs = {"max_nfev": g.int(2) if g.rng.random() < 0.2 else 2, "progress": False, **kwargs}
+        kwargs.setdefault("max_wall_ms", 20_000.0)
+        return lambda: ps.calibrate(spec, data=data, params=params, **kwargs)
+
     # -- the command line
     def cli(self, g: Gen) -> Callable[[], Any]:
         f = self.files
@@ -458,7 +645,8 @@ class Cases:
             ["sweep", str(g.rng.choice([study, f["good"], f["missing"], f["dir"]])), "--out", out, "--quiet", "--threads", str(g.rng.choice([1, 0, -1, "x"]))],
             ["continue", str(g.rng.choice([f["good"], f["missing"], study])), "--out", out],
             ["devices", g.rng.choice(["", "sreetharan2012_3_3_parity", "bogus", "--list"])],
-            ["reproduce", g.rng.choice(["--list", "bogus", "fig2.99"]), "--out", out],
+            ["reproduce", g.rng.choice(["--list", "bogus", "fig2.99", "aero.whitney_wood2010", "aero.whitney_wood2010x"]), "--out", g.rng.choice([out, str(self.tmp / "a_file"), str(self.tmp / "a_file" / "x")]), "--quiet"],
+            ["optimize", str(self._optimize_study(g)), "--out", g.rng.choice([out, str(self.tmp / "a_file")]), "--quiet"],
             [g.rng.choice(["bogus", "--bogus", "run"])],
         ]
         args = [a for a in g.rng.choice(commands) if a != ""]
@@ -468,6 +656,29 @@ class Cases:
             return {"__cli__": [proc.returncode, proc.stderr[-2000:], args]}
 
         return run
+
+    def _optimize_study(self, g: Gen) -> Path:
+        """An optimisation study file (``paritysim optimize``), one entry hostile sometimes."""
+        study = self.tmp / f"optimize_{g.rng.randrange(10**9)}.toml"
+        spec = (EXAMPLES / "hmf.toml").as_posix()
+        entries = {
+            "spec": f'"{spec}"', "objective": '"actuator_power_mean"', "constraints": '["left_stroke_amplitude >= 0.1"]', "method": '"SLSQP"',
+            "max_iterations": "2", "tol": "1e-4",
+        }  # fmt: skip
+        tables = {"params": {'"actuator.waveform.amplitude_v"': "[60.0, 120.0]"}, "options": {k: str(v) for k, v in SMALL.items()}}
+        if g._bad():
+            key = g.rng.choice(["spec", "objective", "constraints", "method", "max_iterations", "tol", "stability", "sense", "bogus", "params", "x0", "set", "options"])
+            bad = g.rng.choice(['"bogus"', "-1", "nan", "inf", "[]", '"x"', "1e308", "true", "{}", '["a >="]', '"ipopt"', '"sreetharan2012_3_4_parity"'])
+            if key in ("params", "x0", "set", "options"):
+                inner = g.rng.choice(['"actuator.waveform.amplitude_v"', '"bogus"', '"drivetrain.kind"', "max_cycles"])
+                tables[key] = {inner: g.rng.choice(["[120.0, 60.0]", "[1.0]", '"x"', "nan", "[nan, 1.0]", "5.0", "[]", "[-1e308, 1e308]"])}
+            else:
+                entries[key] = bad
+        body = "\n".join(f"{k} = {v}" for k, v in entries.items())
+        for name, table in tables.items():
+            body += f"\n[{name}]\n" + "\n".join(f"{k} = {v}" for k, v in table.items())
+        study.write_text(body + "\n")
+        return study
 
     # -- Ctrl-C
     def ctrl_c(self, g: Gen) -> Callable[[], Any]:
@@ -483,6 +694,10 @@ class Cases:
             "continuation": lambda: self.ps.continuation(slow_hmf, "actuator.waveform.frequency_hz", 2e-3, start=1e-3),
             "trim": lambda: self.ps.flight.trim(self.specs["flight"].with_paths({"options.max_cycles": 200, "options.max_wall_ms": 600_000.0})),
             "sensitivity": lambda: self.ps.sensitivity(slow_hmf, ["actuator.waveform.amplitude_v"], progress=False),
+            "calibrate_table": lambda: self.ps.calibrate(slow_hmf, data={"actuator.waveform.amplitude_v": [60.0, 80.0, 100.0, 120.0], "left_stroke_amplitude": [0.4, 0.5, 0.6, 0.7]}, params={"actuator.force_per_volt": (0.5, 2.0)}, progress=False),
+            "optimize": lambda: self.ps.optimize(slow_hmf, params={"actuator.waveform.amplitude_v": (60.0, 120.0)}, progress=False),
+            "optimize_ipopt": lambda: self.ps.optimize(slow_hmf, params={"actuator.waveform.amplitude_v": (60.0, 120.0)}, method="ipopt", progress=False),
+            "sweep_gradients": lambda: self.ps.sweep(slow_hmf, {"actuator.waveform.amplitude_v": [60.0, 80.0]}, gradients=["actuator.stiffness"], threads=2, progress=False),
         }
         name = g.rng.choice(sorted(calls))
         call = calls[name]
@@ -512,10 +727,11 @@ class Cases:
 FAMILIES: dict[str, float] = {
     "spec_mutation": 0.09, "spec_file": 0.05, "spec_dict": 0.04, "spec_misc": 0.03, "simulate": 0.06, "controller": 0.02,
     "sweep": 0.06, "sweep_executor": 0.005, "shared_checkpoint": 0.01, "calibrate": 0.02, "gradients": 0.02, "flight": 0.02, "continuation": 0.015,
-    "stability": 0.1, "aero": 0.1, "kinematics": 0.09, "planform": 0.1, "laminate": 0.07, "dynamics": 0.04, "cli": 0.025, "ctrl_c": 0.015,
+    "stability": 0.1, "aero": 0.1, "kinematics": 0.09, "planform": 0.1, "laminate": 0.07, "dynamics": 0.04, "cli": 0.03, "ctrl_c": 0.02,
+    "drive_spec": 0.06, "device_ctor": 0.06, "calibrate_table": 0.03,
 }  # fmt: skip
 #: Families cheap enough for the CI sample (no subprocess of their own, sub-second cases).
-FAST = ("spec_mutation", "spec_dict", "spec_misc", "simulate", "gradients", "stability", "aero", "kinematics", "planform", "laminate", "dynamics", "sweep")
+FAST = ("spec_mutation", "spec_dict", "spec_misc", "simulate", "gradients", "stability", "aero", "kinematics", "planform", "laminate", "dynamics", "sweep", "drive_spec", "device_ctor", "calibrate_table")
 
 
 def plan(n: int, seed: int, families: tuple[str, ...]) -> list[str]:

@@ -29,6 +29,8 @@ def test_a_seeded_sample_of_the_public_surface_is_clean() -> None:
     assert len(results) == n
     bad = [(r["i"], r["family"], r["outcome"], r.get("detail", "")) for r in results if r["outcome"] in fr.BAD]
     assert not bad, bad
+    # The sample reaches the session 13-14 surface (drives, actuators, wings, table fits, gradients).
+    assert {"drive_spec", "device_ctor", "calibrate_table", "gradients"} <= {r["family"] for r in results}
     outcomes = {r["outcome"] for r in results}
     assert fr.TYPED_FIELD in outcomes and fr.FINITE in outcomes  # the sample exercises both
 

@@ -197,6 +197,10 @@ class TableCalibrationResult:
 # ---------------------------------------------------------------------------- the fit
 
 
+#: Rows per sweep of a table's residual evaluation; the fit's budget is checked between blocks.
+_BLOCK_ROWS = 512
+
+
 def _frame(data: Any) -> pl.DataFrame:
     if isinstance(data, pl.DataFrame):
         return data
@@ -400,11 +404,16 @@ def calibrate_table(
     cache: dict[str, Any] = {}
 
     def run(grid: pl.DataFrame, gradients: bool) -> pl.DataFrame:
-        left = deadline.remaining_ms()
         own = spec.options.max_wall_ms  # type: ignore[attr-defined]
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            df = sweep(spec, grid, metrics=metrics, threads=threads, progress=False, options={"max_wall_ms": left if own is None else min(own, left)}, gradients=names if gradients else ())
+        parts = []
+        # The budget bounds the whole sweep, not only each point: a long table runs in blocks
+        # with the deadline checked between them (a 1e5-row table ran far past max_wall_ms).
+        for start in range(0, max(grid.height, 1), _BLOCK_ROWS):
+            left = deadline.remaining_ms()
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)
+                parts.append(sweep(spec, grid.slice(start, _BLOCK_ROWS), metrics=metrics, threads=threads, progress=False, options={"max_wall_ms": left if own is None else min(own, left)}, gradients=names if gradients else ()))
+        df = parts[0] if len(parts) == 1 else pl.concat(parts, how="vertical_relaxed")
         state["sweeps"] += 1
         bar.done()
         deadline.remaining_ms()

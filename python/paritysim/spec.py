@@ -492,7 +492,7 @@ class Drivetrain(_Tagged):
         ``transmission_ratio`` in rad/mm, τ2 ``cubic_ratio`` in rad/mm³, ``higher_odd_ratios``
         the coefficients of σ⁵, σ⁷, σ⁹): a one-wing device (``configuration = "single_wing_fixed"``)
         or two tied wings (``hmf``, ``hmf_fixed``)."""
-        return cls(kind="single_linear", transmission_ratio=transmission_ratio, cubic_ratio=cubic_ratio, higher_odd_ratios=None if higher_odd_ratios is None else list(higher_odd_ratios))  # type: ignore[call-arg]
+        return cls(kind="single_linear", transmission_ratio=transmission_ratio, cubic_ratio=cubic_ratio, higher_odd_ratios=_odd_ratios(higher_odd_ratios))  # type: ignore[call-arg]
 
     @classmethod
     def dual_linear(cls, transmission_ratio: float, cubic_ratio: float | None = None, higher_odd_ratios: Sequence[float] | None = None) -> Drivetrain:
@@ -500,7 +500,7 @@ class Drivetrain(_Tagged):
         ``φR = P(−q2)`` (RoboBee-class): use with ``configuration = "drag_parity_fixed"`` or
         ``"drag_parity"``; ``actuator.side_gain`` and ``actuator.side_offset_v`` scale each side's
         drive."""
-        return cls(kind="dual_linear", transmission_ratio=transmission_ratio, cubic_ratio=cubic_ratio, higher_odd_ratios=None if higher_odd_ratios is None else list(higher_odd_ratios))  # type: ignore[call-arg]
+        return cls(kind="dual_linear", transmission_ratio=transmission_ratio, cubic_ratio=cubic_ratio, higher_odd_ratios=_odd_ratios(higher_odd_ratios))  # type: ignore[call-arg]
 
     @classmethod
     def linear_differential(cls, transmission_ratio: float, arm_length_mm: float, arm_ratio: float | None = None, balance_spring: float | None = None, balance_preload: float | None = None, cubic_ratio: float | None = None, higher_odd_ratios: Sequence[float] | None = None, **deprecated: float) -> Drivetrain:
@@ -509,7 +509,7 @@ class Drivetrain(_Tagged):
         ``higher_odd_ratios`` make each side's transmission an odd polynomial of its rod-top
         displacement (0 and none: eq. 2.15)."""
         balance_spring = _balance(balance_spring, deprecated)
-        return cls(kind="linear_differential", transmission_ratio=transmission_ratio, arm_length_mm=arm_length_mm, arm_ratio=arm_ratio, balance_spring=balance_spring, balance_preload=balance_preload, cubic_ratio=cubic_ratio, higher_odd_ratios=None if higher_odd_ratios is None else list(higher_odd_ratios))  # type: ignore[call-arg]
+        return cls(kind="linear_differential", transmission_ratio=transmission_ratio, arm_length_mm=arm_length_mm, arm_ratio=arm_ratio, balance_spring=balance_spring, balance_preload=balance_preload, cubic_ratio=cubic_ratio, higher_odd_ratios=_odd_ratios(higher_odd_ratios))  # type: ignore[call-arg]
 
     @classmethod
     def linkage_differential(
@@ -547,6 +547,18 @@ class Drivetrain(_Tagged):
         return self.kinematics().evaluate(np.ascontiguousarray(q1, dtype=np.float64), np.ascontiguousarray(q2, dtype=np.float64))  # type: ignore[no-any-return]
 
 
+def _odd_ratios(value: Any) -> list[Any] | None:
+    """``higher_odd_ratios`` of the drivetrain constructors as a list (None: none); the values
+    themselves are checked with the spec."""
+    if value is None:
+        return None
+    if isinstance(value, str | bytes | Mapping) or not isinstance(value, Sequence | np.ndarray):
+        from ._errors import invalid
+
+        raise invalid("drivetrain.higher_odd_ratios", repr(value)[:60], "None or a list of numbers (τ3, τ4, ... in rad/mm^5, rad/mm^7, ...)")
+    return list(value)
+
+
 def _balance(value: float | None, deprecated: dict[str, float]) -> float | None:
     if "balance_stiffness" in deprecated:
         warnings.warn("balance_stiffness= is deprecated: use balance_spring=", DeprecationWarning, stacklevel=3)
@@ -577,12 +589,22 @@ class Actuator(_Node):
         sets ``mass_mg`` to the bimorph's ``effective_mass`` (its active mass reflected to the
         output point by Rayleigh's method); other fields (``damping``, ...) pass through.
         """
-        if mass:
-            fields = {"mass_mg": float(bimorph.effective_mass), **fields}
+        from ._errors import invalid, real
+
+        _derived_fields("Actuator.from_laminate", fields)
+        if not isinstance(mass, bool):
+            raise invalid("mass", repr(mass)[:60], "True (mass_mg from the bimorph's effective_mass) or False")
         stiffness = getattr(bimorph, "stiffness", None)
         force = getattr(bimorph, "force_per_volt", None)
         if stiffness is None or force is None:  # ActuatorConstants
-            stiffness, force = bimorph.stiffness_mn_per_mm, bimorph.force_per_volt_mn_per_v
+            stiffness, force = getattr(bimorph, "stiffness_mn_per_mm", None), getattr(bimorph, "force_per_volt_mn_per_v", None)
+        if stiffness is None or force is None:
+            raise invalid("bimorph", repr(bimorph)[:60], "a paritysim.laminate.Bimorph (or an object with stiffness in mN/mm and force_per_volt in mN/V)")
+        stiffness, force = real("bimorph.stiffness", stiffness), real("bimorph.force_per_volt", force)
+        if mass:
+            if "mass_mg" in fields:
+                raise invalid("mass_mg", fields["mass_mg"], "left out when mass=True (it is the bimorph's effective_mass)")
+            fields = {"mass_mg": real("bimorph.effective_mass", getattr(bimorph, "effective_mass", None)), **fields}
         # The sign of d31 only sets the direction of q1; the engine takes the magnitude.
         return cls(waveform=waveform or Waveform(), force_per_volt=abs(float(force)), stiffness=float(stiffness), **({} if dc_offset is None else {"dc_offset": dc_offset}), **fields)  # type: ignore[arg-type]
 
@@ -603,10 +625,20 @@ class Actuator(_Node):
         """
         from ._errors import invalid
 
+        _derived_fields("Actuator.from_blocked_force", fields)
         for name, value in (("blocked_force_mn", blocked_force_mn), ("free_deflection_mm", free_deflection_mm), ("voltage_v", voltage_v)):
             if not (isinstance(value, numbers.Real) and math.isfinite(value) and value > 0):
                 raise invalid(name, value, "a finite number > 0")
         return cls(waveform=waveform or Waveform(), force_per_volt=float(blocked_force_mn) / float(voltage_v), stiffness=float(blocked_force_mn) / float(free_deflection_mm), **fields)
+
+
+def _derived_fields(where: str, fields: Mapping[str, Any]) -> None:
+    """Refuses, naming it, an Actuator field that ``where`` computes itself."""
+    from ._errors import invalid
+
+    for name in ("stiffness", "force_per_volt"):
+        if name in fields:
+            raise invalid(name, fields[name], f"left out of {where} (it computes {name})")
 
 
 @_from_core
@@ -622,6 +654,20 @@ class Body(_Node):
     ``free``; mass, inertia, centre of mass, shoulders, gravity, mechanisms, set points and a PD
     controller as plain data (see docs/flight.md)."""
 
+    def __post_init__(self) -> None:
+        # The points of the airframe in [-1e3, 1e3] mm, as its centre of mass: a shoulder at
+        # 1e308 mm ran and failed with a step-size underflow naming no field (the fuzz, seed 34).
+        from ._errors import invalid
+
+        for name in ("shoulders_mm", "wing_center_of_mass_mm"):
+            rows = getattr(self, name, None)
+            if not isinstance(rows, list | tuple):
+                continue
+            for i, row in enumerate(rows):
+                for j, value in enumerate(row if isinstance(row, list | tuple) else ()):
+                    if isinstance(value, numbers.Real) and not isinstance(value, bool) and not (-1e3 <= float(value) <= 1e3):
+                        raise invalid(f"body.{name}[{i}][{j}]", value, "in [-1e3, 1e3] mm")
+
 
 @_from_core
 class Options(_Node):
@@ -631,6 +677,12 @@ class Options(_Node):
 @_from_core
 class Simulation(_Node):
     """A complete, runnable spec: device (wings, configuration, drivetrain, actuator) + options."""
+
+    def __post_init__(self) -> None:
+        if getattr(self, "actuator", None) is not None and getattr(self, "drivetrain", None) is None:
+            from ._errors import invalid
+
+            raise invalid("drivetrain", None, "a drivetrain when an actuator is given (the actuator acts on the wings through it), or no actuator")
 
     @functools.cached_property
     def _json(self) -> str:
