@@ -44,7 +44,7 @@ fn device(values: &[f64]) -> Result<Device> {
 fn sweeps(c: &mut Criterion) {
     let table = Grid::new()
         .axis(
-            "drivetrain.balance_stiffness",
+            "drivetrain.balance_spring",
             (0..8).map(|i| 1.0 + 2.0 * i as f64),
         )
         .and_then(|g| {

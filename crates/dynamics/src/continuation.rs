@@ -10,7 +10,7 @@ use crate::device::{Device, DeviceSpec};
 use crate::integrate::RungeKutta;
 use crate::stability::{
     ShootingOptions, compact_state, drive_period, expand_state, periodic_orbit, stroboscopic_map,
-    with_balance_stiffness,
+    with_balance_spring,
 };
 
 /// `x ↦ P(x; p)` for the device that `build(p)` makes; the state `x` is the compact
@@ -89,14 +89,14 @@ impl<F: Fn(&[f64]) -> Result<Device> + Sync> PeriodMap for DevicePeriodMap<F> {
 /// [`periodic_orbit`] at `start`.
 ///
 /// # Errors
-/// As [`with_balance_stiffness`], [`periodic_orbit`] and [`continue_orbits`].
-pub fn continue_balance_stiffness(
+/// As [`with_balance_spring`], [`periodic_orbit`] and [`continue_orbits`].
+pub fn continue_balance_spring(
     spec: &DeviceSpec,
     start: f64,
     options: &ContinuationOptions,
     shooting: &ShootingOptions,
 ) -> Result<Branch> {
-    let build = |p: &[f64]| Device::new(with_balance_stiffness(spec, p[0])?);
+    let build = |p: &[f64]| Device::new(with_balance_spring(spec, p[0])?);
     let first = build(&[start])?;
     let orbit = periodic_orbit(&first, shooting)?;
     let map = DevicePeriodMap::new(build, &[start], shooting)?;

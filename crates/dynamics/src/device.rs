@@ -38,19 +38,19 @@ use drivetrain_inverse::{
 #[derive(Clone, Debug, PartialEq)]
 pub struct Transmission {
     kinematics: Drivetrain,
-    balance_stiffness: f64,
+    balance_spring: f64,
     preload: f64,
     balance_damping: f64,
     balance_cubic: f64,
 }
 
 impl Transmission {
-    /// `balance_stiffness` K2 on `q2` in mN·mm/rad (>= 0; docs/errata.md#14: not given by the
+    /// `balance_spring` K2 on `q2` in mN·mm/rad (>= 0; docs/errata.md#14: not given by the
     /// thesis).
-    pub fn new(kinematics: Drivetrain, balance_stiffness: f64) -> Result<Self> {
+    pub fn new(kinematics: Drivetrain, balance_spring: f64) -> Result<Self> {
         Ok(Self {
             kinematics,
-            balance_stiffness: check_non_negative("balance_stiffness", balance_stiffness)?,
+            balance_spring: check_non_negative("balance_spring", balance_spring)?,
             preload: 0.0,
             balance_damping: 0.0,
             balance_cubic: 0.0,
@@ -108,7 +108,7 @@ impl Transmission {
                 "a finite torque (mN·mm), and 0 on a 1-DOF drivetrain",
             ));
         }
-        if preload != 0.0 && self.balance_stiffness() == 0.0 {
+        if preload != 0.0 && self.balance_spring() == 0.0 {
             return Err(paritysim_error::Error::invalid(
                 "balance_preload",
                 preload,
@@ -131,8 +131,8 @@ impl Transmission {
     }
 
     /// K2 (mN·mm/rad).
-    pub fn balance_stiffness(&self) -> f64 {
-        self.balance_stiffness
+    pub fn balance_spring(&self) -> f64 {
+        self.balance_spring
     }
 }
 
@@ -286,7 +286,14 @@ impl Device {
                 }
             }
         }
-        let fast = stroke_only(&spec);
+        // The drive load's terms, built once (the forms and the model share this copy).
+        let dual = spec.actuator.is_some()
+            && spec
+                .transmission
+                .as_ref()
+                .is_some_and(|tr| tr.kinematics.is_dual());
+        let drive = drive::DriveSprings::of(&spec, dual);
+        let fast = stroke_only(&spec, &drive);
         let formulation = match (spec.formulation, &fast) {
             (Formulation::Auto, Ok(_)) => Formulation::DrivetrainCoordinates,
             (Formulation::Auto, Err(_)) => Formulation::NullSpace,
@@ -343,12 +350,9 @@ impl Device {
             stroke_plane,
             free_deviation,
             linear_jacobian,
-            drive: drive::DriveSprings::single(0.0, 0.0),
+            drive,
             n_switches: 0,
         };
-        // A dual drivetrain drives both sides through the actuator, when there is one.
-        let dual = device.spec.actuator.is_some() && device.is_dual();
-        device.drive = drive::DriveSprings::of(&device.spec, dual);
         device.form = form::Form::choose(&device, stroke_only);
         device.n_switches = device.blade_switches();
         Ok(device)

@@ -160,7 +160,7 @@ bindings! {
     fn stability_k2_sweep(spec: &str, k2: Floats, options_json: Option<&str>) {
         let device = parse_device(spec)?;
         let opts: ShootingOptions = options(options_json, "options")?;
-        let runs = floquet::balance_stiffness_sweep(device.spec(), &k2, &opts)?;
+        let runs = floquet::balance_spring_sweep(device.spec(), &k2, &opts)?;
         Ok(BalanceSweepRecord::of(&k2, &runs))
     }
 

@@ -77,7 +77,6 @@ impl Simulation {
                     .and_then(|k| Transmission::new(k, d.balance_spring()))
                     .and_then(|t| t.with_preload(d.balance_preload()))
                     .and_then(|t| t.with_balance_losses(d.balance_damping(), d.balance_cubic()))
-                    .map_err(|e| rename_field(e, "balance_stiffness", "balance_spring"))
                     .map_err(|e| e.in_field("drivetrain"))?,
             ),
         };

@@ -124,7 +124,7 @@ impl DriveSprings<f64> {
             |f: fn(&super::Transmission) -> f64| spec.transmission.as_ref().map_or(0.0, f);
         Self {
             k1: actuator(|a| a.stiffness()),
-            k2: transmission(|tr| tr.balance_stiffness()),
+            k2: transmission(|tr| tr.balance_spring()),
             preload: transmission(|tr| tr.preload()),
             k1_cubic: actuator(|a| a.cubic_stiffness()),
             k2_cubic: transmission(|tr| tr.balance_cubic()),

@@ -6,6 +6,7 @@ use nalgebra::{Matrix2, Vector2};
 use paritysim_aero::Branch;
 use paritysim_error::Result;
 
+use super::drive::DriveSprings;
 use super::drivetrain_inverse::singular_drive;
 use super::form::Equations;
 use super::linear_map::{self, LinearMapTerms};
@@ -23,7 +24,10 @@ pub(crate) struct StrokeOnly {
 }
 
 /// Why a device cannot use drivetrain coordinates (None when it can).
-pub(super) fn stroke_only(spec: &DeviceSpec) -> std::result::Result<StrokeOnly, String> {
+pub(super) fn stroke_only(
+    spec: &DeviceSpec,
+    drive: &DriveSprings<f64>,
+) -> std::result::Result<StrokeOnly, String> {
     if spec.wings.len() != 2 {
         return Err("it needs two wings".into());
     }
@@ -63,7 +67,7 @@ pub(super) fn stroke_only(spec: &DeviceSpec) -> std::result::Result<StrokeOnly, 
     }
     Ok(StrokeOnly {
         stroke_inertia,
-        linear: LinearMapTerms::of(spec),
+        linear: LinearMapTerms::of(spec, drive),
     })
 }
 

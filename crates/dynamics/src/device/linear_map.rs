@@ -68,7 +68,7 @@ pub(crate) struct LinearMapTerms<S: Real> {
 impl LinearMapTerms<f64> {
     /// The constants of `spec`, or `None` unless it is a two-DOF linear differential or a
     /// linear drive per wing (`dual_linear`), linear or polynomial, on two wings.
-    pub(crate) fn of(spec: &DeviceSpec) -> Option<Self> {
+    pub(crate) fn of(spec: &DeviceSpec, drive: &DriveSprings<f64>) -> Option<Self> {
         let transmission = spec.transmission.as_ref()?;
         let (rows, polynomial) = match transmission.kinematics() {
             Drivetrain::LinearDifferential(d) => (d.rows(), d.polynomial()),
@@ -81,10 +81,7 @@ impl LinearMapTerms<f64> {
         // As `LinearDifferential::evaluate` builds it.
         let jacobian = [rows[0][0], rows[0][1], rows[1][0], rows[1][1]];
         let mut inertias = [0.0; 2];
-        let drive = DriveSprings::of(
-            spec,
-            spec.actuator.is_some() && transmission.kinematics().is_dual(),
-        );
+        let drive = *drive;
         // The actuator's effective mass on each drive (0 by default: the sums are today's bits).
         let [mass1, mass2] = drive.masses();
         let (mut m00, mut m01, mut m11) = (mass1, 0.0, mass2);
@@ -385,7 +382,8 @@ mod tests {
             )),
             formulation: super::super::Formulation::Auto,
         };
-        LinearMapTerms::of(&spec).unwrap()
+        let dual = spec.transmission.as_ref().unwrap().kinematics().is_dual();
+        LinearMapTerms::of(&spec, &DriveSprings::of(&spec, dual)).unwrap()
     }
 
     /// The polynomial equations with zero coefficients are the linear map's bit for bit: the

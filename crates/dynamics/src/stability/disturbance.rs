@@ -16,7 +16,7 @@ use super::*;
 ///
 /// # Errors
 /// [`Error::Constraint`] without a drivetrain; [`Error::InvalidParameter`] for a bad K2.
-pub fn with_balance_stiffness(spec: &DeviceSpec, k2: f64) -> Result<DeviceSpec> {
+pub fn with_balance_spring(spec: &DeviceSpec, k2: f64) -> Result<DeviceSpec> {
     let Some(tr) = &spec.transmission else {
         bail!(Constraint "a K2 sweep needs a drivetrain");
     };
@@ -31,13 +31,13 @@ pub fn with_balance_stiffness(spec: &DeviceSpec, k2: f64) -> Result<DeviceSpec> 
 /// # Errors
 /// A failing stiffness (an invalid K2, no orbit) is its row's error, located as `k2[i]`; the
 /// call itself fails only when cancelled ([`Error::Cancelled`]) or for a bad thread count.
-pub fn balance_stiffness_sweep(
+pub fn balance_spring_sweep(
     spec: &DeviceSpec,
     k2: &[f64],
     options: &ShootingOptions,
 ) -> Result<Rows<NonlinearFloquet>> {
     super::rows::run_rows(k2.len(), Some("k2"), |i| {
-        let device = Device::new(with_balance_stiffness(spec, k2[i])?)?;
+        let device = Device::new(with_balance_spring(spec, k2[i])?)?;
         floquet(&device, options)
     })
 }
@@ -294,7 +294,7 @@ pub fn linearise(
         .actuator
         .as_ref()
         .map_or(0.0, |a| a.stiffness());
-    let k2 = tr.balance_stiffness();
+    let k2 = tr.balance_spring();
     let integrator = RungeKutta::new(Method::Dop853, 1e-10, 1e-12, 1_000_000)?;
     let (times, states) = orbit_samples(device, orbit, &integrator, samples)?;
     let mut strokes = [

@@ -20,7 +20,7 @@
 //!   from the variational equations ([`crate::integrate::RungeKutta::flow_with_sensitivity`]),
 //!   cycle-to-cycle simulation as the fallback; [`floquet`] returns the Floquet multipliers of
 //!   that monodromy (checked against central differences of the map over the coordinates and
-//!   rates the device integrates); [`balance_stiffness_sweep`] repeats that over K2 on the
+//!   rates the device integrates); [`balance_spring_sweep`] repeats that over K2 on the
 //!   sweep engine (`rows.rs`: one row per value, a failing value a row with its error, the
 //!   sweep's own thread pool), as [`disturbance_responses`] does over frequencies.
 //!

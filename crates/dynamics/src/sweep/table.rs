@@ -5,7 +5,7 @@ use paritysim_error::{Error, Result, bail};
 /// A table of parameter values: named columns, one row per point.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct ParameterTable {
-    /// Column names (e.g. `drivetrain.balance_stiffness`).
+    /// Column names (e.g. `drivetrain.balance_spring`).
     pub names: Vec<String>,
     /// Rows, each as long as `names`.
     pub rows: Vec<Vec<f64>>,

@@ -2,8 +2,8 @@
 //! orbit continued in a parameter, checked against brute-force Floquet analysis.
 
 use paritysim_continuation::{BifurcationKind, ContinuationOptions, Stability, StopReason};
-use paritysim_dynamics::continuation::continue_balance_stiffness;
-use paritysim_dynamics::stability::{ShootingOptions, floquet, with_balance_stiffness};
+use paritysim_dynamics::continuation::continue_balance_spring;
+use paritysim_dynamics::stability::{ShootingOptions, floquet, with_balance_spring};
 
 use super::*;
 
@@ -39,7 +39,7 @@ fn whippletree_stability_boundary_by_continuation_matches_brute_force() {
     options.initial_step = 0.5;
     options.max_step = 1.0;
     options.tolerance = 1e-9;
-    let branch = continue_balance_stiffness(&spec, 1000.0, &options, &shooting).unwrap();
+    let branch = continue_balance_spring(&spec, 1000.0, &options, &shooting).unwrap();
     assert_eq!(branch.stop_reason, StopReason::ReachedStop);
     let kinds: Vec<_> = branch
         .bifurcations
@@ -57,7 +57,7 @@ fn whippletree_stability_boundary_by_continuation_matches_brute_force() {
     // Brute force, independently of the continuation: Newton shooting and the monodromy at
     // K2* ± 2 mN·mm/rad.
     let radius = |k2: f64| {
-        let device = Device::new(with_balance_stiffness(&spec, k2).unwrap()).unwrap();
+        let device = Device::new(with_balance_spring(&spec, k2).unwrap()).unwrap();
         floquet(&device, &shooting).unwrap().spectral_radius()
     };
     assert!(

@@ -653,7 +653,7 @@ fn hmf_is_asymptotically_stable_and_transmits_roll_rigidly() {
 fn k2_sweep_is_parallel_and_equals_single_runs() {
     let spec = section_3_3(31.3, 1.0).spec().clone();
     let k2 = [1.0, 100.0, 500.0];
-    let sweep = balance_stiffness_sweep(&spec, &k2, &options()).unwrap();
+    let sweep = balance_spring_sweep(&spec, &k2, &options()).unwrap();
     let sweep: Vec<_> = sweep.into_iter().map(Result::unwrap).collect();
     for (k, f) in k2.iter().zip(&sweep) {
         let single = floquet(&section_3_3(31.3, *k), &options()).unwrap();
@@ -667,7 +667,7 @@ fn k2_sweep_is_parallel_and_equals_single_runs() {
 fn a_failing_k2_is_a_row_with_its_error_and_the_others_are_kept() {
     // Formerly the first error stopped the whole sweep.
     let spec = section_3_3(31.3, 1.0).spec().clone();
-    let rows = balance_stiffness_sweep(&spec, &[-1.0, 100.0, f64::NAN], &options()).unwrap();
+    let rows = balance_spring_sweep(&spec, &[-1.0, 100.0, f64::NAN], &options()).unwrap();
     assert_eq!(rows.len(), 3);
     for (i, row) in [(0, &rows[0]), (2, &rows[2])] {
         let err = row.as_ref().unwrap_err();
@@ -956,7 +956,7 @@ fn a_cancelled_budget_stops_the_parallel_stability_analyses() {
     let chart = stability_chart(&axis, &axis);
     assert_eq!(chart.unwrap_err().kind(), "Cancelled");
     let spec = section_3_3(31.3, 1.0).spec().clone();
-    let sweep = balance_stiffness_sweep(&spec, &[1.0, 100.0, 500.0], &options());
+    let sweep = balance_spring_sweep(&spec, &[1.0, 100.0, 500.0], &options());
     assert_eq!(sweep.unwrap_err().kind(), "Cancelled");
 }
 
@@ -976,7 +976,7 @@ fn cancelling_a_k2_sweep_from_another_thread_returns_cancelled() {
             std::thread::sleep(std::time::Duration::from_millis(50));
             canceller.cancel();
         });
-        cancellable(&flag, || balance_stiffness_sweep(&spec, &k2, &options()))
+        cancellable(&flag, || balance_spring_sweep(&spec, &k2, &options()))
     });
     assert_eq!(out.unwrap_err().kind(), "Cancelled");
     assert!(started.elapsed().as_secs_f64() < 30.0);

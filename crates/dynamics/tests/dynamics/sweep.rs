@@ -53,7 +53,7 @@ fn study_grid() -> Grid {
     Grid::new()
         .axis("wings[0].aero.omega1", [18.75, 25.0, 31.3])
         .unwrap()
-        .axis("drivetrain.balance_stiffness", [5.0, 20.0])
+        .axis("drivetrain.balance_spring", [5.0, 20.0])
         .unwrap()
         .axis("actuator.waveform.amplitude_v", [40.0, 50.0])
         .unwrap()
@@ -208,7 +208,7 @@ fn failing_points_become_error_rows_and_the_others_are_kept() {
         assert_eq!(r.rows.len(), 4);
         assert!(r.rows[0].outcome.is_ok() && r.rows[3].outcome.is_ok());
         match &r.rows[1].outcome {
-            Err(e) => assert_eq!(e.field(), Some("balance_stiffness"), "{e}"),
+            Err(e) => assert_eq!(e.field(), Some("balance_spring"), "{e}"),
             Ok(_) => panic!("negative K2 must fail"),
         }
         assert!(
