@@ -100,3 +100,18 @@ def test_an_airframe_point_far_outside_the_body_is_named() -> None:
         assert info.value.field == path
     # The bound is the centre of mass's: 1e3 mm is still a spec.
     assert spec.with_paths({"body.shoulders_mm[1][1]": 1e3}).body.shoulders_mm[1][1] == 1e3
+
+
+@pytest.mark.parametrize("kind", ["single_linear", "hmf_four_bar"])
+def test_a_one_dof_drive_on_two_untied_wings_names_the_drivetrain(kind: str) -> None:
+    # Was: ConstraintError naming no field (seed 51, case 1749). The Drag PARITY configuration
+    # leaves the two strokes free, so one actuator through a 1-DOF drivetrain cannot drive both.
+    spec = ps.devices.load("sreetharan2012_3_3_parity").to_dict()
+    spec["drivetrain"] = {"kind": kind} if kind == "hmf_four_bar" else {"kind": kind, "transmission_ratio": 2.67}
+    with pytest.raises(ps.ConstraintError) as info:
+        ps.simulate(ps.Simulation.from_dict(spec))
+    assert info.value.field == "drivetrain.kind"
+    assert kind in str(info.value) and "hmf" in str(info.value)
+    # The same drive on the configuration that ties the strokes builds.
+    spec["configuration"] = {"name": "hmf"}
+    ps.Simulation.from_dict(spec).validate()

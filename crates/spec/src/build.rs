@@ -119,6 +119,20 @@ impl Simulation {
                 ));
             }
         }
+        // The engine checks that a 1-DOF drivetrain's two wings are tied (φL = φR); the field a
+        // user changes for it is the drivetrain (or the configuration).
+        let one_dof_on_two_wings = wings.len() == 2
+            && transmission
+                .as_ref()
+                .is_some_and(|t| t.kinematics().dof() == 1);
+        let kind = transmission
+            .as_ref()
+            .map(|t| t.kinematics().name().to_string());
+        let configuration = self
+            .configuration
+            .name
+            .clone()
+            .unwrap_or_else(|| "explicit rows".into());
         Device::new(DeviceSpec {
             wings,
             constraints,
@@ -130,6 +144,17 @@ impl Simulation {
                 Formulation::Projection => EngineFormulation::Projection,
                 Formulation::DrivetrainCoordinates => EngineFormulation::DrivetrainCoordinates,
             },
+        })
+        .map_err(|e| match (&e, kind) {
+            (Error::Constraint(_), Some(kind)) if one_dof_on_two_wings => e.attributed(
+                "drivetrain.kind",
+                format!("{kind:?}"),
+                format!(
+                    "a drivetrain with a whippletree or a drive per wing for configuration {configuration:?} \
+                     (its strokes are not tied), or a configuration that ties them (e.g. hmf)"
+                ),
+            ),
+            _ => e,
         })
     }
 }
