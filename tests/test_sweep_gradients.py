@@ -93,3 +93,13 @@ def test_a_point_whose_gradient_fails_keeps_its_row_and_says_why():
         differ = df.filter(df["wings[0].springs.stroke.cubic"] == 10.0)
         assert differ["gradient_error"][0].startswith("InvalidParameterError") and "wings" in differ["gradient_error"][0]
         assert differ[f"d(left_stroke_amplitude)/d(wings[*].springs.stroke.cubic)"].is_null().all()
+
+
+def test_gradients_run_on_the_sweeps_own_threads(monkeypatch):
+    # The derivative columns are computed with the sweep's `threads`, not the environment's
+    # default: an unusable PARITYSIM_THREADS must not matter once `threads` is given.
+    monkeypatch.setenv("PARITYSIM_THREADS", "0")
+    df = ps.sweep(_spec(), {"actuator.amplitude_v": [90.0, 100.0]}, metrics=METRICS, gradients=["actuator.amplitude_v"], threads=1, progress=False)
+    assert (df["status"] == "ok").all()
+    assert df["gradient_error"].is_null().all()
+    assert (df["d(left_stroke_amplitude)/d(actuator.amplitude_v)"] > 0).all()

@@ -385,7 +385,7 @@ def sweep(
         at that point (null where the metric is not differentiable there, or the point did not
         converge; ``gradient_error`` says why a converged point has none). Costs one
         sensitivity per point (about ten solves' work for ten paths), computed in this process
-        as each chunk finishes.
+        on the sweep's ``threads`` as each chunk finishes.
 
     Returns
     -------
@@ -431,7 +431,7 @@ def sweep(
     valid_metrics = _core.sweep_metric_names(spec_json)
     metric_names = list(valid_metrics if metrics is None else metrics)
     # Resolves every path (unknown: the nearest valid one), duplicates, metrics: before running.
-    probe = _core.SweepRun(spec_json, [str(c) for c in param_table.columns], "[]", metric_names)
+    probe = _core.SweepRun(spec_json, [str(c) for c in param_table.columns], "[]", metric_names, threads=threads)
     for note in probe.notes:
         warnings.warn(note, DeprecationWarning, stacklevel=2)
     cycle_columns = _cycle_columns(spec_json, keep_cycle)
@@ -485,7 +485,7 @@ def sweep(
         else:
             params = table[points]
         df = _frame(raw, params, points, metric_names, cycle_columns)
-        return _with_gradients(df, spec_json, list(param_table.columns), gradient_paths, metric_names) if gradient_paths else df
+        return _with_gradients(df, spec_json, list(param_table.columns), gradient_paths, metric_names, n_threads) if gradient_paths else df
 
     from tqdm.auto import tqdm  # type: ignore[import-untyped]
 
@@ -552,7 +552,7 @@ def _gradient_columns(metrics: Sequence[str], paths: Sequence[str]) -> list[str]
     return [f"d({m})/d({p})" for p in paths for m in metrics]
 
 
-def _with_gradients(df: pl.DataFrame, spec_json: str, names: list[str], paths: list[str], metrics: list[str]) -> pl.DataFrame:
+def _with_gradients(df: pl.DataFrame, spec_json: str, names: list[str], paths: list[str], metrics: list[str], threads: int) -> pl.DataFrame:
     """``df`` with the derivative columns of its converged rows (see `sweep`'s ``gradients``)."""
     columns = _gradient_columns(metrics, paths)
     values: dict[str, list[float | None]] = {c: [None] * df.height for c in columns}
@@ -560,8 +560,8 @@ def _with_gradients(df: pl.DataFrame, spec_json: str, names: list[str], paths: l
     status = df["status"].to_list()
     rows = df.select(names).rows() if names else [()] * df.height
     converged = [i for i, state in enumerate(status) if state == "ok"]
-    # One native call for the chunk's converged points, run on the sweep engine's threads.
-    raw = _core.sensitivity_rows(spec_json, [_dumps(dict(zip(names, rows[i], strict=True))) for i in converged], paths, metrics)
+    # One native call for the chunk's converged points, on the sweep's own thread count.
+    raw = _core.sensitivity_rows(spec_json, [_dumps(dict(zip(names, rows[i], strict=True))) for i in converged], paths, metrics, threads)
     for i, point, kind, error in zip(converged, raw["rows"], raw["error_kind"], raw["error"], strict=True):
         if not isinstance(point, dict):  # the converter hands an all-failed column over as NaN
             errors[i] = f"{kind}Error: {error}"

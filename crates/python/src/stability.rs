@@ -57,11 +57,12 @@ bindings! {
     }
 
     /// `sensitivity` at each point `rows[i]` (a JSON object of spec paths and values) of a
-    /// JSON spec, on the sweep engine's threads (`paritysim_spec::sensitivity::sensitivities`).
-    #[pyo3(signature = (json, rows, params, metrics = None))]
-    fn sensitivity_rows(json: &str, rows: Vec<String>, params: Vec<String>, metrics: Option<Vec<String>>) {
+    /// JSON spec, on `threads` of the sweep engine (default: as a sweep resolves them;
+    /// `paritysim_spec::sensitivity::sensitivities`).
+    #[pyo3(signature = (json, rows, params, metrics = None, threads = None))]
+    fn sensitivity_rows(json: &str, rows: Vec<String>, params: Vec<String>, metrics: Option<Vec<String>>, threads: Option<usize>) {
         let spec = crate::spec::parse(json)?;
-        paritysim_spec::sensitivity::sensitivities(&spec, &rows, &params, metrics.as_deref())
+        paritysim_spec::sensitivity::sensitivities(&spec, &rows, &params, metrics.as_deref(), threads)
     }
 
     /// Monodromy matrix `M(t0)` of eq. 2.25 (`x'' + β0|cos t| x' + κ x = 0`, period π), 2×2.

@@ -68,18 +68,21 @@ pub fn sensitivity(
 }
 
 /// The sensitivities at the points `rows` of `spec` (each a JSON object of spec paths and
-/// values, as a sweep's rows apply them), one row per point, on the sweep engine's thread
-/// pool: `ps.sweep(..., gradients=...)`. A point that fails is its row's error.
+/// values, as a sweep's rows apply them), one row per point, on `threads` of the sweep engine
+/// (None: `PARITYSIM_THREADS`, else every core): `ps.sweep(..., gradients=...)`. A point that
+/// fails is its row's error.
 ///
 /// # Errors
-/// [`Error::Cancelled`] when the caller's budget is cancelled; the rest are per row.
+/// [`Error::Cancelled`] when the caller's budget is cancelled; [`Error::InvalidParameter`] for
+/// a bad thread count; the rest are per row.
 pub fn sensitivities(
     spec: &Simulation,
     rows: &[String],
     params: &[String],
     metrics: Option<&[String]>,
+    threads: Option<usize>,
 ) -> Result<SensitivityRows> {
-    let runs = paritysim_dynamics::stability::rows::run_rows(rows.len(), None, |i| {
+    let runs = paritysim_dynamics::stability::rows::run_rows(rows.len(), threads, None, |i| {
         let (point, _) = apply_json(spec, &rows[i])?;
         sensitivity(&point, params, metrics).map(|s| s.record())
     })?;

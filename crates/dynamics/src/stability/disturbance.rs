@@ -36,7 +36,7 @@ pub fn balance_spring_sweep(
     k2: &[f64],
     options: &ShootingOptions,
 ) -> Result<Rows<NonlinearFloquet>> {
-    super::rows::run_rows(k2.len(), Some("k2"), |i| {
+    super::rows::run_rows(k2.len(), None, Some("k2"), |i| {
         let device = Device::new(with_balance_spring(spec, k2[i])?)?;
         floquet(&device, options)
     })
@@ -508,7 +508,7 @@ pub fn disturbance_responses(
     amplitude: f64,
     options: &DisturbanceOptions,
 ) -> Result<Rows<DisturbanceResponse>> {
-    super::rows::run_rows(frequencies_hz.len(), Some("frequency_hz"), |i| {
+    super::rows::run_rows(frequencies_hz.len(), None, Some("frequency_hz"), |i| {
         disturbance_response(device, orbit, frequencies_hz[i], amplitude, options)
     })
 }

@@ -381,7 +381,7 @@ pub fn stability_chart(beta0: &[f64], kappa: &[f64]) -> Result<StabilityChart> {
     // checks the caller's budget (its cancel flag): a spent budget fails the chunk, hence the
     // chart; a failing point (only by overflow once the axes are validated) is its entry.
     let chunks = n.div_ceil(CHART_CHUNK);
-    let rows = super::rows::run_rows(chunks, None, |c| {
+    let rows = super::rows::run_rows(chunks, None, None, |c| {
         (c * CHART_CHUNK..((c + 1) * CHART_CHUNK).min(n))
             .map(|idx| {
                 budget::check(0.0)?;

@@ -10,7 +10,7 @@ use crate::sweep::{SweepControl, resolve_threads, run_indexed};
 pub type Rows<T> = Vec<Result<T>>;
 
 /// Runs `point(i)` for `i in 0..n` through [`run_indexed`] (the sweep engine: its own rayon
-/// pool of [`resolve_threads`]`(None)` threads, never the global one; a panic is caught as
+/// pool of [`resolve_threads`]`(threads)` threads, never the global one; a panic is caught as
 /// that row's error), under the caller's wall budget and cancel flag. A failing point's error
 /// is located as `array[i]` (with `array` given; else left as `point` located it) and kept in
 /// its row; the other rows are kept.
@@ -18,13 +18,18 @@ pub type Rows<T> = Vec<Result<T>>;
 /// # Errors
 /// [`Error::Cancelled`] when the caller's budget is cancelled (no new point starts once a
 /// running one saw it); [`Error::InvalidParameter`] for a bad `PARITYSIM_THREADS`.
-pub fn run_rows<T, F>(n: usize, array: Option<&str>, point: F) -> Result<Rows<T>>
+pub fn run_rows<T, F>(
+    n: usize,
+    threads: Option<usize>,
+    array: Option<&str>,
+    point: F,
+) -> Result<Rows<T>>
 where
     T: Send,
     F: Fn(usize) -> Result<T> + Sync,
 {
     let run_budget = budget::current();
-    let threads = resolve_threads(None)?;
+    let threads = resolve_threads(threads)?;
     let control = SweepControl::new();
     let slots = run_indexed(n, threads, &control, |i| {
         let out = budget::carry(&run_budget, || point(i));
@@ -74,5 +79,24 @@ where
             .map(|i| budget::carry(&run_budget, || part(i)))
             .collect();
     }
-    run_rows(n, None, part)?.into_iter().collect()
+    run_rows(n, None, None, part)?.into_iter().collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{run_parts, run_rows};
+
+    #[test]
+    fn the_parts_of_a_row_run_on_the_rows_threads() {
+        // One thread for the rows: each row's parts share it (no pool of every core).
+        for threads in [1, 2] {
+            let rows = run_rows(3, Some(threads), None, |_| {
+                run_parts(4, |_| Ok(rayon::current_num_threads()))
+            })
+            .unwrap();
+            for row in rows {
+                assert_eq!(row.unwrap(), vec![threads; 4]);
+            }
+        }
+    }
 }

@@ -141,10 +141,9 @@ where
         }
         Some(out)
     };
-    if threads == 1 {
-        // No pool: the calling thread does the work (and tests the sequential path).
-        return Ok((0..n).map(one).collect());
-    }
+    // A pool even for one thread: the parallel parts of a point (a sensitivity's columns,
+    // `stability::rows::run_parts`) then run inside it, on the sweep's threads, instead of
+    // opening a pool of every core from the calling thread.
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .thread_name(|i| format!("paritysim-sweep-{i}"))
