@@ -2,7 +2,8 @@
 
 ``reproduced`` runs ``paritysim reproduce --all`` once per session into a temporary directory;
 every test that checks trial outputs or the report reads that directory (and is marked
-``slow``). ``pytest -m "not slow"`` skips it.
+``slow``). ``pytest -m "not slow"`` skips it. Under pytest-xdist (``-n 2 --dist loadgroup``,
+as ``scripts/test`` runs) those tests share one worker, so the trials still run once.
 """
 
 from __future__ import annotations
@@ -32,3 +33,11 @@ def reproduced(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("reproduce_all")
     assert main(["reproduce", "--all", "--out", str(out), "--quiet"]) == 0
     return out
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Every test that reads ``reproduced`` goes to one xdist worker (``--dist loadgroup``):
+    a session fixture runs once per worker, and the trials take about a minute."""
+    for item in items:
+        if "reproduced" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.xdist_group("reproduced"))
