@@ -8,7 +8,7 @@ use paritysim_error::Result;
 
 use super::drive::DriveSprings;
 use super::drivetrain_inverse::singular_drive;
-use super::form::Equations;
+use super::equations::Equations;
 use super::linear_map::{self, LinearMapTerms};
 use super::{Device, DeviceSpec};
 use crate::integrate::State;

@@ -1,9 +1,7 @@
 //! The equations a device integrates, chosen once when the model is built.
 //!
-//! A device has exactly one [`Form`]; each form is one implementation of [`Equations`] (the
-//! right-hand side on the state's own sides or on held blade-element branches, the switching
-//! functions, the analytic variational equations where it has them, batches of states). The
-//! integrator, shooting, sweeps and recordings ask the form; nothing else decides which
+//! A device has exactly one [`Form`]; each form is one implementation of [`Equations`]
+//! (`equations.rs`). The integrator, shooting, sweeps and recordings ask the form; nothing else decides which
 //! equations apply. Adding a form: a variant, an [`Equations`] impl, and its condition in
 //! [`Form::choose`].
 
@@ -12,84 +10,12 @@ use paritysim_error::{Error, Result};
 
 use super::Device;
 use super::drivetrain_coordinates::StrokeOnly;
+use super::equations::Equations;
 use super::free_deviation::FreeDeviation;
 use super::linear_map::LinearMapTerms;
+use super::null_space::General;
 use super::stroke_plane::StrokePlane;
 use crate::integrate::{MAX_SWITCHES, State};
-
-/// One form of the equations of motion (eq. 3.20 and its closed-form reductions).
-pub(crate) trait Equations {
-    /// `ẏ = f(t, y)`, with the blade elements on `branches` when given (event location), else
-    /// on the state's own sides; the last two entries integrate the actuator and aerodynamic
-    /// work.
-    ///
-    /// # Errors
-    /// A pose or drivetrain coordinate outside the model's domain; a singular mass matrix.
-    fn rhs(
-        &self,
-        device: &Device,
-        t: f64,
-        y: &State,
-        branches: Option<[Branch; 2]>,
-        dydt: &mut State,
-    ) -> Result<()>;
-
-    /// The switching functions at `y` (one per blade-element switch, `1` where none).
-    ///
-    /// # Errors
-    /// As the general wing terms.
-    fn switches(&self, device: &Device, y: &State, g: &mut [f64; MAX_SWITCHES]) -> Result<()> {
-        device.blade_switching_functions(y, g)
-    }
-
-    /// The variational equations `Φ̇ = (∂f/∂y) Φ` on `n` coordinates from an analytic Jacobian,
-    /// also writing `f` when `rhs` is given; `None`: the caller differentiates numerically.
-    #[allow(clippy::too_many_arguments)]
-    fn variational(
-        &self,
-        _device: &Device,
-        _t: f64,
-        _y: &State,
-        _branches: Option<[Branch; 2]>,
-        _n: usize,
-        _rhs: Option<&mut [f64]>,
-        _phi: &[f64],
-        _dphi: &mut [f64],
-    ) -> Option<Result<()>> {
-        None
-    }
-
-    /// The right-hand sides of several states at `t` on held `branches`, four at a time in SIMD
-    /// lanes; `None` when the form has no batch (the caller loops).
-    fn rhs_batch(
-        &self,
-        _device: &Device,
-        _t: f64,
-        _branches: [Branch; 2],
-        _ys: &[State],
-        _out: &mut [State],
-    ) -> Option<std::result::Result<(), (usize, Error)>> {
-        None
-    }
-}
-
-/// The general form: eq. 3.20 through the null space or the projection, any wing.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct General;
-
-impl Equations for General {
-    #[inline]
-    fn rhs(
-        &self,
-        device: &Device,
-        t: f64,
-        y: &State,
-        branches: Option<[Branch; 2]>,
-        dydt: &mut State,
-    ) -> Result<()> {
-        device.rhs_null_space_on(t, y, branches, dydt)
-    }
-}
 
 /// The form of a device, chosen by [`Form::choose`].
 #[derive(Clone, Debug, PartialEq)]

@@ -16,7 +16,7 @@ use nalgebra::{Matrix2, SMatrix, SVector, Vector2, Vector3};
 use paritysim_aero::Branch;
 use paritysim_error::{Error, Result};
 
-use super::form::Equations;
+use super::equations::Equations;
 use super::{Device, Formulation};
 use crate::integrate::State;
 

@@ -7,8 +7,27 @@ use paritysim_aero::Branch;
 use paritysim_constraints::{Mat6, Vec6};
 use paritysim_error::{Error, Result};
 
+use super::equations::Equations;
 use super::{Device, Evaluation, Formulation, empty_terms};
 use crate::integrate::State;
+
+/// The general form: eq. 3.20 through the null space or the projection, any wing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct General;
+
+impl Equations for General {
+    #[inline]
+    fn rhs(
+        &self,
+        device: &Device,
+        t: f64,
+        y: &State,
+        branches: Option<[Branch; 2]>,
+        dydt: &mut State,
+    ) -> Result<()> {
+        device.rhs_null_space_on(t, y, branches, dydt)
+    }
+}
 
 impl Device {
     /// Full evaluation at `(t, p, ṗ)`, including the constrained accelerations.

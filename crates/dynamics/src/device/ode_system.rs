@@ -4,7 +4,7 @@
 use paritysim_error::Result;
 
 use super::Device;
-use super::form::Equations;
+use super::equations::Equations;
 use super::switches::branches;
 use crate::integrate::{MAX_SWITCHES, Sides, State};
 

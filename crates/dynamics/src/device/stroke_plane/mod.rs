@@ -19,7 +19,7 @@ use paritysim_aero::Branch;
 use paritysim_error::{Error, Result};
 
 use super::Device;
-use super::form::Equations;
+use super::equations::Equations;
 use crate::WingAero;
 use crate::integrate::{MAX_SWITCHES, State};
 use crate::metrics::needs::StrokeNeeds;
