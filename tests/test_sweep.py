@@ -15,6 +15,7 @@ import pickle
 import signal
 import subprocess
 import sys
+import tempfile
 import textwrap
 import time
 from pathlib import Path
@@ -31,6 +32,8 @@ from paritysim.sweep import grid, sweep, valid_paths
 
 # The module (``paritysim.sweep`` may be re-exported as the function of the same name).
 sweep_module = importlib.import_module("paritysim.sweep")
+# How its chunks run (the functions these tests replace to inject failures and count work).
+chunks_module = importlib.import_module("paritysim._sweep_chunks")
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 FAST = {"max_cycles": 5, "samples_per_cycle": 40, "record_cycles": 1}
@@ -146,7 +149,7 @@ def test_unknown_paths_and_names_are_rejected_before_any_work(parity: ps.Simulat
     def no_work(*_: Any, **__: Any) -> None:
         raise AssertionError("a point was prepared before validation finished")
 
-    monkeypatch.setattr(sweep_module, "_prepare", no_work)
+    monkeypatch.setattr(chunks_module, "prepare", no_work)
     with pytest.raises(ps.InvalidParameterError, match=r"drivetrain\.k3.*did you mean `drivetrain\.") as info:
         sweep(parity, {"drivetrain.balance_spring": [1.0], "drivetrain.k3": [1.0]}, progress=False)
     assert info.value.field == "drivetrain.k3"
@@ -202,7 +205,7 @@ def test_a_non_finite_value_is_an_error_row_naming_its_path(parity: ps.Simulatio
     assert df["error_kind"][1] == "InvalidParameter" and "drivetrain.balance_spring" in df["error"][1]
     plain = sweep(parity, {"drivetrain.balance_spring": [1.0, 2.0]}, metrics=["left_stroke_amplitude"], progress=False)
     assert df["left_stroke_amplitude"].to_list()[::2] == plain["left_stroke_amplitude"].to_list()
-    assert json.loads(sweep_module._rows_json([(np.float64(0.5), 3)])) == [[0.5, 3]]
+    assert json.loads(chunks_module.rows_json([(np.float64(0.5), 3)])) == [[0.5, 3]]
 
 
 def test_option_paths_run_per_point(parity: ps.Simulation) -> None:
@@ -265,7 +268,7 @@ def test_ctrl_c_checkpoints_the_finished_rows_then_raises(parity: ps.Simulation,
     fresh run of the same points."""
     table = grid({"drivetrain.balance_spring": np.linspace(1.0, 2.0, 10_000).tolist()})
     after = 128
-    advance = sweep_module._advance
+    advance = chunks_module.advance
     done = [0]  # points finished so far, over all chunks (`finished` counts within a chunk)
     fired = []
 
@@ -276,7 +279,7 @@ def test_ctrl_c_checkpoints_the_finished_rows_then_raises(parity: ps.Simulation,
             _thread.interrupt_main()
         return advance(bar, finished, reported)
 
-    monkeypatch.setattr(sweep_module, "_advance", advance_then_interrupt)
+    monkeypatch.setattr(chunks_module, "advance", advance_then_interrupt)
     checkpoint = tmp_path / "study.parquet"
     metrics = ["q2_amplitude", "left_stroke_amplitude"]
     with pytest.raises(KeyboardInterrupt) as stopped:
@@ -359,17 +362,17 @@ def test_checkpoint_resumes_a_killed_sweep_and_matches_an_uninterrupted_run(tmp_
     finally:
         sys.path.remove(str(tmp_path))
     ran: list[int] = []
-    real = sweep_module._prepare
+    real = chunks_module.prepare
 
     def counting(chunk: Any) -> Any:
         ran.extend(chunk.points)
         return real(chunk)
 
-    monkeypatch.setattr(sweep_module, "_prepare", counting)
+    monkeypatch.setattr(chunks_module, "prepare", counting)
     resumed = sweep(spec(), table(), threads=2, chunk_size=4, checkpoint=checkpoint, progress=False)
     assert sorted(ran) == sorted(set(range(20)) - set(flushed["point"].to_list())), "only unfinished points run"
     assert checkpoint.exists() and not parts.exists()
-    monkeypatch.setattr(sweep_module, "_prepare", real)
+    monkeypatch.setattr(chunks_module, "prepare", real)
     fresh = sweep(spec(), table(), threads=2, progress=False)
     assert_equivalent(resumed, fresh)
     assert (fresh["status"] == "error").sum() == 5  # 5 kV rows are kept as errors, and resumed as such
@@ -377,7 +380,7 @@ def test_checkpoint_resumes_a_killed_sweep_and_matches_an_uninterrupted_run(tmp_
 
     # a complete checkpoint answers a re-run without running anything; a longer grid reuses it
     ran.clear()
-    monkeypatch.setattr(sweep_module, "_prepare", counting)
+    monkeypatch.setattr(chunks_module, "prepare", counting)
     assert_same(sweep(spec(), table(), checkpoint=checkpoint, progress=False), resumed)
     assert ran == []
     longer = grid({"drivetrain.balance_spring": [1.0, 2.0, 3.0, 4.0, 5.0, 6.0], "actuator.voltage_v": [60.0, 80.0, 100.0, 5000.0]})
@@ -427,7 +430,7 @@ def test_ctrl_c_reaches_the_chunks_running_in_process_pool_workers(monkeypatch: 
     fast rows are checkpointed and `SweepInterrupted` is raised as in process; the workers are
     free again at once (they did not run the slow points to the end)."""
     hmf = ps.load_spec(EXAMPLES / "hmf.toml")
-    real = sweep_module._frame
+    real = chunks_module.frame
     framed: list[int] = []
 
     def frame_then_interrupt(raw: Any, *args: Any) -> Any:
@@ -437,7 +440,7 @@ def test_ctrl_c_reaches_the_chunks_running_in_process_pool_workers(monkeypatch: 
             _thread.interrupt_main()
         return out
 
-    monkeypatch.setattr(sweep_module, "_frame", frame_then_interrupt)
+    monkeypatch.setattr(chunks_module, "frame", frame_then_interrupt)
     checkpoint = tmp_path / "study.parquet"
     values = [100.0, 110.0] + [1e-3] * 4
     with cf.ProcessPoolExecutor(max_workers=2, mp_context=multiprocessing.get_context("spawn")) as pool:
@@ -451,7 +454,7 @@ def test_ctrl_c_reaches_the_chunks_running_in_process_pool_workers(monkeypatch: 
     assert stopped.value.total == len(values)
     saved = pl.concat([pl.read_parquet(f) for f in checkpoint.with_name("study.parquet.parts").glob("part-*.parquet")]).sort("point")
     assert_same(saved, partial)
-    assert not list(Path(sweep_module.tempfile.gettempdir()).glob("paritysim-sweep-*/stop"))
+    assert not list(Path(tempfile.gettempdir()).glob("paritysim-sweep-*/stop"))
 
 
 # ----------------------------------------------------------------------------- CLI
@@ -500,14 +503,14 @@ def test_plot_draws_one_line_per_hue(hmf: ps.Simulation) -> None:
 def test_a_chunk_whose_run_cannot_be_built_becomes_error_rows(parity: ps.Simulation, monkeypatch: pytest.MonkeyPatch) -> None:
     """Any failure of a whole chunk (here its native run raising when built) gives one error row
     per point of that chunk; the other chunks are unaffected."""
-    real = sweep_module._prepare
+    real = chunks_module.prepare
 
     def prepare(chunk: Any) -> Any:
         if 2 in chunk.points:
             raise MemoryError("simulated failure of the chunk")
         return real(chunk)
 
-    monkeypatch.setattr(sweep_module, "_prepare", prepare)
+    monkeypatch.setattr(chunks_module, "prepare", prepare)
     df = sweep(parity, {"actuator.voltage_v": [60.0, 70.0, 80.0, 90.0, 100.0]}, metrics=["left_stroke_amplitude"], chunk_size=2, threads=1, progress=False)
     assert df["point"].to_list() == [0, 1, 2, 3, 4]
     assert df["status"].to_list() == ["ok", "ok", "error", "error", "ok"]
@@ -516,14 +519,14 @@ def test_a_chunk_whose_run_cannot_be_built_becomes_error_rows(parity: ps.Simulat
 
 
 def test_a_chunk_whose_executor_worker_raises_becomes_error_rows(parity: ps.Simulation, monkeypatch: pytest.MonkeyPatch) -> None:
-    real = sweep_module._run_chunk
+    real = chunks_module.run_chunk
 
     def run_chunk(chunk: Any) -> Any:
         if 0 in chunk.points:
             raise RuntimeError("worker lost")
         return real(chunk)
 
-    monkeypatch.setattr(sweep_module, "_run_chunk", run_chunk)
+    monkeypatch.setattr(chunks_module, "run_chunk", run_chunk)
     with cf.ThreadPoolExecutor(2) as pool:
         df = sweep(parity, {"actuator.voltage_v": [60.0, 70.0, 80.0, 90.0]}, metrics=["left_stroke_amplitude"], executor=pool, chunk_size=2, keep_cycle=["left_phi"], progress=False)
     assert df["status"].to_list() == ["error", "error", "ok", "ok"]
