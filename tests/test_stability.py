@@ -1,6 +1,6 @@
 """paritysim.stability from Python: the bindings and the facade's frames, checked against
 independent computations (scipy, numpy) where the Rust tests (crates/dynamics/tests/dynamics/
-floquet.rs) do not already cover the physics: eqs. 2.45, 2.50, 2.54, Brockett's closed forms,
+floquet/) do not already cover the physics: eqs. 2.45, 2.50, 2.54, Brockett's closed forms,
 eq. 2.59, the κ = 0 linear map and the LTI/nonlinear agreement are tested there only."""
 
 from __future__ import annotations

@@ -5,7 +5,7 @@
 mod continuation;
 #[path = "dynamics/drive.rs"]
 mod drive;
-#[path = "dynamics/floquet.rs"]
+#[path = "dynamics/floquet/mod.rs"]
 mod floquet;
 #[path = "dynamics/lanes.rs"]
 mod lanes;

@@ -4,7 +4,7 @@
 //! * **Linearised model (§2.6).** The monodromy matrix of `ẍ + β0|cos t|ẋ + κx = 0` (eq. 2.25,
 //!   period π) is integrated with a Taylor-series method of order [`TAYLOR_ORDER`] on the
 //!   pieces where `|cos t|` is smooth (truncation at round-off level; closed forms of eqs.
-//!   2.45, 2.50 and 2.54 hold to 1e-9 or better in `tests/dynamics/floquet.rs`); its
+//!   2.45, 2.50 and 2.54 hold to 1e-9 or better in `tests/dynamics/floquet/`); its
 //!   half trace `a`, determinant `b` (eq. 2.36), multipliers (eq. 2.37) and region of Fig. 2.13
 //!   ([`Region`], with the corrected Region III bound of docs/errata.md#9) follow. A
 //!   [`stability_chart`] over a (β0, κ) grid is computed on the sweep engine's pool. [`brockett()`]
@@ -25,7 +25,7 @@
 //!   sweep's own thread pool), as [`disturbance_responses`] does over frequencies.
 //!
 //! Errata (docs/errata.md) relied on here, each verified numerically in
-//! `tests/dynamics/floquet.rs`: item 7 (the drag forces of eqs. 2.17–2.19 carry `T³`, so
+//! `tests/dynamics/floquet/`: item 7 (the drag forces of eqs. 2.17–2.19 carry `T³`, so
 //! `β0 = 2ΩΦ/I`), item 8 (eq. 2.27's coefficient is `−¼β0²cos²t`), item 9 (Region I is
 //! `b ≤ 1, |a| ≤ (1 + b)/2`), item 10 (eq. 2.52 is `M = exp(TQ)`, eq. 2.53 is `M^(n+1)`, eq. 2.54
 //! lacks a factor π).
