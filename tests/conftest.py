@@ -2,17 +2,25 @@
 
 ``reproduced`` runs ``paritysim reproduce --all`` once per session into a temporary directory;
 every test that checks trial outputs or the report reads that directory (and is marked
-``slow``). ``pytest -m "not slow"`` skips it. Under pytest-xdist (``-n 2 --dist loadgroup``,
-as ``scripts/test`` runs) those tests share one worker, so the trials still run once.
+``slow``). ``pytest -m "not slow"`` skips it. Under pytest-xdist (``-n 2 --dist loadfile``,
+as ``scripts/test`` runs) a module's tests stay on one worker, so its module fixtures run once,
+and the workers share the one trial run.
 """
 
 from __future__ import annotations
 
+import os
+import shutil
 import signal
 from pathlib import Path
 
 import matplotlib
 import pytest
+
+try:
+    import fcntl
+except ImportError:  # not POSIX: each xdist worker runs the trials itself
+    fcntl = None  # type: ignore[assignment]
 
 matplotlib.use("Agg")
 
@@ -27,17 +35,26 @@ if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
 
 @pytest.fixture(scope="session")
 def reproduced(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The output directory of one ``paritysim reproduce --all`` (CLI entry point, in process)."""
+    """The output directory of one ``paritysim reproduce --all`` (CLI entry point, in process).
+
+    Under pytest-xdist the workers share one run: the first that needs it writes it into their
+    common temporary directory while the others wait on a lock (a session fixture would
+    otherwise run once per worker, and the trials take about a minute)."""
     from paritysim.cli import main
 
-    out = tmp_path_factory.mktemp("reproduce_all")
-    assert main(["reproduce", "--all", "--out", str(out), "--quiet"]) == 0
-    return out
+    def run(out: Path) -> Path:
+        assert main(["reproduce", "--all", "--out", str(out), "--quiet"]) == 0
+        return out
 
-
-def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Every test that reads ``reproduced`` goes to one xdist worker (``--dist loadgroup``):
-    a session fixture runs once per worker, and the trials take about a minute."""
-    for item in items:
-        if "reproduced" in getattr(item, "fixturenames", ()):
-            item.add_marker(pytest.mark.xdist_group("reproduced"))
+    if "PYTEST_XDIST_WORKER" not in os.environ or fcntl is None:
+        return run(tmp_path_factory.mktemp("reproduce_all"))
+    shared = tmp_path_factory.getbasetemp().parent / "reproduce_all"
+    with open(shared.with_name("reproduce_all.lock"), "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        complete = shared.with_name("reproduce_all.complete")
+        if not complete.exists():
+            shutil.rmtree(shared, ignore_errors=True)
+            shared.mkdir()
+            run(shared)
+            complete.touch()
+    return shared
