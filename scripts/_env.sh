@@ -51,5 +51,5 @@ _build_extension() {
 
 paritysim_install() {  # $1: pip extras, e.g. "test"
     stage "python dependencies (${1:-runtime})" _python_deps "${1:-}"
-    stage "build the extension (maturin develop --release; cold: ~4 min on 2 cores)" _build_extension
+    stage "build the extension (maturin develop --release; cold: ~2 min on 2 cores)" _build_extension
 }
