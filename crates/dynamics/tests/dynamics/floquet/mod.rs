@@ -94,6 +94,7 @@ fn slot(y: &mut State, s: usize) -> &mut f64 {
     }
 }
 
+mod budget;
 mod disturbance;
 mod hill;
 mod orbit;
