@@ -115,3 +115,15 @@ def test_a_one_dof_drive_on_two_untied_wings_names_the_drivetrain(kind: str) -> 
     # The same drive on the configuration that ties the strokes builds.
     spec["configuration"] = {"name": "hmf"}
     ps.Simulation.from_dict(spec).validate()
+
+
+def test_a_one_dof_drive_on_tied_wings_is_not_blamed_for_another_constraint() -> None:
+    # The drivetrain is named only for the untied strokes: on the tied §3.4 HMF the 1-DOF four
+    # bar is fine, and the forced drivetrain coordinates (rotating wings) are the cause.
+    spec = ps.devices.load("sreetharan2012_3_4_hmf").to_dict()
+    spec["drivetrain"] = {"kind": "hmf_four_bar"}
+    spec["formulation"] = "drivetrain_coordinates"
+    with pytest.raises(ps.ConstraintError) as info:
+        ps.simulate(ps.Simulation.from_dict(spec))
+    assert info.value.field != "drivetrain.kind"
+    assert "drivetrain coordinates are not available" in str(info.value)

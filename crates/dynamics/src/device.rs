@@ -142,15 +142,10 @@ impl Device {
             if dof == 2 && n_wings != 2 {
                 bail!(Constraint "the {} drivetrain drives two wings but the device has one", tr.kinematics.name());
             }
-            if dof == 1 && n_wings == 2 {
-                let n = spec.constraints.null_basis();
-                let tied =
-                    (0..spec.constraints.n_free()).all(|k| (n[(0, k)] - n[(3, k)]).abs() < 1e-12);
-                if !tied {
-                    bail!(Constraint
-                        "the 1-DOF {} drivetrain requires C to impose phi_L = phi_R (e.g. configuration hmf)",
-                        tr.kinematics.name());
-                }
+            if dof == 1 && n_wings == 2 && !ties_strokes(&spec.constraints) {
+                bail!(Constraint
+                    "the 1-DOF {} drivetrain requires C to impose phi_L = phi_R (e.g. configuration hmf)",
+                    tr.kinematics.name());
             }
         }
         // The drive load's terms, built once (the forms and the model share this copy).
@@ -454,6 +449,13 @@ impl Device {
         use equations::Equations;
         self.form.rhs(self, t, y, None, dydt)
     }
+}
+
+/// Whether `C` of a two-wing device imposes `φL = φR` (every free direction strokes both wings
+/// alike): what a 1-DOF drivetrain on two wings needs.
+pub fn ties_strokes(constraints: &Constraints) -> bool {
+    let n = constraints.null_basis();
+    (0..constraints.n_free()).all(|k| (n[(0, k)] - n[(3, k)]).abs() < 1e-12)
 }
 
 fn empty_terms() -> WingTerms {

@@ -6,7 +6,9 @@ use paritysim_aero::{
     WhitneyWoodModel,
 };
 use paritysim_constraints::{Constraints, Vec6};
-use paritysim_dynamics::device::{DeviceSpec, Formulation as EngineFormulation, Transmission};
+use paritysim_dynamics::device::{
+    DeviceSpec, Formulation as EngineFormulation, Transmission, ties_strokes,
+};
 use paritysim_dynamics::simulate::PerturbTarget as EngineTarget;
 use paritysim_dynamics::{
     Actuator as EngineActuator, DcOffset as EngineDc, Device, JointSpring,
@@ -119,20 +121,19 @@ impl Simulation {
                 ));
             }
         }
-        // The engine checks that a 1-DOF drivetrain's two wings are tied (φL = φR); the field a
-        // user changes for it is the drivetrain (or the configuration).
-        let one_dof_on_two_wings = wings.len() == 2
-            && transmission
-                .as_ref()
-                .is_some_and(|t| t.kinematics().dof() == 1);
-        let kind = transmission
-            .as_ref()
-            .map(|t| t.kinematics().name().to_string());
-        let configuration = self
-            .configuration
-            .name
-            .clone()
-            .unwrap_or_else(|| "explicit rows".into());
+        // A 1-DOF drivetrain on two wings whose strokes `C` leaves untied is the engine's
+        // error; the field a user changes for it is the drivetrain (or the configuration).
+        let untied_kind = match &transmission {
+            Some(t)
+                if wings.len() == 2
+                    && constraints.n_coords() == 6
+                    && t.kinematics().dof() == 1
+                    && !ties_strokes(&constraints) =>
+            {
+                Some(t.kinematics().name().to_string())
+            }
+            _ => None,
+        };
         Device::new(DeviceSpec {
             wings,
             constraints,
@@ -145,16 +146,20 @@ impl Simulation {
                 Formulation::DrivetrainCoordinates => EngineFormulation::DrivetrainCoordinates,
             },
         })
-        .map_err(|e| match (&e, kind) {
-            (Error::Constraint(_), Some(kind)) if one_dof_on_two_wings => e.attributed(
+        .map_err(|e| match untied_kind {
+            Some(kind) => e.attributed(
                 "drivetrain.kind",
                 format!("{kind:?}"),
                 format!(
-                    "a drivetrain with a whippletree or a drive per wing for configuration {configuration:?} \
-                     (its strokes are not tied), or a configuration that ties them (e.g. hmf)"
+                    "a drivetrain with a whippletree or a drive per wing for configuration {:?} \
+                     (its strokes are not tied), or a configuration that ties them (e.g. hmf)",
+                    self.configuration
+                        .name
+                        .as_deref()
+                        .unwrap_or("explicit rows")
                 ),
             ),
-            _ => e,
+            None => e,
         })
     }
 }
