@@ -4,7 +4,7 @@
 every test that checks trial outputs or the report reads that directory (and is marked
 ``slow``). ``pytest -m "not slow"`` skips it. Under pytest-xdist (``-n 2 --dist loadfile``,
 as ``scripts/test`` runs) a module's tests stay on one worker, so its module fixtures run once,
-and the workers share the one trial run.
+and the workers share the one trial run, started in the background as they collect.
 """
 
 from __future__ import annotations
@@ -12,6 +12,9 @@ from __future__ import annotations
 import os
 import shutil
 import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import matplotlib
@@ -33,28 +36,77 @@ if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
-@pytest.fixture(scope="session")
-def reproduced(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The output directory of one ``paritysim reproduce --all`` (CLI entry point, in process).
+def _shared_run(config: pytest.Config) -> Path:
+    """Where the workers' one trial run goes: beside their own temporary directories."""
+    return config._tmp_path_factory.getbasetemp().parent / "reproduce_all"  # type: ignore[attr-defined]
 
-    Under pytest-xdist the workers share one run: the first that needs it writes it into their
-    common temporary directory while the others wait on a lock (a session fixture would
-    otherwise run once per worker, and the trials take about a minute)."""
-    from paritysim.cli import main
 
-    def run(out: Path) -> Path:
-        assert main(["reproduce", "--all", "--out", str(out), "--quiet"]) == 0
-        return out
+_CHILD: subprocess.Popen[bytes] | None = None
 
+
+@pytest.hookimpl(trylast=True)  # after `-m` / `-k` deselected what will not run
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Under pytest-xdist, the first worker to collect a test that reads the trial run starts
+    that run in a background process at once: the trials (about 40 s on one core) then overlap
+    the other tests instead of one worker waiting for the other to finish them."""
     if "PYTEST_XDIST_WORKER" not in os.environ or fcntl is None:
-        return run(tmp_path_factory.mktemp("reproduce_all"))
-    shared = tmp_path_factory.getbasetemp().parent / "reproduce_all"
+        return
+    if not any("reproduced" in getattr(item, "fixturenames", ()) for item in items):
+        return
+    shared = _shared_run(config)
     with open(shared.with_name("reproduce_all.lock"), "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        complete = shared.with_name("reproduce_all.complete")
-        if not complete.exists():
-            shutil.rmtree(shared, ignore_errors=True)
-            shared.mkdir()
-            run(shared)
-            complete.touch()
+        if shared.with_name("reproduce_all.started").exists():
+            return
+        shutil.rmtree(shared, ignore_errors=True)
+        shared.mkdir()
+        done = shared.with_name("reproduce_all.exit")
+        code = (
+            "import sys; from paritysim.cli import main; "
+            f"rc = main(['reproduce', '--all', '--out', {str(shared)!r}, '--quiet']); "
+            f"open({str(done)!r}, 'w').write(str(rc))"
+        )
+        log = open(shared.with_name("reproduce_all.log"), "w")  # noqa: SIM115 - the child's
+        global _CHILD
+        _CHILD = subprocess.Popen([sys.executable, "-c", code], stdout=log, stderr=subprocess.STDOUT)
+        shared.with_name("reproduce_all.started").write_text(str(_CHILD.pid))
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    """A trial run still going when its worker ends is not needed (every test that reads it
+    waited for it): stopped, not left behind."""
+    if _CHILD is not None and _CHILD.poll() is None:
+        _CHILD.kill()
+        _CHILD.wait()
+
+
+@pytest.fixture(scope="session")
+def reproduced(tmp_path_factory: pytest.TempPathFactory, pytestconfig: pytest.Config) -> Path:
+    """The output directory of one ``paritysim reproduce --all`` (CLI entry point).
+
+    Without pytest-xdist it runs here, in process. Under pytest-xdist the workers share one
+    run, started in the background when they collect (`pytest_collection_modifyitems`); this
+    waits for it and fails with its log if it failed."""
+    from paritysim.cli import main
+
+    if "PYTEST_XDIST_WORKER" not in os.environ or fcntl is None:
+        out = tmp_path_factory.mktemp("reproduce_all")
+        assert main(["reproduce", "--all", "--out", str(out), "--quiet"]) == 0
+        return out
+    shared = _shared_run(pytestconfig)
+    started = shared.with_name("reproduce_all.started")
+    done = shared.with_name("reproduce_all.exit")
+    pid = int(started.read_text())
+    deadline = time.monotonic() + 900.0
+    while not done.exists():
+        try:
+            os.kill(pid, 0)  # still running (it writes the exit file before it ends)
+        except ProcessLookupError:
+            time.sleep(0.5)  # the file may land just as the process ends
+            if not done.exists():
+                break
+        assert time.monotonic() < deadline, "the trial run took more than 15 minutes"
+        time.sleep(0.2)
+    log = shared.with_name("reproduce_all.log").read_text()
+    assert done.exists() and done.read_text() == "0", f"paritysim reproduce --all failed:\n{log[-4000:]}"
     return shared
