@@ -60,15 +60,14 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             return
         shutil.rmtree(shared, ignore_errors=True)
         shared.mkdir()
+        cli = f"from paritysim.cli import main; raise SystemExit(main(['reproduce', '--all', '--out', {str(shared)!r}, '--quiet']))"
+        # The shell records the exit status whatever ended the run (an exception, a crash of the
+        # native module), written whole by a rename.
+        record = '"$0" -c "$1"; echo $? > "$2.tmp" && mv "$2.tmp" "$2"'
         done = shared.with_name("reproduce_all.exit")
-        code = (
-            "import sys; from paritysim.cli import main; "
-            f"rc = main(['reproduce', '--all', '--out', {str(shared)!r}, '--quiet']); "
-            f"open({str(done)!r}, 'w').write(str(rc))"
-        )
         log = open(shared.with_name("reproduce_all.log"), "w")  # noqa: SIM115 - the child's
         global _CHILD
-        _CHILD = subprocess.Popen([sys.executable, "-c", code], stdout=log, stderr=subprocess.STDOUT)
+        _CHILD = subprocess.Popen(["sh", "-c", record, sys.executable, cli, str(done)], stdout=log, stderr=subprocess.STDOUT)
         shared.with_name("reproduce_all.started").write_text(str(_CHILD.pid))
 
 
@@ -99,14 +98,21 @@ def reproduced(tmp_path_factory: pytest.TempPathFactory, pytestconfig: pytest.Co
     pid = int(started.read_text())
     deadline = time.monotonic() + 900.0
     while not done.exists():
-        try:
-            os.kill(pid, 0)  # still running (it writes the exit file before it ends)
-        except ProcessLookupError:
-            time.sleep(0.5)  # the file may land just as the process ends
-            if not done.exists():
-                break
+        # Ended without its exit file: killed. (The worker that started it reaps it with
+        # poll(); for the other, a process that is gone.)
+        if _CHILD is not None:
+            ended = _CHILD.poll() is not None
+        else:
+            try:
+                os.kill(pid, 0)
+                ended = False
+            except ProcessLookupError:
+                ended = True
+        if ended and not done.exists():
+            break
         assert time.monotonic() < deadline, "the trial run took more than 15 minutes"
         time.sleep(0.2)
     log = shared.with_name("reproduce_all.log").read_text()
-    assert done.exists() and done.read_text() == "0", f"paritysim reproduce --all failed:\n{log[-4000:]}"
+    status = done.read_text().strip() if done.exists() else "killed"
+    assert status == "0", f"paritysim reproduce --all failed (exit status {status}):\n{log[-4000:]}"
     return shared
