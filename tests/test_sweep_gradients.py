@@ -51,6 +51,14 @@ def test_bad_gradient_paths_are_named_before_running(gradients, named):
     assert named in str(e.value)
 
 
+def test_gradients_none_is_a_sweep_without_them():
+    grid = {"actuator.amplitude_v": [90.0, 100.0]}
+    plain = ps.sweep(_spec(), grid, metrics=METRICS, progress=False)
+    none = ps.sweep(_spec(), grid, metrics=METRICS, gradients=None, progress=False)
+    assert none.columns == plain.columns and not any(c.startswith("d(") for c in none.columns)
+    assert none.select(METRICS).equals(plain.select(METRICS))
+
+
 def test_a_checkpoint_of_a_sweep_without_gradients_is_not_reused(tmp_path):
     spec = _spec()
     path = tmp_path / "study.parquet"

@@ -194,7 +194,7 @@ def sweep(
     chunk_size: int | None = None,
     options: Mapping[str, Any] | None = None,
     labels: Sequence[str] = (),
-    gradients: Sequence[str] = (),
+    gradients: Sequence[str] | None = (),
 ) -> pl.DataFrame:
     """Run ``spec`` over a table of parameter overrides; one row per point, in input order.
 
@@ -244,7 +244,7 @@ def sweep(
         at that point (null where the metric is not differentiable there, or the point did not
         converge; ``gradient_error`` says why a converged point has none). Costs one
         sensitivity per point (about ten solves' work for ten paths), computed in this process
-        on the sweep's ``threads`` as each chunk finishes.
+        on the sweep's ``threads`` as each chunk finishes. ``()`` or None: no derivatives.
 
     Returns
     -------
@@ -393,9 +393,11 @@ class SweepInterrupted(KeyboardInterrupt):
         self.checkpoint = checkpoint
 
 
-def _gradient_paths(spec_json: str, gradients: Sequence[str]) -> list[str]:
+def _gradient_paths(spec_json: str, gradients: Sequence[str] | None) -> list[str]:
     """The ``gradients`` paths, checked before any point runs (unknown, discrete or
-    wing-dependent paths are the typed errors of `paritysim.sensitivity`)."""
+    wing-dependent paths are the typed errors of `paritysim.sensitivity`); None: none."""
+    if gradients is None:
+        return []
     if isinstance(gradients, str):
         gradients = [gradients]
     paths = _names("gradients", gradients)
