@@ -83,39 +83,34 @@ def _check_recovery(estimates: np.ndarray, errors: np.ndarray, converged: int, t
     assert np.all((lo < ratio) & (ratio < hi)), ratio
 
 
+def _symmetric_parity(hmf_table: pl.DataFrame, volts: list[float], freqs: list[float]) -> tuple[ps.Simulation, pl.DataFrame]:
+    """The §3.3 PARITY with a balance spring and its clean table, asserted equal to the HMF's:
+    with identical wings the differential never moves (q2 ≡ 0), so its stroke is the HMF's (a
+    cross-check of the general null-space equations against drivetrain coordinates with the
+    linear map's analytic Jacobian, at about a fifth of the cost per fit)."""
+    spec = ps.devices.load("sreetharan2012_3_3_parity").with_paths({"drivetrain.balance_spring": 10.0})
+    spec = spec.replace(options=_spec().options)
+    table = _clean(spec, volts, freqs)
+    np.testing.assert_allclose(table["stroke_pp_deg"].to_numpy(), hmf_table["stroke_pp_deg"].to_numpy(), rtol=1e-6)
+    return spec, table
+
+
 def test_recovers_the_known_parameters_within_two_standard_errors(small: pl.DataFrame) -> None:
     """10 seeded noisy copies of a 3 × 4 table, 2 parameters: both inside 2 reported standard
     errors (jointly) in at least 9 of 10 trials. Fitted on the symmetric PARITY, whose table is
     the HMF's (asserted here; the other tests fit the HMF itself)."""
-    parity = _symmetric_parity()
-    clean = _clean(parity, [80.0, 120.0, 160.0], [60.0, 100.0, 140.0, 180.0])
-    np.testing.assert_allclose(clean["stroke_pp_deg"].to_numpy(), small["stroke_pp_deg"].to_numpy(), rtol=1e-6)
+    parity, clean = _symmetric_parity(small, [80.0, 120.0, 160.0], [60.0, 100.0, 140.0, 180.0])
     _check_recovery(*_trials(parity, clean, range(10)), trials=10)
-
-
-def _symmetric_parity() -> ps.Simulation:
-    """The §3.3 PARITY with a balance spring: with identical wings the differential never moves
-    (q2 ≡ 0), so its stroke is the HMF's. It integrates in drivetrain coordinates with the
-    linear map's analytic Jacobian, where the HMF takes the general null-space equations:
-    about a fifth of the cost per fit."""
-    spec = ps.devices.load("sreetharan2012_3_3_parity").with_paths({"drivetrain.balance_spring": 10.0})
-    return spec.replace(options=_spec().options)
 
 
 @pytest.mark.slow
 def test_recovery_and_standard_errors_over_forty_trials(spec: ps.Simulation) -> None:
     volts, freqs = [80.0, 110.0, 140.0, 170.0], [60.0, 80.0, 100.0, 120.0, 140.0, 160.0, 180.0]
-    # Two formulations of one physical system: the HMF (rigidly coupled wings, null-space
-    # equations) and the symmetric PARITY (drivetrain coordinates) give the same table.
-    hmf = _clean(spec, volts, freqs)
-    parity = _symmetric_parity()
-    clean = _clean(parity, volts, freqs)
-    np.testing.assert_allclose(clean["stroke_pp_deg"].to_numpy(), hmf["stroke_pp_deg"].to_numpy(), rtol=1e-6)
-    # ... so the 40 fits run on the cheaper one.
-    spec = parity
+    # The 40 fits run on the symmetric PARITY, whose table is the HMF's (asserted).
+    parity, clean = _symmetric_parity(_clean(spec, volts, freqs), volts, freqs)
     # Both parameters at once: about 0.9 for two correlated 95 % intervals with 26 degrees of
     # freedom, so 40 trials are asked for 80 % (36 of 40 measured).
-    _check_recovery(*_trials(spec, clean, range(100, 140)), trials=40, joint=0.8)
+    _check_recovery(*_trials(parity, clean, range(100, 140)), trials=40, joint=0.8)
 
 
 def test_standard_errors_are_the_linear_least_squares_formula(spec: ps.Simulation, small: pl.DataFrame) -> None:

@@ -1,7 +1,7 @@
 """The wheel CI ships: `maturin build` it, install it into a fresh venv, use it there.
 
-Marked slow (a build in the extension's profile plus a venv with the runtime dependencies: minutes); deselect
-with ``-m "not slow"``.
+Marked slow (a build in the extension's profile plus a venv with the runtime dependencies:
+minutes); deselect with ``-m "not slow"``.
 """
 
 from __future__ import annotations
