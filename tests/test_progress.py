@@ -79,3 +79,32 @@ def test_the_bar_never_hides_the_specs_own_error_for_a_bad_budget(budget: object
     with pytest.raises(ps.InvalidParameterError) as info:
         ps.simulate(hmf, max_wall_ms=budget)
     assert info.value.field == "options.max_wall_ms"
+
+
+def test_short_calls_start_no_thread_each(monkeypatch: pytest.MonkeyPatch) -> None:
+    """One watcher serves every call: a thread started per call cost 0.4 ms, 45 % of a short
+    simulate (docs/findings.md §30)."""
+    hmf = ps.load_spec(EXAMPLES / "hmf.toml")
+    ps.simulate(hmf, max_cycles=2, samples_per_cycle=20)  # the watcher exists
+    started: list[str] = []
+    start = _progress.threading.Thread.start
+
+    def counting(self: _progress.threading.Thread) -> None:
+        started.append(self.name)
+        start(self)
+
+    monkeypatch.setattr(_progress.threading.Thread, "start", counting)
+    for _ in range(10):
+        ps.simulate(hmf, max_cycles=2, samples_per_cycle=20)
+    assert started == []
+
+
+def test_a_bar_after_a_short_call_with_a_later_deadline(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """The watcher sleeping towards an earlier call's (long) deadline wakes for a new call due
+    sooner."""
+    monkeypatch.setattr(_progress, "DELAY_S", 30.0)
+    ps.simulate(ps.load_spec(EXAMPLES / "hmf.toml"), max_cycles=2, samples_per_cycle=20)
+    monkeypatch.setattr(_progress, "DELAY_S", 0.05)
+    monkeypatch.setattr(_progress, "REFRESH_S", 0.05)
+    _slow_run()
+    assert "of the wall budget" in capsys.readouterr().err

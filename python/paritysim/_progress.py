@@ -6,7 +6,8 @@ and the runs finished so far for the loops (``calibrate``, ``trim``). It appears
 call has taken `DELAY_S` (a run of a second shows nothing), on stderr, drawn by tqdm as in
 ``ps.sweep`` (the same ``progress=True`` argument: ``False`` turns it off). ``paritysim ...
 --quiet`` turns every bar off (`quiet`). The bar lives on a daemon thread: the engine releases
-the GIL while it runs, so the bar moves while the run does.
+the GIL while it runs, so the bar moves while the run does. One watcher thread serves every call
+and starts a bar's thread only when the call is due: a short call costs a lock, not a thread.
 """
 
 from __future__ import annotations
@@ -67,18 +68,18 @@ class LongRun:
     def __enter__(self) -> LongRun:
         self._start = time.monotonic()
         if self.enabled:
-            self._thread = threading.Thread(target=self._draw, name=f"paritysim-progress-{self.desc}", daemon=True)
-            self._thread.start()
+            _watch(self)
         return self
 
     def __exit__(self, kind: type[BaseException] | None, value: BaseException | None, tb: TracebackType | None) -> None:
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join()
+        with _runs:
+            _active.discard(self)
+            self._stop.set()
+            thread = self._thread
+        if thread is not None:
+            thread.join()
 
     def _draw(self) -> None:
-        if self._stop.wait(DELAY_S):
-            return
         from tqdm.auto import tqdm  # type: ignore[import-untyped]
 
         elapsed = "{n:.0f}/{total:.0f} s of the wall budget" if self.budget_s else "{n:.0f} s"
@@ -95,3 +96,40 @@ class LongRun:
                     break
         finally:
             bar.close()
+
+
+# One watcher thread for every call (a thread started per call cost 0.4 ms, 45 % of a 0.9 ms
+# simulate; docs/findings.md §30): it starts a run's drawing thread once the run is due.
+_runs = threading.Condition()
+_active: set[LongRun] = set()
+_watcher: threading.Thread | None = None
+_wakes_at: float | None = None  # the watcher's next wake-up (None: only when notified)
+
+
+def _watch(run: LongRun) -> None:
+    global _watcher
+    with _runs:
+        _active.add(run)
+        if _watcher is None or not _watcher.is_alive():  # first call, or a forked child
+            _watcher = threading.Thread(target=_watch_loop, name="paritysim-progress", daemon=True)
+            _watcher.start()
+        elif _wakes_at is None or run._start + DELAY_S < _wakes_at:  # it would wake too late
+            _runs.notify()
+
+
+def _watch_loop() -> None:
+    global _wakes_at
+    with _runs:
+        while True:
+            now = time.monotonic()
+            pending = []
+            for run in _active:
+                if run._thread is not None:
+                    continue
+                if now - run._start >= DELAY_S:
+                    run._thread = threading.Thread(target=run._draw, name=f"paritysim-progress-{run.desc}", daemon=True)
+                    run._thread.start()
+                else:
+                    pending.append(run._start + DELAY_S)
+            _wakes_at = min(pending) if pending else None
+            _runs.wait(timeout=_wakes_at - now if _wakes_at is not None else None)
