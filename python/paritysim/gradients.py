@@ -153,13 +153,16 @@ def sensitivity(
         spec = spec.replace(options=spec.options.with_fields("options", **option_overrides))
     with LongRun("sensitivity", progress, spec.options.max_wall_ms):
         raw = _core.sensitivity(spec.to_json(), names, wanted)
-    jacobian = pl.DataFrame({"metric": raw["metric"], "value": np.asarray(raw["value"], dtype=float)})
-    for name, column in zip(raw["parameter"], raw["jacobian"], strict=True):
-        jacobian = jacobian.with_columns(pl.Series(f"d/d({name})", np.asarray(column, dtype=float)))
     reasons = list(raw["not_differentiable"])
-    jacobian = jacobian.with_columns(
-        pl.Series("differentiable", [not r for r in reasons]),
-        pl.Series("reason", [r or None for r in reasons], dtype=pl.String),
+    # One constructor for the table (a with_columns per parameter cost 0.15 ms each).
+    jacobian = pl.DataFrame(
+        {
+            "metric": raw["metric"],
+            "value": np.asarray(raw["value"], dtype=float),
+            **{f"d/d({name})": np.asarray(column, dtype=float) for name, column in zip(raw["parameter"], raw["jacobian"], strict=True)},
+            "differentiable": [not r for r in reasons],
+            "reason": pl.Series([r or None for r in reasons], dtype=pl.String),
+        }
     )
     parameters = pl.DataFrame(
         {"parameter": raw["parameter"], "unit": raw["unit"], "value": np.asarray(raw["parameter_value"], dtype=float)}

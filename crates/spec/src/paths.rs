@@ -35,21 +35,135 @@ pub struct PathInfo {
 
 /// Every canonical path of `spec`, in declaration order.
 pub fn spec_paths(spec: &Simulation) -> Vec<PathInfo> {
+    listing(spec, true)
+}
+
+/// [`spec_paths`] without the `allowed` texts (left empty): what resolving a name needs, at a
+/// tenth of the cost (the texts were 0.5 ms a call, per sweep row with gradients and per
+/// `with_paths`; docs/findings.md §30).
+pub fn field_paths(spec: &Simulation) -> Vec<PathInfo> {
+    listing(spec, false)
+}
+
+fn listing(spec: &Simulation, texts: bool) -> Vec<PathInfo> {
     let value = serde_json::to_value(spec).expect("a spec serialises");
     let mut out = Vec::new();
-    walk(&value, schema(), "", "", &mut out);
+    Walk { texts }.walk(&value, schema(), "", "", &mut out);
     out
 }
 
-fn leaf(path: &str, value: &Value, schema: &Value, parent_unit: &str, out: &mut Vec<PathInfo>) {
-    let n = node(schema);
-    let own = unit(&n).unwrap_or_else(|| parent_unit.to_string());
-    out.push(PathInfo {
-        path: path.to_string(),
-        unit: own,
-        allowed: describe(schema),
-        value: value.clone(),
-    });
+/// A walk of a spec value along its schema, with or without the `allowed` texts.
+#[derive(Clone, Copy)]
+struct Walk {
+    texts: bool,
+}
+
+impl Walk {
+    fn leaf(
+        self,
+        path: &str,
+        value: &Value,
+        schema: &Value,
+        parent_unit: &str,
+        out: &mut Vec<PathInfo>,
+    ) {
+        let n = node(schema);
+        let own = unit(&n).unwrap_or_else(|| parent_unit.to_string());
+        out.push(PathInfo {
+            path: path.to_string(),
+            unit: own,
+            allowed: if self.texts {
+                describe(schema)
+            } else {
+                String::new()
+            },
+            value: value.clone(),
+        });
+    }
+
+    fn walk(
+        self,
+        value: &Value,
+        schema: &Value,
+        path: &str,
+        parent_unit: &str,
+        out: &mut Vec<PathInfo>,
+    ) {
+        let s = node(schema);
+        let unit_here = unit(&s).unwrap_or_else(|| parent_unit.to_string());
+        match classify(&s) {
+            Branch::Optional(inner) => {
+                if value.is_null() {
+                    if is_scalar_schema(inner) {
+                        self.leaf(path, value, schema, &unit_here, out);
+                    }
+                } else {
+                    self.walk(value, inner, path, &unit_here, out);
+                }
+                return;
+            }
+            Branch::Tagged(variants) => {
+                let kind = value
+                    .get("kind")
+                    .and_then(Value::as_str)
+                    .unwrap_or_default();
+                let tags: Vec<&str> = variants.iter().map(|(t, _)| t.as_str()).collect();
+                out.push(PathInfo {
+                    path: join(path, "kind"),
+                    unit: String::new(),
+                    allowed: if self.texts {
+                        format!("one of {}", tags.join(", "))
+                    } else {
+                        String::new()
+                    },
+                    value: Value::String(kind.to_string()),
+                });
+                if let Some((_, branch)) = variants.iter().find(|(t, _)| t == kind) {
+                    self.walk_object(value, branch, path, &unit_here, out);
+                }
+                return;
+            }
+            Branch::Untagged(_) => {
+                self.leaf(path, value, schema, &unit_here, out);
+                return;
+            }
+            Branch::Plain => {}
+        }
+        if s.contains_key("properties") {
+            self.walk_object(value, &s, path, &unit_here, out);
+        } else if let (Some(items), Value::Array(list)) = (s.get("items"), value) {
+            let fixed = s.get("minItems").is_some() && s.get("minItems") == s.get("maxItems");
+            if fixed || !is_scalar_schema(items) {
+                for (i, v) in list.iter().enumerate() {
+                    self.walk(v, items, &format!("{path}[{i}]"), &unit_here, out);
+                }
+            } else {
+                self.leaf(path, value, schema, &unit_here, out);
+            }
+        } else {
+            self.leaf(path, value, schema, &unit_here, out);
+        }
+    }
+
+    fn walk_object(
+        self,
+        value: &Value,
+        s: &serde_json::Map<String, Value>,
+        path: &str,
+        parent_unit: &str,
+        out: &mut Vec<PathInfo>,
+    ) {
+        let Some(props) = s.get("properties").and_then(Value::as_object) else {
+            return;
+        };
+        for (k, sub) in props {
+            if k == "kind" && crate::schema::tag_of(s).is_some() {
+                continue;
+            }
+            let v = value.get(k).unwrap_or(&Value::Null);
+            self.walk(v, sub, &join(path, k), parent_unit, out);
+        }
+    }
 }
 
 fn is_scalar_schema(s: &Value) -> bool {
@@ -58,84 +172,14 @@ fn is_scalar_schema(s: &Value) -> bool {
         return true;
     }
     match n.get("type") {
-        Some(Value::String(t)) => matches!(t.as_str(), "number" | "integer" | "string" | "boolean"),
+        Some(Value::String(t)) => {
+            matches!(t.as_str(), "number" | "integer" | "string" | "boolean")
+        }
         Some(Value::Array(ts)) => ts
             .iter()
             .filter_map(Value::as_str)
             .any(|t| matches!(t, "number" | "integer" | "string" | "boolean")),
         _ => false,
-    }
-}
-
-fn walk(value: &Value, schema: &Value, path: &str, parent_unit: &str, out: &mut Vec<PathInfo>) {
-    let s = node(schema);
-    let unit_here = unit(&s).unwrap_or_else(|| parent_unit.to_string());
-    match classify(&s) {
-        Branch::Optional(inner) => {
-            if value.is_null() {
-                if is_scalar_schema(inner) {
-                    leaf(path, value, schema, &unit_here, out);
-                }
-            } else {
-                walk(value, inner, path, &unit_here, out);
-            }
-            return;
-        }
-        Branch::Tagged(variants) => {
-            let kind = value
-                .get("kind")
-                .and_then(Value::as_str)
-                .unwrap_or_default();
-            let tags: Vec<&str> = variants.iter().map(|(t, _)| t.as_str()).collect();
-            out.push(PathInfo {
-                path: join(path, "kind"),
-                unit: String::new(),
-                allowed: format!("one of {}", tags.join(", ")),
-                value: Value::String(kind.to_string()),
-            });
-            if let Some((_, branch)) = variants.iter().find(|(t, _)| t == kind) {
-                walk_object(value, branch, path, &unit_here, out);
-            }
-            return;
-        }
-        Branch::Untagged(_) => {
-            leaf(path, value, schema, &unit_here, out);
-            return;
-        }
-        Branch::Plain => {}
-    }
-    if s.contains_key("properties") {
-        walk_object(value, &s, path, &unit_here, out);
-    } else if let (Some(items), Value::Array(list)) = (s.get("items"), value) {
-        let fixed = s.get("minItems").is_some() && s.get("minItems") == s.get("maxItems");
-        if fixed || !is_scalar_schema(items) {
-            for (i, v) in list.iter().enumerate() {
-                walk(v, items, &format!("{path}[{i}]"), &unit_here, out);
-            }
-        } else {
-            leaf(path, value, schema, &unit_here, out);
-        }
-    } else {
-        leaf(path, value, schema, &unit_here, out);
-    }
-}
-
-fn walk_object(
-    value: &Value,
-    s: &serde_json::Map<String, Value>,
-    path: &str,
-    parent_unit: &str,
-    out: &mut Vec<PathInfo>,
-) {
-    let Some(props) = s.get("properties").and_then(Value::as_object) else {
-        return;
-    };
-    for (k, sub) in props {
-        if k == "kind" && crate::schema::tag_of(s).is_some() {
-            continue;
-        }
-        let v = value.get(k).unwrap_or(&Value::Null);
-        walk(v, sub, &join(path, k), parent_unit, out);
     }
 }
 
@@ -155,7 +199,7 @@ pub struct Parameter {
 /// # Errors
 /// [`Error::InvalidParameter`] naming the path, with the nearest valid path.
 pub fn resolve(spec: &Simulation, name: &str) -> Result<Parameter> {
-    let paths = spec_paths(spec);
+    let paths = field_paths(spec);
     resolve_in(spec, &paths, name)
 }
 
@@ -266,6 +310,14 @@ fn unknown(name: &str, paths: &[PathInfo]) -> Error {
     Error::invalid(name.to_string(), "<unknown parameter path>", allowed)
 }
 
+/// The field at `path` (canonical) in a spec value, if there is one.
+pub fn get<'a>(value: &'a Value, path: &str) -> Option<&'a Value> {
+    tokens(path)?.iter().try_fold(value, |node, t| match t {
+        Token::Key(k) => node.get(k),
+        Token::Index(i) => node.get(*i),
+    })
+}
+
 /// Sets `path` (canonical) in a spec value.
 ///
 /// # Errors
@@ -334,7 +386,18 @@ fn tokens(path: &str) -> Option<Vec<Token>> {
 /// # Errors
 /// The typed errors of [`crate::from_value`] for the resulting spec.
 pub fn apply(spec: &Simulation, overrides: &[(&Parameter, &Value)]) -> Result<Simulation> {
-    let mut value = serde_json::to_value(spec).expect("a spec serialises");
+    apply_to(
+        serde_json::to_value(spec).expect("a spec serialises"),
+        overrides,
+    )
+}
+
+/// [`apply`] to a spec already serialised (`serde_json::to_value`): the serialisation was
+/// nine tenths of an [`apply`], paid once where one spec is varied many times.
+///
+/// # Errors
+/// As [`apply`].
+pub fn apply_to(mut value: Value, overrides: &[(&Parameter, &Value)]) -> Result<Simulation> {
     for (param, v) in overrides {
         if v.is_null() {
             continue;
@@ -359,7 +422,7 @@ pub fn apply(spec: &Simulation, overrides: &[(&Parameter, &Value)]) -> Result<Si
 pub fn apply_json(spec: &Simulation, values: &str) -> Result<(Simulation, Vec<String>)> {
     let values: serde_json::Map<String, Value> = serde_json::from_str(values)
         .map_err(|e| Error::invalid("values", e.to_string(), "a JSON object of path: value"))?;
-    let listed = spec_paths(spec);
+    let listed = field_paths(spec);
     let params = values
         .keys()
         .map(|k| resolve_in(spec, &listed, k))

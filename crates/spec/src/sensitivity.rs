@@ -6,7 +6,7 @@ use paritysim_dynamics::sensitivity::{SteadySensitivity, steady_sensitivity};
 use paritysim_error::{Error, Result};
 use serde_json::Value;
 
-use crate::paths::{Parameter, apply, apply_json, resolve_in, spec_paths};
+use crate::paths::{Parameter, apply_to, field_paths, get, resolve_in, spec_paths};
 use crate::spec::Simulation;
 
 /// What [`sensitivity`] returns: the resolved parameters with their units and base values,
@@ -36,13 +36,21 @@ pub fn sensitivity(
     params: &[String],
     metrics: Option<&[String]>,
 ) -> Result<Sensitivity> {
-    if params.is_empty() {
-        return Err(Error::invalid(
-            "params",
-            "[]",
-            "at least one continuous spec path (see ps.spec_paths)",
-        ));
-    }
+    let (parameters, units, _) = self::parameters(spec, params)?;
+    let value = serde_json::to_value(spec).expect("a spec serialises");
+    sensitivity_at(spec, value, parameters, units, metrics)
+}
+
+/// [`sensitivity`] with the parameters resolved (on this spec or on the base spec of a sweep:
+/// the paths are the same) and the spec serialised: the perturbed specs are this value with
+/// the parameters set, and the parameters' values are read from it.
+fn sensitivity_at(
+    spec: &Simulation,
+    value: Value,
+    parameters: Vec<Parameter>,
+    units: Vec<String>,
+    metrics: Option<&[String]>,
+) -> Result<Sensitivity> {
     let (device, options) = spec.model()?;
     if spec.flight(&device)?.is_some() {
         return Err(Error::invalid(
@@ -52,11 +60,14 @@ pub fn sensitivity(
         ));
     }
     let options = spec.with_outputs(&device, &options, Some(&[]), metrics)?;
-    let (parameters, units, values) = parameters(spec, params)?;
+    let values = parameters
+        .iter()
+        .map(|p| value_of(&value, p))
+        .collect::<Result<Vec<_>>>()?;
     let device_at = |p: &[f64]| -> Result<paritysim_dynamics::Device> {
         let numbers: Vec<Value> = p.iter().map(|&x| Value::from(x)).collect();
         let pairs: Vec<(&Parameter, &Value)> = parameters.iter().zip(&numbers).collect();
-        apply(spec, &pairs)?.device()
+        apply_to(value.clone(), &pairs)?.device()
     };
     let result = steady_sensitivity(&device_at, &values, None, &options)?;
     Ok(Sensitivity {
@@ -65,6 +76,37 @@ pub fn sensitivity(
         values,
         result,
     })
+}
+
+/// The value of parameter `param` in the serialised spec `value`: one number on all its
+/// targets (a `wings[*]` path), divided by the target's scale (`omega_ratio`).
+fn value_of(value: &Value, param: &Parameter) -> Result<f64> {
+    let mut base = None;
+    for (path, scale) in &param.targets {
+        let field = get(value, path).unwrap_or(&Value::Null);
+        let Some(x) = field.as_f64().filter(|_| continuous(field)) else {
+            return Err(Error::invalid(
+                param.name.clone(),
+                field.to_string(),
+                format!(
+                    "a continuous number to differentiate by ({path} is discrete or not a number)"
+                ),
+            ));
+        };
+        let x = scale.map_or(x, |s| x / s);
+        match base {
+            None => base = Some(x),
+            Some(b) if b != x => {
+                return Err(Error::invalid(
+                    param.name.clone(),
+                    format!("{b} and {x}"),
+                    "one value on every wing: name each wing's path to differentiate by it",
+                ));
+            }
+            Some(_) => {}
+        }
+    }
+    base.ok_or_else(|| Error::invalid(param.name.clone(), "<no target>", "a spec path"))
 }
 
 /// The sensitivities at the points `rows` of `spec` (each a JSON object of spec paths and
@@ -82,9 +124,41 @@ pub fn sensitivities(
     metrics: Option<&[String]>,
     threads: Option<usize>,
 ) -> Result<SensitivityRows> {
+    // The paths are resolved once on the base spec (as the sweep resolves its columns), the
+    // gradients' and each row's: per point only the values change.
+    let (parameters, units, _) = self::parameters(spec, params)?;
+    let base = serde_json::to_value(spec).expect("a spec serialises");
+    let listed = field_paths(spec);
+    let mut columns: Vec<(String, Parameter)> = Vec::new();
+    let points: Vec<Result<Vec<(usize, Value)>>> = rows
+        .iter()
+        .map(|row| {
+            let values: serde_json::Map<String, Value> =
+                serde_json::from_str(row).map_err(|e| {
+                    Error::invalid("values", e.to_string(), "a JSON object of path: value")
+                })?;
+            values
+                .into_iter()
+                .map(|(key, v)| {
+                    let k = match columns.iter().position(|(name, _)| *name == key) {
+                        Some(k) => k,
+                        None => {
+                            columns.push((key.clone(), resolve_in(spec, &listed, &key)?));
+                            columns.len() - 1
+                        }
+                    };
+                    Ok((k, v))
+                })
+                .collect()
+        })
+        .collect();
     let runs = paritysim_dynamics::stability::rows::run_rows(rows.len(), threads, None, |i| {
-        let (point, _) = apply_json(spec, &rows[i])?;
-        sensitivity(&point, params, metrics).map(|s| s.record())
+        let point = points[i].as_ref().map_err(Clone::clone)?;
+        let pairs: Vec<(&Parameter, &Value)> =
+            point.iter().map(|(k, v)| (&columns[*k].1, v)).collect();
+        let spec = apply_to(base.clone(), &pairs)?;
+        let value = serde_json::to_value(&spec).expect("a spec serialises");
+        sensitivity_at(&spec, value, parameters.clone(), units.clone(), metrics).map(|s| s.record())
     })?;
     Ok(SensitivityRows {
         error: runs
@@ -126,7 +200,7 @@ pub fn parameters(
             "at least one continuous spec path (see ps.spec_paths)",
         ));
     }
-    let listed = spec_paths(spec);
+    let listed = field_paths(spec);
     let mut parameters = Vec::new();
     let mut units = Vec::new();
     let mut values = Vec::new();
@@ -139,12 +213,16 @@ pub fn parameters(
                 .find(|i| &i.path == path)
                 .expect("a resolved path is listed");
             let Some(x) = info.value.as_f64().filter(|_| continuous(&info.value)) else {
+                let allowed = spec_paths(spec)
+                    .into_iter()
+                    .find(|i| &i.path == path)
+                    .map(|i| i.allowed)
+                    .unwrap_or_default();
                 return Err(Error::invalid(
                     name.clone(),
                     info.value.to_string(),
                     format!(
-                        "a continuous number to differentiate by ({}: {} is discrete or not a number)",
-                        path, info.allowed
+                        "a continuous number to differentiate by ({path}: {allowed} is discrete or not a number)"
                     ),
                 ));
             };
