@@ -186,3 +186,40 @@ fn floats_survive_json_bit_for_bit() {
         assert_eq!(back.to_bits(), x.to_bits(), "{text}");
     }
 }
+
+/// The listing without texts (what resolving a name reads) holds the same paths, units and
+/// values as `spec_paths`; `get` reads what `set` writes.
+#[test]
+fn field_paths_are_spec_paths_without_their_texts_and_get_reads_what_set_writes() {
+    for file in ["drag_parity.toml", "hmf.toml"] {
+        let (spec, _) = from_toml(&example(file)).unwrap();
+        let full = paths::spec_paths(&spec);
+        let lean = paths::field_paths(&spec);
+        assert_eq!(full.len(), lean.len(), "{file}");
+        for (f, l) in full.iter().zip(&lean) {
+            assert_eq!((&f.path, &f.unit, &f.value), (&l.path, &l.unit, &l.value));
+            assert!(l.allowed.is_empty());
+        }
+        assert!(full.iter().all(|f| !f.allowed.is_empty()), "{file}");
+        let mut value = serde_json::to_value(&spec).unwrap();
+        for info in &full {
+            assert_eq!(
+                paths::get(&value, &info.path).unwrap_or(&serde_json::Value::Null),
+                &info.value,
+                "{}",
+                info.path
+            );
+        }
+        paths::set(
+            &mut value,
+            "drivetrain.balance_spring",
+            serde_json::json!(7.5),
+        )
+        .unwrap();
+        assert_eq!(
+            paths::get(&value, "drivetrain.balance_spring"),
+            Some(&serde_json::json!(7.5))
+        );
+        assert_eq!(paths::get(&value, "drivetrain.no_such_field"), None);
+    }
+}
