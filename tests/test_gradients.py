@@ -5,6 +5,7 @@ device; neutral families flagged; bad paths named."""
 from __future__ import annotations
 
 import numpy as np
+import polars as pl
 import pytest
 
 import paritysim as ps
@@ -125,3 +126,20 @@ def test_bad_parameters_are_named(params, named):
     with pytest.raises(InvalidParameterError) as e:
         ps.sensitivity(spec, params, progress=False)
     assert named in str(e.value)
+
+
+@pytest.mark.parametrize("balance_spring", [5.0, 0.0])
+def test_sensitivity_periods_in_lanes_equal_the_scalar_ones(balance_spring: float, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A linear-map device's perturbed periods run four at a time in SIMD lanes
+    (``crates/dynamics/src/lanes/batch.rs``); ``PARITYSIM_LANES=1`` runs them scalar: the same
+    bits, central differences (K2 = 5) and one-sided ones at the range's end (K2 = 0), the
+    frequency (a scaled grid) included."""
+    spec = ps.devices.load("sreetharan2012_3_3_parity").with_paths({"drivetrain.balance_spring": balance_spring, "wings.left.omega_ratio": 0.7})
+    params = ["wings[0].aero.omega1", "drivetrain.balance_spring", "actuator.stiffness", "actuator.waveform.amplitude_v", "actuator.waveform.frequency_hz", "drivetrain.transmission_ratio"]
+    metrics = ["delta_tau_peak", "tau_r_peak", "tau_l_peak", "imbalance_peak_pct", "left_stroke_amplitude"]
+    lanes = ps.sensitivity(spec, params, metrics=metrics, progress=False)
+    monkeypatch.setenv("PARITYSIM_LANES", "1")
+    scalar = ps.sensitivity(spec, params, metrics=metrics, progress=False)
+    assert lanes.jacobian.equals(scalar.jacobian)
+    assert np.array_equal(lanes.state_jacobian, scalar.state_jacobian)
+    assert np.isfinite(lanes.jacobian.select(pl.col("^d/d.*$")).to_numpy()).all()

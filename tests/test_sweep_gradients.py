@@ -20,6 +20,11 @@ def _spec() -> ps.Simulation:
 
 
 def test_gradient_columns_equal_sensitivity_at_each_point():
+    """The rows' derivatives are taken at the sweep's (chained) orbits, ps.sensitivity's at
+    the orbit of a run from rest: they agree to the derivatives' own accuracy at the spec's
+    rtol 1e-8 (measured: up to 8.7e-6 relative apart on the small cross-derivative
+    d(right_stroke_amplitude)/d(left Ω), where each is up to 6.7e-6 off rtol-1e-11 runs), and
+    both are that close to the tight derivatives."""
     spec = _spec()
     paths = ["actuator.amplitude_v", "wings[0].aero.omega1"]
     df = ps.sweep(spec, {"actuator.amplitude_v": [80.0, 100.0], "wings.left.omega_ratio": [1.0, 0.6]}, metrics=METRICS, gradients=paths, progress=False)
@@ -27,9 +32,12 @@ def test_gradient_columns_equal_sensitivity_at_each_point():
     for row in df.iter_rows(named=True):
         point = spec.with_paths({"actuator.amplitude_v": row["actuator.amplitude_v"], "wings.left.omega_ratio": row["wings.left.omega_ratio"]})
         s = ps.sensitivity(point, paths, metrics=METRICS, progress=False)
+        tight = ps.sensitivity(point, paths, metrics=METRICS, progress=False, rtol=1e-11, atol=1e-13, steady_tol=1e-11)
         for m in METRICS:
             for p in paths:
-                assert row[f"d({m})/d({p})"] == pytest.approx(s.derivative(m, p), rel=1e-12, abs=1e-15)
+                ours = row[f"d({m})/d({p})"]
+                assert ours == pytest.approx(s.derivative(m, p), rel=2e-5, abs=1e-9)
+                assert ours == pytest.approx(tight.derivative(m, p), rel=1e-5, abs=1e-9)
     # The stroke amplitude grows with the drive at every point.
     assert (df["d(left_stroke_amplitude)/d(actuator.amplitude_v)"] > 0).all()
 

@@ -57,9 +57,35 @@ struct Point {
     period: f64,
 }
 
+/// A periodic orbit to differentiate at: its start state on the section `t ≡ 0`, the step
+/// grid of its period map and the drive periods it spans.
+#[derive(Clone, Debug)]
+pub struct Orbit {
+    /// The start state (coordinates and rates; the work integrals are not read).
+    pub state: State,
+    /// The fixed step grid of the period map (`simulate`'s `step_grid`); fewer than two
+    /// times: one adaptive period picks it.
+    pub grid: Vec<f64>,
+    /// Drive periods per period of the orbit (2: a period-doubled orbit).
+    pub cycles: usize,
+}
+
+/// The options `simulate` runs with to find the orbit a sensitivity differentiates at: one
+/// recorded cycle, no columns, shooting (a transient steady state is no exact orbit).
+pub fn orbit_options(options: &SimulationOptions) -> SimulationOptions {
+    let mut run_options = options.clone();
+    run_options.record_cycles = 1;
+    run_options.columns = Some(Vec::new());
+    if run_options.steady_state == SteadyState::Transient {
+        run_options.steady_state = SteadyState::Shooting;
+    }
+    run_options
+}
+
 /// Derivatives of the steady-state metrics of `device_at(p0)` with respect to `p` (see the
-/// module). `steps[j]`: the finite-difference step of parameter `j` (`None`:
-/// [`PARAMETER_STEP`] × max(|p0[j]|, 1e-3)).
+/// module) at the orbit a run of [`orbit_options`] from the spec's own start reaches.
+/// `steps[j]`: the finite-difference step of parameter `j` (`None`: [`PARAMETER_STEP`] ×
+/// max(|p0[j]|, 1e-3)).
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for a non-finite or non-positive step; those of `device_at`
@@ -70,6 +96,47 @@ pub fn steady_sensitivity(
     p0: &[f64],
     steps: Option<&[f64]>,
     options: &SimulationOptions,
+) -> Result<SteadySensitivity> {
+    let device = device_at(p0)?;
+    let run = simulate(&device, &orbit_options(options))?;
+    if !run.converged {
+        return Err(unconverged(
+            run.cycles_run as f64 * run.period_ms,
+            run.steady_state.to_vec(),
+            run.residual,
+        ));
+    }
+    let orbit = Orbit {
+        state: run.steady_state,
+        grid: run.step_grid,
+        cycles: run.orbit_cycles,
+    };
+    steady_sensitivity_at(device_at, &device, p0, steps, options, &orbit)
+}
+
+/// The error of a point whose run ended without a steady state (at `time`, in `state`).
+pub fn unconverged(time: f64, state: Vec<f64>, residual: f64) -> Error {
+    Error::Integration {
+        time,
+        state,
+        reason: format!(
+            "no steady state to differentiate: the run ended unconverged (residual {residual:e})"
+        ),
+    }
+}
+
+/// [`steady_sensitivity`] at a known `orbit` of `device` (= `device_at(p0)`): a sweep's
+/// converged point, for one.
+///
+/// # Errors
+/// As [`steady_sensitivity`], but for the run.
+pub fn steady_sensitivity_at(
+    device_at: &(dyn Fn(&[f64]) -> Result<Device> + Sync),
+    device: &Device,
+    p0: &[f64],
+    steps: Option<&[f64]>,
+    options: &SimulationOptions,
+    orbit: &Orbit,
 ) -> Result<SteadySensitivity> {
     let steps: Vec<f64> = match steps {
         Some(s) => s.to_vec(),
@@ -92,52 +159,37 @@ pub fn steady_sensitivity(
             "finite positive steps",
         ));
     }
-    let device = device_at(p0)?;
-    let mut run_options = options.clone();
-    run_options.record_cycles = 1;
-    run_options.columns = Some(Vec::new());
-    if run_options.steady_state == SteadyState::Transient {
-        run_options.steady_state = SteadyState::Shooting;
-    }
-    let run = simulate(&device, &run_options)?;
-    if !run.converged {
-        return Err(Error::Integration {
-            time: run.cycles_run as f64 * run.period_ms,
-            state: run.steady_state.to_vec(),
-            reason: format!(
-                "no steady state to differentiate: the run ended unconverged (residual {:e})",
-                run.residual
-            ),
-        });
-    }
+    let Some(period) = device.period() else {
+        return Err(Error::Constraint(
+            "a sensitivity needs a periodic drive (the device has no actuator)".into(),
+        ));
+    };
     let n = device.n_dof();
-    let map_cycles = run.orbit_cycles as f64;
     let rk = RungeKutta::new(
         options.method,
         options.rtol,
         options.atol,
         options.max_steps,
     )?;
-    let x_star = run.steady_state.without_work();
-    let grid = if run.step_grid.len() >= 2 {
-        run.step_grid.clone()
+    let x_star = orbit.state.without_work();
+    let grid = if orbit.grid.len() >= 2 {
+        orbit.grid.clone()
     } else {
         // A transient steady state: one adaptive period picks the grid.
         let (_, steps) = rk.with_work(false).advance_with_steps(
-            &device,
+            device,
             0.0,
             &x_star,
-            run.period_ms * map_cycles,
+            period * orbit.cycles.max(1) as f64,
         )?;
         steps
     };
-    let period = run.period_ms;
-    let switched = crate::integrate::OdeSystem::n_switches(&device) > 0;
+    let switched = crate::integrate::OdeSystem::n_switches(device) > 0;
     let (mapped, monodromy) = if switched && !device.has_analytic_jacobian() {
-        fixed_grid_monodromy(&device, &rk, &grid, &x_star)?
+        fixed_grid_monodromy(device, &rk, &grid, &x_star)?
     } else {
         rk.with_work(false)
-            .flow_with_sensitivity_on_grid(&device, &grid, &x_star)?
+            .flow_with_sensitivity_on_grid(device, &grid, &x_star)?
     };
     let residual = crate::shooting::newton::residual(n, &x_star, &mapped.without_work()).1;
     let multipliers = crate::stability::eigenvalues(&monodromy).unwrap_or_default();
@@ -151,11 +203,8 @@ pub fn steady_sensitivity(
             .collect(),
         None => Vec::new(),
     };
-    let window = |point: &Point, y: &State| -> Result<Vec<(String, f64)>> {
-        crate::simulate::grid_window(&point.device, &rk, &point.grid, point.period, y, options)
-    };
     let mut base_metrics =
-        crate::simulate::grid_window(&device, &rk, &grid, period, &x_star, options)?;
+        crate::simulate::grid_window(device, &rk, &grid, period, &x_star, options)?;
     if let Some(asked) = &options.metrics {
         // The window computes what the asked metrics need (and may compute more).
         base_metrics = asked
@@ -165,14 +214,12 @@ pub fn steady_sensitivity(
     }
     let n_params = p0.len();
     let base_map = mapped.without_work().compact(n);
-    // Per parameter: dx*/dp_j, and the metrics along (dx*/dp_j, 1): central differences at
-    // p0 ± h, or the second-order one-sided formula at p0 + h, p0 + 2h where p0 − h is outside
-    // the parameter's range (K2 = 0).
-    let column = |j: usize| {
-        let h = steps[j];
+    // Per parameter: its two perturbed points, central (p0 ± h) or, where p0 − h is outside
+    // the parameter's range (K2 = 0), one-sided (p0 + h, p0 + 2h: the second-order formula).
+    let perturbed = |j: usize| -> Result<(Point, Point, bool)> {
         let at = |offset: f64| -> Result<Option<Point>> {
             let mut p = p0.to_vec();
-            p[j] += offset * h;
+            p[j] += offset * steps[j];
             let device = match device_at(&p) {
                 Ok(d) => d,
                 // Below the parameter's range (K2 = 0, a cubic spring at 0; a spec reports
@@ -187,44 +234,48 @@ pub fn steady_sensitivity(
                 period: shifted,
             }))
         };
-        let (near, far, central) = match at(-1.0)? {
+        Ok(match at(-1.0)? {
             Some(minus) => (minus, at(1.0)?.expect("a forward step"), true),
             None => (
                 at(1.0)?.expect("a forward step"),
                 at(2.0)?.expect("a forward step"),
                 false,
             ),
-        };
-        let map = |point: &Point, y: &State| -> Result<DVector<f64>> {
-            let end = rk.with_work(false).integrate_on_grid(
-                &point.device,
-                &point.grid,
-                y,
-                &[],
-                &mut |_, _, _| Ok(()),
-            )?;
-            Ok(end.without_work().compact(n))
-        };
-        // (f(near), f(far)) -> df/dp: central (p0 - h, p0 + h) or one-sided (p0 + h, p0 + 2h).
-        let derivative = |f0: f64, f_near: f64, f_far: f64| {
-            if central {
-                (f_far - f_near) / (2.0 * h)
-            } else {
-                (-3.0 * f0 + 4.0 * f_near - f_far) / (2.0 * h)
-            }
-        };
-        let (p_near, p_far) = (map(&near, &x_star)?, map(&far, &x_star)?);
-        let dp = DVector::from_fn(2 * n, |i, _| derivative(base_map[i], p_near[i], p_far[i]));
-        let dx = crate::shooting::newton::least_squares_step(a.clone(), &dp).ok_or_else(|| {
-            Error::Singular("the orbit's sensitivity: non-finite monodromy".into())
-        })?;
-        let (o_near, o_far) = if central { (-1.0, 1.0) } else { (1.0, 2.0) };
-        let moved = |offset: f64| State::from_compact(n, &(x_star.compact(n) + &dx * (offset * h)));
-        let m_near = window(&near, &moved(o_near))?;
-        let m_far = window(&far, &moved(o_far))?;
-        Ok((dx, m_near, m_far, central))
+        })
     };
-    let columns = crate::stability::rows::run_parts(n_params, column)?;
+    let pairs = (0..n_params)
+        .map(perturbed)
+        .collect::<Result<Vec<(Point, Point, bool)>>>()?;
+    let points: Vec<&Point> = pairs.iter().flat_map(|(a, b, _)| [a, b]).collect();
+    // The perturbed periods: the maps from x*, then the windows along (dx*/dp_j, 1).
+    let maps = periods(&points, &vec![x_star; points.len()], false, &rk, options)?;
+    let dxs = pairs
+        .iter()
+        .enumerate()
+        .map(|(j, (_, _, central))| {
+            let (near, far) = (&maps[2 * j].0, &maps[2 * j + 1].0);
+            let dp = difference(*central, steps[j], &base_map, near, far);
+            crate::shooting::newton::least_squares_step(a.clone(), &dp).ok_or_else(|| {
+                Error::Singular("the orbit's sensitivity: non-finite monodromy".into())
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let starts: Vec<State> = pairs
+        .iter()
+        .zip(&dxs)
+        .enumerate()
+        .flat_map(|(j, ((_, _, central), dx))| {
+            let offsets = if *central { [-1.0, 1.0] } else { [1.0, 2.0] };
+            offsets.map(|o| State::from_compact(n, &(x_star.compact(n) + dx * (o * steps[j]))))
+        })
+        .collect();
+    let windows = periods(&points, &starts, true, &rk, options)?;
+    let columns: Vec<_> = (0..n_params)
+        .map(|j| {
+            let (m_near, m_far) = (&windows[2 * j].1, &windows[2 * j + 1].1);
+            (&dxs[j], m_near, m_far, pairs[j].2)
+        })
+        .collect();
     let n_metrics = base_metrics.len();
     let mut jacobian = DMatrix::zeros(n_metrics, n_params);
     let mut state_jacobian = DMatrix::zeros(2 * n, n_params);
@@ -233,7 +284,7 @@ pub fn steady_sensitivity(
         .map(|(_, m)| (!m.is_finite()).then(|| "not defined at this point (NaN)".to_string()))
         .collect();
     for (j, (dx, m_near, m_far, central)) in columns.iter().enumerate() {
-        state_jacobian.set_column(j, dx);
+        state_jacobian.set_column(j, *dx);
         let h = steps[j];
         for (i, (name, m0)) in base_metrics.iter().enumerate() {
             let (near, far) = (value_of(m_near, name), value_of(m_far, name));
@@ -258,8 +309,7 @@ pub fn steady_sensitivity(
     for v in &neutral {
         let eps = 1e-6;
         let along = |sign: f64| State::from_compact(n, &(x_star.compact(n) + v * (sign * eps)));
-        let base =
-            |y: &State| crate::simulate::grid_window(&device, &rk, &grid, period, y, options);
+        let base = |y: &State| crate::simulate::grid_window(device, &rk, &grid, period, y, options);
         let (mp, mm) = (base(&along(1.0))?, base(&along(-1.0))?);
         for (i, (name, m0)) in base_metrics.iter().enumerate() {
             let slope = (value_of(&mp, name) - value_of(&mm, name)) / (2.0 * eps);
@@ -282,6 +332,98 @@ pub fn steady_sensitivity(
         neutral_directions: neutral.len(),
         not_differentiable,
         residual,
+    })
+}
+
+/// A perturbed period's end state (compact) or its window's metrics.
+type Period = (DVector<f64>, Vec<(String, f64)>);
+
+/// `df/dp` from `f(near)`, `f(far)`: central `(p0 − h, p0 + h)` or, at the range's end,
+/// the second-order one-sided formula on `(p0 + h, p0 + 2h)` with `f0 = f(p0)`.
+fn difference(
+    central: bool,
+    h: f64,
+    f0: &DVector<f64>,
+    near: &DVector<f64>,
+    far: &DVector<f64>,
+) -> DVector<f64> {
+    if central {
+        (far - near) / (2.0 * h)
+    } else {
+        (near * 4.0 - f0 * 3.0 - far) / (2.0 * h)
+    }
+}
+
+/// One fixed-grid period of each `points[k]` from `starts[k]`: its end state (compact) or,
+/// with `record`, its recorded window's metrics (`simulate::grid_window`).
+/// Four at a time in the lanes where every device has a lane model (bit-identical to the
+/// scalar periods, `crate::lanes::batch`), else on the sensitivity's threads.
+fn periods(
+    points: &[&Point],
+    starts: &[State],
+    record: bool,
+    rk: &RungeKutta,
+    options: &SimulationOptions,
+) -> Result<Vec<Period>> {
+    // The lanes compute stroke metrics only: a window asking every metric runs scalar.
+    let lane_metrics = match (record, &options.metrics) {
+        (false, _) => Some(&[][..]),
+        (true, Some(names)) => Some(names.as_slice()),
+        (true, None) => None,
+    };
+    // `PARITYSIM_LANES=1` runs the scalar path, as for sweeps.
+    let lanes = crate::lanes::resolve_lanes(None)? > 1;
+    if let (crate::integrate::Method::Dop853, Some(names), true) =
+        (options.method, lane_metrics, lanes)
+    {
+        let jobs: Vec<crate::lanes::batch::Job<'_>> = points
+            .iter()
+            .zip(starts)
+            .map(|(point, y)| crate::lanes::batch::Job {
+                device: &point.device,
+                grid: std::rc::Rc::from(point.grid.as_slice()),
+                y0: *y,
+                times: record.then(|| {
+                    crate::simulate::grid_window_times(&point.grid, point.period, options).into()
+                }),
+            })
+            .collect();
+        let tol = crate::integrate::lanes::LaneTolerances {
+            rtol: options.rtol,
+            atol: options.atol,
+        };
+        if let Some(done) = crate::lanes::batch::run(&jobs, names, tol, options.weight_mn) {
+            return Ok(done
+                .into_iter()
+                .map(|(end, metrics)| (DVector::from_row_slice(&end), metrics.unwrap_or_default()))
+                .collect());
+        }
+    }
+    crate::stability::rows::run_parts(points.len(), |k| {
+        let point = points[k];
+        Ok(match record {
+            true => {
+                let metrics = crate::simulate::grid_window(
+                    &point.device,
+                    rk,
+                    &point.grid,
+                    point.period,
+                    &starts[k],
+                    options,
+                )?;
+                (DVector::zeros(0), metrics)
+            }
+            false => {
+                let end = rk.with_work(false).integrate_on_grid(
+                    &point.device,
+                    &point.grid,
+                    &starts[k],
+                    &[],
+                    &mut |_, _, _| Ok(()),
+                )?;
+                (end.without_work().compact(point.device.n_dof()), Vec::new())
+            }
+        })
     })
 }
 

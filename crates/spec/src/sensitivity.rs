@@ -2,7 +2,10 @@
 //! the paths resolved and checked once here, the derivatives from
 //! [`paritysim_dynamics::sensitivity`].
 
-use paritysim_dynamics::sensitivity::{SteadySensitivity, steady_sensitivity};
+use paritysim_dynamics::SimulationOptions;
+use paritysim_dynamics::sensitivity::{
+    Orbit, SteadySensitivity, orbit_options, steady_sensitivity, steady_sensitivity_at, unconverged,
+};
 use paritysim_error::{Error, Result};
 use serde_json::Value;
 
@@ -38,19 +41,16 @@ pub fn sensitivity(
 ) -> Result<Sensitivity> {
     let (parameters, units, _) = self::parameters(spec, params)?;
     let value = serde_json::to_value(spec).expect("a spec serialises");
-    sensitivity_at(spec, value, parameters, units, metrics)
+    let (device, options) = prepared(spec, metrics)?;
+    differentiate(&value, parameters, units, &device, &options, None)
 }
 
-/// [`sensitivity`] with the parameters resolved (on this spec or on the base spec of a sweep:
-/// the paths are the same) and the spec serialised: the perturbed specs are this value with
-/// the parameters set, and the parameters' values are read from it.
-fn sensitivity_at(
+/// The device of a sensitivity at `spec` (a fixed body) and its options ([`orbit_options`]:
+/// one recorded cycle, no columns, shooting; the asked metrics).
+fn prepared(
     spec: &Simulation,
-    value: Value,
-    parameters: Vec<Parameter>,
-    units: Vec<String>,
     metrics: Option<&[String]>,
-) -> Result<Sensitivity> {
+) -> Result<(paritysim_dynamics::Device, SimulationOptions)> {
     let (device, options) = spec.model()?;
     if spec.flight(&device)?.is_some() {
         return Err(Error::invalid(
@@ -60,16 +60,35 @@ fn sensitivity_at(
         ));
     }
     let options = spec.with_outputs(&device, &options, Some(&[]), metrics)?;
+    Ok((device, orbit_options(&options)))
+}
+
+/// The derivatives at the spec serialised as `value` (its `device` and `options`, see
+/// [`prepared`]) by the `parameters` (resolved on it or on a sweep's base spec: the paths are
+/// the same; their values are read from `value`, the perturbed specs are `value` with them
+/// set), at `orbit` when it is known (a sweep's converged point), else at the orbit a run from
+/// the spec's own start reaches.
+fn differentiate(
+    value: &Value,
+    parameters: Vec<Parameter>,
+    units: Vec<String>,
+    device: &paritysim_dynamics::Device,
+    options: &SimulationOptions,
+    orbit: Option<&Orbit>,
+) -> Result<Sensitivity> {
     let values = parameters
         .iter()
-        .map(|p| value_of(&value, p))
+        .map(|p| value_of(value, p))
         .collect::<Result<Vec<_>>>()?;
     let device_at = |p: &[f64]| -> Result<paritysim_dynamics::Device> {
         let numbers: Vec<Value> = p.iter().map(|&x| Value::from(x)).collect();
         let pairs: Vec<(&Parameter, &Value)> = parameters.iter().zip(&numbers).collect();
         apply_to(value.clone(), &pairs)?.device()
     };
-    let result = steady_sensitivity(&device_at, &values, None, &options)?;
+    let result = match orbit {
+        Some(orbit) => steady_sensitivity_at(&device_at, device, &values, None, options, orbit)?,
+        None => steady_sensitivity(&device_at, &values, None, options)?,
+    };
     Ok(Sensitivity {
         parameters,
         units,
@@ -152,13 +171,53 @@ pub fn sensitivities(
                 .collect()
         })
         .collect();
+    // Each row's spec (serialised), device and options.
+    let (values, inputs): (Vec<_>, Vec<_>) = points
+        .iter()
+        .map(|point| {
+            let point = point.as_ref().map_err(Clone::clone)?;
+            let pairs: Vec<(&Parameter, &Value)> =
+                point.iter().map(|(k, v)| (&columns[*k].1, v)).collect();
+            let spec = apply_to(base.clone(), &pairs)?;
+            let value = serde_json::to_value(&spec).expect("a spec serialises");
+            Ok((value, prepared(&spec, metrics)?))
+        })
+        .map(|r: Result<_>| match r {
+            Ok((value, input)) => (Some(value), Ok(input)),
+            Err(e) => (None, Err(e)),
+        })
+        .unzip();
+    // The orbits as the sweep finds them (chained neighbours, SIMD lanes: a tenth of a cold
+    // run each, docs/findings.md §30), then the derivatives at each.
+    let names = metrics.map(<[String]>::to_vec).unwrap_or_default();
+    let control = paritysim_dynamics::sweep::SweepControl::new();
+    let orbits = paritysim_dynamics::sweep::run_points(&inputs, &names, false, threads, &control)?;
     let runs = paritysim_dynamics::stability::rows::run_rows(rows.len(), threads, None, |i| {
-        let point = points[i].as_ref().map_err(Clone::clone)?;
-        let pairs: Vec<(&Parameter, &Value)> =
-            point.iter().map(|(k, v)| (&columns[*k].1, v)).collect();
-        let spec = apply_to(base.clone(), &pairs)?;
-        let value = serde_json::to_value(&spec).expect("a spec serialises");
-        sensitivity_at(&spec, value, parameters.clone(), units.clone(), metrics).map(|s| s.record())
+        let (device, options) = inputs[i].as_ref().map_err(Clone::clone)?;
+        let found = orbits[i].as_ref().ok_or(Error::Cancelled)?;
+        let found = found.as_ref().map_err(Clone::clone)?;
+        if !found.converged {
+            let time = found.cycles_run as f64 * device.period().unwrap_or(f64::NAN);
+            return Err(unconverged(time, Vec::new(), found.residual));
+        }
+        let Some((p, p_dot)) = found.steady_state else {
+            return Err(unconverged(f64::NAN, Vec::new(), found.residual));
+        };
+        let orbit = Orbit {
+            state: device.state_from(&p, &p_dot)?,
+            grid: found.step_grid.clone(),
+            cycles: found.orbit_cycles,
+        };
+        let value = values[i].as_ref().expect("a prepared row has its spec");
+        differentiate(
+            value,
+            parameters.clone(),
+            units.clone(),
+            device,
+            options,
+            Some(&orbit),
+        )
+        .map(|s| s.record())
     })?;
     Ok(SensitivityRows {
         error: runs

@@ -32,6 +32,7 @@
 //!   a spent budget is the point's row, the scalar path's budget error (not a rerun). The
 //!   sweep's cancel is checked between periods.
 
+pub(crate) mod batch;
 pub(crate) mod linear_stroke;
 mod point;
 mod schedule;
@@ -189,4 +190,10 @@ pub(super) fn cached_window_times(
 /// rerun on the scalar path are not counted).
 pub fn points_completed_in_lanes() -> usize {
     COMPLETED_IN_LANES.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// How many sensitivity periods (perturbed maps and windows, `batch`) the SIMD lanes have
+/// completed in this process (monotonic).
+pub fn periods_completed_in_lanes() -> usize {
+    batch::COMPLETED.load(std::sync::atomic::Ordering::Relaxed)
 }

@@ -73,7 +73,7 @@ pub(super) struct LanePoint<'a> {
 }
 
 /// The compact `[q1, q2, q̇1, q̇2]` of a two-DOF state.
-fn compact4(y: &State) -> [f64; 4] {
+pub(super) fn compact4(y: &State) -> [f64; 4] {
     [y.coords[0], y.coords[1], y.rates[0], y.rates[1]]
 }
 
@@ -245,31 +245,15 @@ impl<'a> LanePoint<'a> {
         }
     }
 
-    /// Feeds recorded samples to the metrics in order, as the scalar window's sink does
-    /// (`StrokeSample::of_stroke_device`, then the accumulator); `false`: the scalar path
-    /// would fail here.
+    /// Feeds recorded samples to the metrics in order ([`feed_samples`]).
     pub(super) fn sample(&mut self, block: &SampleBlock) -> bool {
-        let (inside, stroke, roll) = self.model.stroke_samples(&block.y);
-        let all = (1u32 << block.count) - 1;
-        if inside & all != all {
-            return false;
-        }
-        let mut actuator_force = [0.0; 4];
-        if self.with_force {
-            for (f, &t) in actuator_force.iter_mut().zip(&block.t).take(block.count) {
-                *f = self.model.force(t);
-            }
-        }
-        self.metrics.add_stroke_block(&StrokeBlock {
-            count: block.count,
-            closing: block.first + block.count - 1 == self.samples_per_cycle,
-            time: block.t,
-            stroke: [stroke[0].to_array(), stroke[1].to_array()],
-            roll_aero: [roll[0].to_array(), roll[1].to_array()],
-            actuator_force,
-            q2: block.y[1].to_array(),
-        });
-        true
+        feed_samples(
+            &self.model,
+            &mut self.metrics,
+            block,
+            self.samples_per_cycle,
+            self.with_force,
+        )
     }
 
     /// Starts the shooting machine from the first map `mapped` of the iterate on `grid`.
@@ -442,4 +426,37 @@ impl<'a> LanePoint<'a> {
             .output(),
         )
     }
+}
+
+/// Feeds a lane's recorded samples to `metrics` in order, as the scalar window's sink does
+/// (`StrokeSample::of_stroke_device`, then the accumulator); `closing`: the window's last
+/// sample index. `false`: the scalar path would fail here.
+pub(super) fn feed_samples(
+    model: &LinearStroke<'_>,
+    metrics: &mut MetricsAccumulator,
+    block: &SampleBlock,
+    closing: usize,
+    with_force: bool,
+) -> bool {
+    let (inside, stroke, roll) = model.stroke_samples(&block.y);
+    let all = (1u32 << block.count) - 1;
+    if inside & all != all {
+        return false;
+    }
+    let mut actuator_force = [0.0; 4];
+    if with_force {
+        for (f, &t) in actuator_force.iter_mut().zip(&block.t).take(block.count) {
+            *f = model.force(t);
+        }
+    }
+    metrics.add_stroke_block(&StrokeBlock {
+        count: block.count,
+        closing: block.first + block.count - 1 == closing,
+        time: block.t,
+        stroke: [stroke[0].to_array(), stroke[1].to_array()],
+        roll_aero: [roll[0].to_array(), roll[1].to_array()],
+        actuator_force,
+        q2: block.y[1].to_array(),
+    });
+    true
 }

@@ -68,7 +68,6 @@ pub(crate) fn grid_window(
     options: &SimulationOptions,
 ) -> Result<Vec<(String, f64)>> {
     let window = grid[grid.len() - 1] - grid[0];
-    let cycles = ((window / period).round() as usize).max(1);
     let stroke = stroke_sampling(device, options.metrics.as_deref(), &[]);
     let (_, metrics, _) = record_window(
         device,
@@ -76,7 +75,7 @@ pub(crate) fn grid_window(
         grid[0],
         &y.without_work(),
         window,
-        options.samples_per_cycle * cycles,
+        window_samples(grid, period, options),
         Some(period),
         None,
         Vec::new(),
@@ -85,6 +84,23 @@ pub(crate) fn grid_window(
         options.weight_mn,
     )?;
     Ok(metrics)
+}
+
+/// The number of samples of [`grid_window`]'s window (`samples_per_cycle` per period).
+fn window_samples(grid: &[f64], period: f64, options: &SimulationOptions) -> usize {
+    let window = grid[grid.len() - 1] - grid[0];
+    let cycles = ((window / period).round() as usize).max(1);
+    options.samples_per_cycle * cycles
+}
+
+/// The sample times of [`grid_window`]'s window (`record_window`'s).
+pub(crate) fn grid_window_times(
+    grid: &[f64],
+    period: f64,
+    options: &SimulationOptions,
+) -> Vec<f64> {
+    let window = grid[grid.len() - 1] - grid[0];
+    window_times(grid[0], window, window_samples(grid, period, options)).collect()
 }
 
 /// How samples are taken (see [`SimulationOptions::metrics`]): `Some(needs)` for lean

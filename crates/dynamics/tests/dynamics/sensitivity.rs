@@ -124,3 +124,33 @@ fn bad_steps_are_named() {
         .unwrap_err();
     assert!(e.to_string().contains("steps"), "{e}");
 }
+
+/// The perturbed periods of a linear-map device with stroke metrics run in the SIMD lanes
+/// (`lanes::batch`; bit-identical to the scalar ones: tests/test_gradients.py) and the
+/// derivatives still equal the per-metric ones of the scalar windows (all metrics asked).
+#[test]
+fn the_perturbed_periods_run_in_the_lanes() {
+    let p0 = [18.75, 5.0, 50.0, 110.0];
+    let stroke: Vec<String> = ["tau_r_peak", "tau_l_peak", "delta_tau_peak"]
+        .map(String::from)
+        .to_vec();
+    let options = SimulationOptions {
+        metrics: Some(stroke.clone()),
+        ..tight()
+    };
+    let before = paritysim_dynamics::lanes::periods_completed_in_lanes();
+    let lanes = steady_sensitivity(&design, &p0, None, &options).unwrap();
+    assert!(paritysim_dynamics::lanes::periods_completed_in_lanes() - before >= 4 * p0.len());
+    let all = steady_sensitivity(&design, &p0, None, &tight()).unwrap();
+    for (i, (name, _)) in lanes.metrics.iter().enumerate() {
+        let k = all.metrics.iter().position(|(m, _)| m == name).unwrap();
+        for j in 0..p0.len() {
+            let (a, b) = (lanes.jacobian[(i, j)], all.jacobian[(k, j)]);
+            assert_eq!(
+                a.to_bits(),
+                b.to_bits(),
+                "d {name} / d p{j}: {a:e} against {b:e}"
+            );
+        }
+    }
+}

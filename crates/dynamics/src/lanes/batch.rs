@@ -1,0 +1,124 @@
+//! Fixed-grid periods of several devices at once in the lanes, four at a time: the
+//! sensitivities' perturbed period maps and recorded windows (`crate::sensitivity`), which are
+//! independent integrations on one grid. Each lane performs the scalar path's operations
+//! (see the module `lanes`), so the results are bit-identical to the scalar integrations.
+
+use std::rc::Rc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use crate::device::Device;
+use crate::integrate::State;
+use crate::integrate::lanes::{LANES, LaneOutcome, LaneProblem, LaneStepper, LaneTolerances};
+use crate::metrics::MetricsAccumulator;
+
+use super::linear_stroke::{LinearStroke, LinearStrokeLanes};
+use super::point::{compact4, feed_samples};
+
+/// Periods completed here (`super::periods_completed_in_lanes`).
+pub(crate) static COMPLETED: AtomicUsize = AtomicUsize::new(0);
+
+/// One period to integrate.
+pub(crate) struct Job<'a> {
+    pub(crate) device: &'a Device,
+    /// The fixed step grid.
+    pub(crate) grid: Rc<[f64]>,
+    /// The state at `grid[0]`.
+    pub(crate) y0: State,
+    /// The recorded window's sample times (`record_window`'s), or `None`: the map only.
+    pub(crate) times: Option<Rc<[f64]>>,
+}
+
+/// A job's state at its grid's end (compact `[q1, q2, q̇1, q̇2]`) and, for a window, its
+/// metrics.
+pub(crate) type Done = ([f64; 4], Option<Vec<(String, f64)>>);
+
+/// Runs `jobs` in the lanes, windows with the metrics `metric_names` (stroke metrics only):
+/// `None` when a device has no lane model, a metric is not a stroke metric, or a lane would
+/// fail where the scalar path reports the error (the caller then runs them scalar).
+pub(crate) fn run(
+    jobs: &[Job<'_>],
+    metric_names: &[String],
+    tol: LaneTolerances,
+    weight: Option<f64>,
+) -> Option<Vec<Done>> {
+    if !metric_names
+        .iter()
+        .all(|m| crate::metrics::is_stroke_metric(m))
+    {
+        return None;
+    }
+    let models: Vec<LinearStroke<'_>> = jobs
+        .iter()
+        .map(|j| LinearStroke::of(j.device))
+        .collect::<Option<_>>()?;
+    let with_force = metric_names.iter().any(|m| m == "actuator_force_peak");
+    let mut metrics: Vec<Option<MetricsAccumulator>> = jobs
+        .iter()
+        .map(|j| {
+            let period = j.device.period();
+            j.times
+                .as_ref()
+                .map(|_| MetricsAccumulator::new(j.device, period).with_weight(weight))
+        })
+        .collect();
+    // The closing sample's index: the window's sample count.
+    let closing: Vec<usize> = jobs
+        .iter()
+        .map(|j| j.times.as_ref().map_or(0, |t| t.len().saturating_sub(1)))
+        .collect();
+    let mut stepper: LaneStepper<4> = LaneStepper::new();
+    let mut lanes = LinearStrokeLanes::new();
+    let mut in_lane: [Option<usize>; LANES] = [None; LANES];
+    let mut done: Vec<Option<Done>> = jobs.iter().map(|_| None).collect();
+    let (mut next, mut fresh) = (0, 0u32);
+    loop {
+        for (l, slot) in in_lane.iter_mut().enumerate() {
+            if slot.is_some() || next == jobs.len() {
+                continue;
+            }
+            let k = next;
+            next += 1;
+            let job = &jobs[k];
+            lanes.load(l, &models[k]);
+            lanes.load_forcing(l, Some(models[k].forcing(&job.grid)));
+            let problem = LaneProblem {
+                grid: job.grid.clone(),
+                adaptive: None,
+                y0: compact4(&job.y0),
+                times: job.times.clone().unwrap_or_else(|| Rc::from([])),
+                tol,
+            };
+            let (model, sink) = (&models[k], &mut metrics[k]);
+            let mut feed = |_: usize, block: &_| {
+                sink.as_mut()
+                    .is_none_or(|m| feed_samples(model, m, block, closing[k], with_force))
+            };
+            if !stepper.start(l, problem, &mut feed) {
+                return None;
+            }
+            *slot = Some(k);
+            fresh |= 1 << l;
+        }
+        if !stepper.any_busy() {
+            break;
+        }
+        let finished = {
+            let mut feed = |l: usize, block: &_| {
+                let k = in_lane[l].expect("a busy lane has a job");
+                metrics[k]
+                    .as_mut()
+                    .is_none_or(|m| feed_samples(&models[k], m, block, closing[k], with_force))
+            };
+            stepper.run(&lanes, std::mem::take(&mut fresh), &mut feed)
+        };
+        for (l, outcome) in finished {
+            let k = in_lane[l].take().expect("a busy lane has a job");
+            let LaneOutcome::Done { y, .. } = outcome else {
+                return None;
+            };
+            done[k] = Some((y, metrics[k].take().map(|m| m.finish())));
+        }
+    }
+    COMPLETED.fetch_add(jobs.len(), Ordering::Relaxed);
+    done.into_iter().collect()
+}
