@@ -131,7 +131,9 @@ def sensitivity(
     within 1e-5 relative, ``crates/dynamics/tests/dynamics/sensitivity.rs``).
 
     Cost: one steady-state run, one variational period, then two periods and two recorded
-    windows per parameter.
+    windows per parameter (four at a time in SIMD lanes on a linear-map device asked for
+    stroke metrics; on the §3.3 benchmark point with 8 parameters about 5× a
+    `paritysim.simulate`, docs/findings.md §30).
 
     Raises
     ------

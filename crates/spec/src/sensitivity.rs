@@ -171,17 +171,18 @@ pub fn sensitivities(
                 .collect()
         })
         .collect();
-    // Each row's spec (serialised), device and options.
-    let (values, inputs): (Vec<_>, Vec<_>) = points
-        .iter()
-        .map(|point| {
-            let point = point.as_ref().map_err(Clone::clone)?;
+    // Each row's spec (serialised), device and options, on the sweep's threads.
+    let rows_prepared =
+        paritysim_dynamics::stability::rows::run_rows(rows.len(), threads, None, |i| {
+            let point = points[i].as_ref().map_err(Clone::clone)?;
             let pairs: Vec<(&Parameter, &Value)> =
                 point.iter().map(|(k, v)| (&columns[*k].1, v)).collect();
             let spec = apply_to(base.clone(), &pairs)?;
             let value = serde_json::to_value(&spec).expect("a spec serialises");
             Ok((value, prepared(&spec, metrics)?))
-        })
+        })?;
+    let (values, inputs): (Vec<_>, Vec<_>) = rows_prepared
+        .into_iter()
         .map(|r: Result<_>| match r {
             Ok((value, input)) => (Some(value), Ok(input)),
             Err(e) => (None, Err(e)),
