@@ -191,7 +191,8 @@ pub fn sensitivities(
     // The orbits as the sweep finds them (chained neighbours, SIMD lanes: a tenth of a cold
     // run each, docs/findings.md §30), then the derivatives at each.
     let names = metrics.map(<[String]>::to_vec).unwrap_or_default();
-    let control = paritysim_dynamics::sweep::SweepControl::new();
+    // A cancel of the call (Ctrl-C) stops the sweep too.
+    let control = paritysim_dynamics::sweep::SweepControl::of_current_budget();
     let orbits = paritysim_dynamics::sweep::run_points(&inputs, &names, false, threads, &control)?;
     let runs = paritysim_dynamics::stability::rows::run_rows(rows.len(), threads, None, |i| {
         let (device, options) = inputs[i].as_ref().map_err(Clone::clone)?;

@@ -156,6 +156,11 @@ impl Budget {
         BudgetGuard { previous }
     }
 
+    /// The cancel flag, if the budget has one.
+    pub(crate) fn cancel_flag(&self) -> Option<CancelFlag> {
+        self.cancel.clone()
+    }
+
     fn check(&self) -> Result<(), Stop> {
         if self.cancel.as_ref().is_some_and(CancelFlag::is_cancelled) {
             return Err(Stop::Cancelled);

@@ -56,6 +56,20 @@ impl SweepControl {
         Self::default()
     }
 
+    /// A control whose cancel flag is the calling thread's budget's ([`budget::current`]),
+    /// if it has one: a sweep run inside a cancellable call (a binding's Ctrl-C) stops with
+    /// it.
+    ///
+    /// [`budget::current`]: crate::integrate::budget::current
+    pub fn of_current_budget() -> Self {
+        Self {
+            finished: AtomicUsize::new(0),
+            cancelled: crate::integrate::budget::current()
+                .and_then(|b| b.cancel_flag())
+                .unwrap_or_default(),
+        }
+    }
+
     /// Points finished so far (successfully or not).
     pub fn finished(&self) -> usize {
         self.finished.load(Ordering::Acquire)

@@ -449,3 +449,38 @@ fn a_cancel_stops_a_continuation_chain_between_its_points() {
     assert!(r.rows.iter().enumerate().all(|(i, row)| row.index == i));
     assert!(r.rows.iter().all(|row| row.outcome.is_ok()));
 }
+
+/// A sweep inside a cancellable call (a binding's Ctrl-C, `budget::cancellable`) takes the
+/// call's cancel flag with `SweepControl::of_current_budget`: once cancelled, no point runs
+/// (the sensitivity rows of `sweep(gradients=)` sweep for their orbits this way); outside such
+/// a call the control is a fresh one.
+#[test]
+fn a_control_of_the_current_budget_stops_with_the_call() {
+    use paritysim_dynamics::integrate::budget::{CancelFlag, cancellable};
+    use paritysim_dynamics::sweep::run_points;
+    let points: Vec<_> = [18.75, 25.0, 31.3]
+        .into_iter()
+        .flat_map(|omega| [5.0, 20.0].map(|k2| study_device(&[omega, k2, 50.0])))
+        .map(|d| d.map(|d| (d, fast_options())))
+        .collect();
+    assert!(!SweepControl::of_current_budget().is_cancelled());
+    let cancel = CancelFlag::new();
+    let mut slots = Vec::new();
+    cancellable(&cancel, || {
+        let control = SweepControl::of_current_budget();
+        assert!(!control.is_cancelled());
+        cancel.cancel(); // the call's Ctrl-C, before its sweep
+        assert!(control.is_cancelled());
+        slots = run_points(&points, &[], false, Some(1), &control)?;
+        Ok(())
+    })
+    .unwrap();
+    assert_eq!(slots.len(), points.len());
+    assert!(
+        slots.iter().all(Option::is_none),
+        "a point ran after the cancel"
+    );
+    // The same points with a fresh control all run.
+    let ran = run_points(&points, &[], false, Some(1), &SweepControl::new()).unwrap();
+    assert!(ran.iter().all(Option::is_some));
+}
