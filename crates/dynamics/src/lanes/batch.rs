@@ -32,6 +32,9 @@ pub(crate) struct Job<'a> {
 /// metrics.
 pub(crate) type Done = ([f64; 4], Option<Vec<(String, f64)>>);
 
+/// A grid, an actuator and the actuator's force at the grid's stage times.
+type DriveTable<'a> = (Rc<[f64]>, &'a crate::actuator::Actuator, Rc<[f64]>);
+
 /// Runs `jobs` in the lanes, windows with the metrics `metric_names` (stroke metrics only):
 /// `None` when a device has no lane model, a metric is not a stroke metric, or a lane would
 /// fail where the scalar path reports the error (the caller then runs them scalar).
@@ -70,6 +73,9 @@ pub(crate) fn run(
     let mut lanes = LinearStrokeLanes::new();
     let mut in_lane: [Option<usize>; LANES] = [None; LANES];
     let mut done: Vec<Option<Done>> = jobs.iter().map(|_| None).collect();
+    // The drive's table per grid and actuator: the parameters that move neither (a wing's Ω,
+    // a spring) share the base point's (its `sin` per stage was a tenth of the time).
+    let mut tables: Vec<DriveTable<'_>> = Vec::new();
     let (mut next, mut fresh) = (0, 0u32);
     loop {
         for (l, slot) in in_lane.iter_mut().enumerate() {
@@ -80,7 +86,19 @@ pub(crate) fn run(
             next += 1;
             let job = &jobs[k];
             lanes.load(l, &models[k]);
-            lanes.load_forcing(l, Some(models[k].forcing(&job.grid)));
+            let actuator = models[k].actuator();
+            let shared = tables
+                .iter()
+                .find(|(grid, drive, _)| **grid == *job.grid && *drive == actuator);
+            let table = match shared {
+                Some((_, _, table)) => table.clone(),
+                None => {
+                    let table = models[k].forcing(&job.grid);
+                    tables.push((job.grid.clone(), actuator, table.clone()));
+                    table
+                }
+            };
+            lanes.load_forcing(l, Some(table));
             let problem = LaneProblem {
                 grid: job.grid.clone(),
                 adaptive: None,
