@@ -97,6 +97,7 @@ pub fn steady_sensitivity(
     steps: Option<&[f64]>,
     options: &SimulationOptions,
 ) -> Result<SteadySensitivity> {
+    finite_difference_steps(p0, steps)?; // bad steps are refused before the run
     let device = device_at(p0)?;
     let run = simulate(&device, &orbit_options(options))?;
     if !run.converged {
@@ -112,6 +113,32 @@ pub fn steady_sensitivity(
         cycles: run.orbit_cycles,
     };
     steady_sensitivity_at(device_at, &device, p0, steps, options, &orbit)
+}
+
+/// The steps of the parameters' differences: `steps`, or [`PARAMETER_STEP`] × max(|p0|, 1e-3).
+fn finite_difference_steps(p0: &[f64], steps: Option<&[f64]>) -> Result<Vec<f64>> {
+    let steps: Vec<f64> = match steps {
+        Some(s) => s.to_vec(),
+        None => p0
+            .iter()
+            .map(|p| PARAMETER_STEP * p.abs().max(1e-3))
+            .collect(),
+    };
+    if steps.len() != p0.len() {
+        return Err(Error::invalid(
+            "steps",
+            steps.len().to_string(),
+            format!("one step per parameter ({})", p0.len()),
+        ));
+    }
+    if let Some(bad) = steps.iter().find(|h| !(h.is_finite() && **h > 0.0)) {
+        return Err(Error::invalid(
+            "steps",
+            bad.to_string(),
+            "finite positive steps",
+        ));
+    }
+    Ok(steps)
 }
 
 /// The error of a point whose run ended without a steady state (at `time`, in `state`).
@@ -138,27 +165,7 @@ pub fn steady_sensitivity_at(
     options: &SimulationOptions,
     orbit: &Orbit,
 ) -> Result<SteadySensitivity> {
-    let steps: Vec<f64> = match steps {
-        Some(s) => s.to_vec(),
-        None => p0
-            .iter()
-            .map(|p| PARAMETER_STEP * p.abs().max(1e-3))
-            .collect(),
-    };
-    if steps.len() != p0.len() {
-        return Err(Error::invalid(
-            "steps",
-            steps.len().to_string(),
-            format!("one step per parameter ({})", p0.len()),
-        ));
-    }
-    if let Some(bad) = steps.iter().find(|h| !(h.is_finite() && **h > 0.0)) {
-        return Err(Error::invalid(
-            "steps",
-            bad.to_string(),
-            "finite positive steps",
-        ));
-    }
+    let steps = finite_difference_steps(p0, steps)?;
     let Some(period) = device.period() else {
         return Err(Error::Constraint(
             "a sensitivity needs a periodic drive (the device has no actuator)".into(),
