@@ -108,3 +108,35 @@ def test_a_bar_after_a_short_call_with_a_later_deadline(monkeypatch: pytest.Monk
     monkeypatch.setattr(_progress, "REFRESH_S", 0.05)
     _slow_run()
     assert "of the wall budget" in capsys.readouterr().err
+
+
+def _child_can_lock() -> bool:
+    got = _progress._runs.acquire(timeout=2.0)
+    if got:
+        _progress._runs.release()
+    return got
+
+
+def test_a_forked_child_does_not_inherit_a_held_watcher_lock() -> None:
+    """The watcher holds its lock between waits; a process pool forking then gave its worker a
+    lock nobody would release (the worker's first bar would hang)."""
+    import multiprocessing
+
+    import threading
+
+    held, done = threading.Event(), threading.Event()
+
+    def hold() -> None:  # the watcher's place: another thread holds the lock at the fork
+        with _progress._runs:
+            held.set()
+            done.wait(30)
+
+    holder = threading.Thread(target=hold)
+    holder.start()
+    held.wait(30)
+    try:
+        with multiprocessing.get_context("fork").Pool(1) as pool:
+            assert pool.apply(_child_can_lock)
+    finally:
+        done.set()
+        holder.join()

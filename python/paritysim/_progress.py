@@ -13,6 +13,7 @@ and starts a bar's thread only when the call is due: a short call costs a lock, 
 from __future__ import annotations
 
 import math
+import os
 import sys
 import threading
 import time
@@ -133,3 +134,16 @@ def _watch_loop() -> None:
                     pending.append(run._start + DELAY_S)
             _wakes_at = min(pending) if pending else None
             _runs.wait(timeout=_wakes_at - now if _wakes_at is not None else None)
+
+
+def _reset_after_fork() -> None:
+    """A forked child (a process pool's worker) starts with no watcher and a fresh lock: the
+    parent's lock may have been held by its watcher at the fork, and no thread survives it."""
+    global _runs, _watcher, _wakes_at
+    _runs = threading.Condition()
+    _active.clear()
+    _watcher, _wakes_at = None, None
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_reset_after_fork)
