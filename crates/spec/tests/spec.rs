@@ -187,6 +187,36 @@ fn floats_survive_json_bit_for_bit() {
     }
 }
 
+/// A spec perturbed in place equals one perturbed on a copy, and the value is restored
+/// whether the perturbed spec is valid or not.
+#[test]
+fn applying_in_place_equals_applying_to_a_copy_and_restores_the_value() {
+    let (spec, _) = from_toml(&example("drag_parity.toml")).unwrap();
+    let listed = paths::field_paths(&spec);
+    let wings = paths::resolve_in(&spec, &listed, "wings[*].aero.omega1").unwrap();
+    let spring = paths::resolve_in(&spec, &listed, "drivetrain.balance_spring").unwrap();
+    let original = serde_json::to_value(&spec).unwrap();
+    let mut value = original.clone();
+    let (x, k) = (serde_json::json!(0.75), serde_json::json!(12.5));
+    let overrides = [(&wings, &x), (&spring, &k)];
+    let in_place = paths::apply_in_place(&mut value, &overrides).unwrap();
+    assert_eq!(value, original);
+    let copied = paths::apply_to(original.clone(), &overrides).unwrap();
+    assert_eq!(
+        serde_json::to_value(&in_place).unwrap(),
+        serde_json::to_value(&copied).unwrap()
+    );
+    assert_eq!(
+        serde_json::to_value(&in_place).unwrap()["drivetrain"]["balance_spring"],
+        k
+    );
+    // A negative spring is refused, and the value is still restored.
+    let negative = serde_json::json!(-1.0);
+    let e = paths::apply_in_place(&mut value, &[(&wings, &x), (&spring, &negative)]).unwrap_err();
+    assert_eq!(e.kind(), "InvalidParameter", "{e}");
+    assert_eq!(value, original);
+}
+
 /// The listing without texts (what resolving a name reads) holds the same paths, units and
 /// values as `spec_paths`; `get` reads what `set` writes.
 #[test]

@@ -127,7 +127,7 @@ pub(super) fn drive<const M: usize, S: Stepper<M>>(
     if next < times.len() && times[next] <= t0 {
         let state = rhs.expand(&y);
         while next < times.len() && times[next] <= t0 {
-            sink(next, times[next], &state)?;
+            super::stepper::emit(rhs, sink, (next, times[next]), &y, &state)?;
             next += 1;
         }
     }

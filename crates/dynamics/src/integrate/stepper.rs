@@ -27,6 +27,22 @@ pub(crate) trait Rhs<const M: usize> {
     }
     /// The branch the following evaluations take.
     fn set_sides(&mut self, _sides: Sides) {}
+    /// Sees the whole integrated vector of each sample before the sink gets its state (the
+    /// variational equations' `Φ` at the recorded times); nothing by default.
+    fn observe_sample(&mut self, _c: &[f64; M]) {}
+}
+
+/// Hands sample `i` (the integrated vector `c`, expanded to `state`) to
+/// [`Rhs::observe_sample`], then to `sink`.
+pub(super) fn emit<const M: usize>(
+    rhs: &mut dyn Rhs<M>,
+    sink: &mut Sink<'_>,
+    (i, t): (usize, f64),
+    c: &[f64; M],
+    state: &State,
+) -> Result<()> {
+    rhs.observe_sample(c);
+    sink(i, t, state)
 }
 
 /// An explicit embedded pair with dense output.
@@ -103,7 +119,7 @@ pub(super) fn sample_step<const M: usize, S: Stepper<M>>(
             if !state.is_finite() {
                 return Err(integration_error(times[*next], &state, "non-finite state"));
             }
-            sink(*next, times[*next], &state)?;
+            emit(rhs, sink, (*next, times[*next]), &sample, &state)?;
             *next += 1;
         }
     }
@@ -112,7 +128,7 @@ pub(super) fn sample_step<const M: usize, S: Stepper<M>>(
         return Err(integration_error(t_stop, &state, "non-finite state"));
     }
     while *next < times.len() && times[*next] <= t_stop {
-        sink(*next, times[*next], &state)?;
+        emit(rhs, sink, (*next, times[*next]), y_stop, &state)?;
         *next += 1;
     }
     Ok(state)

@@ -13,8 +13,8 @@ use nalgebra::DMatrix;
 use paritysim_error::Result;
 
 use super::{
-    MAX_SWITCHES, OdeSystem, Rhs, RungeKutta, Sides, State, Tolerances, check_grid, drive_method,
-    drive_method_on_grid, integration_error,
+    MAX_SWITCHES, OdeSystem, Rhs, RungeKutta, Sides, Sink, State, Tolerances, check_grid,
+    drive_method, drive_method_on_grid, integration_error,
 };
 
 /// Relative size of the directional difference step.
@@ -26,6 +26,8 @@ struct Variational<'a> {
     calls: usize,
     /// The branch held by event location (switches of the state part; None on fixed grids).
     sides: Option<Sides>,
+    /// `Φ` (column-major, `m × m`) at each sample handed to the sink, when recorded.
+    sampled_phi: Option<Vec<f64>>,
 }
 
 fn to_state(n: usize, c: &[f64]) -> State {
@@ -139,6 +141,13 @@ impl Variational<'_> {
 }
 
 impl<const M: usize> Rhs<M> for Variational<'_> {
+    fn observe_sample(&mut self, c: &[f64; M]) {
+        let m = 2 * self.n;
+        if let Some(phi) = &mut self.sampled_phi {
+            phi.extend_from_slice(&c[m..m + m * m]);
+        }
+    }
+
     fn eval(&mut self, t: f64, c: &[f64; M], dc: &mut [f64; M]) -> Result<()> {
         let m = 2 * self.n;
         let y = to_state(self.n, &c[..m]);
@@ -219,8 +228,9 @@ impl RungeKutta {
                 format!("> t0 = {t0}"),
             ));
         }
-        self.sensitivity_any(system, t0, y0, t1, None)
-            .map(|(y, phi, _)| (y, phi))
+        let sink = &mut |_: usize, _: f64, _: &State| Ok(());
+        self.sensitivity_any(system, t0, y0, t1, None, Along { times: &[], sink })
+            .map(|(y, phi, _, _)| (y, phi))
     }
 
     /// [`Self::flow_with_sensitivity`] that also returns the accepted step times (from `t0`
@@ -242,7 +252,9 @@ impl RungeKutta {
                 format!("> t0 = {t0}"),
             ));
         }
-        self.sensitivity_any(system, t0, y0, t1, None)
+        let sink = &mut |_: usize, _: f64, _: &State| Ok(());
+        self.sensitivity_any(system, t0, y0, t1, None, Along { times: &[], sink })
+            .map(|(y, phi, steps, _)| (y, phi, steps))
     }
 
     /// The flow and its sensitivity on the fixed steps of `grid` (see
@@ -256,10 +268,29 @@ impl RungeKutta {
         grid: &[f64],
         y0: &State,
     ) -> Result<(State, DMatrix<f64>)> {
+        self.flow_with_sensitivity_on_grid_sampled(system, grid, y0, &[], &mut |_, _, _| Ok(()))
+            .map(|(y, phi, _)| (y, phi))
+    }
+
+    /// [`Self::flow_with_sensitivity_on_grid`] sampled at `times` (within the grid): each
+    /// sample's state goes to `sink`, and its `Φ(t, grid[0])` (the active rows and columns, as
+    /// the monodromy) is returned, in order.
+    ///
+    /// # Errors
+    /// As [`Self::flow_with_sensitivity_on_grid`]; whatever `sink` returns.
+    pub(crate) fn flow_with_sensitivity_on_grid_sampled(
+        &self,
+        system: &dyn OdeSystem,
+        grid: &[f64],
+        y0: &State,
+        times: &[f64],
+        sink: &mut Sink<'_>,
+    ) -> Result<(State, DMatrix<f64>, Vec<DMatrix<f64>>)> {
         check_grid(grid)?;
         let (t0, t1) = (grid[0], grid[grid.len() - 1]);
-        self.sensitivity_any(system, t0, y0, t1, Some(grid))
-            .map(|(y, phi, _)| (y, phi))
+        let along = Along { times, sink };
+        self.sensitivity_any(system, t0, y0, t1, Some(grid), along)
+            .map(|(y, phi, _, sampled)| (y, phi, sampled))
     }
 
     fn sensitivity_any(
@@ -269,26 +300,25 @@ impl RungeKutta {
         y0: &State,
         t1: f64,
         grid: Option<&[f64]>,
-    ) -> Result<(State, DMatrix<f64>, Vec<f64>)> {
+        along: Along<'_, '_>,
+    ) -> Result<Sensitivities> {
         let n_real = system.n_active().clamp(1, 6);
         match n_real {
-            1..=2 => self.sensitivity::<20>(system, 2, n_real, t0, y0, t1, grid),
-            3..=4 => self.sensitivity::<72>(system, 4, n_real, t0, y0, t1, grid),
-            _ => self.sensitivity::<156>(system, 6, n_real, t0, y0, t1, grid),
+            1..=2 => self.sensitivity::<20>(system, 2, n_real, (t0, y0, t1), grid, along),
+            3..=4 => self.sensitivity::<72>(system, 4, n_real, (t0, y0, t1), grid, along),
+            _ => self.sensitivity::<156>(system, 6, n_real, (t0, y0, t1), grid, along),
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn sensitivity<const M: usize>(
         &self,
         system: &dyn OdeSystem,
         n: usize,
         n_real: usize,
-        t0: f64,
-        y0: &State,
-        t1: f64,
+        (t0, y0, t1): (f64, &State, f64),
         grid: Option<&[f64]>,
-    ) -> Result<(State, DMatrix<f64>, Vec<f64>)> {
+        along: Along<'_, '_>,
+    ) -> Result<Sensitivities> {
         let m = 2 * n;
         debug_assert_eq!(M, m + m * m);
         let mut c0 = [0.0; M];
@@ -302,13 +332,14 @@ impl RungeKutta {
             n,
             calls: 0,
             sides: None,
+            sampled_phi: (!along.times.is_empty())
+                .then(|| Vec::with_capacity(along.times.len() * m * m)),
         };
         let tol = Tolerances {
             rtol: self.rtol,
             atol: self.atol,
             controlled: m,
         };
-        let none = &mut |_: usize, _: f64, _: &State| Ok(());
         let mut steps = vec![t0];
         let (c, _) = match grid {
             None => drive_method(
@@ -319,19 +350,41 @@ impl RungeKutta {
                 t0,
                 c0,
                 t1,
-                &[],
-                none,
+                along.times,
+                along.sink,
                 &mut |t, _| steps.push(t),
             )?,
-            Some(grid) => drive_method_on_grid(self.method, &mut rhs, &tol, grid, c0, &[], none)?,
+            Some(grid) => drive_method_on_grid(
+                self.method,
+                &mut rhs,
+                &tol,
+                grid,
+                c0,
+                along.times,
+                along.sink,
+            )?,
         };
         // Rows/columns of the active entries: coords 0..n_real, rates n..n + n_real.
         let index = |k: usize| if k < n_real { k } else { n + k - n_real };
-        let phi = DMatrix::from_fn(2 * n_real, 2 * n_real, |i, j| {
-            c[m + index(j) * m + index(i)]
-        });
-        Ok((to_state(n, &c[..m]), phi, steps))
+        let active = |full: &[f64]| {
+            DMatrix::from_fn(2 * n_real, 2 * n_real, |i, j| full[index(j) * m + index(i)])
+        };
+        let sampled = rhs
+            .sampled_phi
+            .as_deref()
+            .map(|all| all.chunks_exact(m * m).map(active).collect())
+            .unwrap_or_default();
+        Ok((to_state(n, &c[..m]), active(&c[m..]), steps, sampled))
     }
+}
+
+/// The flow, its sensitivity, the accepted step times and `Φ` at the samples.
+type Sensitivities = (State, DMatrix<f64>, Vec<f64>, Vec<DMatrix<f64>>);
+
+/// The samples a sensitivity run hands out: their times and the sink of their states.
+struct Along<'a, 's> {
+    times: &'a [f64],
+    sink: &'a mut Sink<'s>,
 }
 
 #[cfg(test)]
@@ -371,5 +424,48 @@ mod tests {
         assert!((lin[1] - y1.rates[0]).abs() < 1e-9);
         // Liouville: det Φ(T) = exp(−c T).
         assert!((phi.determinant() - (-c * period).exp()).abs() < 1e-9);
+    }
+
+    /// Sampled on a grid, a linear flow's states are `Φ(t) y0` at every sample, the states are
+    /// the plain run's, and the first and last `Φ` are the identity and the monodromy.
+    #[test]
+    fn sampled_sensitivities_carry_each_samples_phi() {
+        let system = Mathieu(0.3, 1.7, 0.8);
+        let rk = RungeKutta::new(Method::Dop853, 1e-10, 1e-12, 100_000).unwrap();
+        let period = std::f64::consts::TAU;
+        let (_, _, grid) = rk
+            .flow_with_sensitivity_and_steps(&system, 0.0, &State::default(), period)
+            .unwrap();
+        let mut y0 = State::default();
+        y0.coords[0] = 0.4;
+        y0.rates[0] = -1.1;
+        let times: Vec<f64> = (0..=40).map(|k| period * f64::from(k) / 40.0).collect();
+        let mut states = Vec::new();
+        let (_, monodromy, phis) = rk
+            .flow_with_sensitivity_on_grid_sampled(&system, &grid, &y0, &times, &mut |_, _, y| {
+                states.push(*y);
+                Ok(())
+            })
+            .unwrap();
+        let mut plain = Vec::new();
+        rk.integrate_on_grid(&system, &grid, &y0, &times, &mut |_, _, y| {
+            plain.push(*y);
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!((phis.len(), states.len(), plain.len()), (41, 41, 41));
+        let start = nalgebra::DVector::from_vec(vec![0.4, -1.1]);
+        for ((phi, y), p) in phis.iter().zip(&states).zip(&plain) {
+            let lin = phi * &start;
+            // Φ from central differences of the right-hand side: exact for a linear one up to
+            // rounding over the difference step (measured: up to 1.2e-8 here).
+            let off = (lin[0] - y.coords[0])
+                .abs()
+                .max((lin[1] - y.rates[0]).abs());
+            assert!(off < 1e-7, "{off:e}");
+            assert!((y.coords[0] - p.coords[0]).abs() < 1e-12);
+        }
+        assert_eq!(phis[0], DMatrix::identity(2, 2));
+        assert_eq!(phis[40], monodromy);
     }
 }

@@ -156,36 +156,8 @@ pub(super) fn record_window(
 ) -> Result<Recorded> {
     let t_end = t_start + window;
     let times: Vec<f64> = window_times(t_start, window, n_samples).collect();
-    let mut metrics = MetricsAccumulator::new(device, period).with_weight(weight);
-    let plane = device.formulation() != crate::device::Formulation::DrivetrainCoordinates;
-    let mut recorder = Recorder::new(columns, times.len());
-    let mut sink = |i: usize, t: f64, y: &State| -> Result<()> {
-        // `stroke` is only set for drivetrain-coordinate and stroke-plane devices (see
-        // `stroke_sampling`).
-        if let Some(needs) = stroke {
-            let closing = i == n_samples;
-            if plane {
-                if let Some(sample) = PlaneSample::new(device, t, y, needs) {
-                    metrics.add_plane(&sample?, closing);
-                    if needs.forces {
-                        metrics.add_forces(&forces::of_state(device, y)?, closing);
-                    }
-                    return Ok(());
-                }
-                // Outside the closed form: the general sample (which reports why).
-            } else {
-                let sample = StrokeSample::of_stroke_device(device, t, y, needs)?;
-                metrics.add_stroke(&sample, closing);
-                if needs.forces {
-                    metrics.add_forces(&forces::of_state(device, y)?, closing);
-                }
-                return Ok(());
-            }
-        }
-        let sample = Sample::new(device, t, y)?;
-        metrics.add(&sample, i == n_samples);
-        recorder.push(&sample)
-    };
+    let mut sampler = WindowSampler::new(device, period, columns, stroke, n_samples, weight);
+    let mut sink = |i: usize, t: f64, y: &State| sampler.add(i, t, y);
     let end = match (perturbation, grid) {
         (None, Some(grid)) => integrator.integrate_on_grid(device, grid, y, &times, &mut sink)?,
         (None, None) => integrator.integrate_with(device, t_start, y, t_end, &times, &mut sink)?,
@@ -205,5 +177,103 @@ pub(super) fn record_window(
             integrator.integrate_with(device, t_kick, &y_kicked, t_end, after, &mut shifted)?
         }
     };
-    Ok((recorder.finish(), metrics.finish(), end))
+    let (trajectory, metrics) = sampler.finish();
+    Ok((trajectory, metrics, end))
+}
+
+/// A window's samples turned into its metrics and asked columns, one sample at a time
+/// ([`record_window`]'s sink; the sensitivities' windows sampled in another run).
+pub(crate) struct WindowSampler<'d> {
+    device: &'d Device,
+    metrics: MetricsAccumulator,
+    recorder: Recorder,
+    stroke: Option<StrokeNeeds>,
+    plane: bool,
+    /// The closing sample's index.
+    closing: usize,
+}
+
+impl<'d> WindowSampler<'d> {
+    /// A sampler of `n_samples + 1` samples (see [`record_window`]).
+    pub(crate) fn new(
+        device: &'d Device,
+        period: Option<f64>,
+        columns: Vec<crate::trajectory::Column>,
+        stroke: Option<StrokeNeeds>,
+        n_samples: usize,
+        weight: Option<f64>,
+    ) -> Self {
+        Self {
+            device,
+            metrics: MetricsAccumulator::new(device, period).with_weight(weight),
+            recorder: Recorder::new(columns, n_samples + 1),
+            stroke,
+            plane: device.formulation() != crate::device::Formulation::DrivetrainCoordinates,
+            closing: n_samples,
+        }
+    }
+
+    /// The sampler of [`grid_window`]'s window (its metrics, no columns) and its sample times.
+    pub(crate) fn of_grid_window(
+        device: &'d Device,
+        grid: &[f64],
+        period: f64,
+        options: &SimulationOptions,
+    ) -> (Self, Vec<f64>) {
+        let stroke = stroke_sampling(device, options.metrics.as_deref(), &[]);
+        let n_samples = window_samples(grid, period, options);
+        let sampler = Self::new(
+            device,
+            Some(period),
+            Vec::new(),
+            stroke,
+            n_samples,
+            options.weight_mn,
+        );
+        (sampler, grid_window_times(grid, period, options))
+    }
+
+    /// Whether the metrics read the work integrals (which only a run with work integrates).
+    pub(crate) fn reads_work(&self) -> bool {
+        self.stroke.is_none_or(|needs| needs.work)
+    }
+
+    /// Adds sample `i` (at `t`, in state `y`).
+    ///
+    /// # Errors
+    /// A model evaluation outside its domain.
+    pub(crate) fn add(&mut self, i: usize, t: f64, y: &State) -> Result<()> {
+        let (device, closing) = (self.device, i == self.closing);
+        // `stroke` is only set for drivetrain-coordinate and stroke-plane devices (see
+        // `stroke_sampling`).
+        if let Some(needs) = self.stroke {
+            if self.plane {
+                if let Some(sample) = PlaneSample::new(device, t, y, needs) {
+                    self.metrics.add_plane(&sample?, closing);
+                    if needs.forces {
+                        self.metrics
+                            .add_forces(&forces::of_state(device, y)?, closing);
+                    }
+                    return Ok(());
+                }
+                // Outside the closed form: the general sample (which reports why).
+            } else {
+                let sample = StrokeSample::of_stroke_device(device, t, y, needs)?;
+                self.metrics.add_stroke(&sample, closing);
+                if needs.forces {
+                    self.metrics
+                        .add_forces(&forces::of_state(device, y)?, closing);
+                }
+                return Ok(());
+            }
+        }
+        let sample = Sample::new(device, t, y)?;
+        self.metrics.add(&sample, closing);
+        self.recorder.push(&sample)
+    }
+
+    /// The columns and the metrics.
+    pub(crate) fn finish(self) -> (Trajectory, Vec<(String, f64)>) {
+        (self.recorder.finish(), self.metrics.finish())
+    }
 }

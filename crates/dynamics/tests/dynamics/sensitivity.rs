@@ -44,7 +44,7 @@ fn metrics_at(p: &[f64]) -> Vec<(String, f64)> {
 #[test]
 fn metric_derivatives_equal_central_differences_of_whole_runs() {
     let p0 = [18.75, 5.0, 50.0, 110.0];
-    let s = steady_sensitivity(&design, &p0, None, &tight()).unwrap();
+    let s = steady_sensitivity(&design, &design(&p0).unwrap(), &p0, None, &tight()).unwrap();
     assert_eq!(s.neutral_directions, 0, "K2 > 0: no neutral family");
     assert!(s.residual < 1e-9, "orbit residual {:e}", s.residual);
     let mut checked = 0;
@@ -91,7 +91,7 @@ fn a_neutral_family_is_left_out_and_the_metrics_moving_along_it_are_flagged() {
     // K2 = 0 with identical wings: every constant q2 offset is an orbit (a multiplier at 1).
     // K2 = 0 is its range's end: its derivative takes the one-sided formula.
     let p0 = [31.3, 0.0, 50.0, 110.0];
-    let s = steady_sensitivity(&design, &p0, None, &tight()).unwrap();
+    let s = steady_sensitivity(&design, &design(&p0).unwrap(), &p0, None, &tight()).unwrap();
     assert_eq!(s.neutral_directions, 1);
     for (i, (name, m)) in s.metrics.iter().enumerate() {
         if m.is_finite() {
@@ -120,8 +120,14 @@ fn a_neutral_family_is_left_out_and_the_metrics_moving_along_it_are_flagged() {
 
 #[test]
 fn bad_steps_are_named() {
-    let e = steady_sensitivity(&design, &[18.75, 5.0, 50.0, 110.0], Some(&[1e-4]), &tight())
-        .unwrap_err();
+    let e = steady_sensitivity(
+        &design,
+        &design(&[18.75, 5.0, 50.0, 110.0]).unwrap(),
+        &[18.75, 5.0, 50.0, 110.0],
+        Some(&[1e-4]),
+        &tight(),
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("steps"), "{e}");
 }
 
@@ -139,9 +145,9 @@ fn the_perturbed_periods_run_in_the_lanes() {
         ..tight()
     };
     let before = paritysim_dynamics::lanes::periods_completed_in_lanes();
-    let lanes = steady_sensitivity(&design, &p0, None, &options).unwrap();
+    let lanes = steady_sensitivity(&design, &design(&p0).unwrap(), &p0, None, &options).unwrap();
     assert!(paritysim_dynamics::lanes::periods_completed_in_lanes() - before >= 4 * p0.len());
-    let all = steady_sensitivity(&design, &p0, None, &tight()).unwrap();
+    let all = steady_sensitivity(&design, &design(&p0).unwrap(), &p0, None, &tight()).unwrap();
     for (i, (name, _)) in lanes.metrics.iter().enumerate() {
         let k = all.metrics.iter().position(|(m, _)| m == name).unwrap();
         for j in 0..p0.len() {
