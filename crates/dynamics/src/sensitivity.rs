@@ -278,7 +278,14 @@ pub fn steady_sensitivity_at(
         .collect::<Result<Vec<(Point, Point, bool)>>>()?;
     let points: Vec<&Point> = pairs.iter().flat_map(|(a, b, _)| [a, b]).collect();
     // The perturbed periods: the maps from x*, then the windows along (dx*/dp_j, 1).
-    let maps = periods(&points, &vec![x_star; points.len()], false, &rk, options)?;
+    let mut tables = Vec::new();
+    let maps = periods(
+        &points,
+        &vec![x_star; points.len()],
+        (false, &mut tables),
+        &rk,
+        options,
+    )?;
     let dxs = pairs
         .iter()
         .enumerate()
@@ -299,7 +306,7 @@ pub fn steady_sensitivity_at(
             offsets.map(|o| State::from_compact(n, &(x_star.compact(n) + dx * (o * steps[j]))))
         })
         .collect();
-    let windows = periods(&points, &starts, true, &rk, options)?;
+    let windows = periods(&points, &starts, (true, &mut tables), &rk, options)?;
     let columns: Vec<_> = (0..n_params)
         .map(|j| {
             let (m_near, m_far) = (&windows[2 * j].1, &windows[2 * j + 1].1);
@@ -433,10 +440,10 @@ fn difference(
 /// with `record`, its recorded window's metrics (`simulate::grid_window`).
 /// Four at a time in the lanes where every device has a lane model (bit-identical to the
 /// scalar periods, `crate::lanes::batch`), else on the sensitivity's threads.
-fn periods(
-    points: &[&Point],
+fn periods<'a>(
+    points: &[&'a Point],
     starts: &[State],
-    record: bool,
+    (record, tables): (bool, &mut crate::lanes::batch::DriveTables<'a>),
     rk: &RungeKutta,
     options: &SimulationOptions,
 ) -> Result<Vec<Period>> {
@@ -467,7 +474,7 @@ fn periods(
             rtol: options.rtol,
             atol: options.atol,
         };
-        if let Some(done) = crate::lanes::batch::run(&jobs, names, tol, options.weight_mn) {
+        if let Some(done) = crate::lanes::batch::run(&jobs, names, tol, options.weight_mn, tables) {
             return Ok(done
                 .into_iter()
                 .map(|(end, metrics)| (DVector::from_row_slice(&end), metrics.unwrap_or_default()))

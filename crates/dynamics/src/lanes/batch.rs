@@ -35,14 +35,21 @@ pub(crate) type Done = ([f64; 4], Option<Vec<(String, f64)>>);
 /// A grid, an actuator and the actuator's force at the grid's stage times.
 type DriveTable<'a> = (Rc<[f64]>, &'a crate::actuator::Actuator, Rc<[f64]>);
 
+/// The drive tables of several [`run`]s (a sensitivity's maps and windows share them): the
+/// parameters that move neither the grid nor the actuator (a wing's Ω, a spring) share the
+/// base point's, and each run of a point reuses its own (the drive's `sin` per stage was a
+/// tenth of the time).
+pub(crate) type DriveTables<'a> = Vec<DriveTable<'a>>;
+
 /// Runs `jobs` in the lanes, windows with the metrics `metric_names` (stroke metrics only):
 /// `None` when a device has no lane model, a metric is not a stroke metric, or a lane would
 /// fail where the scalar path reports the error (the caller then runs them scalar).
-pub(crate) fn run(
-    jobs: &[Job<'_>],
+pub(crate) fn run<'a>(
+    jobs: &[Job<'a>],
     metric_names: &[String],
     tol: LaneTolerances,
     weight: Option<f64>,
+    tables: &mut DriveTables<'a>,
 ) -> Option<Vec<Done>> {
     if !metric_names
         .iter()
@@ -73,9 +80,6 @@ pub(crate) fn run(
     let mut lanes = LinearStrokeLanes::new();
     let mut in_lane: [Option<usize>; LANES] = [None; LANES];
     let mut done: Vec<Option<Done>> = jobs.iter().map(|_| None).collect();
-    // The drive's table per grid and actuator: the parameters that move neither (a wing's Ω,
-    // a spring) share the base point's (its `sin` per stage was a tenth of the time).
-    let mut tables: Vec<DriveTable<'_>> = Vec::new();
     let (mut next, mut fresh) = (0, 0u32);
     loop {
         for (l, slot) in in_lane.iter_mut().enumerate() {

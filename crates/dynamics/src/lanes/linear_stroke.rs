@@ -55,14 +55,14 @@ impl<'a> LinearStroke<'a> {
     }
 }
 
-impl LinearStroke<'_> {
+impl<'a> LinearStroke<'a> {
     /// The actuator force at `t` (mN).
     pub(crate) fn force(&self, t: f64) -> f64 {
         self.actuator.force(t)
     }
 
     /// The actuator.
-    pub(crate) fn actuator(&self) -> &Actuator {
+    pub(crate) fn actuator(&self) -> &'a Actuator {
         self.actuator
     }
 
