@@ -161,3 +161,20 @@ def test_sensitivity_periods_in_lanes_equal_the_scalar_ones(balance_spring: floa
     assert lanes.jacobian.equals(scalar.jacobian)
     assert np.array_equal(lanes.state_jacobian, scalar.state_jacobian)
     assert np.isfinite(lanes.jacobian.select(pl.col("^d/d.*$")).to_numpy()).all()
+
+
+@pytest.mark.parametrize("threads", ["1", "2", "3"])
+def test_a_sensitivity_is_the_same_on_any_number_of_threads(threads: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The parameters' perturbed devices and periods run in groups on the sensitivity's
+    threads (``PARITYSIM_THREADS``): the same bits on one thread or several, lanes or scalar."""
+    spec = ps.devices.load("sreetharan2012_3_3_parity").with_paths({"drivetrain.balance_spring": 5.0, "wings.left.omega_ratio": 0.7})
+    params = ["wings[0].aero.omega1", "drivetrain.balance_spring", "actuator.stiffness", "actuator.waveform.amplitude_v", "actuator.waveform.frequency_hz"]
+    metrics = ["delta_tau_peak", "tau_r_peak", "left_stroke_amplitude"]
+    monkeypatch.setenv("PARITYSIM_THREADS", "1")
+    one = ps.sensitivity(spec, params, metrics=metrics, progress=False)
+    monkeypatch.setenv("PARITYSIM_THREADS", threads)
+    for lanes in ("4", "1"):
+        monkeypatch.setenv("PARITYSIM_LANES", lanes)
+        several = ps.sensitivity(spec, params, metrics=metrics, progress=False)
+        assert several.jacobian.equals(one.jacobian), lanes
+        assert np.array_equal(several.state_jacobian, one.state_jacobian), lanes

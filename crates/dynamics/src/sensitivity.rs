@@ -273,46 +273,64 @@ pub fn steady_sensitivity_at(
             ),
         })
     };
-    let pairs = (0..n_params)
-        .map(perturbed)
-        .collect::<Result<Vec<(Point, Point, bool)>>>()?;
-    let points: Vec<&Point> = pairs.iter().flat_map(|(a, b, _)| [a, b]).collect();
-    // The perturbed periods: the maps from x*, then the windows along (dx*/dp_j, 1).
-    let mut tables = Vec::new();
-    let maps = periods(
-        &points,
-        &vec![x_star; points.len()],
-        (false, &mut tables),
-        &rk,
-        options,
-    )?;
-    let dxs = pairs
-        .iter()
-        .enumerate()
-        .map(|(j, (_, _, central))| {
-            let (near, far) = (&maps[2 * j].0, &maps[2 * j + 1].0);
-            let dp = difference(*central, steps[j], &base_map, near, far);
-            crate::shooting::newton::least_squares_step(a.clone(), &dp).ok_or_else(|| {
-                Error::Singular("the orbit's sensitivity: non-finite monodromy".into())
+    // The parameters in groups (a group's four perturbed periods fill the lanes once), each
+    // group's devices, maps and windows on one of the sensitivity's threads: the maps from x*,
+    // then the windows along (dx*/dp_j, 1).
+    let groups: Vec<std::ops::Range<usize>> = (0..n_params)
+        .step_by(PARAMETERS_PER_GROUP)
+        .map(|first| first..(first + PARAMETERS_PER_GROUP).min(n_params))
+        .collect();
+    let columns = crate::stability::rows::run_parts(groups.len(), |g| {
+        let group = groups[g].clone();
+        let pairs = group
+            .clone()
+            .map(perturbed)
+            .collect::<Result<Vec<(Point, Point, bool)>>>()?;
+        let points: Vec<&Point> = pairs.iter().flat_map(|(a, b, _)| [a, b]).collect();
+        let mut tables = Vec::new();
+        let starts = vec![x_star; points.len()];
+        let maps = periods(&points, &starts, (false, &mut tables), &rk, options)?;
+        let dxs = pairs
+            .iter()
+            .zip(group.clone())
+            .enumerate()
+            .map(|(k, ((_, _, central), j))| {
+                let (near, far) = (&maps[2 * k].0, &maps[2 * k + 1].0);
+                let dp = difference(*central, steps[j], &base_map, near, far);
+                crate::shooting::newton::least_squares_step(a.clone(), &dp).ok_or_else(|| {
+                    Error::Singular("the orbit's sensitivity: non-finite monodromy".into())
+                })
             })
-        })
-        .collect::<Result<Vec<_>>>()?;
-    let starts: Vec<State> = pairs
-        .iter()
-        .zip(&dxs)
-        .enumerate()
-        .flat_map(|(j, ((_, _, central), dx))| {
-            let offsets = if *central { [-1.0, 1.0] } else { [1.0, 2.0] };
-            offsets.map(|o| State::from_compact(n, &(x_star.compact(n) + dx * (o * steps[j]))))
-        })
-        .collect();
-    let windows = periods(&points, &starts, (true, &mut tables), &rk, options)?;
-    let columns: Vec<_> = (0..n_params)
-        .map(|j| {
-            let (m_near, m_far) = (&windows[2 * j].1, &windows[2 * j + 1].1);
-            (&dxs[j], m_near, m_far, pairs[j].2)
-        })
-        .collect();
+            .collect::<Result<Vec<_>>>()?;
+        let starts: Vec<State> = pairs
+            .iter()
+            .zip(group)
+            .zip(&dxs)
+            .flat_map(|(((_, _, central), j), dx)| {
+                let offsets = if *central { [-1.0, 1.0] } else { [1.0, 2.0] };
+                offsets.map(|o| State::from_compact(n, &(x_star.compact(n) + dx * (o * steps[j]))))
+            })
+            .collect();
+        let mut windows = periods(&points, &starts, (true, &mut tables), &rk, options)?
+            .into_iter()
+            .map(|(_, metrics)| metrics);
+        Ok(pairs
+            .iter()
+            .zip(dxs)
+            .map(|((_, _, central), dx)| {
+                let (near, far) = (windows.next(), windows.next());
+                (
+                    dx,
+                    near.unwrap_or_default(),
+                    far.unwrap_or_default(),
+                    *central,
+                )
+            })
+            .collect::<Vec<_>>())
+    })?
+    .into_iter()
+    .flatten()
+    .collect::<Vec<_>>();
     let n_metrics = base_metrics.len();
     let mut jacobian = DMatrix::zeros(n_metrics, n_params);
     let mut state_jacobian = DMatrix::zeros(2 * n, n_params);
@@ -321,7 +339,7 @@ pub fn steady_sensitivity_at(
         .map(|(_, m)| (!m.is_finite()).then(|| "not defined at this point (NaN)".to_string()))
         .collect();
     for (j, (dx, m_near, m_far, central)) in columns.iter().enumerate() {
-        state_jacobian.set_column(j, *dx);
+        state_jacobian.set_column(j, dx);
         let h = steps[j];
         for (i, (name, m0)) in base_metrics.iter().enumerate() {
             let (near, far) = (value_of(m_near, name), value_of(m_far, name));
@@ -416,6 +434,10 @@ impl Replay {
         Ok(sampler.finish().1)
     }
 }
+
+/// Parameters whose perturbed periods run together: two central differences are four periods,
+/// one load of the lanes.
+const PARAMETERS_PER_GROUP: usize = 2;
 
 /// A perturbed period's end state (compact) or its window's metrics.
 type Period = (DVector<f64>, Vec<(String, f64)>);

@@ -80,15 +80,20 @@ fn differentiate(
         .iter()
         .map(|p| value_of(value, p))
         .collect::<Result<Vec<_>>>()?;
-    // One copy of the value, perturbed in place for each device.
-    let scratch = std::sync::Mutex::new(value.clone());
+    // A copy of the value per thread building devices, perturbed in place for each.
+    let copies = std::sync::Mutex::new(Vec::new());
     let device_at = |p: &[f64]| -> Result<paritysim_dynamics::Device> {
         let numbers: Vec<Value> = p.iter().map(|&x| Value::from(x)).collect();
         let pairs: Vec<(&Parameter, &Value)> = parameters.iter().zip(&numbers).collect();
-        let mut value = scratch
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        apply_in_place(&mut value, &pairs)?.device()
+        let lock = || {
+            copies
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+        };
+        let mut copy = lock().pop().unwrap_or_else(|| value.clone());
+        let spec = apply_in_place(&mut copy, &pairs);
+        lock().push(copy);
+        spec?.device()
     };
     let result = match orbit {
         Some(orbit) => steady_sensitivity_at(&device_at, device, &values, None, options, orbit)?,
