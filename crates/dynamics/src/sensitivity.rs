@@ -7,7 +7,12 @@
 //! no step-size control to make it noisy; a frequency change scales the grid with the
 //! period). A metric's derivative is the central difference of the recorded window (on that
 //! grid) along the direction `(dx*/dp, 1)`: the orbit moves with the parameter, so no
-//! finite difference ever runs through the shooting's convergence. Directions with a
+//! finite difference ever runs through the shooting's convergence. The window at
+//! `(x* + h dx*/dp, p + h)` is the map's own samples from `(x*, p + h)` moved by `Φ(t)·h dx*/dp`,
+//! `Φ(t)` the base orbit's, sampled in its variational period (the first-order errors of both
+//! cancel in the central differences; measured within 5e-9 of integrated windows). Metrics that
+//! read the work integrals, and devices whose monodromy is differenced, integrate the
+//! windows. Directions with a
 //! multiplier at 1 (a neutral family, K2 = 0's whippletree) are left out of `(∂P/∂x − I)⁺`,
 //! not divided by; a metric that changes along them, or whose one-sided differences disagree
 //! (a peak jumping between two maxima), is flagged as not differentiable there.
@@ -220,7 +225,7 @@ pub fn steady_sensitivity_at(
                 sampler.add(i, t, y)
             },
         )?;
-        let replay = Replay { times, states, phi };
+        let replay = Replay { states, phi };
         (mapped, monodromy, Some(replay), sampler.finish().1)
     };
     let residual = crate::shooting::newton::residual(n, &x_star, &mapped.without_work()).1;
@@ -289,31 +294,56 @@ pub fn steady_sensitivity_at(
         let points: Vec<&Point> = pairs.iter().flat_map(|(a, b, _)| [a, b]).collect();
         let mut tables = Vec::new();
         let starts = vec![x_star; points.len()];
-        let maps = periods(&points, &starts, (false, &mut tables), &rk, options)?;
+        let keep = if replay.is_some() {
+            Keep::Samples
+        } else {
+            Keep::End
+        };
+        let maps = periods(&points, &starts, (keep, &mut tables), &rk, options)?;
         let dxs = pairs
             .iter()
             .zip(group.clone())
             .enumerate()
             .map(|(k, ((_, _, central), j))| {
-                let (near, far) = (&maps[2 * k].0, &maps[2 * k + 1].0);
+                let (near, far) = (&maps[2 * k].end, &maps[2 * k + 1].end);
                 let dp = difference(*central, steps[j], &base_map, near, far);
                 crate::shooting::newton::least_squares_step(a.clone(), &dp).ok_or_else(|| {
                     Error::Singular("the orbit's sensitivity: non-finite monodromy".into())
                 })
             })
             .collect::<Result<Vec<_>>>()?;
-        let starts: Vec<State> = pairs
+        let shifts: Vec<DVector<f64>> = pairs
             .iter()
             .zip(group)
             .zip(&dxs)
             .flat_map(|(((_, _, central), j), dx)| {
                 let offsets = if *central { [-1.0, 1.0] } else { [1.0, 2.0] };
-                offsets.map(|o| State::from_compact(n, &(x_star.compact(n) + dx * (o * steps[j]))))
+                offsets.map(|o| dx * (o * steps[j]))
             })
             .collect();
-        let mut windows = periods(&points, &starts, (true, &mut tables), &rk, options)?
-            .into_iter()
-            .map(|(_, metrics)| metrics);
+        let mut windows = match &replay {
+            // Each window from its map's samples moved by Φ(t)·shift.
+            Some(replay) => points
+                .iter()
+                .zip(&maps)
+                .zip(&shifts)
+                .map(|((point, map), shift)| {
+                    let at = (&point.device, point.grid.as_slice(), point.period);
+                    replay.window_along(at, &map.states, shift, options)
+                })
+                .collect::<Result<Vec<_>>>()?,
+            None => {
+                let starts: Vec<State> = shifts
+                    .iter()
+                    .map(|shift| State::from_compact(n, &(x_star.compact(n) + shift)))
+                    .collect();
+                periods(&points, &starts, (Keep::Metrics, &mut tables), &rk, options)?
+                    .into_iter()
+                    .map(|period| period.metrics)
+                    .collect()
+            }
+        }
+        .into_iter();
         Ok(pairs
             .iter()
             .zip(dxs)
@@ -366,7 +396,9 @@ pub fn steady_sensitivity_at(
         let along = |sign: f64| -> Result<Vec<(String, f64)>> {
             let shift = v * (sign * eps);
             match &replay {
-                Some(replay) => replay.window_along(device, &grid, period, options, &shift),
+                Some(replay) => {
+                    replay.window_along((device, &grid, period), &replay.states, &shift, options)
+                }
                 None => {
                     let y = State::from_compact(n, &(x_star.compact(n) + shift));
                     crate::simulate::grid_window(device, &rk, &grid, period, &y, options)
@@ -401,35 +433,59 @@ pub fn steady_sensitivity_at(
 /// The base window's samples (times, states) and `Φ(t, 0)` at each: the window of a start
 /// `x* + δ` is, to first order in `δ`, the window of the states `y(t) + Φ(t) δ`.
 struct Replay {
-    times: Vec<f64>,
     states: Vec<State>,
     phi: Vec<DMatrix<f64>>,
 }
 
 impl Replay {
-    /// The metrics of the base window moved to the start `x* + shift` (compact) to first order.
+    /// The metrics of the window of `point` whose sample states are `states` (at the base
+    /// window's phases) moved to the start `x* + shift` (compact): to first order, the states
+    /// `y(t) + Φ(t) shift`. The central differences cancel the first-order error of taking
+    /// the base point's `Φ` at a perturbed one.
     fn window_along(
         &self,
-        device: &Device,
-        grid: &[f64],
-        period: f64,
-        options: &SimulationOptions,
+        (device, grid, period): (&Device, &[f64], f64),
+        states: &[State],
         shift: &DVector<f64>,
+        options: &SimulationOptions,
     ) -> Result<Vec<(String, f64)>> {
         let n = device.n_dof();
-        let (mut sampler, _) = WindowSampler::of_grid_window(device, grid, period, options);
-        for (i, ((t, y), phi)) in self
-            .times
+        let m = 2 * n;
+        let shift = shift.as_slice();
+        let moved: Vec<State> = states
             .iter()
-            .zip(&self.states)
             .zip(&self.phi)
-            .enumerate()
-        {
-            sampler.add(
-                i,
-                *t,
-                &State::from_compact(n, &(y.compact(n) + phi * shift)),
-            )?;
+            .map(|(y, phi)| {
+                // Φ·shift, Φ column-major.
+                let mut delta = [0.0; 2 * crate::integrate::MAX_DOF];
+                for (column, s) in phi.as_slice().chunks_exact(m).zip(shift) {
+                    for (d, p) in delta.iter_mut().zip(column) {
+                        *d += p * s;
+                    }
+                }
+                let mut moved = *y;
+                for i in 0..n {
+                    moved.coords[i] += delta[i];
+                    moved.rates[i] += delta[n + i];
+                }
+                moved
+            })
+            .collect();
+        let (mut sampler, times) = WindowSampler::of_grid_window(device, grid, period, options);
+        if let (Some(names), true) = (&options.metrics, in_lanes(options)?) {
+            // The lanes' sampling, as the lanes' windows took theirs (the same bits).
+            if let Some(metrics) = crate::lanes::batch::window_metrics(
+                device,
+                &times,
+                &moved,
+                names,
+                options.weight_mn,
+            ) {
+                return Ok(metrics);
+            }
+        }
+        for (i, (t, y)) in times.iter().zip(&moved).enumerate() {
+            sampler.add(i, *t, y)?;
         }
         Ok(sampler.finish().1)
     }
@@ -439,8 +495,25 @@ impl Replay {
 /// one load of the lanes.
 const PARAMETERS_PER_GROUP: usize = 2;
 
-/// A perturbed period's end state (compact) or its window's metrics.
-type Period = (DVector<f64>, Vec<(String, f64)>);
+/// What a perturbed period keeps.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Keep {
+    /// The end state (a map).
+    End,
+    /// The end state and the window's sample states (a map whose window is replayed).
+    Samples,
+    /// The recorded window's metrics.
+    Metrics,
+}
+
+/// A perturbed period: its end state (compact; `Keep::End`, `Keep::Samples`), its window's
+/// sample states (`Keep::Samples`) or metrics (`Keep::Metrics`).
+#[derive(Default)]
+struct Period {
+    end: DVector<f64>,
+    states: Vec<State>,
+    metrics: Vec<(String, f64)>,
+}
 
 /// `df/dp` from `f(near)`, `f(far)`: central `(p0 − h, p0 + h)` or, at the range's end,
 /// the second-order one-sided formula on `(p0 + h, p0 + 2h)` with `f0 = f(p0)`.
@@ -458,28 +531,35 @@ fn difference(
     }
 }
 
-/// One fixed-grid period of each `points[k]` from `starts[k]`: its end state (compact) or,
-/// with `record`, its recorded window's metrics (`simulate::grid_window`).
-/// Four at a time in the lanes where every device has a lane model (bit-identical to the
-/// scalar periods, `crate::lanes::batch`), else on the sensitivity's threads.
+/// Whether the perturbed periods run in the lanes (`crate::lanes::batch`): DOP853 and not
+/// `PARITYSIM_LANES=1` (the scalar path, as for sweeps); the batch itself refuses devices
+/// without a lane model and metrics other than stroke metrics.
+fn in_lanes(options: &SimulationOptions) -> Result<bool> {
+    Ok(
+        options.method == crate::integrate::Method::Dop853
+            && crate::lanes::resolve_lanes(None)? > 1,
+    )
+}
+
+/// One fixed-grid period of each `points[k]` from `starts[k]`, keeping `keep`. Four at a time
+/// in the lanes where every device has a lane model (bit-identical to the scalar periods,
+/// `crate::lanes::batch`), else on the sensitivity's threads.
 fn periods<'a>(
     points: &[&'a Point],
     starts: &[State],
-    (record, tables): (bool, &mut crate::lanes::batch::DriveTables<'a>),
+    (keep, tables): (Keep, &mut crate::lanes::batch::DriveTables<'a>),
     rk: &RungeKutta,
     options: &SimulationOptions,
 ) -> Result<Vec<Period>> {
     // The lanes compute stroke metrics only: a window asking every metric runs scalar.
-    let lane_metrics = match (record, &options.metrics) {
-        (false, _) => Some(&[][..]),
-        (true, Some(names)) => Some(names.as_slice()),
-        (true, None) => None,
+    let lane_metrics = match (keep, &options.metrics) {
+        (Keep::End | Keep::Samples, _) => Some(&[][..]),
+        (Keep::Metrics, Some(names)) => Some(names.as_slice()),
+        (Keep::Metrics, None) => None,
     };
-    // `PARITYSIM_LANES=1` runs the scalar path, as for sweeps.
-    let lanes = crate::lanes::resolve_lanes(None)? > 1;
-    if let (crate::integrate::Method::Dop853, Some(names), true) =
-        (options.method, lane_metrics, lanes)
-    {
+    let times =
+        |point: &Point| crate::simulate::grid_window_times(&point.grid, point.period, options);
+    if let (Some(names), true) = (lane_metrics, in_lanes(options)?) {
         let jobs: Vec<crate::lanes::batch::Job<'_>> = points
             .iter()
             .zip(starts)
@@ -487,46 +567,63 @@ fn periods<'a>(
                 device: &point.device,
                 grid: std::rc::Rc::from(point.grid.as_slice()),
                 y0: *y,
-                times: record.then(|| {
-                    crate::simulate::grid_window_times(&point.grid, point.period, options).into()
-                }),
+                times: (keep != Keep::End).then(|| times(point).into()),
             })
             .collect();
         let tol = crate::integrate::lanes::LaneTolerances {
             rtol: options.rtol,
             atol: options.atol,
         };
-        if let Some(done) = crate::lanes::batch::run(&jobs, names, tol, options.weight_mn, tables) {
+        let capture = keep == Keep::Samples;
+        if let Some(done) =
+            crate::lanes::batch::run(&jobs, (names, capture), tol, options.weight_mn, tables)
+        {
             return Ok(done
                 .into_iter()
-                .map(|(end, metrics)| (DVector::from_row_slice(&end), metrics.unwrap_or_default()))
+                .map(|done| Period {
+                    end: DVector::from_row_slice(&done.end),
+                    states: done.states,
+                    metrics: done.metrics.unwrap_or_default(),
+                })
                 .collect());
         }
     }
     crate::stability::rows::run_parts(points.len(), |k| {
         let point = points[k];
-        Ok(match record {
-            true => {
-                let metrics = crate::simulate::grid_window(
-                    &point.device,
-                    rk,
-                    &point.grid,
-                    point.period,
-                    &starts[k],
-                    options,
-                )?;
-                (DVector::zeros(0), metrics)
-            }
-            false => {
-                let end = rk.with_work(false).integrate_on_grid(
-                    &point.device,
-                    &point.grid,
-                    &starts[k],
-                    &[],
-                    &mut |_, _, _| Ok(()),
-                )?;
-                (end.without_work().compact(point.device.n_dof()), Vec::new())
-            }
+        if keep == Keep::Metrics {
+            let metrics = crate::simulate::grid_window(
+                &point.device,
+                rk,
+                &point.grid,
+                point.period,
+                &starts[k],
+                options,
+            )?;
+            return Ok(Period {
+                metrics,
+                ..Period::default()
+            });
+        }
+        let sample_times = if keep == Keep::Samples {
+            times(point)
+        } else {
+            Vec::new()
+        };
+        let mut states = Vec::with_capacity(sample_times.len());
+        let end = rk.with_work(false).integrate_on_grid(
+            &point.device,
+            &point.grid,
+            &starts[k],
+            &sample_times,
+            &mut |_, _, y| {
+                states.push(*y);
+                Ok(())
+            },
+        )?;
+        Ok(Period {
+            end: end.without_work().compact(point.device.n_dof()),
+            states,
+            metrics: Vec::new(),
         })
     })
 }

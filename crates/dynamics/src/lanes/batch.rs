@@ -8,11 +8,13 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::device::Device;
 use crate::integrate::State;
-use crate::integrate::lanes::{LANES, LaneOutcome, LaneProblem, LaneStepper, LaneTolerances};
+use crate::integrate::lanes::{
+    LANES, LaneOutcome, LaneProblem, LaneStepper, LaneTolerances, SampleBlock,
+};
 use crate::metrics::MetricsAccumulator;
 
 use super::linear_stroke::{LinearStroke, LinearStrokeLanes};
-use super::point::{compact4, feed_samples};
+use super::point::{compact4, expand4, feed_samples};
 
 /// Periods completed here (`super::periods_completed_in_lanes`).
 pub(crate) static COMPLETED: AtomicUsize = AtomicUsize::new(0);
@@ -29,8 +31,42 @@ pub(crate) struct Job<'a> {
 }
 
 /// A job's state at its grid's end (compact `[q1, q2, q̇1, q̇2]`) and, for a window, its
-/// metrics.
-pub(crate) type Done = ([f64; 4], Option<Vec<(String, f64)>>);
+/// metrics or (captured) its sample states.
+pub(crate) struct Done {
+    pub(crate) end: [f64; 4],
+    pub(crate) metrics: Option<Vec<(String, f64)>>,
+    pub(crate) states: Vec<State>,
+}
+
+/// What a job keeps of its window's samples.
+enum Window {
+    None,
+    Metrics(Box<MetricsAccumulator>),
+    States(Vec<State>),
+}
+
+impl Window {
+    /// Takes `block`: `false` when a sample is outside the lane model (see [`feed_samples`]).
+    fn take(
+        &mut self,
+        model: &LinearStroke<'_>,
+        block: &SampleBlock,
+        closing: usize,
+        with_force: bool,
+    ) -> bool {
+        match self {
+            Window::None => true,
+            Window::Metrics(m) => feed_samples(model, m, block, closing, with_force),
+            Window::States(states) => {
+                states.extend(
+                    (0..block.count)
+                        .map(|i| expand4(&std::array::from_fn(|c| block.y[c].as_array()[i]))),
+                );
+                true
+            }
+        }
+    }
+}
 
 /// A grid, an actuator and the actuator's force at the grid's stage times.
 type DriveTable<'a> = (Rc<[f64]>, &'a crate::actuator::Actuator, Rc<[f64]>);
@@ -41,12 +77,13 @@ type DriveTable<'a> = (Rc<[f64]>, &'a crate::actuator::Actuator, Rc<[f64]>);
 /// tenth of the time).
 pub(crate) type DriveTables<'a> = Vec<DriveTable<'a>>;
 
-/// Runs `jobs` in the lanes, windows with the metrics `metric_names` (stroke metrics only):
-/// `None` when a device has no lane model, a metric is not a stroke metric, or a lane would
-/// fail where the scalar path reports the error (the caller then runs them scalar).
+/// Runs `jobs` in the lanes, windows with the metrics `metric_names` (stroke metrics only),
+/// or, with `capture`, keeping the windows' sample states: `None` when a device has no lane
+/// model, a metric is not a stroke metric, or a lane would fail where the scalar path reports
+/// the error (the caller then runs them scalar).
 pub(crate) fn run<'a>(
     jobs: &[Job<'a>],
-    metric_names: &[String],
+    (metric_names, capture): (&[String], bool),
     tol: LaneTolerances,
     weight: Option<f64>,
     tables: &mut DriveTables<'a>,
@@ -62,13 +99,14 @@ pub(crate) fn run<'a>(
         .map(|j| LinearStroke::of(j.device))
         .collect::<Option<_>>()?;
     let with_force = metric_names.iter().any(|m| m == "actuator_force_peak");
-    let mut metrics: Vec<Option<MetricsAccumulator>> = jobs
+    let mut windows: Vec<Window> = jobs
         .iter()
-        .map(|j| {
-            let period = j.device.period();
-            j.times
-                .as_ref()
-                .map(|_| MetricsAccumulator::new(j.device, period).with_weight(weight))
+        .map(|j| match (&j.times, capture) {
+            (None, _) => Window::None,
+            (Some(times), true) => Window::States(Vec::with_capacity(times.len())),
+            (Some(_), false) => Window::Metrics(Box::new(
+                MetricsAccumulator::new(j.device, j.device.period()).with_weight(weight),
+            )),
         })
         .collect();
     // The closing sample's index: the window's sample count.
@@ -110,11 +148,8 @@ pub(crate) fn run<'a>(
                 times: job.times.clone().unwrap_or_else(|| Rc::from([])),
                 tol,
             };
-            let (model, sink) = (&models[k], &mut metrics[k]);
-            let mut feed = |_: usize, block: &_| {
-                sink.as_mut()
-                    .is_none_or(|m| feed_samples(model, m, block, closing[k], with_force))
-            };
+            let (model, window) = (&models[k], &mut windows[k]);
+            let mut feed = |_: usize, block: &_| window.take(model, block, closing[k], with_force);
             if !stepper.start(l, problem, &mut feed) {
                 return None;
             }
@@ -127,9 +162,7 @@ pub(crate) fn run<'a>(
         let finished = {
             let mut feed = |l: usize, block: &_| {
                 let k = in_lane[l].expect("a busy lane has a job");
-                metrics[k]
-                    .as_mut()
-                    .is_none_or(|m| feed_samples(&models[k], m, block, closing[k], with_force))
+                windows[k].take(&models[k], block, closing[k], with_force)
             };
             stepper.run(&lanes, std::mem::take(&mut fresh), &mut feed)
         };
@@ -138,9 +171,54 @@ pub(crate) fn run<'a>(
             let LaneOutcome::Done { y, .. } = outcome else {
                 return None;
             };
-            done[k] = Some((y, metrics[k].take().map(|m| m.finish())));
+            let (metrics, states) = match std::mem::replace(&mut windows[k], Window::None) {
+                Window::None => (None, Vec::new()),
+                Window::Metrics(m) => (Some(m.finish()), Vec::new()),
+                Window::States(states) => (None, states),
+            };
+            done[k] = Some(Done {
+                end: y,
+                metrics,
+                states,
+            });
         }
     }
     COMPLETED.fetch_add(jobs.len(), Ordering::Relaxed);
     done.into_iter().collect()
+}
+
+/// The stroke metrics `metric_names` of a window of `device` from its sample `states` at
+/// `times`, four samples at a time as [`run`] takes them: `None` as for [`run`].
+pub(crate) fn window_metrics(
+    device: &Device,
+    times: &[f64],
+    states: &[State],
+    metric_names: &[String],
+    weight: Option<f64>,
+) -> Option<Vec<(String, f64)>> {
+    if !metric_names
+        .iter()
+        .all(|m| crate::metrics::is_stroke_metric(m))
+    {
+        return None;
+    }
+    let model = LinearStroke::of(device)?;
+    let with_force = metric_names.iter().any(|m| m == "actuator_force_peak");
+    let mut metrics = MetricsAccumulator::new(device, device.period()).with_weight(weight);
+    let closing = times.len().saturating_sub(1);
+    for (b, (t, y)) in times.chunks(LANES).zip(states.chunks(LANES)).enumerate() {
+        let count = t.len().min(y.len());
+        // A short last block repeats its last sample in the unused lanes.
+        let compact: [[f64; 4]; LANES] = std::array::from_fn(|i| compact4(&y[i.min(count - 1)]));
+        let block = SampleBlock {
+            first: b * LANES,
+            count,
+            t: std::array::from_fn(|i| t[i.min(count - 1)]),
+            y: std::array::from_fn(|c| wide::f64x4::new(std::array::from_fn(|i| compact[i][c]))),
+        };
+        if !feed_samples(&model, &mut metrics, &block, closing, with_force) {
+            return None;
+        }
+    }
+    Some(metrics.finish())
 }

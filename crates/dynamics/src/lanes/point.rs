@@ -78,7 +78,7 @@ pub(super) fn compact4(y: &State) -> [f64; 4] {
 }
 
 /// The state of a compact one (work integrals zero, as the shooting's states).
-fn expand4(c: &[f64; 4]) -> State {
+pub(super) fn expand4(c: &[f64; 4]) -> State {
     let mut y = State::default();
     y.coords[..2].copy_from_slice(&c[..2]);
     y.rates[..2].copy_from_slice(&c[2..]);

@@ -132,8 +132,9 @@ fn bad_steps_are_named() {
 }
 
 /// The perturbed periods of a linear-map device with stroke metrics run in the SIMD lanes
-/// (`lanes::batch`; bit-identical to the scalar ones: tests/test_gradients.py) and the
-/// derivatives still equal the per-metric ones of the scalar windows (all metrics asked).
+/// (`lanes::batch`; bit-identical to the scalar ones: tests/test_gradients.py), two maps per
+/// parameter whose windows are replayed from their samples moved by Φ(t)·δ; the derivatives
+/// agree with those of integrated windows (all metrics asked: they read work integrals).
 #[test]
 fn the_perturbed_periods_run_in_the_lanes() {
     let p0 = [18.75, 5.0, 50.0, 110.0];
@@ -146,15 +147,16 @@ fn the_perturbed_periods_run_in_the_lanes() {
     };
     let before = paritysim_dynamics::lanes::periods_completed_in_lanes();
     let lanes = steady_sensitivity(&design, &design(&p0).unwrap(), &p0, None, &options).unwrap();
-    assert!(paritysim_dynamics::lanes::periods_completed_in_lanes() - before >= 4 * p0.len());
+    assert!(paritysim_dynamics::lanes::periods_completed_in_lanes() - before >= 2 * p0.len());
     let all = steady_sensitivity(&design, &design(&p0).unwrap(), &p0, None, &tight()).unwrap();
-    for (i, (name, _)) in lanes.metrics.iter().enumerate() {
+    for (i, (name, value)) in lanes.metrics.iter().enumerate() {
         let k = all.metrics.iter().position(|(m, _)| m == name).unwrap();
-        for j in 0..p0.len() {
+        for (j, p) in p0.iter().enumerate() {
             let (a, b) = (lanes.jacobian[(i, j)], all.jacobian[(k, j)]);
-            assert_eq!(
-                a.to_bits(),
-                b.to_bits(),
+            // Relative to the derivative's scale (measured: within 5e-9).
+            let scale = (value.abs() / p.abs()).max(b.abs());
+            assert!(
+                (a - b).abs() <= 1e-7 * scale,
                 "d {name} / d p{j}: {a:e} against {b:e}"
             );
         }
