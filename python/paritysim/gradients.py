@@ -130,10 +130,13 @@ def sensitivity(
     orbit (measured against central differences of whole ``ps.simulate`` runs at rtol 1e-11:
     within 1e-5 relative, ``crates/dynamics/tests/dynamics/sensitivity.rs``).
 
-    Cost: one steady-state run, one variational period, then two periods and two recorded
-    windows per parameter (four at a time in SIMD lanes on a linear-map device asked for
-    stroke metrics; on the §3.3 benchmark point with 8 parameters about 5× a
-    `paritysim.simulate`, docs/findings.md §30).
+    Cost: one steady-state run and one variational period (which also samples the base
+    window and its Φ), then per parameter two perturbed periods whose windows are their own
+    samples moved by Φ (four at a time in SIMD lanes on a linear-map device asked for stroke
+    metrics; parameters in pairs on the sweep's threads, ``PARITYSIM_THREADS``). Metrics that
+    read work integrals (the powers, the work per cycle) integrate each window instead. On the
+    §3.3 benchmark point with 8 parameters about 6× the instructions of a `paritysim.simulate`;
+    on the §3.4 1-Cut with 3 parameters about 3.4× (docs/findings.md §30).
 
     Raises
     ------
