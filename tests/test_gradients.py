@@ -178,3 +178,25 @@ def test_a_sensitivity_is_the_same_on_any_number_of_threads(threads: str, monkey
         several = ps.sensitivity(spec, params, metrics=metrics, progress=False)
         assert several.jacobian.equals(one.jacobian), lanes
         assert np.array_equal(several.state_jacobian, one.state_jacobian), lanes
+
+
+def _sensitivity_in_child(spec_json: str) -> list[list[float]]:
+    # The engine's call itself: polars keeps a thread pool of its own, which a forked child
+    # cannot use either (polars documents fork as unsupported).
+    from paritysim import _core
+
+    params = ["drivetrain.balance_spring", "actuator.stiffness", "actuator.waveform.amplitude_v"]
+    return _core.sensitivity(spec_json, params, ["tau_r_peak"])["jacobian"]
+
+
+def test_a_forked_child_starts_its_own_thread_pool(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The engine keeps its thread pools for the process; a forked child (a process pool's
+    worker) has none of their threads and must build its own instead of waiting on them."""
+    import multiprocessing
+
+    monkeypatch.setenv("PARITYSIM_THREADS", "2")
+    spec = ps.devices.load("sreetharan2012_3_3_parity").with_paths({"drivetrain.balance_spring": 5.0})
+    here = _sensitivity_in_child(spec.to_json())  # the parent's pool exists from here on
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        child = pool.apply_async(_sensitivity_in_child, (spec.to_json(),)).get(timeout=60)
+    assert np.array_equal(child, here)

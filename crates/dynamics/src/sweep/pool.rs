@@ -158,6 +158,35 @@ where
     // A pool even for one thread: the parallel parts of a point (a sensitivity's columns,
     // `stability::rows::run_parts`) then run inside it, on the sweep's threads, instead of
     // opening a pool of every core from the calling thread.
+    let pool = pool_of(threads)?;
+    // One point per task: points take milliseconds, so scheduling overhead is negligible and
+    // fine-grained stealing keeps both ends of the run busy.
+    Ok(pool.install(|| (0..n).into_par_iter().with_max_len(1).map(one).collect()))
+}
+
+/// The process's pool of `threads` threads, built on first use: a sensitivity runs its
+/// parameter groups on one per call, and a pool built per call started its threads anew each
+/// time.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] when the OS cannot start the threads.
+fn pool_of(threads: usize) -> Result<std::sync::Arc<rayon::ThreadPool>> {
+    type Pools = Vec<(u32, usize, std::sync::Arc<rayon::ThreadPool>)>;
+    static POOLS: std::sync::Mutex<Pools> = std::sync::Mutex::new(Vec::new());
+    let pid = std::process::id();
+    let mut pools = POOLS
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    // A forked child (a process pool's worker) has none of its parent's threads: its pools
+    // are forgotten, not shut down.
+    let (stale, own): (Pools, Pools) = std::mem::take(&mut *pools)
+        .into_iter()
+        .partition(|(owner, _, _)| *owner != pid);
+    std::mem::forget(stale);
+    *pools = own;
+    if let Some((_, _, pool)) = pools.iter().find(|(_, n, _)| *n == threads) {
+        return Ok(pool.clone());
+    }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .thread_name(|i| format!("paritysim-sweep-{i}"))
@@ -169,7 +198,7 @@ where
                 format!("a count the OS can start ({e})"),
             )
         })?;
-    // One point per task: points take milliseconds, so scheduling overhead is negligible and
-    // fine-grained stealing keeps both ends of the run busy.
-    Ok(pool.install(|| (0..n).into_par_iter().with_max_len(1).map(one).collect()))
+    let pool = std::sync::Arc::new(pool);
+    pools.push((pid, threads, pool.clone()));
+    Ok(pool)
 }
