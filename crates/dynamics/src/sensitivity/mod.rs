@@ -25,6 +25,12 @@ use crate::integrate::{RungeKutta, State};
 use crate::shooting::newton::NEUTRAL_SINGULAR_TOL;
 use crate::simulate::{SimulationOptions, SteadyState, WindowSampler, simulate};
 
+mod periods;
+mod replay;
+
+use periods::{Keep, periods};
+use replay::Replay;
+
 /// One-sided differences of a metric that disagree by more than this (relative to the larger)
 /// mark a kink: a peak switching between two maxima, a clipped quantity.
 pub const KINK_TOLERANCE: f64 = 1e-2;
@@ -430,90 +436,9 @@ pub fn steady_sensitivity_at(
     })
 }
 
-/// The base window's samples (times, states) and `Φ(t, 0)` at each: the window of a start
-/// `x* + δ` is, to first order in `δ`, the window of the states `y(t) + Φ(t) δ`.
-struct Replay {
-    states: Vec<State>,
-    phi: Vec<DMatrix<f64>>,
-}
-
-impl Replay {
-    /// The metrics of the window of `point` whose sample states are `states` (at the base
-    /// window's phases) moved to the start `x* + shift` (compact): to first order, the states
-    /// `y(t) + Φ(t) shift`. The central differences cancel the first-order error of taking
-    /// the base point's `Φ` at a perturbed one.
-    fn window_along(
-        &self,
-        (device, grid, period): (&Device, &[f64], f64),
-        states: &[State],
-        shift: &DVector<f64>,
-        options: &SimulationOptions,
-    ) -> Result<Vec<(String, f64)>> {
-        let n = device.n_dof();
-        let m = 2 * n;
-        let shift = shift.as_slice();
-        let moved: Vec<State> = states
-            .iter()
-            .zip(&self.phi)
-            .map(|(y, phi)| {
-                // Φ·shift, Φ column-major.
-                let mut delta = [0.0; 2 * crate::integrate::MAX_DOF];
-                for (column, s) in phi.as_slice().chunks_exact(m).zip(shift) {
-                    for (d, p) in delta.iter_mut().zip(column) {
-                        *d += p * s;
-                    }
-                }
-                let mut moved = *y;
-                for i in 0..n {
-                    moved.coords[i] += delta[i];
-                    moved.rates[i] += delta[n + i];
-                }
-                moved
-            })
-            .collect();
-        let (mut sampler, times) = WindowSampler::of_grid_window(device, grid, period, options);
-        if let (Some(names), true) = (&options.metrics, in_lanes(options)?) {
-            // The lanes' sampling, as the lanes' windows took theirs (the same bits).
-            if let Some(metrics) = crate::lanes::batch::window_metrics(
-                device,
-                &times,
-                &moved,
-                names,
-                options.weight_mn,
-            ) {
-                return Ok(metrics);
-            }
-        }
-        for (i, (t, y)) in times.iter().zip(&moved).enumerate() {
-            sampler.add(i, *t, y)?;
-        }
-        Ok(sampler.finish().1)
-    }
-}
-
 /// Parameters whose perturbed periods run together: two central differences are four periods,
 /// one load of the lanes.
 const PARAMETERS_PER_GROUP: usize = 2;
-
-/// What a perturbed period keeps.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Keep {
-    /// The end state (a map).
-    End,
-    /// The end state and the window's sample states (a map whose window is replayed).
-    Samples,
-    /// The recorded window's metrics.
-    Metrics,
-}
-
-/// A perturbed period: its end state (compact; `Keep::End`, `Keep::Samples`), its window's
-/// sample states (`Keep::Samples`) or metrics (`Keep::Metrics`).
-#[derive(Default)]
-struct Period {
-    end: DVector<f64>,
-    states: Vec<State>,
-    metrics: Vec<(String, f64)>,
-}
 
 /// `df/dp` from `f(near)`, `f(far)`: central `(p0 − h, p0 + h)` or, at the range's end,
 /// the second-order one-sided formula on `(p0 + h, p0 + 2h)` with `f0 = f(p0)`.
@@ -529,103 +454,6 @@ fn difference(
     } else {
         (near * 4.0 - f0 * 3.0 - far) / (2.0 * h)
     }
-}
-
-/// Whether the perturbed periods run in the lanes (`crate::lanes::batch`): DOP853 and not
-/// `PARITYSIM_LANES=1` (the scalar path, as for sweeps); the batch itself refuses devices
-/// without a lane model and metrics other than stroke metrics.
-fn in_lanes(options: &SimulationOptions) -> Result<bool> {
-    Ok(
-        options.method == crate::integrate::Method::Dop853
-            && crate::lanes::resolve_lanes(None)? > 1,
-    )
-}
-
-/// One fixed-grid period of each `points[k]` from `starts[k]`, keeping `keep`. Four at a time
-/// in the lanes where every device has a lane model (bit-identical to the scalar periods,
-/// `crate::lanes::batch`), else on the sensitivity's threads.
-fn periods<'a>(
-    points: &[&'a Point],
-    starts: &[State],
-    (keep, tables): (Keep, &mut crate::lanes::batch::DriveTables<'a>),
-    rk: &RungeKutta,
-    options: &SimulationOptions,
-) -> Result<Vec<Period>> {
-    // The lanes compute stroke metrics only: a window asking every metric runs scalar.
-    let lane_metrics = match (keep, &options.metrics) {
-        (Keep::End | Keep::Samples, _) => Some(&[][..]),
-        (Keep::Metrics, Some(names)) => Some(names.as_slice()),
-        (Keep::Metrics, None) => None,
-    };
-    let times =
-        |point: &Point| crate::simulate::grid_window_times(&point.grid, point.period, options);
-    if let (Some(names), true) = (lane_metrics, in_lanes(options)?) {
-        let jobs: Vec<crate::lanes::batch::Job<'_>> = points
-            .iter()
-            .zip(starts)
-            .map(|(point, y)| crate::lanes::batch::Job {
-                device: &point.device,
-                grid: std::rc::Rc::from(point.grid.as_slice()),
-                y0: *y,
-                times: (keep != Keep::End).then(|| times(point).into()),
-            })
-            .collect();
-        let tol = crate::integrate::lanes::LaneTolerances {
-            rtol: options.rtol,
-            atol: options.atol,
-        };
-        let capture = keep == Keep::Samples;
-        if let Some(done) =
-            crate::lanes::batch::run(&jobs, (names, capture), tol, options.weight_mn, tables)
-        {
-            return Ok(done
-                .into_iter()
-                .map(|done| Period {
-                    end: DVector::from_row_slice(&done.end),
-                    states: done.states,
-                    metrics: done.metrics.unwrap_or_default(),
-                })
-                .collect());
-        }
-    }
-    crate::stability::rows::run_parts(points.len(), |k| {
-        let point = points[k];
-        if keep == Keep::Metrics {
-            let metrics = crate::simulate::grid_window(
-                &point.device,
-                rk,
-                &point.grid,
-                point.period,
-                &starts[k],
-                options,
-            )?;
-            return Ok(Period {
-                metrics,
-                ..Period::default()
-            });
-        }
-        let sample_times = if keep == Keep::Samples {
-            times(point)
-        } else {
-            Vec::new()
-        };
-        let mut states = Vec::with_capacity(sample_times.len());
-        let end = rk.with_work(false).integrate_on_grid(
-            &point.device,
-            &point.grid,
-            &starts[k],
-            &sample_times,
-            &mut |_, _, y| {
-                states.push(*y);
-                Ok(())
-            },
-        )?;
-        Ok(Period {
-            end: end.without_work().compact(point.device.n_dof()),
-            states,
-            metrics: Vec::new(),
-        })
-    })
 }
 
 /// The fixed-grid period map from `x` and its Jacobian by central differences of the map (each
