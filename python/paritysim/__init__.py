@@ -46,14 +46,15 @@ if TYPE_CHECKING:  # what type checkers see; at run time the names below load la
     from . import aero, claims, devices, dynamics, flight, kinematics, laminate, planform, plots, spec, stability, trials
     from .calibration import CalibrationResult, Measured, TableCalibrationResult, calibrate, measured
     from .continuation import ContinuationResult
-    from .gradients import OptimizationResult, SensitivityResult, optimize, sensitivity
+    from .gradients import SensitivityResult, sensitivity
+    from .optimizer import OptimizationResult, optimize
     from .planform import Planform
     from .simulation import SimulationResult, simulate
     from .spec import Actuator, Aero, Body, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, Springs, TunableHinge, Waveform, Wing, load_spec, spec_paths
     from .sweep import grid, sweep
 
 #: Lazily loaded submodules.
-_SUBMODULES = ("aero", "calibration", "claims", "continuation", "devices", "dynamics", "flight", "gradients", "kinematics", "laminate", "planform", "plots", "simulation", "spec", "stability", "sweep", "trials")
+_SUBMODULES = ("aero", "calibration", "claims", "continuation", "devices", "dynamics", "flight", "gradients", "kinematics", "laminate", "optimizer", "planform", "plots", "simulation", "spec", "stability", "sweep", "trials")
 #: Lazily loaded names -> the submodule defining them.
 _NAMES = {
     "CalibrationResult": "calibration",
@@ -62,9 +63,9 @@ _NAMES = {
     "TableCalibrationResult": "calibration",
     "measured": "calibration",
     "ContinuationResult": "continuation",
-    "OptimizationResult": "gradients",
+    "OptimizationResult": "optimizer",
     "SensitivityResult": "gradients",
-    "optimize": "gradients",
+    "optimize": "optimizer",
     "sensitivity": "gradients",
     "Planform": "planform",
     "SimulationResult": "simulation",

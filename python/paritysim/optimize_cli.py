@@ -116,7 +116,7 @@ def load_study(path: str | Path) -> OptimizeStudy:
 def run_study(study: OptimizeStudy, out: str | Path, stem: str, progress: bool = True) -> tuple[Any, dict[str, Path]]:
     """Runs a parsed study; writes the optimum spec, the history and the convergence plot into
     ``out``. Returns the `OptimizationResult` and the written paths."""
-    from .gradients import optimize
+    from .optimizer import optimize
 
     result = optimize(
         study.spec,
