@@ -60,6 +60,22 @@ pub fn from_value(mut value: Value) -> Result<(Simulation, Vec<String>)> {
 pub fn from_current(value: &Value) -> Result<Simulation> {
     let mut problems = Vec::new();
     schema::check(value, &mut problems);
+    read_checked(value, problems)
+}
+
+/// [`from_current`] of a valid spec's value in which only the fields at the canonical
+/// `changed` paths were set: the schema is checked along those paths only.
+///
+/// # Errors
+/// As [`from_value`].
+pub(crate) fn from_changed(value: &Value, changed: &[&str]) -> Result<Simulation> {
+    let mut problems = Vec::new();
+    schema::check_along(value, changed, &mut problems);
+    read_checked(value, problems)
+}
+
+/// The spec in `value` when its schema check found no `problems`.
+fn read_checked(value: &Value, problems: Vec<paritysim_error::Problem>) -> Result<Simulation> {
     if !problems.is_empty() {
         return Err(problems.into());
     }

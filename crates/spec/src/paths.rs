@@ -35,30 +35,54 @@ pub struct PathInfo {
 
 /// Every canonical path of `spec`, in declaration order.
 pub fn spec_paths(spec: &Simulation) -> Vec<PathInfo> {
-    listing(spec, true)
+    listing(
+        spec,
+        Walk {
+            texts: true,
+            only: None,
+        },
+    )
 }
 
 /// [`spec_paths`] without the `allowed` texts (left empty): what resolving a name needs, at a
 /// tenth of the cost (the texts were 0.5 ms a call, per sweep row with gradients and per
 /// `with_paths`; docs/findings.md §30).
 pub fn field_paths(spec: &Simulation) -> Vec<PathInfo> {
-    listing(spec, false)
+    listing(
+        spec,
+        Walk {
+            texts: false,
+            only: None,
+        },
+    )
 }
 
-fn listing(spec: &Simulation, texts: bool) -> Vec<PathInfo> {
+fn listing(spec: &Simulation, walk: Walk<'_>) -> Vec<PathInfo> {
     let value = serde_json::to_value(spec).expect("a spec serialises");
     let mut out = Vec::new();
-    Walk { texts }.walk(&value, schema(), "", "", &mut out);
+    walk.walk(&value, schema(), "", "", &mut out);
     out
 }
 
-/// A walk of a spec value along its schema, with or without the `allowed` texts.
+/// A walk of a spec value along its schema, with or without the `allowed` texts, into every
+/// field or only those on the way to the canonical paths `only`.
 #[derive(Clone, Copy)]
-struct Walk {
+struct Walk<'a> {
     texts: bool,
+    only: Option<&'a [String]>,
 }
 
-impl Walk {
+impl Walk<'_> {
+    /// Whether the walk enters `path`: every path, or one of `only` or a field above one.
+    fn enters(self, path: &str) -> bool {
+        self.only.is_none_or(|only| {
+            only.iter().any(|w| {
+                w.strip_prefix(path)
+                    .is_some_and(|rest| rest.is_empty() || rest.starts_with(['.', '[']))
+            })
+        })
+    }
+
     fn leaf(
         self,
         path: &str,
@@ -108,16 +132,19 @@ impl Walk {
                     .and_then(Value::as_str)
                     .unwrap_or_default();
                 let tags: Vec<&str> = variants.iter().map(|(t, _)| t.as_str()).collect();
-                out.push(PathInfo {
-                    path: join(path, "kind"),
-                    unit: String::new(),
-                    allowed: if self.texts {
-                        format!("one of {}", tags.join(", "))
-                    } else {
-                        String::new()
-                    },
-                    value: Value::String(kind.to_string()),
-                });
+                let kind_path = join(path, "kind");
+                if self.enters(&kind_path) {
+                    out.push(PathInfo {
+                        path: kind_path,
+                        unit: String::new(),
+                        allowed: if self.texts {
+                            format!("one of {}", tags.join(", "))
+                        } else {
+                            String::new()
+                        },
+                        value: Value::String(kind.to_string()),
+                    });
+                }
                 if let Some((_, branch)) = variants.iter().find(|(t, _)| t == kind) {
                     self.walk_object(value, branch, path, &unit_here, out);
                 }
@@ -135,7 +162,10 @@ impl Walk {
             let fixed = s.get("minItems").is_some() && s.get("minItems") == s.get("maxItems");
             if fixed || !is_scalar_schema(items) {
                 for (i, v) in list.iter().enumerate() {
-                    self.walk(v, items, &format!("{path}[{i}]"), &unit_here, out);
+                    let item = format!("{path}[{i}]");
+                    if self.enters(&item) {
+                        self.walk(v, items, &item, &unit_here, out);
+                    }
                 }
             } else {
                 self.leaf(path, value, schema, &unit_here, out);
@@ -160,8 +190,11 @@ impl Walk {
             if k == "kind" && crate::schema::tag_of(s).is_some() {
                 continue;
             }
-            let v = value.get(k).unwrap_or(&Value::Null);
-            self.walk(v, sub, &join(path, k), parent_unit, out);
+            let field = join(path, k);
+            if self.enters(&field) {
+                let v = value.get(k).unwrap_or(&Value::Null);
+                self.walk(v, sub, &field, parent_unit, out);
+            }
         }
     }
 }
@@ -199,15 +232,45 @@ pub struct Parameter {
 /// # Errors
 /// [`Error::InvalidParameter`] naming the path, with the nearest valid path.
 pub fn resolve(spec: &Simulation, name: &str) -> Result<Parameter> {
-    let paths = field_paths(spec);
-    resolve_in(spec, &paths, name)
+    let (mut parameters, _) = resolve_all(spec, &[name.to_string()])?;
+    Ok(parameters.remove(0))
 }
 
-/// [`resolve`] with the paths already listed.
+/// [`resolve`] for several names, and the paths they were resolved against: only the fields
+/// on the way to the paths the names can spell are listed (the whole listing was 1.1 M
+/// instructions a `ps.sensitivity` for a few names; docs/findings.md §30). An unknown name is
+/// resolved again against the whole listing, for its error's nearest paths.
 ///
 /// # Errors
 /// See [`resolve`].
-pub fn resolve_in(spec: &Simulation, paths: &[PathInfo], name: &str) -> Result<Parameter> {
+pub fn resolve_all(spec: &Simulation, names: &[String]) -> Result<(Vec<Parameter>, Vec<PathInfo>)> {
+    let wanted: Vec<String> = names
+        .iter()
+        .filter_map(|name| spellings(spec, name).ok())
+        .flat_map(|(paths, _)| paths)
+        .map(|p| match p.strip_suffix(".omega_ratio") {
+            Some(head) => format!("{head}.aero.omega1"),
+            None => p,
+        })
+        .collect();
+    let resolve = |paths: Vec<PathInfo>| -> Result<(Vec<Parameter>, Vec<PathInfo>)> {
+        let parameters = names
+            .iter()
+            .map(|name| resolve_in(spec, &paths, name))
+            .collect::<Result<Vec<_>>>()?;
+        Ok((parameters, paths))
+    };
+    let only = Walk {
+        texts: false,
+        only: Some(&wanted),
+    };
+    resolve(listing(spec, only)).or_else(|_| resolve(field_paths(spec)))
+}
+
+/// The canonical paths `name` spells (every wing of a `wings[*]` name, `wings[0]` for
+/// `wings.left`, today's spelling of a deprecated one, the waveform's field of an `actuator.`
+/// shorthand), and the deprecation notes; an `omega_ratio` is left for [`resolve_in`].
+fn spellings(spec: &Simulation, name: &str) -> Result<(Vec<String>, Vec<String>)> {
     let mut notes = Vec::new();
     let n_wings = spec.wings.len();
     let mut expanded: Vec<String> = if let Some(rest) = name.strip_prefix("wings[*].") {
@@ -235,6 +298,15 @@ pub fn resolve_in(spec: &Simulation, paths: &[PathInfo], name: &str) -> Result<P
             }
         }
     }
+    Ok((expanded, notes))
+}
+
+/// [`resolve`] with the paths already listed.
+///
+/// # Errors
+/// See [`resolve`].
+pub fn resolve_in(spec: &Simulation, paths: &[PathInfo], name: &str) -> Result<Parameter> {
+    let (expanded, notes) = spellings(spec, name)?;
     let mut targets = Vec::new();
     for p in expanded {
         if let Some(head) = p.strip_suffix(".omega_ratio") {
@@ -402,8 +474,9 @@ pub fn apply_to(mut value: Value, overrides: &[(&Parameter, &Value)]) -> Result<
     crate::from_value(value).map(|(s, _)| s)
 }
 
-/// [`apply_to`] without a copy of `value`: the overrides are set in it, the spec is read
-/// ([`crate::from_current`]) and the old values are put back. A copy of the §3.3 spec's value
+/// [`apply_to`] without a copy of `value`, a valid spec's own serialisation: the overrides
+/// are set in it, the spec is read with the schema checked along the overridden fields only
+/// (the rest was valid), and the old values are put back. A copy of the §3.3 spec's value
 /// cost half of reading it back (12.5 of 25.6 µs).
 ///
 /// # Errors
@@ -418,8 +491,10 @@ pub fn apply_in_place(value: &mut Value, overrides: &[(&Parameter, &Value)]) -> 
         return apply_to(value.clone(), overrides);
     }
     let mut old = Vec::new();
-    let spec =
-        set_overrides(value, overrides, Some(&mut old)).and_then(|()| crate::from_current(value));
+    let spec = set_overrides(value, overrides, Some(&mut old)).and_then(|()| {
+        let changed: Vec<&str> = old.iter().map(|(path, _)| path.as_str()).collect();
+        crate::from_changed(value, &changed)
+    });
     for (path, before) in old.into_iter().rev() {
         let restored = set(value, &path, before);
         debug_assert!(restored.is_ok(), "{path} exists");

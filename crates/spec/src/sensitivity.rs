@@ -9,7 +9,9 @@ use paritysim_dynamics::sensitivity::{
 use paritysim_error::{Error, Result};
 use serde_json::Value;
 
-use crate::paths::{Parameter, apply_in_place, apply_to, field_paths, get, resolve_in, spec_paths};
+use crate::paths::{
+    Parameter, apply_in_place, apply_to, field_paths, get, resolve_all, resolve_in, spec_paths,
+};
 use crate::spec::Simulation;
 
 /// What [`sensitivity`] returns: the resolved parameters with their units and base values,
@@ -83,8 +85,14 @@ fn differentiate(
     // A copy of the value per thread building devices, perturbed in place for each.
     let copies = std::sync::Mutex::new(Vec::new());
     let device_at = |p: &[f64]| -> Result<paritysim_dynamics::Device> {
-        let numbers: Vec<Value> = p.iter().map(|&x| Value::from(x)).collect();
-        let pairs: Vec<(&Parameter, &Value)> = parameters.iter().zip(&numbers).collect();
+        // Only the parameters that moved are set: the others are in the value already.
+        let moved: Vec<(&Parameter, Value)> = parameters
+            .iter()
+            .zip(p.iter().zip(&values))
+            .filter(|(_, (x, base))| x.to_bits() != base.to_bits())
+            .map(|(param, (&x, _))| (param, Value::from(x)))
+            .collect();
+        let pairs: Vec<(&Parameter, &Value)> = moved.iter().map(|(p, v)| (*p, v)).collect();
         let lock = || {
             copies
                 .lock()
@@ -271,12 +279,11 @@ pub fn parameters(
             "at least one continuous spec path (see ps.spec_paths)",
         ));
     }
-    let listed = field_paths(spec);
+    let (resolved, listed) = resolve_all(spec, params)?;
     let mut parameters = Vec::new();
     let mut units = Vec::new();
     let mut values = Vec::new();
-    for name in params {
-        let param = resolve_in(spec, &listed, name)?;
+    for (name, param) in params.iter().zip(resolved) {
         let mut base = None;
         for (path, scale) in &param.targets {
             let info = listed

@@ -18,7 +18,7 @@ use paritysim_dynamics::{Device, SimulationOptions};
 use paritysim_error::{Error, Result};
 use serde_json::Value;
 
-use crate::paths::{Parameter, field_paths, resolve_in};
+use crate::paths::{Parameter, resolve_all};
 use crate::spec::Simulation;
 
 /// A validated sweep: base spec, resolved parameters, rows of values, what to report.
@@ -49,11 +49,7 @@ impl SweepPlan {
         threads: Option<usize>,
     ) -> Result<Self> {
         let threads = resolve_threads(threads)?;
-        let paths = field_paths(&base);
-        let parameters = names
-            .iter()
-            .map(|n| resolve_in(&base, &paths, n))
-            .collect::<Result<Vec<_>>>()?;
+        let (parameters, _) = resolve_all(&base, names)?;
         let mut seen: Vec<(&str, &str)> = Vec::new();
         for p in &parameters {
             for (target, _) in &p.targets {

@@ -253,3 +253,103 @@ fn field_paths_are_spec_paths_without_their_texts_and_get_reads_what_set_writes(
         assert_eq!(paths::get(&value, "drivetrain.no_such_field"), None);
     }
 }
+
+/// Resolving names against the fields on their way only (`resolve_all`) gives the parameters
+/// and listed entries of the whole listing, for every path and every alias, and the same
+/// error (with the same nearest paths) for an unknown name.
+#[test]
+fn names_resolved_along_their_paths_equal_names_resolved_against_the_whole_listing() {
+    for file in ["drag_parity.toml", "hmf.toml"] {
+        let (spec, _) = from_toml(&example(file)).unwrap();
+        let all = paths::field_paths(&spec);
+        let mut names: Vec<String> = all.iter().map(|i| i.path.clone()).collect();
+        names.extend(
+            [
+                "wings[*].aero.omega1",
+                "wings.left.springs.hinge.stiffness",
+                "wings.right.omega_ratio",
+                "wings[0].omega_ratio",
+                "actuator.frequency_hz",
+                "actuator.voltage_v",
+                "drivetrain.k2",
+            ]
+            .map(String::from),
+        );
+        for name in &names {
+            let whole = paths::resolve_in(&spec, &all, name);
+            let Ok(whole) = whole else { continue }; // a name this spec does not have
+            let (along, listed) = paths::resolve_all(&spec, std::slice::from_ref(name)).unwrap();
+            assert_eq!(along[0], whole, "{file}: {name}");
+            assert!(
+                listed.len() < all.len() / 4,
+                "{file}: {name}: {}",
+                listed.len()
+            );
+            for (target, _) in &whole.targets {
+                let entry = |l: &[paths::PathInfo]| l.iter().find(|i| &i.path == target).cloned();
+                assert_eq!(entry(&listed), entry(&all), "{file}: {target}");
+            }
+        }
+        // A typo of a real path: one letter dropped.
+        let real = &all
+            .iter()
+            .find(|i| i.path.ends_with("stiffness"))
+            .unwrap()
+            .path;
+        let unknown = [real[..real.len() - 1].to_string()];
+        let e = paths::resolve_all(&spec, &unknown).unwrap_err();
+        let whole = paths::resolve_in(&spec, &all, &unknown[0]).unwrap_err();
+        assert_eq!(e.to_string(), whole.to_string());
+        assert!(e.to_string().contains(real.as_str()), "{e}");
+    }
+}
+
+/// A spec read in place checks the schema along the overridden fields only: for every field
+/// of two specs set to values in and out of its range, or of the wrong type, it gives the
+/// spec or the error (path, value, allowed range) that checking the whole value gives.
+#[test]
+fn a_spec_checked_along_its_overridden_fields_equals_one_checked_whole() {
+    for file in ["drag_parity.toml", "hmf.toml"] {
+        let (spec, _) = from_toml(&example(file)).unwrap();
+        let original = serde_json::to_value(&spec).unwrap();
+        let mut value = original.clone();
+        let (mut refused, mut read) = (0, 0);
+        for info in paths::field_paths(&spec) {
+            let param = paths::Parameter {
+                name: info.path.clone(),
+                targets: vec![(info.path.clone(), None)],
+                notes: Vec::new(),
+            };
+            for new in [
+                serde_json::json!(-1e9),
+                serde_json::json!(1e9),
+                serde_json::json!(0.5),
+                serde_json::json!("x"),
+                serde_json::json!(null),
+            ] {
+                let overrides = [(&param, &new)];
+                let whole = paths::apply_to(original.clone(), &overrides);
+                let along = paths::apply_in_place(&mut value, &overrides);
+                assert_eq!(value, original, "{file}: {}", info.path);
+                match (whole, along) {
+                    (Ok(w), Ok(a)) => {
+                        read += 1;
+                        assert_eq!(
+                            serde_json::to_value(w).unwrap(),
+                            serde_json::to_value(a).unwrap()
+                        );
+                    }
+                    (Err(w), Err(a)) => {
+                        refused += 1;
+                        assert_eq!(w.to_string(), a.to_string(), "{file}: {}", info.path);
+                    }
+                    (w, a) => panic!("{file}: {} = {new}: whole {w:?}, along {a:?}", info.path),
+                }
+            }
+        }
+        assert!(
+            refused > 50 && read > 50,
+            "{file}: {refused} refused, {read} read"
+        );
+    }
+}

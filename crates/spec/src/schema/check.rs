@@ -248,7 +248,22 @@ impl Path<'_> {
 /// Walks `value` against the whole spec schema, pushing every problem.
 pub(crate) fn check(value: &Value, problems: &mut Vec<Problem>) {
     let v = validator();
-    walk(&v.compiled.nodes, v.root, value, &Path::Root(""), problems);
+    walk(
+        &v.compiled.nodes,
+        v.root,
+        value,
+        (&Path::Root(""), None),
+        problems,
+    );
+}
+
+/// [`check`] of a value that was a valid spec before the fields at the canonical `paths` were
+/// set: only those fields (and the objects on their way) are walked. A perturbed spec of a
+/// sensitivity was checked whole in 40 % of its read (docs/findings.md §30).
+pub(crate) fn check_along(value: &Value, paths: &[&str], problems: &mut Vec<Problem>) {
+    let v = validator();
+    let only = (&Path::Root(""), Some(paths));
+    walk(&v.compiled.nodes, v.root, value, only, problems);
 }
 
 /// Walks `value` against the schema's definition `name` (e.g. `Drivetrain`), with paths under
@@ -256,16 +271,64 @@ pub(crate) fn check(value: &Value, problems: &mut Vec<Problem>) {
 pub(crate) fn check_definition(value: &Value, name: &str, path: &str, problems: &mut Vec<Problem>) {
     let v = validator();
     if let Some(&id) = v.definitions.get(name) {
-        walk(&v.compiled.nodes, id, value, &Path::Root(path), problems);
+        walk(
+            &v.compiled.nodes,
+            id,
+            value,
+            (&Path::Root(path), None),
+            problems,
+        );
     }
 }
 
-fn walk(nodes: &[Node], id: Id, value: &Value, path: &Path<'_>, problems: &mut Vec<Problem>) {
+/// The fields a walk enters below its node: all (`None`), or only those on the way to the
+/// `only` paths, written relative to the node (`.a.b[2]`, `[0].c`; an empty one: all below).
+type Only<'a> = Option<&'a [&'a str]>;
+
+/// Where a walk limited to `only` goes at a child `step` (an object's key, an array's `[i]`).
+enum Enter<'a> {
+    /// Every field below the child.
+    All,
+    /// Only the paths (relative to the child) below it.
+    Only(Vec<&'a str>),
+    /// Not the child.
+    Skip,
+}
+
+fn enter<'a>(only: &[&'a str], step: &str) -> Enter<'a> {
+    let mut below = Vec::new();
+    for w in only {
+        let Some(rest) = w.strip_prefix(step) else {
+            continue;
+        };
+        if rest.is_empty() {
+            return Enter::All;
+        }
+        if let Some(r) = rest.strip_prefix('.') {
+            below.push(r);
+        } else if rest.starts_with('[') {
+            below.push(rest);
+        }
+    }
+    if below.is_empty() {
+        Enter::Skip
+    } else {
+        Enter::Only(below)
+    }
+}
+
+fn walk(
+    nodes: &[Node],
+    id: Id,
+    value: &Value,
+    (path, only): (&Path<'_>, Only<'_>),
+    problems: &mut Vec<Problem>,
+) {
     match &nodes[id] {
-        Node::Plain(plain) => walk_plain(nodes, plain, value, path, problems),
+        Node::Plain(plain) => walk_plain(nodes, plain, value, (path, only), problems),
         Node::Optional(inner) => {
             if !value.is_null() {
-                walk(nodes, *inner, value, path, problems);
+                walk(nodes, *inner, value, (path, only), problems);
             }
         }
         Node::Tagged { schema, tags } => {
@@ -282,7 +345,7 @@ fn walk(nodes: &[Node], id: Id, value: &Value, path: &Path<'_>, problems: &mut V
                     one_of(),
                 )),
                 Some(Value::String(kind)) => match tags.iter().find(|(t, _)| t == kind) {
-                    Some((_, branch)) => walk(nodes, *branch, value, path, problems),
+                    Some((_, branch)) => walk(nodes, *branch, value, (path, only), problems),
                     None => problems.push(Problem::new(
                         Path::Key(path, "kind").text(),
                         format!("{kind:?}"),
@@ -306,7 +369,7 @@ fn walk(nodes: &[Node], id: Id, value: &Value, path: &Path<'_>, problems: &mut V
             }
             let fits = branches.iter().any(|&b| {
                 let mut sub = Vec::new();
-                walk(nodes, b, value, path, &mut sub);
+                walk(nodes, b, value, (path, only), &mut sub);
                 sub.is_empty()
             });
             if !fits {
@@ -320,7 +383,7 @@ fn walk_plain(
     nodes: &[Node],
     s: &Plain,
     value: &Value,
-    path: &Path<'_>,
+    (path, only): (&Path<'_>, Only<'_>),
     problems: &mut Vec<Problem>,
 ) {
     let described = || describe(&Value::Object(s.map.clone()));
@@ -393,16 +456,34 @@ fn walk_plain(
             }
             if let Some(item) = s.items {
                 for (i, v) in items.iter().enumerate() {
-                    walk(nodes, item, v, &Path::Index(path, i), problems);
+                    let below;
+                    let only = match only.map(|o| enter(o, &format!("[{i}]"))) {
+                        None | Some(Enter::All) => None,
+                        Some(Enter::Only(paths)) => {
+                            below = paths;
+                            Some(&below[..])
+                        }
+                        Some(Enter::Skip) => continue,
+                    };
+                    walk(nodes, item, v, (&Path::Index(path, i), only), problems);
                 }
             }
         }
         Value::Object(obj) => {
             for (k, v) in obj {
+                let below;
+                let only = match only.map(|o| enter(o, k)) {
+                    None | Some(Enter::All) => None,
+                    Some(Enter::Only(paths)) => {
+                        below = paths;
+                        Some(&below[..])
+                    }
+                    Some(Enter::Skip) => continue,
+                };
                 match s.properties.iter().find(|(name, _)| *name == k.as_str()) {
                     // The tag of a tagged enum was checked by the caller.
                     Some(_) if k == "kind" && s.tagged => {}
-                    Some(&(_, sub)) => walk(nodes, sub, v, &Path::Key(path, k), problems),
+                    Some(&(_, sub)) => walk(nodes, sub, v, (&Path::Key(path, k), only), problems),
                     None if s.closed => problems.push(Problem::new(
                         Path::Key(path, k).text(),
                         "<unknown field>",

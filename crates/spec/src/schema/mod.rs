@@ -13,7 +13,7 @@ use serde_json::{Map, Value};
 use crate::spec::Simulation;
 
 mod check;
-pub(crate) use check::{check, check_definition};
+pub(crate) use check::{check, check_along, check_definition};
 
 /// The JSON Schema (draft 2020-12) of [`Simulation`].
 pub fn schema() -> &'static Value {
