@@ -22,7 +22,7 @@ use paritysim_error::{Error, Result};
 
 use crate::device::Device;
 use crate::integrate::{RungeKutta, State};
-use crate::shooting::newton::NEUTRAL_SINGULAR_TOL;
+use crate::shooting::newton::LeastSquares;
 use crate::simulate::{SimulationOptions, SteadyState, WindowSampler, simulate};
 
 mod periods;
@@ -241,16 +241,11 @@ pub fn steady_sensitivity_at(
     };
     let residual = crate::shooting::newton::residual(n, &x_star, &mapped.without_work()).1;
     let multipliers = crate::stability::eigenvalues(&monodromy).unwrap_or_default();
-    let a = monodromy - DMatrix::identity(2 * n, 2 * n);
-    let svd = a.clone().svd(true, true);
-    let cutoff = NEUTRAL_SINGULAR_TOL * svd.singular_values.max().max(f64::MIN_POSITIVE);
-    let neutral: Vec<DVector<f64>> = match &svd.v_t {
-        Some(v_t) => (0..svd.singular_values.len())
-            .filter(|&i| svd.singular_values[i] <= cutoff)
-            .map(|i| v_t.row(i).transpose())
-            .collect(),
-        None => Vec::new(),
-    };
+    // One SVD of `DP − I` for the neutral directions and every parameter's `dx*/dp`.
+    let non_finite = || Error::Singular("the orbit's sensitivity: non-finite monodromy".into());
+    let least_squares =
+        LeastSquares::new(monodromy - DMatrix::identity(2 * n, 2 * n)).ok_or_else(non_finite)?;
+    let neutral = least_squares.neutral_directions();
     if let Some(asked) = &options.metrics {
         // The window computes what the asked metrics need (and may compute more).
         base_metrics = asked
@@ -318,9 +313,7 @@ pub fn steady_sensitivity_at(
             .map(|(k, ((_, _, central), j))| {
                 let (near, far) = (&maps[2 * k].end, &maps[2 * k + 1].end);
                 let dp = difference(*central, steps[j], &base_map, near, far);
-                crate::shooting::newton::least_squares_step(a.clone(), &dp).ok_or_else(|| {
-                    Error::Singular("the orbit's sensitivity: non-finite monodromy".into())
-                })
+                least_squares.step(&dp).ok_or_else(non_finite)
             })
             .collect::<Result<Vec<_>>>()?;
         let shifts: Vec<DVector<f64>> = pairs

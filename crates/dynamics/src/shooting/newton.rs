@@ -53,12 +53,47 @@ pub(crate) fn least_squares_step(
     jac_minus_eye: DMatrix<f64>,
     f: &DVector<f64>,
 ) -> Option<DVector<f64>> {
-    if jac_minus_eye.iter().chain(f.iter()).any(|v| !v.is_finite()) {
-        return None;
+    LeastSquares::new(jac_minus_eye)?.step(f)
+}
+
+/// The SVD of `DP − I` behind [`least_squares_step`], kept for several right-hand sides (a
+/// sensitivity's parameters) and for its neutral directions.
+pub(crate) struct LeastSquares {
+    svd: nalgebra::SVD<f64, nalgebra::Dyn, nalgebra::Dyn>,
+    cutoff: f64,
+}
+
+impl LeastSquares {
+    /// `None` for a non-finite matrix.
+    pub(crate) fn new(jac_minus_eye: DMatrix<f64>) -> Option<Self> {
+        if jac_minus_eye.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let svd = jac_minus_eye.svd(true, true);
+        let cutoff = NEUTRAL_SINGULAR_TOL * svd.singular_values.max().max(f64::MIN_POSITIVE);
+        Some(Self { svd, cutoff })
     }
-    let svd = jac_minus_eye.svd(true, true);
-    let cutoff = NEUTRAL_SINGULAR_TOL * svd.singular_values.max().max(f64::MIN_POSITIVE);
-    svd.solve(&(-f), cutoff).ok()
+
+    /// The step `Δ` of `(DP − I) Δ = −f` ([`least_squares_step`]); `None` for a non-finite `f`.
+    pub(crate) fn step(&self, f: &DVector<f64>) -> Option<DVector<f64>> {
+        if f.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        self.svd.solve(&(-f), self.cutoff).ok()
+    }
+
+    /// The neutral directions: right singular vectors of singular values at or below the
+    /// cutoff.
+    pub(crate) fn neutral_directions(&self) -> Vec<DVector<f64>> {
+        let values = &self.svd.singular_values;
+        match &self.svd.v_t {
+            Some(v_t) => (0..values.len())
+                .filter(|&i| values[i] <= self.cutoff)
+                .map(|i| v_t.row(i).transpose())
+                .collect(),
+            None => Vec::new(),
+        }
+    }
 }
 
 /// Tolerances of the adaptive period that picks the grid, relative to the run's: the fixed-grid

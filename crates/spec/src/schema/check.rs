@@ -258,8 +258,8 @@ pub(crate) fn check(value: &Value, problems: &mut Vec<Problem>) {
 }
 
 /// [`check`] of a value that was a valid spec before the fields at the canonical `paths` were
-/// set: only those fields (and the objects on their way) are walked. A perturbed spec of a
-/// sensitivity was checked whole in 40 % of its read (docs/findings.md §30).
+/// set: only those fields (and the objects on their way) are walked. The whole check was
+/// most of reading a sensitivity's perturbed spec (docs/findings.md §30, session 21).
 pub(crate) fn check_along(value: &Value, paths: &[&str], problems: &mut Vec<Problem>) {
     let v = validator();
     let only = (&Path::Root(""), Some(paths));
