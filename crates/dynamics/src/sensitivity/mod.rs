@@ -206,11 +206,10 @@ pub fn steady_sensitivity_at(
     let switched = crate::integrate::OdeSystem::n_switches(device) > 0;
     let differenced = switched && !device.has_analytic_jacobian();
     let (sampler, times) = WindowSampler::of_grid_window(device, &grid, period, options);
-    let reads_work = sampler.reads_work();
     // The base window is sampled in the variational period, unless the metrics read the work
     // integrals (which that run does not integrate) or the monodromy is differenced; `Φ` at
     // its samples then moves the window to nearby starts without integrating again.
-    let (mapped, monodromy, replay, mut base_metrics) = if differenced || reads_work {
+    let (mapped, monodromy, replay, mut base_metrics) = if differenced || sampler.reads_work() {
         let (mapped, monodromy) = if differenced {
             fixed_grid_monodromy(device, &rk, &grid, &x_star)?
         } else {
@@ -220,24 +219,20 @@ pub fn steady_sensitivity_at(
         let metrics = crate::simulate::grid_window(device, &rk, &grid, period, &x_star, options)?;
         (mapped, monodromy, None, metrics)
     } else {
+        let mut sampler = sampler;
         let mut states = Vec::with_capacity(times.len());
         let (mapped, monodromy, phi) = rk.with_work(false).flow_with_sensitivity_on_grid_sampled(
             device,
             &grid,
             &x_star,
             &times,
-            &mut |_, _, y| {
+            &mut |i, t, y| {
                 states.push(*y);
-                Ok(())
+                sampler.add(i, t, y)
             },
         )?;
         let replay = Replay { states, phi };
-        // The base window is sampled as the perturbed ones are (in the lanes where they are:
-        // a fifth of the scalar sampler's instructions on §3.3).
-        let at = (device, grid.as_slice(), period);
-        let zero = DVector::zeros(2 * n);
-        let metrics = replay.window_along(at, &replay.states, &zero, options)?;
-        (mapped, monodromy, Some(replay), metrics)
+        (mapped, monodromy, Some(replay), sampler.finish().1)
     };
     let residual = crate::shooting::newton::residual(n, &x_star, &mapped.without_work()).1;
     let multipliers = crate::stability::eigenvalues(&monodromy).unwrap_or_default();

@@ -31,30 +31,25 @@ impl Replay {
         let n = device.n_dof();
         let m = 2 * n;
         let shift = shift.as_slice();
-        let moved: std::borrow::Cow<'_, [State]> = if shift.iter().all(|s| *s == 0.0) {
-            states.into() // the window itself
-        } else {
-            states
-                .iter()
-                .zip(&self.phi)
-                .map(|(y, phi)| {
-                    // Φ·shift, Φ column-major.
-                    let mut delta = [0.0; 2 * crate::integrate::MAX_DOF];
-                    for (column, s) in phi.as_slice().chunks_exact(m).zip(shift) {
-                        for (d, p) in delta.iter_mut().zip(column) {
-                            *d += p * s;
-                        }
+        let moved: Vec<State> = states
+            .iter()
+            .zip(&self.phi)
+            .map(|(y, phi)| {
+                // Φ·shift, Φ column-major.
+                let mut delta = [0.0; 2 * crate::integrate::MAX_DOF];
+                for (column, s) in phi.as_slice().chunks_exact(m).zip(shift) {
+                    for (d, p) in delta.iter_mut().zip(column) {
+                        *d += p * s;
                     }
-                    let mut moved = *y;
-                    for i in 0..n {
-                        moved.coords[i] += delta[i];
-                        moved.rates[i] += delta[n + i];
-                    }
-                    moved
-                })
-                .collect::<Vec<_>>()
-                .into()
-        };
+                }
+                let mut moved = *y;
+                for i in 0..n {
+                    moved.coords[i] += delta[i];
+                    moved.rates[i] += delta[n + i];
+                }
+                moved
+            })
+            .collect();
         let (mut sampler, times) = WindowSampler::of_grid_window(device, grid, period, options);
         if let (Some(names), true) = (&options.metrics, in_lanes(options)?) {
             // The lanes' sampling, as the lanes' windows took theirs (the same bits).
@@ -68,7 +63,7 @@ impl Replay {
                 return Ok(metrics);
             }
         }
-        for (i, (t, y)) in times.iter().zip(moved.iter()).enumerate() {
+        for (i, (t, y)) in times.iter().zip(&moved).enumerate() {
             sampler.add(i, *t, y)?;
         }
         Ok(sampler.finish().1)
