@@ -315,7 +315,11 @@ mod tests {
     fn kept_configurations_equal_built_ones() {
         for name in CONFIGURATION_NAMES {
             let kept = Constraints::configuration(name).unwrap();
-            assert_eq!(kept, Constraints::build_configuration(name).unwrap(), "{name}");
+            assert_eq!(
+                kept,
+                Constraints::build_configuration(name).unwrap(),
+                "{name}"
+            );
             assert_eq!(kept.n_coords(), 6);
         }
         let e = Constraints::configuration("drag_parityy").unwrap_err();
