@@ -173,7 +173,7 @@ pub(crate) fn run<'a>(
             };
             let (metrics, states) = match std::mem::replace(&mut windows[k], Window::None) {
                 Window::None => (None, Vec::new()),
-                Window::Metrics(m) => (Some(m.finish()), Vec::new()),
+                Window::Metrics(m) => (Some(m.finish_only(Some(metric_names))), Vec::new()),
                 Window::States(states) => (None, states),
             };
             done[k] = Some(Done {
@@ -220,5 +220,5 @@ pub(crate) fn window_metrics(
             return None;
         }
     }
-    Some(metrics.finish())
+    Some(metrics.finish_only(Some(metric_names)))
 }
