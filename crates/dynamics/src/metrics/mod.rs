@@ -192,8 +192,13 @@ struct Core {
 impl MetricsAccumulator {
     /// An empty accumulator for `device` with drive `period` (ms).
     pub fn new(device: &Device, period: Option<f64>) -> Self {
+        Self::of_layout(device.n_wings(), period, forces::offers_forces(device))
+    }
+
+    /// An empty accumulator of `n_wings` wings, with force metrics or not.
+    fn of_layout(n_wings: usize, period: Option<f64>, forces: bool) -> Self {
         Self {
-            n_wings: device.n_wings(),
+            n_wings,
             period,
             omega: period.map_or(0.0, |p| TAU / p),
             wings: [WingAcc::default(); 2],
@@ -207,7 +212,7 @@ impl MetricsAccumulator {
             work_actuator: 0.0,
             work_aero: 0.0,
             lean: None,
-            forces: forces::offers_forces(device).then(ForceAcc::default),
+            forces: forces.then(ForceAcc::default),
             weight: None,
         }
     }
@@ -657,24 +662,8 @@ mod tests {
     use super::*;
 
     fn accumulator(n_wings: usize, forces: bool, weight: bool) -> MetricsAccumulator {
-        MetricsAccumulator {
-            n_wings,
-            period: Some(10.0),
-            omega: TAU / 10.0,
-            wings: [WingAcc::default(); 2],
-            force: Range::default(),
-            q2: Range::default(),
-            total: [Stats::default(); 3],
-            delta_tau: Range::default(),
-            body_samples: 0,
-            first_time: None,
-            last_time: 0.0,
-            work_actuator: 0.0,
-            work_aero: 0.0,
-            lean: None,
-            forces: forces.then(ForceAcc::default),
-            weight: weight.then_some(1.0),
-        }
+        MetricsAccumulator::of_layout(n_wings, Some(10.0), forces)
+            .with_weight(weight.then_some(1.0))
     }
 
     /// The names kept per layout are each layout's own, whatever layout came first: every
