@@ -17,7 +17,9 @@ use serde::Serialize;
 use serde_json::Value;
 
 use crate::migrate::migrate_path;
-use crate::schema::{Branch, classify, describe, join, node, schema, suggestion_for, unit};
+use crate::schema::{
+    Branch, Enter, classify, describe, enter, join, node, schema, suggestion_for, unit,
+};
 use crate::spec::Simulation;
 
 /// One settable path of a spec.
@@ -65,22 +67,24 @@ fn listing(spec: &Simulation, walk: Walk<'_>) -> Vec<PathInfo> {
 }
 
 /// A walk of a spec value along its schema, with or without the `allowed` texts, into every
-/// field or only those on the way to the canonical paths `only`.
+/// field or only those on the way to the paths `only` (relative to the walk's node).
 #[derive(Clone, Copy)]
 struct Walk<'a> {
     texts: bool,
-    only: Option<&'a [String]>,
+    only: Option<&'a [&'a str]>,
 }
 
 impl Walk<'_> {
-    /// Whether the walk enters `path`: every path, or one of `only` or a field above one.
-    fn enters(self, path: &str) -> bool {
-        self.only.is_none_or(|only| {
-            only.iter().any(|w| {
-                w.strip_prefix(path)
-                    .is_some_and(|rest| rest.is_empty() || rest.starts_with(['.', '[']))
-            })
-        })
+    /// The walk of the child `step` of this node (`None`: not on the way), given to `then`.
+    fn enter(self, step: &str, then: impl FnOnce(Walk<'_>)) {
+        match self.only.map(|only| enter(only, step)) {
+            None | Some(Enter::All) => then(Walk { only: None, ..self }),
+            Some(Enter::Only(below)) => then(Walk {
+                texts: self.texts,
+                only: Some(&below),
+            }),
+            Some(Enter::Skip) => {}
+        }
     }
 
     fn leaf(
@@ -133,7 +137,10 @@ impl Walk<'_> {
                     .unwrap_or_default();
                 let tags: Vec<&str> = variants.iter().map(|(t, _)| t.as_str()).collect();
                 let kind_path = join(path, "kind");
-                if self.enters(&kind_path) {
+                if self
+                    .only
+                    .is_none_or(|only| !matches!(enter(only, "kind"), Enter::Skip))
+                {
                     out.push(PathInfo {
                         path: kind_path,
                         unit: String::new(),
@@ -162,10 +169,9 @@ impl Walk<'_> {
             let fixed = s.get("minItems").is_some() && s.get("minItems") == s.get("maxItems");
             if fixed || !is_scalar_schema(items) {
                 for (i, v) in list.iter().enumerate() {
-                    let item = format!("{path}[{i}]");
-                    if self.enters(&item) {
-                        self.walk(v, items, &item, &unit_here, out);
-                    }
+                    self.enter(&format!("[{i}]"), |walk| {
+                        walk.walk(v, items, &format!("{path}[{i}]"), &unit_here, out);
+                    });
                 }
             } else {
                 self.leaf(path, value, schema, &unit_here, out);
@@ -190,11 +196,10 @@ impl Walk<'_> {
             if k == "kind" && crate::schema::tag_of(s).is_some() {
                 continue;
             }
-            let field = join(path, k);
-            if self.enters(&field) {
+            self.enter(k, |walk| {
                 let v = value.get(k).unwrap_or(&Value::Null);
-                self.walk(v, sub, &field, parent_unit, out);
-            }
+                walk.walk(v, sub, &join(path, k), parent_unit, out);
+            });
         }
     }
 }
@@ -260,6 +265,7 @@ pub fn resolve_all(spec: &Simulation, names: &[String]) -> Result<(Vec<Parameter
             .collect::<Result<Vec<_>>>()?;
         Ok((parameters, paths))
     };
+    let wanted: Vec<&str> = wanted.iter().map(String::as_str).collect();
     let only = Walk {
         texts: false,
         only: Some(&wanted),

@@ -13,8 +13,8 @@ use paritysim_error::Problem;
 use serde_json::{Map, Value};
 
 use super::{
-    Branch, classify, describe, is_null_schema, join_values, node, num, schema, short, suggestion,
-    tag_of, types,
+    Branch, Enter, classify, describe, enter, is_null_schema, join_values, node, num, schema,
+    short, suggestion, tag_of, types,
 };
 
 /// Index of a compiled node in [`Compiled::nodes`].
@@ -284,38 +284,6 @@ pub(crate) fn check_definition(value: &Value, name: &str, path: &str, problems: 
 /// The fields a walk enters below its node: all (`None`), or only those on the way to the
 /// `only` paths, written relative to the node (`.a.b[2]`, `[0].c`; an empty one: all below).
 type Only<'a> = Option<&'a [&'a str]>;
-
-/// Where a walk limited to `only` goes at a child `step` (an object's key, an array's `[i]`).
-enum Enter<'a> {
-    /// Every field below the child.
-    All,
-    /// Only the paths (relative to the child) below it.
-    Only(Vec<&'a str>),
-    /// Not the child.
-    Skip,
-}
-
-fn enter<'a>(only: &[&'a str], step: &str) -> Enter<'a> {
-    let mut below = Vec::new();
-    for w in only {
-        let Some(rest) = w.strip_prefix(step) else {
-            continue;
-        };
-        if rest.is_empty() {
-            return Enter::All;
-        }
-        if let Some(r) = rest.strip_prefix('.') {
-            below.push(r);
-        } else if rest.starts_with('[') {
-            below.push(rest);
-        }
-    }
-    if below.is_empty() {
-        Enter::Skip
-    } else {
-        Enter::Only(below)
-    }
-}
 
 fn walk(
     nodes: &[Node],

@@ -230,6 +230,40 @@ pub(crate) fn join(path: &str, key: &str) -> String {
     }
 }
 
+/// Where a walk limited to a few canonical paths goes at a child `step` (an object's key, an
+/// array's `[i]`): the one rule of the path listing's and the schema check's limited walks.
+pub(crate) enum Enter<'a> {
+    /// Every field below the child (it is one of the paths).
+    All,
+    /// Only these paths, relative to the child (`a.b`, `[0].c`).
+    Only(Vec<&'a str>),
+    /// Not the child.
+    Skip,
+}
+
+/// [`Enter`] at the child `step` of a node for the paths `only`, relative to that node.
+pub(crate) fn enter<'a>(only: &[&'a str], step: &str) -> Enter<'a> {
+    let mut below = Vec::new();
+    for w in only {
+        let Some(rest) = w.strip_prefix(step) else {
+            continue;
+        };
+        if rest.is_empty() {
+            return Enter::All;
+        }
+        if let Some(r) = rest.strip_prefix('.') {
+            below.push(r);
+        } else if rest.starts_with('[') {
+            below.push(rest);
+        }
+    }
+    if below.is_empty() {
+        Enter::Skip
+    } else {
+        Enter::Only(below)
+    }
+}
+
 /// The nearest candidate ([`close`]), when one is close enough.
 pub fn nearest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
     close(word, candidates, 1).into_iter().next()
