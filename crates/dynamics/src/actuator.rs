@@ -288,6 +288,15 @@ impl Actuator {
         self.force_per_volt * v
     }
 
+    /// Whether [`Self::force`] is the same function of time as `other`'s (the fields it reads
+    /// are equal; the springs, mass and damping may differ): a table of one's forces is the
+    /// other's.
+    pub fn same_force(&self, other: &Self) -> bool {
+        self.force_per_volt == other.force_per_volt
+            && self.dc_offset == other.dc_offset
+            && self.waveform == other.waveform
+    }
+
     /// Stiffness K1 (mN/mm).
     pub fn stiffness(&self) -> f64 {
         self.stiffness

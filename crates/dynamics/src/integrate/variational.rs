@@ -274,7 +274,7 @@ impl RungeKutta {
 
     /// [`Self::flow_with_sensitivity_on_grid`] sampled at `times` (within the grid): each
     /// sample's state goes to `sink`, and its `Φ(t, grid[0])` (the active rows and columns, as
-    /// the monodromy) is returned, in order.
+    /// the monodromy; column-major) is returned, one block after another.
     ///
     /// # Errors
     /// As [`Self::flow_with_sensitivity_on_grid`]; whatever `sink` returns.
@@ -285,7 +285,7 @@ impl RungeKutta {
         y0: &State,
         times: &[f64],
         sink: &mut Sink<'_>,
-    ) -> Result<(State, DMatrix<f64>, Vec<DMatrix<f64>>)> {
+    ) -> Result<(State, DMatrix<f64>, Vec<f64>)> {
         check_grid(grid)?;
         let (t0, t1) = (grid[0], grid[grid.len() - 1]);
         let along = Along { times, sink };
@@ -369,17 +369,27 @@ impl RungeKutta {
         let active = |full: &[f64]| {
             DMatrix::from_fn(2 * n_real, 2 * n_real, |i, j| full[index(j) * m + index(i)])
         };
+        // Each sample's active block, column-major, one after another.
         let sampled = rhs
             .sampled_phi
             .as_deref()
-            .map(|all| all.chunks_exact(m * m).map(active).collect())
+            .map(|all| {
+                all.chunks_exact(m * m)
+                    .flat_map(|full| {
+                        (0..2 * n_real).flat_map(move |j| {
+                            (0..2 * n_real).map(move |i| full[index(j) * m + index(i)])
+                        })
+                    })
+                    .collect()
+            })
             .unwrap_or_default();
         Ok((to_state(n, &c[..m]), active(&c[m..]), steps, sampled))
     }
 }
 
-/// The flow, its sensitivity, the accepted step times and `Φ` at the samples.
-type Sensitivities = (State, DMatrix<f64>, Vec<f64>, Vec<DMatrix<f64>>);
+/// The flow, its sensitivity, the accepted step times and `Φ` at the samples (the active
+/// blocks, column-major, one after another).
+type Sensitivities = (State, DMatrix<f64>, Vec<f64>, Vec<f64>);
 
 /// The samples a sensitivity run hands out: their times and the sink of their states.
 struct Along<'a, 's> {
@@ -453,6 +463,10 @@ mod tests {
             Ok(())
         })
         .unwrap();
+        let phis: Vec<DMatrix<f64>> = phis
+            .chunks_exact(4)
+            .map(|phi| DMatrix::from_column_slice(2, 2, phi))
+            .collect();
         assert_eq!((phis.len(), states.len(), plain.len()), (41, 41, 41));
         let start = nalgebra::DVector::from_vec(vec![0.4, -1.1]);
         for ((phi, y), p) in phis.iter().zip(&states).zip(&plain) {

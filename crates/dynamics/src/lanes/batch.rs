@@ -77,6 +77,25 @@ type DriveTable<'a> = (Rc<[f64]>, &'a crate::actuator::Actuator, Rc<[f64]>);
 /// tenth of the time).
 pub(crate) type DriveTables<'a> = Vec<DriveTable<'a>>;
 
+/// `device`'s actuator forces at the stage times of `grid` (`None`: no lane model): one
+/// table computed once for several runs' [`DriveTables`] on other threads (see [`seeded`]).
+pub(crate) fn drive_table(device: &Device, grid: &[f64]) -> Option<Vec<f64>> {
+    LinearStroke::of(device).map(|model| model.forcing(grid).to_vec())
+}
+
+/// Drive tables holding `device`'s `forces` on `grid` (from [`drive_table`]), if any.
+pub(crate) fn seeded<'a>(
+    device: &'a Device,
+    grid: &[f64],
+    forces: Option<&[f64]>,
+) -> DriveTables<'a> {
+    let actuator = LinearStroke::of(device).map(|model| model.actuator());
+    match (actuator, forces) {
+        (Some(actuator), Some(forces)) => vec![(Rc::from(grid), actuator, Rc::from(forces))],
+        _ => Vec::new(),
+    }
+}
+
 /// Runs `jobs` in the lanes, windows with the metrics `metric_names` (stroke metrics only),
 /// or, with `capture`, keeping the windows' sample states: `None` when a device has no lane
 /// model, a metric is not a stroke metric, or a lane would fail where the scalar path reports
@@ -131,7 +150,7 @@ pub(crate) fn run<'a>(
             let actuator = models[k].actuator();
             let shared = tables
                 .iter()
-                .find(|(grid, drive, _)| **grid == *job.grid && *drive == actuator);
+                .find(|(grid, drive, _)| **grid == *job.grid && drive.same_force(actuator));
             let table = match shared {
                 Some((_, _, table)) => table.clone(),
                 None => {
@@ -187,12 +206,13 @@ pub(crate) fn run<'a>(
     done.into_iter().collect()
 }
 
-/// The stroke metrics `metric_names` of a window of `device` from its sample `states` at
-/// `times`, four samples at a time as [`run`] takes them: `None` as for [`run`].
+/// The stroke metrics `metric_names` of a window of `device` from its sample states at
+/// `times` (compact `[q1, q2, q̇1, q̇2]`), four samples at a time as [`run`] takes them:
+/// `None` as for [`run`].
 pub(crate) fn window_metrics(
     device: &Device,
     times: &[f64],
-    states: &[State],
+    states: &[[f64; 4]],
     metric_names: &[String],
     weight: Option<f64>,
 ) -> Option<Vec<(String, f64)>> {
@@ -209,7 +229,7 @@ pub(crate) fn window_metrics(
     for (b, (t, y)) in times.chunks(LANES).zip(states.chunks(LANES)).enumerate() {
         let count = t.len().min(y.len());
         // A short last block repeats its last sample in the unused lanes.
-        let compact: [[f64; 4]; LANES] = std::array::from_fn(|i| compact4(&y[i.min(count - 1)]));
+        let compact: [[f64; 4]; LANES] = std::array::from_fn(|i| y[i.min(count - 1)]);
         let block = SampleBlock {
             first: b * LANES,
             count,

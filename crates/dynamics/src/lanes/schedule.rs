@@ -28,7 +28,7 @@ fn forcing(point: &mut LanePoint<'_>, cache: &mut ForcingCache) -> Rc<[f64]> {
     }
     let table = match cache {
         Some((grid, actuator, table))
-            if **grid == *point.grid && actuator == point.model.actuator() =>
+            if **grid == *point.grid && actuator.same_force(point.model.actuator()) =>
         {
             table.clone()
         }

@@ -282,6 +282,12 @@ pub fn steady_sensitivity_at(
     // The parameters in groups (a group's four perturbed periods fill the lanes once), each
     // group's devices, maps and windows on one of the sensitivity's threads: the maps from x*,
     // then the windows along (dx*/dp_j, 1).
+    // The base point's drive table, shared by the groups' periods that keep its drive.
+    let base_table = if periods::in_lanes(options)? {
+        crate::lanes::batch::drive_table(device, &grid)
+    } else {
+        None
+    };
     let groups: Vec<std::ops::Range<usize>> = (0..n_params)
         .step_by(PARAMETERS_PER_GROUP)
         .map(|first| first..(first + PARAMETERS_PER_GROUP).min(n_params))
@@ -293,7 +299,7 @@ pub fn steady_sensitivity_at(
             .map(perturbed)
             .collect::<Result<Vec<(Point, Point, bool)>>>()?;
         let points: Vec<&Point> = pairs.iter().flat_map(|(a, b, _)| [a, b]).collect();
-        let mut tables = Vec::new();
+        let mut tables = crate::lanes::batch::seeded(device, &grid, base_table.as_deref());
         let starts = vec![x_star; points.len()];
         let keep = if replay.is_some() {
             Keep::Samples

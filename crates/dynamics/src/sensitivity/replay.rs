@@ -1,6 +1,6 @@
 //! The windows of starts near the orbit, from the base window's samples moved by `Φ(t)`.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 use paritysim_error::Result;
 
 use crate::device::Device;
@@ -13,7 +13,8 @@ use super::periods::in_lanes;
 /// `x* + δ` is, to first order in `δ`, the window of the states `y(t) + Φ(t) δ`.
 pub(super) struct Replay {
     pub(super) states: Vec<State>,
-    pub(super) phi: Vec<DMatrix<f64>>,
+    /// `Φ` at each sample: `2n × 2n` (compact state), column-major, one after another.
+    pub(super) phi: Vec<f64>,
 }
 
 impl Replay {
@@ -31,40 +32,48 @@ impl Replay {
         let n = device.n_dof();
         let m = 2 * n;
         let shift = shift.as_slice();
-        let moved: Vec<State> = states
-            .iter()
-            .zip(&self.phi)
-            .map(|(y, phi)| {
-                // Φ·shift, Φ column-major.
-                let mut delta = [0.0; 2 * crate::integrate::MAX_DOF];
-                for (column, s) in phi.as_slice().chunks_exact(m).zip(shift) {
-                    for (d, p) in delta.iter_mut().zip(column) {
-                        *d += p * s;
-                    }
+        // `Φ·shift` at each sample, into `delta` (compact).
+        let moved = |y: &State, phi: &[f64], delta: &mut [f64]| {
+            delta.fill(0.0);
+            for (column, s) in phi.chunks_exact(m).zip(shift) {
+                for (d, p) in delta.iter_mut().zip(column) {
+                    *d += p * s;
                 }
-                let mut moved = *y;
-                for i in 0..n {
-                    moved.coords[i] += delta[i];
-                    moved.rates[i] += delta[n + i];
-                }
-                moved
-            })
-            .collect();
+            }
+            for i in 0..n {
+                delta[i] += y.coords[i];
+                delta[n + i] += y.rates[i];
+            }
+        };
+        let samples = states.iter().zip(self.phi.chunks_exact(m * m));
         let (mut sampler, times) = WindowSampler::of_grid_window(device, grid, period, options);
-        if let (Some(names), true) = (&options.metrics, in_lanes(options)?) {
+        if let (Some(names), true, 2) = (&options.metrics, in_lanes(options)?, n) {
             // The lanes' sampling, as the lanes' windows took theirs (the same bits).
+            let compact: Vec<[f64; 4]> = samples
+                .clone()
+                .map(|(y, phi)| {
+                    let mut c = [0.0; 4];
+                    moved(y, phi, &mut c);
+                    c
+                })
+                .collect();
             if let Some(metrics) = crate::lanes::batch::window_metrics(
                 device,
                 &times,
-                &moved,
+                &compact,
                 names,
                 options.weight_mn,
             ) {
                 return Ok(metrics);
             }
         }
-        for (i, (t, y)) in times.iter().zip(&moved).enumerate() {
-            sampler.add(i, *t, y)?;
+        let mut delta = vec![0.0; m];
+        for (i, (t, (y, phi))) in times.iter().zip(samples).enumerate() {
+            moved(y, phi, &mut delta);
+            let mut y = *y;
+            y.coords[..n].copy_from_slice(&delta[..n]);
+            y.rates[..n].copy_from_slice(&delta[n..]);
+            sampler.add(i, *t, &y)?;
         }
         Ok(sampler.finish().1)
     }
