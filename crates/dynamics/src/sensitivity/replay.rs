@@ -32,30 +32,15 @@ impl Replay {
         let n = device.n_dof();
         let m = 2 * n;
         let shift = shift.as_slice();
-        // `Φ·shift` at each sample, into `delta` (compact).
-        let moved = |y: &State, phi: &[f64], delta: &mut [f64]| {
-            delta.fill(0.0);
-            for (column, s) in phi.chunks_exact(m).zip(shift) {
-                for (d, p) in delta.iter_mut().zip(column) {
-                    *d += p * s;
-                }
-            }
-            for i in 0..n {
-                delta[i] += y.coords[i];
-                delta[n + i] += y.rates[i];
-            }
-        };
         let samples = states.iter().zip(self.phi.chunks_exact(m * m));
         let (mut sampler, times) = WindowSampler::of_grid_window(device, grid, period, options);
-        if let (Some(names), true, 2) = (&options.metrics, in_lanes(options)?, n) {
+        if let (Some(names), true, Ok(shift)) =
+            (&options.metrics, in_lanes(options)?, shift.try_into())
+        {
             // The lanes' sampling, as the lanes' windows took theirs (the same bits).
             let compact: Vec<[f64; 4]> = samples
                 .clone()
-                .map(|(y, phi)| {
-                    let mut c = [0.0; 4];
-                    moved(y, phi, &mut c);
-                    c
-                })
+                .map(|(y, phi)| moved(y, phi, shift))
                 .collect();
             if let Some(metrics) = crate::lanes::batch::window_metrics(
                 device,
@@ -67,14 +52,57 @@ impl Replay {
                 return Ok(metrics);
             }
         }
-        let mut delta = vec![0.0; m];
-        for (i, (t, (y, phi))) in times.iter().zip(samples).enumerate() {
-            moved(y, phi, &mut delta);
-            let mut y = *y;
-            y.coords[..n].copy_from_slice(&delta[..n]);
-            y.rates[..n].copy_from_slice(&delta[n..]);
-            sampler.add(i, *t, &y)?;
+        let phis = self.phi.chunks_exact(m * m);
+        match m {
+            2 => sample_moved::<2>(&mut sampler, &times, states, phis, shift)?,
+            4 => sample_moved::<4>(&mut sampler, &times, states, phis, shift)?,
+            6 => sample_moved::<6>(&mut sampler, &times, states, phis, shift)?,
+            8 => sample_moved::<8>(&mut sampler, &times, states, phis, shift)?,
+            10 => sample_moved::<10>(&mut sampler, &times, states, phis, shift)?,
+            _ => sample_moved::<12>(&mut sampler, &times, states, phis, shift)?,
         }
         Ok(sampler.finish().1)
     }
+}
+
+/// Adds to `sampler` the samples `states` moved by `Φ·shift` (`M = 2n`, see [`moved`]).
+fn sample_moved<const M: usize>(
+    sampler: &mut WindowSampler,
+    times: &[f64],
+    states: &[State],
+    phis: std::slice::ChunksExact<'_, f64>,
+    shift: &[f64],
+) -> Result<()> {
+    let shift: &[f64; M] = shift.try_into().map_err(|_| {
+        paritysim_error::Error::Singular(format!(
+            "a window's shift has {} entries, not {M}",
+            shift.len()
+        ))
+    })?;
+    let n = M / 2;
+    for (i, ((t, y), phi)) in times.iter().zip(states).zip(phis).enumerate() {
+        let compact = moved(y, phi, shift);
+        let mut y = *y;
+        y.coords[..n].copy_from_slice(&compact[..n]);
+        y.rates[..n].copy_from_slice(&compact[n..]);
+        sampler.add(i, *t, &y)?;
+    }
+    Ok(())
+}
+
+/// The compact state `y + Φ·shift` (`M = 2n`; `Φ` column-major, `M × M`).
+#[inline]
+fn moved<const M: usize>(y: &State, phi: &[f64], shift: &[f64; M]) -> [f64; M] {
+    let mut delta = [0.0; M];
+    for (column, s) in phi.chunks_exact(M).zip(shift) {
+        for (d, p) in delta.iter_mut().zip(column) {
+            *d += p * s;
+        }
+    }
+    let n = M / 2;
+    for i in 0..n {
+        delta[i] += y.coords[i];
+        delta[n + i] += y.rates[i];
+    }
+    delta
 }
