@@ -181,6 +181,8 @@ def _slow_stability_calls() -> dict[str, Any]:
         "disturbance_response": lambda: stability.disturbance_response(parity, [10.0, 20.0], 0.1),
         "stability_chart": lambda: stability.stability_chart(np.linspace(0.0, 3.0, 2000), np.linspace(-1.0, 30.0, 2000), brockett=False),
         "continuation": lambda: ps.continuation(hmf, "actuator.waveform.frequency_hz", 2e-3, start=1e-3),
+        # Run on the calling thread (no worker thread): polled from the orbit's solve.
+        "sensitivity": lambda: ps.sensitivity(hmf, params=["actuator.stiffness"], progress=False),
     }
 
 

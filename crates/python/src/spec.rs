@@ -155,6 +155,17 @@ pub(crate) fn cancellable<T: Send>(
     interruptible(py, &cancel, move || budget::cancellable(&flag, work))
 }
 
+/// [`cancellable`] on this thread ([`interruptible_here`]): no worker thread to spawn and join;
+/// Python's signals are polled from this thread's budget checks.
+pub(crate) fn cancellable_here<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> Result<T> + Send,
+) -> PyResult<T> {
+    let cancel = CancelFlag::new();
+    let flag = cancel.clone();
+    interruptible_here(py, &cancel, move || budget::cancellable(&flag, work))
+}
+
 /// Runs `work` with a wall-clock budget of `max_wall_ms` (None: none of its own) installed on
 /// this thread (`budget::Budget`; the call's cancel flag and any outer deadline still apply):
 /// every integration and `budget::check` it makes stops once the budget is spent, and the call

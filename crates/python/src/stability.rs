@@ -18,7 +18,7 @@ use pyo3::types::PyDict;
 
 use crate::convert::{Floats, bindings, from_json, to_vec};
 use crate::errors::IntoPyResult;
-use crate::spec::{cancellable, device as parse_device, within};
+use crate::spec::{cancellable, cancellable_here, device as parse_device, within};
 use paritysim_dynamics::integrate::budget;
 
 fn c64(z: Complex<f64>) -> Complex64 {
@@ -35,6 +35,7 @@ bindings! {
     extra stability_chart;
     extra stability_region;
     extra stability_lti_transfer;
+    extra sensitivity;
 
     /// The continuous spec paths `params` of a JSON spec resolved: their names, units and
     /// values (`paritysim_spec::sensitivity::parameters`).
@@ -45,15 +46,6 @@ bindings! {
                 let names: Vec<String> = p.into_iter().map(|p| p.name).collect();
                 (names, units, values)
             })
-    }
-
-    /// Derivatives of a JSON spec's steady-state metrics (`metrics`, or all) by the continuous
-    /// spec paths `params` (`paritysim_spec::sensitivity`), as plain columns.
-    #[pyo3(signature = (json, params, metrics = None))]
-    fn sensitivity(json: &str, params: Vec<String>, metrics: Option<Vec<String>>) {
-        let spec = crate::spec::parse(json)?;
-        paritysim_spec::sensitivity::sensitivity(&spec, &params, metrics.as_deref())
-            .map(|s| s.record())
     }
 
     /// `sensitivity` at each point `rows[i]` (a JSON object of spec paths and values) of a
@@ -201,6 +193,28 @@ bindings! {
 /// With `brockett`, also `brockett_bounded` (`floquet::brockett_hill` at every computed point
 /// with κ > 0; false elsewhere), inside the same budget.
 /// `max_wall_ms` bounds the whole chart (None: no budget of its own).
+/// Derivatives of a JSON spec's steady-state metrics (`metrics`, or all) by the continuous
+/// spec paths `params` (`paritysim_spec::sensitivity`), as plain columns. On this thread
+/// (`cancellable_here`): the worker thread of `cancellable` cost 0.2-0.3 ms a call, a fifth
+/// of a short sensitivity's wall time. Ctrl-C is polled from this thread's budget checks (the
+/// orbit's solve, the variational period); while the parameter groups run on the pool it
+/// waits for them.
+#[pyfunction]
+#[pyo3(signature = (json, params, metrics = None))]
+fn sensitivity<'py>(
+    py: Python<'py>,
+    json: &str,
+    params: Vec<String>,
+    metrics: Option<Vec<String>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let record = cancellable_here(py, || {
+        let spec = crate::spec::parse(json)?;
+        paritysim_spec::sensitivity::sensitivity(&spec, &params, metrics.as_deref())
+            .map(|s| s.record())
+    })?;
+    crate::convert::to_py(py, &record)
+}
+
 #[pyfunction]
 #[pyo3(signature = (beta0, kappa, max_wall_ms = None, brockett = false))]
 fn stability_chart<'py>(

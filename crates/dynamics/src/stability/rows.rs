@@ -62,7 +62,8 @@ where
 ///
 /// Where they run: called from a pool thread (a point of a sweep, or a part of an outer
 /// analysis) on that pool, whose threads the sweep already budgets; from a plain call on the
-/// sweep engine's own pool ([`run_rows`]), never rayon's global one.
+/// sweep engine's own pool ([`run_rows`]), never rayon's global one; a single part on the
+/// calling thread.
 ///
 /// # Errors
 /// The first failing part's error (in index order); [`Error::Cancelled`] as [`run_rows`].
@@ -72,6 +73,10 @@ where
     F: Fn(usize) -> Result<T> + Sync,
 {
     use rayon::prelude::*;
+    if n == 1 {
+        // One part: on this thread, under its own budget (no hand-off to a pool and back).
+        return Ok(vec![part(0)?]);
+    }
     if rayon::current_thread_index().is_some() {
         let run_budget = budget::current();
         return (0..n)
