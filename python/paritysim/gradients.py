@@ -128,8 +128,9 @@ def sensitivity(
     samples moved by Φ (four at a time in SIMD lanes on a linear-map device asked for stroke
     metrics; parameters in pairs on the sweep's threads, ``PARITYSIM_THREADS``). Metrics that
     read work integrals (the powers, the work per cycle) integrate each window instead. On the
-    §3.3 benchmark point with 8 parameters about 4.2× the instructions of a `paritysim.simulate`;
-    on the §3.4 1-Cut with 3 parameters about 3× (docs/findings.md §30).
+    §3.3 benchmark point about 2.2× the instructions of a `paritysim.simulate` with one
+    parameter, 2.8× with four, 3.8× with eight (about two simulates, then a quarter of one per
+    parameter); on the §3.4 1-Cut with 3 parameters about 3× (docs/findings.md §30).
 
     Raises
     ------
