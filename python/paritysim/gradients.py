@@ -123,13 +123,13 @@ def sensitivity(
     orbit (measured against central differences of whole ``ps.simulate`` runs at rtol 1e-11:
     within 1e-5 relative, ``crates/dynamics/tests/dynamics/sensitivity.rs``).
 
-    Cost: one steady-state run and one variational period (which also samples the base
-    window and its Φ), then per parameter two perturbed periods whose windows are their own
+    Cost: one steady-state run whose last Newton period also integrates the variational
+    equations (the base window and its Φ), then per parameter two perturbed periods whose windows are their own
     samples moved by Φ (four at a time in SIMD lanes on a linear-map device asked for stroke
     metrics; parameters in pairs on the sweep's threads, ``PARITYSIM_THREADS``). Metrics that
     read work integrals (the powers, the work per cycle) integrate each window instead. On the
-    §3.3 benchmark point about 2.2× the instructions of a `paritysim.simulate` with one
-    parameter, 2.8× with four, 3.8× with eight (about two simulates, then a quarter of one per
+    §3.3 benchmark point about 2.0× the instructions of a `paritysim.simulate` with one
+    parameter, 2.6× with four, 3.7× with eight (about 1.8 simulates, then a quarter of one per
     parameter); on the §3.4 1-Cut with 3 parameters about 3× (docs/findings.md §30).
 
     Raises

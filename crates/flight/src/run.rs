@@ -683,6 +683,7 @@ pub fn fly_controlled(
         monodromy: None,
         step_grid: Vec::new(),
         orbit_cycles: 1,
+        orbit_samples: None,
     })
 }
 

@@ -227,6 +227,7 @@ pub fn sensitivities(
             state: device.state_from(&p, &p_dot)?,
             grid: found.step_grid.clone(),
             cycles: found.orbit_cycles,
+            samples: None,
         };
         let value = values[i].as_ref().expect("a prepared row has its spec");
         differentiate(

@@ -123,6 +123,7 @@ impl Converged<'_> {
             monodromy: Some(self.jacobian),
             step_grid: self.grid,
             orbit_cycles: 1,
+            orbit_samples: None,
         };
         let coordinates = self.device.coordinates(&steady_state).ok();
         COMPLETED_IN_LANES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);

@@ -79,6 +79,10 @@ pub struct Orbit {
     pub grid: Vec<f64>,
     /// Drive periods per period of the orbit (2: a period-doubled orbit).
     pub cycles: usize,
+    /// The variational record of the orbit's last shooting period on `grid`, when the run
+    /// kept it ([`SimulationOptions::sampled_orbit`]): the base window and `Φ` then need no
+    /// period of their own.
+    pub samples: Option<crate::simulate::OrbitSamples>,
 }
 
 /// The options `simulate` runs with to find the orbit a sensitivity differentiates at: one
@@ -111,7 +115,11 @@ pub fn steady_sensitivity(
     options: &SimulationOptions,
 ) -> Result<SteadySensitivity> {
     finite_difference_steps(p0, steps)?; // bad steps are refused before the run
-    let run = simulate(device, &orbit_options(options))?;
+    let mut run_options = orbit_options(options);
+    // The run's last shooting period keeps the base window and `Φ` where the sensitivity
+    // would integrate them (see `steady_sensitivity_at`): not for a differenced monodromy.
+    run_options.sampled_orbit = !differenced(device);
+    let run = simulate(device, &run_options)?;
     if !run.converged {
         return Err(unconverged(
             run.cycles_run as f64 * run.period_ms,
@@ -123,6 +131,7 @@ pub fn steady_sensitivity(
         state: run.steady_state,
         grid: run.step_grid,
         cycles: run.orbit_cycles,
+        samples: run.orbit_samples,
     };
     steady_sensitivity_at(device_at, device, p0, steps, options, &orbit)
 }
@@ -203,13 +212,24 @@ pub fn steady_sensitivity_at(
         )?;
         steps
     };
-    let switched = crate::integrate::OdeSystem::n_switches(device) > 0;
-    let differenced = switched && !device.has_analytic_jacobian();
+    let differenced = differenced(device);
     let (sampler, times) = WindowSampler::of_grid_window(device, &grid, period, options);
+    let kept = orbit
+        .samples
+        .as_ref()
+        .filter(|kept| !differenced && !sampler.reads_work() && kept.states.len() == times.len());
     // The base window is sampled in the variational period, unless the metrics read the work
     // integrals (which that run does not integrate) or the monodromy is differenced; `Φ` at
     // its samples then moves the window to nearby starts without integrating again.
-    let (mapped, monodromy, replay, mut base_metrics) = if differenced || sampler.reads_work() {
+    let (mapped, monodromy, replay, mut base_metrics) = if let Some(kept) = kept {
+        // The run's last shooting period: this very period, integrated there.
+        let replay = Replay {
+            states: kept.states.clone(),
+            phi: kept.phi.clone(),
+        };
+        let metrics = kept.metrics.clone();
+        (kept.end, kept.monodromy.clone(), Some(replay), metrics)
+    } else if differenced || sampler.reads_work() {
         let (mapped, monodromy) = if differenced {
             fixed_grid_monodromy(device, &rk, &grid, &x_star)?
         } else {
@@ -484,6 +504,12 @@ fn fixed_grid_monodromy(
     })?;
     let mapped = State::from_compact(n, &map(x)?);
     Ok((mapped, DMatrix::from_columns(&columns)))
+}
+
+/// Whether `device`'s monodromy is differenced ([`fixed_grid_monodromy`]): a switched device
+/// without an analytic Jacobian.
+fn differenced(device: &Device) -> bool {
+    crate::integrate::OdeSystem::n_switches(device) > 0 && !device.has_analytic_jacobian()
 }
 
 /// Step of the central differences of [`fixed_grid_monodromy`] (relative, absolute below 1).

@@ -18,9 +18,9 @@ pub use crate::trajectory::{Trajectory, record};
 use options::check_recording_size;
 pub(crate) use options::validate;
 pub use options::{
-    DEFAULT_MAX_WALL_MS, MAX_RECORDED_SAMPLES, MAX_RECORDING_BYTES, PERIOD_DOUBLED_SEPARATION,
-    PERIOD_DOUBLED_SETTLED, PerturbTarget, Perturbation, SHOOTING_RETRY_APART, SimulationOptions,
-    SimulationResult, SteadyState,
+    DEFAULT_MAX_WALL_MS, MAX_RECORDED_SAMPLES, MAX_RECORDING_BYTES, OrbitSamples,
+    PERIOD_DOUBLED_SEPARATION, PERIOD_DOUBLED_SETTLED, PerturbTarget, Perturbation,
+    SHOOTING_RETRY_APART, SimulationOptions, SimulationResult, SteadyState,
 };
 use shooting::Shot;
 pub use shooting::UNSTABLE_MARGIN;
@@ -78,6 +78,7 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
     let mut orbit_cycles = 1;
     // The recorded window when the shooting's last period already was it.
     let mut recorded: Option<(Trajectory, Vec<(String, f64)>)> = None;
+    let mut orbit_samples = None;
     let stroke = stroke_sampling(device, options.metrics.as_deref(), &columns);
     // Lean samples that read no work integral need no work in the recorded window either.
     let recording = match stroke {
@@ -102,6 +103,7 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
                         monodromy = Some(found.jacobian);
                         step_grid = found.grid;
                         recorded = found.recorded;
+                        orbit_samples = found.sampled;
                         transient_needed = false;
                     }
                     Shot::Unstable(state) => retry = Some(Some(state)),
@@ -306,6 +308,7 @@ pub fn simulate(device: &Device, options: &SimulationOptions) -> Result<Simulati
         monodromy,
         step_grid,
         orbit_cycles,
+        orbit_samples,
     })
 }
 

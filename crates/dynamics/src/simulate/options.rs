@@ -104,6 +104,11 @@ pub struct SimulationOptions {
     /// Weight (mN) the metric `lift_to_weight` divides the mean lift by (`None`: no such
     /// metric); the spec sets it from its `body` section (body and wing masses times `|g|`).
     pub weight_mn: Option<f64>,
+    /// The shooting's last (recorded) period of a period-1 orbit also integrates the
+    /// variational equations and keeps the states and `Φ(t)` at the window's samples
+    /// ([`SimulationResult::orbit_samples`]): a sensitivity's base window, which then needs no
+    /// period of its own (`crate::sensitivity`). The shooting itself is unchanged.
+    pub sampled_orbit: bool,
 }
 
 /// Default wall-clock budget of one run (ms): a minute.
@@ -132,6 +137,7 @@ impl Default for SimulationOptions {
             max_wall_ms: Some(DEFAULT_MAX_WALL_MS),
             cancel: None,
             weight_mn: None,
+            sampled_orbit: false,
         }
     }
 }
@@ -173,6 +179,27 @@ pub struct SimulationResult {
     /// `orbit_cycles × record_cycles` drive periods, the residual is that of the two-cycle map,
     /// and the multipliers and `monodromy` are of the two-cycle map.
     pub orbit_cycles: usize,
+    /// With [`SimulationOptions::sampled_orbit`], when the shooting's last period recorded
+    /// the window of a period-1 orbit: that period's variational record.
+    pub orbit_samples: Option<OrbitSamples>,
+}
+
+/// The shooting's last period integrated with the variational equations on
+/// [`SimulationResult::step_grid`] from [`SimulationResult::steady_state`], sampled at the
+/// recorded window's times.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OrbitSamples {
+    /// The period map's value `P(x*)` (no work integrals).
+    pub end: State,
+    /// The exact monodromy `∂P/∂x` at the orbit (active rows and columns).
+    pub monodromy: nalgebra::DMatrix<f64>,
+    /// The states at the window's samples.
+    pub states: Vec<State>,
+    /// `Φ(t)` at each sample, as [`SimulationResult::monodromy`]'s block, column-major, one
+    /// after another.
+    pub phi: Vec<f64>,
+    /// The window's metrics from those samples (all of them, as the window computes).
+    pub metrics: Vec<(String, f64)>,
 }
 
 /// A transient whose state changes by less than this over two cycles (relative, as the

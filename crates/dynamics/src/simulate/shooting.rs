@@ -52,6 +52,8 @@ pub(crate) struct ShotSteadyState {
     pub(super) multipliers: Vec<nalgebra::Complex<f64>>,
     /// The recorded window, when the last Newton period recorded it.
     pub(super) recorded: Option<(Trajectory, Vec<(String, f64)>)>,
+    /// That period's variational record ([`SimulationOptions::sampled_orbit`]).
+    pub(super) sampled: Option<super::OrbitSamples>,
 }
 
 /// [`SteadyState::Shooting`](super::SteadyState::Shooting): warm-up (without a neighbour's Jacobian), then Newton on the
@@ -119,11 +121,35 @@ pub(crate) fn shooting_steady_state(
     let n_samples = options.samples_per_cycle * orbit_cycles;
     let records = options.record_cycles == 1 && options.perturbation.is_none();
     let mut recorded = None;
+    let mut sampled = None;
     let mut finish = |grid: &[f64], y: &State| -> Result<Finished> {
         if !records {
             return transient
                 .integrate_on_grid(device, grid, y, &[], &mut |_, _, _| Ok(()))
                 .map(|end| (end, None));
+        }
+        if options.sampled_orbit && orbit_cycles == 1 && stroke.is_some_and(|s| !s.work) {
+            // The machine gets the end state only: the shooting runs as without the record. A
+            // failing variational period (not the budget) leaves the plain record below.
+            match super::window::record_window_sampled(
+                device,
+                transient,
+                y,
+                n_samples,
+                period,
+                columns.to_vec(),
+                stroke,
+                grid,
+                options.weight_mn,
+            ) {
+                Ok(((trajectory, metrics, end), samples)) => {
+                    recorded = Some((trajectory, metrics));
+                    sampled = Some(samples);
+                    return Ok((end, None));
+                }
+                Err(e) if crate::shooting::newton::out_of_budget(&e) => return Err(e),
+                Err(_) => sampled = None,
+            }
         }
         // Samples that read no work integral: the lighter state suffices.
         let integrator = match stroke {
@@ -269,6 +295,7 @@ pub(crate) fn shooting_steady_state(
         grid: orbit.grid,
         multipliers,
         recorded,
+        sampled,
     })))
 }
 

@@ -137,6 +137,49 @@ pub(crate) fn window_times(
 /// A recorded window: its columns, its metrics and the state at its end.
 pub(super) type Recorded = (Trajectory, Vec<(String, f64)>, State);
 
+/// [`record_window`] of a period-1 orbit on its `grid` (no kick) integrating the variational
+/// equations too: also the states and `Φ(t)` at the samples and the monodromy
+/// ([`SimulationOptions::sampled_orbit`](super::SimulationOptions::sampled_orbit)). The state
+/// part integrates as the plain period does. `integrator` without work integrals.
+///
+/// # Errors
+/// As [`record_window`].
+#[allow(clippy::too_many_arguments)]
+pub(super) fn record_window_sampled(
+    device: &Device,
+    integrator: &RungeKutta,
+    y: &State,
+    n_samples: usize,
+    period: f64,
+    columns: Vec<crate::trajectory::Column>,
+    stroke: Option<StrokeNeeds>,
+    grid: &[f64],
+    weight: Option<f64>,
+) -> Result<(Recorded, super::OrbitSamples)> {
+    let times: Vec<f64> = window_times(grid[0], period, n_samples).collect();
+    let mut sampler = WindowSampler::new(device, Some(period), columns, stroke, n_samples, weight);
+    let mut states = Vec::with_capacity(times.len());
+    let (end, monodromy, phi) = integrator.flow_with_sensitivity_on_grid_sampled(
+        device,
+        grid,
+        y,
+        &times,
+        &mut |i, t, y| {
+            states.push(*y);
+            sampler.add(i, t, y)
+        },
+    )?;
+    let (trajectory, metrics) = sampler.finish();
+    let samples = super::OrbitSamples {
+        end: end.without_work(),
+        monodromy,
+        states,
+        phi,
+        metrics: metrics.clone(),
+    };
+    Ok(((trajectory, metrics, end), samples))
+}
+
 /// Integrates the recorded window from `(t_start, y)`, evaluating each of the `n_samples + 1`
 /// samples once: it feeds the metrics and the asked columns, nothing else is kept.
 #[allow(clippy::too_many_arguments)]

@@ -162,3 +162,58 @@ fn the_perturbed_periods_run_in_the_lanes() {
         }
     }
 }
+
+/// The orbit's last shooting period kept by its run (`sampled_orbit`) is the period a
+/// sensitivity integrates otherwise: the same derivatives to the bit, and the run itself (its
+/// orbit, residual and metrics) is the run without it.
+#[test]
+fn the_runs_kept_period_gives_the_bits_of_a_period_of_its_own() {
+    use paritysim_dynamics::sensitivity::{Orbit, orbit_options, steady_sensitivity_at};
+    let p0 = [18.75, 5.0, 50.0, 110.0];
+    let options = SimulationOptions {
+        metrics: Some(
+            ["tau_r_peak", "delta_tau_peak", "left_stroke_amplitude"]
+                .map(String::from)
+                .to_vec(),
+        ),
+        ..tight()
+    };
+    let device = design(&p0).unwrap();
+    let plain = simulate(&device, &orbit_options(&options)).unwrap();
+    let kept_run = simulate(
+        &device,
+        &SimulationOptions {
+            sampled_orbit: true,
+            ..orbit_options(&options)
+        },
+    )
+    .unwrap();
+    assert!(plain.orbit_samples.is_none());
+    let samples = kept_run
+        .orbit_samples
+        .clone()
+        .expect("the last period kept");
+    assert_eq!(kept_run.steady_state, plain.steady_state);
+    assert_eq!(kept_run.residual, plain.residual);
+    // Bit for bit, NaN (the metrics these samples do not compute) included.
+    let bits = |m: &[(String, f64)]| -> Vec<(String, u64)> {
+        m.iter().map(|(n, v)| (n.clone(), v.to_bits())).collect()
+    };
+    assert_eq!(bits(&kept_run.metrics), bits(&plain.metrics));
+    assert_eq!(bits(&samples.metrics), bits(&plain.metrics));
+    let orbit = |samples| Orbit {
+        state: plain.steady_state,
+        grid: plain.step_grid.clone(),
+        cycles: plain.orbit_cycles,
+        samples,
+    };
+    let at = |samples| {
+        steady_sensitivity_at(&design, &device, &p0, None, &options, &orbit(samples)).unwrap()
+    };
+    let (kept, own) = (at(Some(samples)), at(None));
+    assert_eq!(kept.jacobian, own.jacobian);
+    assert_eq!(bits(&kept.metrics), bits(&own.metrics));
+    assert_eq!(kept.multipliers, own.multipliers);
+    assert_eq!(kept.residual, own.residual);
+    assert_eq!(kept.not_differentiable, own.not_differentiable);
+}
