@@ -150,20 +150,24 @@ pub(crate) fn cancellable<T: Send>(
     py: Python<'_>,
     work: impl FnOnce() -> Result<T> + Send,
 ) -> PyResult<T> {
-    let cancel = CancelFlag::new();
-    let flag = cancel.clone();
-    interruptible(py, &cancel, move || budget::cancellable(&flag, work))
+    cancellable_on(py, false, work)
 }
 
-/// [`cancellable`] on this thread ([`interruptible_here`]): no worker thread to spawn and join;
-/// Python's signals are polled from this thread's budget checks.
-pub(crate) fn cancellable_here<T: Send>(
+/// [`cancellable`], on this thread with `here` ([`interruptible_here`]: no worker thread to
+/// spawn and join; Python's signals polled from this thread's budget checks only).
+pub(crate) fn cancellable_on<T: Send>(
     py: Python<'_>,
+    here: bool,
     work: impl FnOnce() -> Result<T> + Send,
 ) -> PyResult<T> {
     let cancel = CancelFlag::new();
     let flag = cancel.clone();
-    interruptible_here(py, &cancel, move || budget::cancellable(&flag, work))
+    let work = move || budget::cancellable(&flag, work);
+    if here {
+        interruptible_here(py, &cancel, work)
+    } else {
+        interruptible(py, &cancel, work)
+    }
 }
 
 /// Runs `work` with a wall-clock budget of `max_wall_ms` (None: none of its own) installed on

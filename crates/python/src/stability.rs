@@ -18,7 +18,7 @@ use pyo3::types::PyDict;
 
 use crate::convert::{Floats, bindings, from_json, to_vec};
 use crate::errors::IntoPyResult;
-use crate::spec::{cancellable, cancellable_here, device as parse_device, within};
+use crate::spec::{cancellable, cancellable_on, device as parse_device, within};
 use paritysim_dynamics::integrate::budget;
 
 fn c64(z: Complex<f64>) -> Complex64 {
@@ -195,7 +195,7 @@ bindings! {
 /// `max_wall_ms` bounds the whole chart (None: no budget of its own).
 /// Derivatives of a JSON spec's steady-state metrics (`metrics`, or all) by the continuous
 /// spec paths `params` (`paritysim_spec::sensitivity`), as plain columns. On this thread
-/// (`cancellable_here`): the worker thread of `cancellable` cost 0.2-0.3 ms a call, a fifth
+/// (`cancellable_on`): the worker thread of `cancellable` cost 0.2-0.3 ms a call, a fifth
 /// of a short sensitivity's wall time. Ctrl-C is polled from this thread's budget checks (the
 /// orbit's solve, the variational period); while the parameter groups run on the pool it
 /// waits for them.
@@ -207,7 +207,7 @@ fn sensitivity<'py>(
     params: Vec<String>,
     metrics: Option<Vec<String>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let record = cancellable_here(py, || {
+    let record = cancellable_on(py, true, || {
         let spec = crate::spec::parse(json)?;
         paritysim_spec::sensitivity::sensitivity(&spec, &params, metrics.as_deref())
             .map(|s| s.record())
