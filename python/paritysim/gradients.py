@@ -124,13 +124,14 @@ def sensitivity(
     within 1e-5 relative, ``crates/dynamics/tests/dynamics/sensitivity.rs``).
 
     Cost: one steady-state run whose last Newton period also integrates the variational
-    equations (the base window and its Φ), then per parameter two perturbed periods whose windows are their own
-    samples moved by Φ (four at a time in SIMD lanes on a linear-map device asked for stroke
-    metrics; parameters in pairs on the sweep's threads, ``PARITYSIM_THREADS``). Metrics that
+    equations (the base window and its Φ), then per parameter two perturbed periods whose
+    windows are their own samples moved by Φ (four at a time in SIMD lanes on a linear-map
+    device asked for stroke metrics; parameters in pairs on the sweep's threads,
+    ``PARITYSIM_THREADS``). Metrics that
     read work integrals (the powers, the work per cycle) integrate each window instead. On the
     §3.3 benchmark point about 2.0× the instructions of a `paritysim.simulate` with one
     parameter, 2.6× with four, 3.7× with eight (about 1.8 simulates, then a quarter of one per
-    parameter); on the §3.4 1-Cut with 3 parameters about 3× (docs/findings.md §30).
+    parameter); on the §3.4 1-Cut with 3 parameters about 2.7× (docs/findings.md §30).
 
     Raises
     ------
