@@ -104,8 +104,9 @@ pub struct SimulationOptions {
     /// Weight (mN) the metric `lift_to_weight` divides the mean lift by (`None`: no such
     /// metric); the spec sets it from its `body` section (body and wing masses times `|g|`).
     pub weight_mn: Option<f64>,
-    /// The shooting's last (recorded) period of a period-1 orbit also integrates the
-    /// variational equations and keeps the states and `Φ(t)` at the window's samples
+    /// The shooting's last (recorded) period of a period-1 orbit, when its samples read no
+    /// work integral (lean stroke samples), also integrates the variational equations and
+    /// keeps the states and `Φ(t)` at the window's samples
     /// ([`SimulationResult::orbit_samples`]): a sensitivity's base window, which then needs no
     /// period of its own (`crate::sensitivity`). The shooting itself is unchanged.
     pub sampled_orbit: bool,
