@@ -493,17 +493,14 @@ fn fixed_grid_monodromy(
         Ok(end.without_work().compact(n))
     };
     let base = x.compact(n);
-    let columns = crate::stability::rows::run_parts(2 * n, |j| {
-        let h = MONODROMY_STEP * base[j].abs().max(1.0);
-        let shifted = |sign: f64| {
-            let mut v = base.clone();
-            v[j] += sign * h;
-            map(&State::from_compact(n, &v))
-        };
-        Ok((shifted(1.0)? - shifted(-1.0)?) / (2.0 * h))
-    })?;
+    let steps: Vec<f64> = base
+        .iter()
+        .map(|x| MONODROMY_STEP * x.abs().max(1.0))
+        .collect();
+    let map_compact = |v: &DVector<f64>| map(&State::from_compact(n, v));
+    let jacobian = crate::shooting::newton::difference_jacobian(&base, &steps, &map_compact)?;
     let mapped = State::from_compact(n, &map(x)?);
-    Ok((mapped, DMatrix::from_columns(&columns)))
+    Ok((mapped, jacobian))
 }
 
 /// Whether `device`'s monodromy is differenced ([`fixed_grid_monodromy`]): a switched device

@@ -145,19 +145,11 @@ pub struct PeriodicOrbit {
 
 /// The `2n` integrated entries (coordinates, then rates) of a state.
 pub fn compact_state(n: usize, y: &State) -> DVector<f64> {
-    compact(n, y)
+    y.compact(n)
 }
 
 /// A state from its `2n` integrated entries (work integrals zero).
 pub fn expand_state(n: usize, v: &DVector<f64>) -> State {
-    expand(n, v)
-}
-
-fn compact(n: usize, y: &State) -> DVector<f64> {
-    y.compact(n)
-}
-
-fn expand(n: usize, v: &DVector<f64>) -> State {
     State::from_compact(n, v)
 }
 
@@ -219,18 +211,15 @@ pub fn map_jacobian(
     y: &State,
     fd_step: f64,
 ) -> Result<DMatrix<f64>> {
-    let steps = fd_steps(n, y, fd_step);
-    let base = compact(n, y);
-    let columns = super::rows::run_parts(2 * n, |j| {
-        let mut plus = base.clone();
-        let mut minus = base.clone();
-        plus[j] += steps[j];
-        minus[j] -= steps[j];
-        let fp = stroboscopic_map(system, integrator, t0, period, &expand(n, &plus))?;
-        let fm = stroboscopic_map(system, integrator, t0, period, &expand(n, &minus))?;
-        Ok((compact(n, &fp) - compact(n, &fm)) / (2.0 * steps[j]))
-    })?;
-    Ok(DMatrix::from_columns(&columns))
+    let map = |x: &DVector<f64>| -> Result<DVector<f64>> {
+        let out = stroboscopic_map(system, integrator, t0, period, &expand_state(n, x))?;
+        Ok(compact_state(n, &out))
+    };
+    crate::shooting::newton::difference_jacobian(
+        &compact_state(n, y),
+        &fd_steps(n, y, fd_step),
+        &map,
+    )
 }
 
 /// Finds the periodic orbit of a driven device on the section `t ≡ t0 (mod T)`.
@@ -458,14 +447,14 @@ fn damped_newton(
         let fresh = at == y;
         iterations += 1;
         let a = jac - DMatrix::<f64>::identity(2 * n, 2 * n);
-        let f = compact(n, &py) - compact(n, &y);
+        let f = compact_state(n, &py) - compact_state(n, &y);
         let delta = crate::shooting::newton::least_squares_step(a, &f).ok_or_else(|| {
             Error::Singular("Newton step of the shooting method: non-finite Jacobian".into())
         })?;
         let mut lambda = 1.0;
         let mut accepted = false;
         for _ in 0..if fresh { 8 } else { 1 } {
-            let trial = expand(n, &(compact(n, &y) + &delta * lambda));
+            let trial = expand_state(n, &(compact_state(n, &y) + &delta * lambda));
             // A trial step may leave the linkage's reach: treat it as a failed step.
             match stroboscopic_map(device, integrator, t0, period, &trial) {
                 Ok(pt) => {
