@@ -101,7 +101,8 @@ class OptimizationResult:
     ``evaluations``: the distinct points evaluated (objective, constraints and gradients);
     ``sensitivities``: every `sensitivity` run, those points' and the stability constraint's
     one-sided differences (one more per parameter and point): the search's cost, each about
-    one steady-state solve plus two periods per parameter.
+    one steady-state solve plus two periods per parameter (the stability differences read
+    only the multipliers and differentiate by one parameter).
     """
 
     success: bool
@@ -283,9 +284,9 @@ def optimize(
     warned: dict[str, str] = {}  # metric -> its warning, issued once after the search
     counts = {"evaluations": 0, "sensitivities": 0}
 
-    def solve(spec_: Simulation, wanted: list[str]) -> SensitivityResult:
+    def solve(spec_: Simulation, wanted: list[str], by: list[str] = paths) -> SensitivityResult:
         counts["sensitivities"] += 1
-        return _sensitivity_or_params(spec_, paths, wanted)
+        return _sensitivity_or_params(spec_, by, wanted)
 
     def x_of(z: np.ndarray) -> np.ndarray:
         return low + np.clip(z, 0.0, 1.0) * width
@@ -294,7 +295,9 @@ def optimize(
         return run_spec.with_paths({p: float(v) for p, v in zip(paths, x, strict=True)})
 
     def rho_at(z: np.ndarray) -> float:
-        s = solve(at(x_of(z)), metrics[:1])
+        # Only the multipliers are read: they are the exact monodromy's at the orbit, whatever
+        # the parameters, so one parameter's derivatives (not every path's) come with them.
+        s = solve(at(x_of(z)), metrics[:1], paths[:1])
         return _largest_non_neutral(s.multipliers)
 
     def evaluate(z: np.ndarray) -> _Eval:
