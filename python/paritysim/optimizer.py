@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 import re
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -100,9 +100,10 @@ class OptimizationResult:
     (``iteration``, ``objective``, ``max_violation``, one column per parameter).
     ``evaluations``: the distinct points evaluated (objective, constraints and gradients);
     ``sensitivities``: every `sensitivity` run, those points' and the stability constraint's
-    one-sided differences (one more per parameter and point): the search's cost, each about
-    one steady-state solve plus two periods per parameter (the stability differences read
-    only the multipliers and differentiate by one parameter).
+    one-sided differences (one more per parameter at each point whose gradients the solver
+    asks for; its line-search trials need none): the search's cost, each about one
+    steady-state solve plus two periods per parameter (the stability differences read only
+    the multipliers and differentiate by one parameter).
     """
 
     success: bool
@@ -176,6 +177,15 @@ class _Eval:
     grads: dict[str, np.ndarray]  # d metric / d z (scaled parameters)
     multipliers: np.ndarray
     rho: float  # largest non-neutral |multiplier|
+    # d rho / d z ("" in `grads` once computed): one solve per parameter, so only at the
+    # points whose constraint gradients the solver asks for (not at its line-search trials).
+    stability_gradient: Callable[[], np.ndarray] | None = None
+
+    def gradient(self, metric: str) -> np.ndarray:
+        """``d metric / d z``; ``""``: the stability bound's, computed on first use."""
+        if metric not in self.grads and self.stability_gradient is not None:
+            self.grads[metric] = self.stability_gradient()
+        return self.grads[metric]
 
 
 def _largest_non_neutral(multipliers: np.ndarray) -> float:
@@ -328,7 +338,8 @@ def optimize(
                 warned[name] = f"ps.optimize: {name} is not differentiable at {shown} ({row['reason']}); its derivative there is the core's and may mislead the optimiser"
             values[name], grads[name] = float(value), g
         rho = _largest_non_neutral(s.multipliers)
-        if stability is not None:
+
+        def stability_gradient() -> np.ndarray:
             g = np.empty(len(paths))
             for k in range(len(paths)):
                 step = STABILITY_STEP if z[k] + STABILITY_STEP <= 1.0 else -STABILITY_STEP
@@ -338,8 +349,9 @@ def optimize(
                     g[k] = (rho_at(zk) - rho) / step
                 except ParitysimError as exc:
                     raise _Stop(f"no steady state for the stability derivative near {shown}: {exc}") from exc
-            grads[""] = g
-        e = _Eval(values, grads, s.multipliers, rho)
+            return g
+
+        e = _Eval(values, grads, s.multipliers, rho, stability_gradient if stability is not None else None)
         cache[key] = e
         return e
 
@@ -368,7 +380,7 @@ def optimize(
             e = evaluate(z)
             rows = []
             for c in group:
-                g = e.grads[c.metric]
+                g = e.gradient(c.metric)
                 if c.absolute:
                     g = g * (1.0 if e.values[c.metric] >= 0 else -1.0)
                 rows.append((g if c.op != "<=" else -g) / c.scale())
