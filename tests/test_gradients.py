@@ -128,6 +128,22 @@ def test_metric_selection_elasticities_and_plot():
     assert s.plot().axes
 
 
+def test_the_arrays_are_the_tables_and_the_tables_wait_until_read():
+    spec = _set(ps.devices.load("sreetharan2012_3_3_parity"), {"drivetrain.balance_spring": 5.0})
+    params = ["actuator.amplitude_v", "drivetrain.balance_spring"]
+    s = ps.sensitivity(spec, params, metrics=["right_stroke_amplitude", "delta_tau_peak"], progress=False)
+    # The polars tables are built on first use (ps.optimize reads only the arrays).
+    assert "jacobian" not in vars(s) and "parameters" not in vars(s)
+    assert s.matrix.shape == (2, 2) and list(s.metric_names) == s.jacobian["metric"].to_list()
+    for j, p in enumerate(params):
+        assert s.matrix[:, j].tolist() == s.jacobian[f"d/d({p})"].to_list()
+        assert s.derivative("delta_tau_peak", p) == s.matrix[1, j]
+    assert s.values.tolist() == s.jacobian["value"].to_list()
+    assert [r is None for r in s.reasons] == s.jacobian["differentiable"].to_list()
+    assert s.parameter_values.tolist() == s.parameters["value"].to_list() == [spec.actuator.waveform.amplitude_v, 5.0]
+    assert s.jacobian is s.jacobian  # built once
+
+
 @pytest.mark.parametrize(
     ("params", "named"),
     [

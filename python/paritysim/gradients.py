@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -29,14 +30,18 @@ from .spec import Simulation
 __all__ = ["SensitivityResult", "sensitivity"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class SensitivityResult:
     """Derivatives of the steady-state metrics with respect to spec paths.
 
-    ``jacobian``: one row per metric: ``metric``, ``value`` (at the spec's point), one column
-    ``d/d(<path>)`` per parameter (metric units per parameter unit), ``differentiable`` and
-    ``reason`` (why not: a kink such as a peak switching between two maxima, a metric that
-    moves along a family of orbits, or one not defined here).
+    As arrays: ``metric_names``, ``values`` (the metrics at the spec's point), ``matrix``
+    (``d metric / d parameter``, metrics x parameters, metric units per parameter unit),
+    ``reasons`` (per metric: why its derivatives are not to be trusted, ``None`` where they
+    are: a kink such as a peak switching between two maxima, a metric that moves along a
+    family of orbits, or one not defined here), ``parameter_names``, ``units`` and
+    ``parameter_values``.
+    As tables (built on first use): ``jacobian``, one row per metric: ``metric``, ``value``,
+    one column ``d/d(<path>)`` per parameter, ``differentiable`` and ``reason``;
     ``parameters``: ``parameter``, ``unit``, ``value``.
     ``multipliers``: Floquet multipliers of the exact monodromy, largest modulus first.
     ``neutral_directions``: directions with a multiplier at 1, left out of ``dx*/dp``.
@@ -44,22 +49,50 @@ class SensitivityResult:
     parameter. ``residual``: the orbit's period-map residual on its grid.
     """
 
-    jacobian: pl.DataFrame
-    parameters: pl.DataFrame
+    metric_names: tuple[str, ...]
+    values: np.ndarray
+    matrix: np.ndarray
+    reasons: tuple[str | None, ...]
+    parameter_names: tuple[str, ...]
+    units: tuple[str, ...]
+    parameter_values: np.ndarray
     multipliers: np.ndarray
     neutral_directions: int
     state_jacobian: np.ndarray
     residual: float
 
+    @cached_property
+    def jacobian(self) -> pl.DataFrame:
+        """One row per metric: ``metric``, ``value``, ``d/d(<path>)`` per parameter,
+        ``differentiable``, ``reason``."""
+        # One constructor from rows: a with_columns per parameter cost 0.15 ms each, and rows
+        # build the §3.3 benchmark's table in 0.13 ms against 0.31 ms from numpy columns.
+        derivatives = {f"d/d({name})": pl.Float64 for name in self.parameter_names}
+        return pl.DataFrame(
+            [
+                (metric, float(value), *(float(d) for d in row), reason is None, reason)
+                for metric, value, row, reason in zip(self.metric_names, self.values, self.matrix, self.reasons, strict=True)
+            ],
+            schema={"metric": pl.String, "value": pl.Float64, **derivatives, "differentiable": pl.Boolean, "reason": pl.String},
+            orient="row",
+        )
+
+    @cached_property
+    def parameters(self) -> pl.DataFrame:
+        """``parameter``, ``unit``, ``value``."""
+        return pl.DataFrame(
+            list(zip(self.parameter_names, self.units, (float(v) for v in self.parameter_values), strict=True)),
+            schema={"parameter": pl.String, "unit": pl.String, "value": pl.Float64},
+            orient="row",
+        )
+
     def derivative(self, metric: str, parameter: str) -> float:
         """``d metric / d parameter`` (names as given to `sensitivity`)."""
-        rows = self.jacobian.filter(pl.col("metric") == metric)
-        if rows.height == 0:
-            raise invalid("metric", metric, "one of the result's metrics: " + ", ".join(self.jacobian["metric"].head(5)))
-        column = f"d/d({parameter})"
-        if column not in self.jacobian.columns:
-            raise invalid("parameter", parameter, "one of " + ", ".join(self.parameters["parameter"]))
-        return float(rows[column][0])
+        if metric not in self.metric_names:
+            raise invalid("metric", metric, "one of the result's metrics: " + ", ".join(self.metric_names[:5]))
+        if parameter not in self.parameter_names:
+            raise invalid("parameter", parameter, "one of " + ", ".join(self.parameter_names))
+        return float(self.matrix[self.metric_names.index(metric), self.parameter_names.index(parameter)])
 
     def elasticities(self) -> pl.DataFrame:
         """``(p / m) dm/dp``: the relative change of each metric per relative change of each
@@ -97,10 +130,10 @@ class SensitivityResult:
         return fig
 
     def __repr__(self) -> str:
-        bad = int((~self.jacobian["differentiable"]).sum())
+        bad = sum(reason is not None for reason in self.reasons)
         largest = abs(self.multipliers[0]) if len(self.multipliers) else float("nan")
         return (
-            f"SensitivityResult({self.jacobian.height} metrics x {self.parameters.height} parameters, "
+            f"SensitivityResult({len(self.metric_names)} metrics x {len(self.parameter_names)} parameters, "
             f"{bad} not differentiable, {self.neutral_directions} neutral direction(s), "
             f"largest |multiplier| {largest:.4g}, orbit residual {self.residual:.1e})"
         )
@@ -129,9 +162,11 @@ def sensitivity(
     device asked for stroke metrics; parameters in pairs on the sweep's threads,
     ``PARITYSIM_THREADS``). Metrics that
     read work integrals (the powers, the work per cycle) integrate each window instead. On the
-    §3.3 benchmark point about 2.0× the instructions of a `paritysim.simulate` with one
-    parameter, 2.6× with four, 3.7× with eight (about 1.8 simulates, then a quarter of one per
-    parameter); on the §3.4 1-Cut with 3 parameters about 2.7× (docs/findings.md §30).
+    §3.3 benchmark point about 1.9× the instructions of a `paritysim.simulate` with one
+    parameter, 3.5× with eight, 3.9× with ten (about 1.7 simulates, then a fifth of one per
+    parameter; reading the ``jacobian`` and ``parameters`` tables, built on first use, adds
+    about 0.1 simulate); on the §3.4 1-Cut with 3 parameters about 2.7× (docs/findings.md
+    §30).
 
     Raises
     ------
@@ -153,28 +188,19 @@ def sensitivity(
         spec = spec.replace(options=spec.options.with_fields("options", **option_overrides))
     with LongRun("sensitivity", progress, spec.options.max_wall_ms):
         raw = _core.sensitivity(spec.to_json(), names, wanted)
-    reasons = list(raw["not_differentiable"])
-    # Each table in one constructor from rows: a with_columns per parameter cost 0.15 ms each,
-    # and rows build the §3.3 benchmark's tables in 0.23 ms against 0.41 ms from columns.
-    derivatives = {f"d/d({name})": pl.Float64 for name in raw["parameter"]}
-    jacobian = pl.DataFrame(
-        [
-            (metric, value, *(float(column[i]) for column in raw["jacobian"]), not reason, reason or None)
-            for i, (metric, value, reason) in enumerate(zip(raw["metric"], raw["value"], reasons, strict=True))
-        ],
-        schema={"metric": pl.String, "value": pl.Float64, **derivatives, "differentiable": pl.Boolean, "reason": pl.String},
-        orient="row",
-    )
-    parameters = pl.DataFrame(
-        list(zip(raw["parameter"], raw["unit"], raw["parameter_value"], strict=True)),
-        schema={"parameter": pl.String, "unit": pl.String, "value": pl.Float64},
-        orient="row",
-    )
     multipliers = np.array([complex(re, im) for re, im in raw["multipliers"]], dtype=complex)
     state = np.asarray(raw["state_jacobian"], dtype=float).T if len(raw["state_jacobian"]) else np.zeros((0, 0))
+    parameter_names, metric_names = tuple(raw["parameter"]), tuple(raw["metric"])
+    # The core's Jacobian comes by columns (one per parameter, over the metrics).
+    matrix = np.asarray(raw["jacobian"], dtype=float).reshape(len(parameter_names), len(metric_names)).T
     return SensitivityResult(
-        jacobian=jacobian,
-        parameters=parameters,
+        metric_names=metric_names,
+        values=np.asarray(raw["value"], dtype=float),
+        matrix=matrix,
+        reasons=tuple(reason or None for reason in raw["not_differentiable"]),
+        parameter_names=parameter_names,
+        units=tuple(raw["unit"]),
+        parameter_values=np.asarray(raw["parameter_value"], dtype=float),
         multipliers=multipliers,
         neutral_directions=int(raw["neutral_directions"]),
         state_jacobian=state,

@@ -286,7 +286,7 @@ def optimize(
     width = high - low
     z0 = _start(paths, low, high, start, x0)
     if z0 is None:  # a path whose value only the core knows (an alias): read it at the spec
-        start = [float(v) for v in _sensitivity_or_params(run_spec, paths, metrics[:1]).parameters["value"]]
+        start = [float(v) for v in _sensitivity_or_params(run_spec, paths, metrics[:1]).parameter_values]
         z0 = _start(paths, low, high, start, x0)
         assert z0 is not None
 
@@ -326,16 +326,15 @@ def optimize(
         counts["evaluations"] += 1
         values: dict[str, float] = {}
         grads: dict[str, np.ndarray] = {}
-        for row in s.jacobian.iter_rows(named=True):
-            name = row["metric"]
-            value = row["value"]
-            g = np.array([row[f"d/d({p})"] for p in paths], dtype=float) * width
-            if value is None or not math.isfinite(value):
+        # The result's arrays (the columns are `paths`, in order), not its tables.
+        for name, value, row, reason in zip(s.metric_names, s.values, s.matrix, s.reasons, strict=True):
+            g = row * width
+            if not math.isfinite(value):
                 raise _Stop(f"{name} is not defined at {shown}", name)
             if not np.isfinite(g).all():
-                raise _Stop(f"the gradient of {name} is not defined at {shown}: {row['reason'] or 'not finite'}", name)
-            if not row["differentiable"] and name not in warned:
-                warned[name] = f"ps.optimize: {name} is not differentiable at {shown} ({row['reason']}); its derivative there is the core's and may mislead the optimiser"
+                raise _Stop(f"the gradient of {name} is not defined at {shown}: {reason or 'not finite'}", name)
+            if reason is not None and name not in warned:
+                warned[name] = f"ps.optimize: {name} is not differentiable at {shown} ({reason}); its derivative there is the core's and may mislead the optimiser"
             values[name], grads[name] = float(value), g
         rho = _largest_non_neutral(s.multipliers)
 
