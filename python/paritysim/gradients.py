@@ -165,7 +165,7 @@ def sensitivity(
     §3.3 benchmark point about 1.9× the instructions of a `paritysim.simulate` with one
     parameter, 3.5× with eight, 3.9× with ten (about 1.7 simulates, then a fifth of one per
     parameter; reading the ``jacobian`` and ``parameters`` tables, built on first use, adds
-    about 0.1 simulate); on the §3.4 1-Cut with 3 parameters about 2.7× (docs/findings.md
+    0.1 to 0.2 of a simulate); on the §3.4 1-Cut with 3 parameters about 2.7× (docs/findings.md
     §30).
 
     Raises
