@@ -224,8 +224,8 @@ pub fn steady_sensitivity_at(
     let (mapped, monodromy, replay, mut base_metrics) = if let Some(kept) = kept {
         // The run's last shooting period: this very period, integrated there.
         let replay = Replay {
-            states: kept.states.clone(),
-            phi: kept.phi.clone(),
+            states: kept.states.as_slice().into(),
+            phi: kept.phi.as_slice().into(),
         };
         let metrics = kept.metrics.clone();
         (kept.end, kept.monodromy.clone(), Some(replay), metrics)
@@ -251,7 +251,10 @@ pub fn steady_sensitivity_at(
                 sampler.add(i, t, y)
             },
         )?;
-        let replay = Replay { states, phi };
+        let replay = Replay {
+            states: states.into(),
+            phi: phi.into(),
+        };
         (mapped, monodromy, Some(replay), sampler.finish().1)
     };
     let residual = crate::shooting::newton::residual(n, &x_star, &mapped.without_work()).1;

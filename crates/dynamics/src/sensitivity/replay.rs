@@ -1,5 +1,7 @@
 //! The windows of starts near the orbit, from the base window's samples moved by `Φ(t)`.
 
+use std::borrow::Cow;
+
 use nalgebra::DVector;
 use paritysim_error::Result;
 
@@ -11,13 +13,14 @@ use super::periods::in_lanes;
 
 /// The base window's samples (times, states) and `Φ(t, 0)` at each: the window of a start
 /// `x* + δ` is, to first order in `δ`, the window of the states `y(t) + Φ(t) δ`.
-pub(super) struct Replay {
-    pub(super) states: Vec<State>,
+/// Borrowed from the run's kept period, or owned when the sensitivity integrated its own.
+pub(super) struct Replay<'a> {
+    pub(super) states: Cow<'a, [State]>,
     /// `Φ` at each sample: `2n × 2n` (compact state), column-major, one after another.
-    pub(super) phi: Vec<f64>,
+    pub(super) phi: Cow<'a, [f64]>,
 }
 
-impl Replay {
+impl Replay<'_> {
     /// The metrics of the window of `point` whose sample states are `states` (at the base
     /// window's phases) moved to the start `x* + shift` (compact): to first order, the states
     /// `y(t) + Φ(t) shift`. The central differences cancel the first-order error of taking
