@@ -55,6 +55,12 @@ impl State {
         y
     }
 
+    /// Appends [`Self::compact`]'s entries to `out` (samples kept flat, `2n` each).
+    pub fn push_compact(&self, n: usize, out: &mut Vec<f64>) {
+        out.extend_from_slice(&self.coords[..n]);
+        out.extend_from_slice(&self.rates[..n]);
+    }
+
     /// The state with both work integrals set to zero.
     pub fn without_work(mut self) -> Self {
         self.work_actuator = 0.0;

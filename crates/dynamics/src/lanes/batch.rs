@@ -14,7 +14,7 @@ use crate::integrate::lanes::{
 use crate::metrics::MetricsAccumulator;
 
 use super::linear_stroke::{LinearStroke, LinearStrokeLanes};
-use super::point::{compact4, expand4, feed_samples};
+use super::point::{compact4, feed_samples};
 
 /// Periods completed here (`super::periods_completed_in_lanes`).
 pub(crate) static COMPLETED: AtomicUsize = AtomicUsize::new(0);
@@ -31,18 +31,18 @@ pub(crate) struct Job<'a> {
 }
 
 /// A job's state at its grid's end (compact `[q1, q2, q̇1, q̇2]`) and, for a window, its
-/// metrics or (captured) its sample states.
+/// metrics or (captured) its sample states (compact, one after another).
 pub(crate) struct Done {
     pub(crate) end: [f64; 4],
     pub(crate) metrics: Option<Vec<(String, f64)>>,
-    pub(crate) states: Vec<State>,
+    pub(crate) states: Vec<f64>,
 }
 
 /// What a job keeps of its window's samples.
 enum Window {
     None,
     Metrics(Box<MetricsAccumulator>),
-    States(Vec<State>),
+    States(Vec<f64>),
 }
 
 impl Window {
@@ -58,10 +58,9 @@ impl Window {
             Window::None => true,
             Window::Metrics(m) => feed_samples(model, m, block, closing, with_force),
             Window::States(states) => {
-                states.extend(
-                    (0..block.count)
-                        .map(|i| expand4(&std::array::from_fn(|c| block.y[c].as_array()[i]))),
-                );
+                for i in 0..block.count {
+                    states.extend(block.y.iter().map(|component| component.as_array()[i]));
+                }
                 true
             }
         }
@@ -122,7 +121,7 @@ pub(crate) fn run<'a>(
         .iter()
         .map(|j| match (&j.times, capture) {
             (None, _) => Window::None,
-            (Some(times), true) => Window::States(Vec::with_capacity(times.len())),
+            (Some(times), true) => Window::States(Vec::with_capacity(4 * times.len())),
             (Some(_), false) => Window::Metrics(Box::new(
                 MetricsAccumulator::new(j.device, j.device.period()).with_weight(weight),
             )),

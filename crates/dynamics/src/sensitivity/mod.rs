@@ -214,10 +214,9 @@ pub fn steady_sensitivity_at(
     };
     let differenced = differenced(device);
     let (sampler, times) = WindowSampler::of_grid_window(device, &grid, period, options);
-    let kept = orbit
-        .samples
-        .as_ref()
-        .filter(|kept| !differenced && !sampler.reads_work() && kept.states.len() == times.len());
+    let kept = orbit.samples.as_ref().filter(|kept| {
+        !differenced && !sampler.reads_work() && kept.states.len() == 2 * n * times.len()
+    });
     // The base window is sampled in the variational period, unless the metrics read the work
     // integrals (which that run does not integrate) or the monodromy is differenced; `Φ` at
     // its samples then moves the window to nearby starts without integrating again.
@@ -240,14 +239,14 @@ pub fn steady_sensitivity_at(
         (mapped, monodromy, None, metrics)
     } else {
         let mut sampler = sampler;
-        let mut states = Vec::with_capacity(times.len());
+        let mut states = Vec::with_capacity(2 * n * times.len());
         let (mapped, monodromy, phi) = rk.with_work(false).flow_with_sensitivity_on_grid_sampled(
             device,
             &grid,
             &x_star,
             &times,
             &mut |i, t, y| {
-                states.push(*y);
+                y.push_compact(n, &mut states);
                 sampler.add(i, t, y)
             },
         )?;

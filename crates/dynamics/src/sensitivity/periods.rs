@@ -21,11 +21,11 @@ pub(super) enum Keep {
 }
 
 /// A perturbed period: its end state (compact; `Keep::End`, `Keep::Samples`), its window's
-/// sample states (`Keep::Samples`) or metrics (`Keep::Metrics`).
+/// sample states (`Keep::Samples`, compact, one after another) or metrics (`Keep::Metrics`).
 #[derive(Default)]
 pub(super) struct Period {
     pub(super) end: DVector<f64>,
-    pub(super) states: Vec<State>,
+    pub(super) states: Vec<f64>,
     pub(super) metrics: Vec<(String, f64)>,
 }
 
@@ -107,19 +107,20 @@ pub(super) fn periods<'a>(
         } else {
             Vec::new()
         };
-        let mut states = Vec::with_capacity(sample_times.len());
+        let n = point.device.n_dof();
+        let mut states = Vec::with_capacity(2 * n * sample_times.len());
         let end = rk.with_work(false).integrate_on_grid(
             &point.device,
             &point.grid,
             &starts[k],
             &sample_times,
             &mut |_, _, y| {
-                states.push(*y);
+                y.push_compact(n, &mut states);
                 Ok(())
             },
         )?;
         Ok(Period {
-            end: end.without_work().compact(point.device.n_dof()),
+            end: end.without_work().compact(n),
             states,
             metrics: Vec::new(),
         })

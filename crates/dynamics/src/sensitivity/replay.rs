@@ -15,27 +15,27 @@ use super::periods::in_lanes;
 /// `x* + δ` is, to first order in `δ`, the window of the states `y(t) + Φ(t) δ`.
 /// Borrowed from the run's kept period, or owned when the sensitivity integrated its own.
 pub(super) struct Replay<'a> {
-    pub(super) states: Cow<'a, [State]>,
+    /// The sample states, compact (`2n` each), one after another.
+    pub(super) states: Cow<'a, [f64]>,
     /// `Φ` at each sample: `2n × 2n` (compact state), column-major, one after another.
     pub(super) phi: Cow<'a, [f64]>,
 }
 
 impl Replay<'_> {
-    /// The metrics of the window of `point` whose sample states are `states` (at the base
-    /// window's phases) moved to the start `x* + shift` (compact): to first order, the states
+    /// The metrics of the window of `point` whose sample states are `states` (compact, at the
+    /// base window's phases) moved to the start `x* + shift` (compact): to first order, the states
     /// `y(t) + Φ(t) shift`. The central differences cancel the first-order error of taking
     /// the base point's `Φ` at a perturbed one.
     pub(super) fn window_along(
         &self,
         (device, grid, period): (&Device, &[f64], f64),
-        states: &[State],
+        states: &[f64],
         shift: &DVector<f64>,
         options: &SimulationOptions,
     ) -> Result<Vec<(String, f64)>> {
-        let n = device.n_dof();
-        let m = 2 * n;
+        let m = 2 * device.n_dof();
         let shift = shift.as_slice();
-        let samples = states.iter().zip(self.phi.chunks_exact(m * m));
+        let samples = states.chunks_exact(m).zip(self.phi.chunks_exact(m * m));
         let (mut sampler, times) = WindowSampler::of_grid_window(device, grid, period, options);
         if let (Some(names), true, Ok(shift)) =
             (&options.metrics, in_lanes(options)?, shift.try_into())
@@ -68,11 +68,12 @@ impl Replay<'_> {
     }
 }
 
-/// Adds to `sampler` the samples `states` moved by `Φ·shift` (`M = 2n`, see [`moved`]).
+/// Adds to `sampler` the samples `states` (compact) moved by `Φ·shift` (`M = 2n`, see
+/// [`moved`]).
 fn sample_moved<const M: usize>(
     sampler: &mut WindowSampler,
     times: &[f64],
-    states: &[State],
+    states: &[f64],
     phis: std::slice::ChunksExact<'_, f64>,
     shift: &[f64],
 ) -> Result<()> {
@@ -83,9 +84,14 @@ fn sample_moved<const M: usize>(
         ))
     })?;
     let n = M / 2;
-    for (i, ((t, y), phi)) in times.iter().zip(states).zip(phis).enumerate() {
+    for (i, ((t, y), phi)) in times
+        .iter()
+        .zip(states.chunks_exact(M))
+        .zip(phis)
+        .enumerate()
+    {
         let compact = moved(y, phi, shift);
-        let mut y = *y;
+        let mut y = State::default();
         y.coords[..n].copy_from_slice(&compact[..n]);
         y.rates[..n].copy_from_slice(&compact[n..]);
         sampler.add(i, *t, &y)?;
@@ -93,19 +99,17 @@ fn sample_moved<const M: usize>(
     Ok(())
 }
 
-/// The compact state `y + Φ·shift` (`M = 2n`; `Φ` column-major, `M × M`).
+/// The compact state `y + Φ·shift` (`y` compact; `M = 2n`; `Φ` column-major, `M × M`).
 #[inline]
-fn moved<const M: usize>(y: &State, phi: &[f64], shift: &[f64; M]) -> [f64; M] {
+fn moved<const M: usize>(y: &[f64], phi: &[f64], shift: &[f64; M]) -> [f64; M] {
     let mut delta = [0.0; M];
     for (column, s) in phi.chunks_exact(M).zip(shift) {
         for (d, p) in delta.iter_mut().zip(column) {
             *d += p * s;
         }
     }
-    let n = M / 2;
-    for i in 0..n {
-        delta[i] += y.coords[i];
-        delta[n + i] += y.rates[i];
+    for (d, y) in delta.iter_mut().zip(y) {
+        *d += y;
     }
     delta
 }

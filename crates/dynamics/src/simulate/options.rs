@@ -194,8 +194,9 @@ pub struct OrbitSamples {
     pub end: State,
     /// The exact monodromy `∂P/∂x` at the orbit (active rows and columns).
     pub monodromy: nalgebra::DMatrix<f64>,
-    /// The states at the window's samples.
-    pub states: Vec<State>,
+    /// The states at the window's samples, compact (coordinates, then rates: `2n` each), one
+    /// after another.
+    pub states: Vec<f64>,
     /// `Φ(t)` at each sample, as [`SimulationResult::monodromy`]'s block, column-major, one
     /// after another.
     pub phi: Vec<f64>,

@@ -158,14 +158,15 @@ pub(super) fn record_window_sampled(
 ) -> Result<(Recorded, super::OrbitSamples)> {
     let times: Vec<f64> = window_times(grid[0], period, n_samples).collect();
     let mut sampler = WindowSampler::new(device, Some(period), columns, stroke, n_samples, weight);
-    let mut states = Vec::with_capacity(times.len());
+    let n = device.n_dof();
+    let mut states = Vec::with_capacity(2 * n * times.len());
     let (end, monodromy, phi) = integrator.flow_with_sensitivity_on_grid_sampled(
         device,
         grid,
         y,
         &times,
         &mut |i, t, y| {
-            states.push(*y);
+            y.push_compact(n, &mut states);
             sampler.add(i, t, y)
         },
     )?;
