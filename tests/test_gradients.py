@@ -167,9 +167,17 @@ def test_sensitivity_periods_in_lanes_equal_the_scalar_ones(balance_spring: floa
     """A linear-map device's perturbed periods run four at a time in SIMD lanes
     (``crates/dynamics/src/lanes/batch.rs``); ``PARITYSIM_LANES=1`` runs them scalar: the same
     bits, central differences (K2 = 5) and one-sided ones at the range's end (K2 = 0), the
-    frequency (a scaled grid) included."""
+    frequency (a scaled grid) included, and the drives that scale the base drive's sines."""
     spec = ps.devices.load("sreetharan2012_3_3_parity").with_paths({"drivetrain.balance_spring": balance_spring, "wings.left.omega_ratio": 0.7})
-    params = ["wings[0].aero.omega1", "drivetrain.balance_spring", "actuator.stiffness", "actuator.waveform.amplitude_v", "actuator.waveform.frequency_hz", "drivetrain.transmission_ratio"]
+    params = [
+        "wings[0].aero.omega1",
+        "drivetrain.balance_spring",
+        "actuator.stiffness",
+        "actuator.waveform.amplitude_v",
+        "actuator.waveform.frequency_hz",
+        "actuator.force_per_volt",
+        "drivetrain.transmission_ratio",
+    ]
     metrics = ["delta_tau_peak", "tau_r_peak", "tau_l_peak", "imbalance_peak_pct", "left_stroke_amplitude"]
     lanes = ps.sensitivity(spec, params, metrics=metrics, progress=False)
     monkeypatch.setenv("PARITYSIM_LANES", "1")

@@ -27,11 +27,14 @@ def linear_map_design(steady_state: str = "shooting") -> ps.Simulation:
     )
 
 
-def run(monkeypatch: pytest.MonkeyPatch, lanes: str, threads: int) -> np.ndarray:
+OMEGA_K2 = {"wings.left.omega_ratio": np.linspace(0.3, 1.0, 3), "drivetrain.balance_spring": np.linspace(0.0, 100.0, 12)}
+
+
+def run(monkeypatch: pytest.MonkeyPatch, lanes: str, threads: int, axes: dict[str, np.ndarray] = OMEGA_K2) -> np.ndarray:
     monkeypatch.setenv("PARITYSIM_LANES", lanes)
     df = ps.sweep(
         linear_map_design(),
-        {"wings.left.omega_ratio": np.linspace(0.3, 1.0, 3), "drivetrain.balance_spring": np.linspace(0.0, 100.0, 12)},
+        axes,
         metrics=METRICS,
         threads=threads,
         progress=False,
@@ -49,6 +52,14 @@ def test_every_lane_width_gives_the_one_by_one_sweep_bit_for_bit(monkeypatch: py
     for lanes, threads in [("2", 1), ("4", 2), ("3", 2)]:
         other = run(monkeypatch, lanes, threads)
         assert np.array_equal(scalar, other), f"lanes {lanes}, threads {threads}"
+
+
+def test_a_drive_amplitude_sweep_in_lanes_is_the_one_by_one_sweep_bit_for_bit(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Neighbours that differ in amplitude or force per volt take their forces from the same
+    # table of the drive's sines (lanes/linear_stroke.rs, DriveTables): the same bits.
+    axes = {"actuator.waveform.amplitude_v": np.linspace(60.0, 140.0, 6), "actuator.force_per_volt": [1.1, 1.2]}
+    scalar = run(monkeypatch, "1", 1, axes)
+    assert np.array_equal(scalar, run(monkeypatch, "4", 1, axes))
 
 
 def test_a_bad_lane_width_is_a_named_error(monkeypatch: pytest.MonkeyPatch) -> None:

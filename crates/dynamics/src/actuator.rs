@@ -122,16 +122,59 @@ impl Waveform {
         }
     }
 
+    /// `sin(2π f t + φ)` of a sine drive at `t` (`None`: a sampled drive): what
+    /// [`Self::voltage`] scales and offsets ([`Self::voltage_of_sine`]).
+    #[inline]
+    pub fn sine_at(&self, t: f64) -> Option<f64> {
+        match self {
+            Waveform::Sine {
+                frequency_khz,
+                phase,
+                ..
+            } => Some((std::f64::consts::TAU * frequency_khz * t + phase).sin()),
+            Waveform::Sampled { .. } => None,
+        }
+    }
+
+    /// The voltage of a sine drive whose [`Self::sine_at`] is `sine` (V), by [`Self::voltage`]'s
+    /// own operations; a sampled drive's is NaN.
+    #[inline]
+    pub fn voltage_of_sine(&self, sine: f64) -> f64 {
+        match self {
+            Waveform::Sine {
+                amplitude_v,
+                offset_v,
+                ..
+            } => offset_v + amplitude_v * sine,
+            Waveform::Sampled { .. } => f64::NAN,
+        }
+    }
+
+    /// Whether `other` is a sine drive with the same [`Self::sine_at`] (frequency and phase): a
+    /// table of one's sines is the other's, whatever the amplitudes and offsets.
+    pub fn same_sine(&self, other: &Self) -> bool {
+        match (self, other) {
+            (
+                Waveform::Sine {
+                    frequency_khz: f,
+                    phase: p,
+                    ..
+                },
+                Waveform::Sine {
+                    frequency_khz: g,
+                    phase: q,
+                    ..
+                },
+            ) => f == g && p == q,
+            _ => false,
+        }
+    }
+
     /// `V(t)` (V).
     #[inline]
     pub fn voltage(&self, t: f64) -> f64 {
         match self {
-            Waveform::Sine {
-                amplitude_v,
-                frequency_khz,
-                offset_v,
-                phase,
-            } => offset_v + amplitude_v * (std::f64::consts::TAU * frequency_khz * t + phase).sin(),
+            Waveform::Sine { .. } => self.voltage_of_sine(self.sine_at(t).unwrap_or(f64::NAN)),
             Waveform::Sampled {
                 times_ms,
                 voltages_v,
@@ -280,7 +323,19 @@ impl Actuator {
     /// Force (mN) at time `t` (ms).
     #[inline]
     pub fn force(&self, t: f64) -> f64 {
-        let v = self.waveform.voltage(t);
+        self.force_of_voltage(self.waveform.voltage(t))
+    }
+
+    /// The force of a sine drive whose [`Waveform::sine_at`] is `sine` at the time, by
+    /// [`Self::force`]'s own operations: a table of sines gives its forces bit for bit.
+    #[inline]
+    pub fn force_of_sine(&self, sine: f64) -> f64 {
+        self.force_of_voltage(self.waveform.voltage_of_sine(sine))
+    }
+
+    /// The force at the drive voltage `v` (the DC treatment, then the force per volt).
+    #[inline]
+    fn force_of_voltage(&self, v: f64) -> f64 {
         let v = match self.dc_offset {
             DcOffset::AsForce => v,
             DcOffset::Ignore => v - self.waveform.offset(),

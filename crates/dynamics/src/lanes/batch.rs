@@ -13,6 +13,7 @@ use crate::integrate::lanes::{
 };
 use crate::metrics::MetricsAccumulator;
 
+pub(crate) use super::linear_stroke::{DriveSeed, DriveTables};
 use super::linear_stroke::{LinearStroke, LinearStrokeLanes};
 use super::point::{compact4, feed_samples};
 
@@ -67,32 +68,12 @@ impl Window {
     }
 }
 
-/// A grid, an actuator and the actuator's force at the grid's stage times.
-type DriveTable<'a> = (Rc<[f64]>, &'a crate::actuator::Actuator, Rc<[f64]>);
-
-/// The drive tables of several [`run`]s (a sensitivity's maps and windows share them): the
-/// parameters that move neither the grid nor the actuator (a wing's Ω, a spring) share the
-/// base point's, and each run of a point reuses its own (the drive's `sin` per stage was a
-/// tenth of the time).
-pub(crate) type DriveTables<'a> = Vec<DriveTable<'a>>;
-
-/// `device`'s actuator forces at the stage times of `grid` (`None`: no lane model): one
-/// table computed once for several runs' [`DriveTables`] on other threads (see [`seeded`]).
-pub(crate) fn drive_table(device: &Device, grid: &[f64]) -> Option<Vec<f64>> {
-    LinearStroke::of(device).map(|model| model.forcing(grid).to_vec())
-}
-
-/// Drive tables holding `device`'s `forces` on `grid` (from [`drive_table`]), if any.
-pub(crate) fn seeded<'a>(
-    device: &'a Device,
-    grid: &[f64],
-    forces: Option<&[f64]>,
-) -> DriveTables<'a> {
-    let actuator = LinearStroke::of(device).map(|model| model.actuator());
-    match (actuator, forces) {
-        (Some(actuator), Some(forces)) => vec![(Rc::from(grid), actuator, Rc::from(forces))],
-        _ => Vec::new(),
-    }
+/// `device`'s drive tables on `grid` (`None`: no lane model), computed once to seed the
+/// [`DriveTables`] of several runs on other threads (a sensitivity's parameter groups: the
+/// parameters that move neither the grid nor the drive share the base point's forces, those
+/// that scale the drive its sines).
+pub(crate) fn drive_seed(device: &Device, grid: &[f64]) -> Option<DriveSeed> {
+    LinearStroke::of(device).map(|model| DriveTables::seed(grid, model.actuator()))
 }
 
 /// Runs `jobs` in the lanes, windows with the metrics `metric_names` (stroke metrics only),
@@ -104,7 +85,7 @@ pub(crate) fn run<'a>(
     (metric_names, capture): (&[String], bool),
     tol: LaneTolerances,
     weight: Option<f64>,
-    tables: &mut DriveTables<'a>,
+    tables: &mut DriveTables,
 ) -> Option<Vec<Done>> {
     if !metric_names
         .iter()
@@ -146,19 +127,7 @@ pub(crate) fn run<'a>(
             next += 1;
             let job = &jobs[k];
             lanes.load(l, &models[k]);
-            let actuator = models[k].actuator();
-            let shared = tables
-                .iter()
-                .find(|(grid, drive, _)| **grid == *job.grid && drive.same_force(actuator));
-            let table = match shared {
-                Some((_, _, table)) => table.clone(),
-                None => {
-                    let table = models[k].forcing(&job.grid);
-                    tables.push((job.grid.clone(), actuator, table.clone()));
-                    table
-                }
-            };
-            lanes.load_forcing(l, Some(table));
+            lanes.load_forcing(l, Some(tables.forces(&job.grid, models[k].actuator())));
             let problem = LaneProblem {
                 grid: job.grid.clone(),
                 adaptive: None,

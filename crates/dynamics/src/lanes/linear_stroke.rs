@@ -6,7 +6,7 @@
 
 use wide::f64x4;
 
-use crate::actuator::Actuator;
+use crate::actuator::{Actuator, Waveform};
 use crate::device::{Device, Formulation};
 use std::rc::Rc;
 
@@ -66,16 +66,6 @@ impl<'a> LinearStroke<'a> {
         self.actuator
     }
 
-    /// The actuator force at every [`stage_times`] of `grid`: the drive's `sin` once per
-    /// grid instead of once per evaluation (the grid is shared by a point's Newton periods
-    /// and usually by its chain neighbours).
-    pub(crate) fn forcing(&self, grid: &[f64]) -> Rc<[f64]> {
-        stage_times(grid)
-            .into_iter()
-            .map(|t| self.actuator.force(t))
-            .collect()
-    }
-
     /// What `StrokeSample::of_stroke_device` computes at up to four states of this device
     /// (one per vector lane, compact `[q1, q2, q̇1, q̇2]`), with its operations: the mask of
     /// states inside the drivetrain's domain, the strokes `(φL, φR)` and the roll torques
@@ -99,6 +89,120 @@ impl<'a> LinearStroke<'a> {
             }
         };
         (inside, stroke, [-torque(0), torque(1)])
+    }
+}
+
+/// A table on a grid (its stage times) of what `K` (a drive) gives there.
+type Table<K> = (Rc<[f64]>, K, Rc<[f64]>);
+
+/// Tables of actuator forces at the [`stage_times`] of grids: the drive's `sin` once per grid
+/// instead of once per evaluation (a grid is shared by a point's Newton periods, usually by
+/// its chain neighbours, and by a sensitivity's perturbed periods). Drives with the same force
+/// ([`Actuator::same_force`]) share a table; sine drives that differ only in amplitude,
+/// offset, DC treatment or force per volt share the sines ([`Waveform::same_sine`]), each
+/// force computed from them by [`Actuator::force_of_sine`], the force's own operations, so a
+/// table holds [`Actuator::force`]'s bits.
+#[derive(Clone, Default)]
+pub(crate) struct DriveTables {
+    forces: Vec<Table<Actuator>>,
+    sines: Vec<Table<Waveform>>,
+    /// Keep only the newest table of each kind (a sweep lane's, whose neighbours share it).
+    newest_only: bool,
+}
+
+impl DriveTables {
+    /// Tables that keep only the newest force and sine tables.
+    pub(crate) fn newest_only() -> Self {
+        Self {
+            newest_only: true,
+            ..Self::default()
+        }
+    }
+
+    /// `actuator`'s forces at the stage times of `grid`, from a table when one fits.
+    pub(crate) fn forces(&mut self, grid: &Rc<[f64]>, actuator: &Actuator) -> Rc<[f64]> {
+        if let Some((_, _, table)) = self
+            .forces
+            .iter()
+            .find(|(g, a, _)| **g == **grid && a.same_force(actuator))
+        {
+            return table.clone();
+        }
+        let waveform = actuator.waveform();
+        let table: Rc<[f64]> = match self.sines(grid, waveform) {
+            Some(sines) => sines.iter().map(|&s| actuator.force_of_sine(s)).collect(),
+            None => stage_times(grid)
+                .into_iter()
+                .map(|t| actuator.force(t))
+                .collect(),
+        };
+        if self.newest_only {
+            self.forces.clear();
+        }
+        self.forces
+            .push((grid.clone(), actuator.clone(), table.clone()));
+        table
+    }
+
+    /// The sines of `waveform` at the stage times of `grid` (`None`: not a sine drive).
+    fn sines(&mut self, grid: &Rc<[f64]>, waveform: &Waveform) -> Option<Rc<[f64]>> {
+        if let Some((_, _, table)) = self
+            .sines
+            .iter()
+            .find(|(g, w, _)| **g == **grid && w.same_sine(waveform))
+        {
+            return Some(table.clone());
+        }
+        let table: Rc<[f64]> = stage_times(grid)
+            .into_iter()
+            .map(|t| waveform.sine_at(t))
+            .collect::<Option<_>>()?;
+        if self.newest_only {
+            self.sines.clear();
+        }
+        self.sines
+            .push((grid.clone(), waveform.clone(), table.clone()));
+        Some(table)
+    }
+}
+
+/// A [`DriveTables`]'s tables of one drive on one grid as vectors, to seed the tables of
+/// other threads ([`DriveTables::seeded`]; the tables themselves share by `Rc`).
+pub(crate) struct DriveSeed {
+    grid: Vec<f64>,
+    actuator: Actuator,
+    forces: Vec<f64>,
+    sines: Option<Vec<f64>>,
+}
+
+impl DriveTables {
+    /// `actuator`'s tables on `grid`, computed here to seed other threads' ([`Self::seeded`]).
+    pub(crate) fn seed(grid: &[f64], actuator: &Actuator) -> DriveSeed {
+        let mut tables = Self::default();
+        let forces = tables.forces(&Rc::from(grid), actuator);
+        DriveSeed {
+            grid: grid.to_vec(),
+            actuator: actuator.clone(),
+            forces: forces.to_vec(),
+            sines: tables.sines.first().map(|(_, _, sines)| sines.to_vec()),
+        }
+    }
+
+    /// Tables holding `seed`'s.
+    pub(crate) fn seeded(seed: &DriveSeed) -> Self {
+        let grid: Rc<[f64]> = Rc::from(seed.grid.as_slice());
+        let waveform = seed.actuator.waveform();
+        Self {
+            forces: vec![(
+                grid.clone(),
+                seed.actuator.clone(),
+                Rc::from(seed.forces.as_slice()),
+            )],
+            sines: (seed.sines.iter())
+                .map(|sines| (grid.clone(), waveform.clone(), Rc::from(sines.as_slice())))
+                .collect(),
+            newest_only: false,
+        }
     }
 }
 
@@ -238,5 +342,62 @@ impl LaneRhs<20> for VariationalLanes<'_, '_> {
         let forces = [force, V::splat(0.0)];
         linear_map::variational(&rhs.terms, forces, &y, &c[4..], &mut dc[4..]);
         failed
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::actuator::DcOffset;
+
+    /// Drives that differ only in amplitude, offset, DC treatment or force per volt take their
+    /// forces from one table of sines, and those are `Actuator::force`'s bits; another
+    /// frequency or a sampled drive gets its own.
+    #[test]
+    fn forces_from_shared_sines_are_the_forces_bit_for_bit() {
+        let grid: Rc<[f64]> = Rc::from([0.0, 0.37, 1.1, 2.5, 3.1, 5.0, 8.3].as_slice());
+        let drive =
+            |amplitude: f64, offset: f64, frequency_hz: f64, dc: DcOffset, per_volt: f64| {
+                let waveform = Waveform::sine(amplitude, frequency_hz, offset, 0.3).unwrap();
+                Actuator::new(per_volt, 1.0, waveform, dc).unwrap()
+            };
+        let drives = [
+            drive(100.0, 0.0, 120.0, DcOffset::AsForce, 0.03),
+            drive(100.0 * (1.0 + 1e-5), 0.0, 120.0, DcOffset::AsForce, 0.03),
+            drive(100.0, 7.0, 120.0, DcOffset::Ignore, 0.03),
+            drive(100.0, 7.0, 120.0, DcOffset::AsForce, 0.03 * (1.0 - 1e-5)),
+            drive(100.0, 0.0, 121.0, DcOffset::AsForce, 0.03),
+        ];
+        let mut tables = DriveTables::default();
+        for actuator in &drives {
+            let table = tables.forces(&grid, actuator);
+            let direct: Vec<f64> = stage_times(&grid)
+                .iter()
+                .map(|&t| actuator.force(t))
+                .collect();
+            assert_eq!(table.len(), direct.len());
+            assert!(
+                table
+                    .iter()
+                    .zip(&direct)
+                    .all(|(a, b)| a.to_bits() == b.to_bits())
+            );
+        }
+        assert_eq!(tables.forces.len(), drives.len());
+        assert_eq!(tables.sines.len(), 2, "121 Hz has sines of its own");
+        let sampled = Waveform::sampled(vec![0.0, 2.0], vec![0.0, 50.0], 8.3).unwrap();
+        let actuator = Actuator::new(0.03, 1.0, sampled, DcOffset::AsForce).unwrap();
+        let table = tables.forces(&grid, &actuator);
+        let direct: Vec<f64> = stage_times(&grid)
+            .iter()
+            .map(|&t| actuator.force(t))
+            .collect();
+        assert!(
+            table
+                .iter()
+                .zip(&direct)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+        );
+        assert_eq!(tables.sines.len(), 2);
     }
 }

@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use paritysim_error::Result;
 
-use super::linear_stroke::{LinearStrokeLanes, VariationalLanes};
+use super::linear_stroke::{DriveTables, LinearStrokeLanes, VariationalLanes};
 use super::point::{LanePoint, Next};
 use crate::device::Device;
 use crate::integrate::lanes::{LaneOutcome, LaneStepper, SampleBlock};
@@ -18,30 +18,16 @@ use crate::sweep::{
     continued_options, remember, run_tasks,
 };
 
-/// The last forcing table built in a lane: its grid, actuator and forces.
-type ForcingCache = Option<(Rc<[f64]>, crate::actuator::Actuator, Rc<[f64]>)>;
+/// A lane's drive tables: the newest of each kind, which its chain's next point usually
+/// shares (the same grid; the same drive, or one that scales the same sines).
+type ForcingCache = DriveTables;
 
 /// `point`'s forcing table, from `cache` when a previous point had the same grid and drive.
 fn forcing(point: &mut LanePoint<'_>, cache: &mut ForcingCache) -> Rc<[f64]> {
     if let Some(f) = &point.forcing {
         return f.clone();
     }
-    let table = match cache {
-        Some((grid, actuator, table))
-            if **grid == *point.grid && actuator.same_force(point.model.actuator()) =>
-        {
-            table.clone()
-        }
-        _ => {
-            let table = point.model.forcing(&point.grid);
-            *cache = Some((
-                point.grid.clone(),
-                point.model.actuator().clone(),
-                table.clone(),
-            ));
-            table
-        }
-    };
+    let table = cache.forces(&point.grid, point.model.actuator());
     point.forcing = Some(table.clone());
     table
 }
@@ -224,7 +210,8 @@ fn run_worker(
     let mut times_cache = None;
     // One per lane: a lane's next point usually has its chain predecessor's grid (one cache
     // for the worker was overwritten by the other lanes' chains: 366 tables for 256 points).
-    let mut forcing_cache: Vec<ForcingCache> = (0..lanes).map(|_| None).collect();
+    let mut forcing_cache: Vec<ForcingCache> =
+        (0..lanes).map(|_| DriveTables::newest_only()).collect();
     loop {
         if control.is_cancelled() {
             break;

@@ -306,7 +306,7 @@ pub fn steady_sensitivity_at(
     // then the windows along (dx*/dp_j, 1).
     // The base point's drive table, shared by the groups' periods that keep its drive.
     let base_table = if periods::in_lanes(options)? {
-        crate::lanes::batch::drive_table(device, &grid)
+        crate::lanes::batch::drive_seed(device, &grid)
     } else {
         None
     };
@@ -321,7 +321,9 @@ pub fn steady_sensitivity_at(
             .map(perturbed)
             .collect::<Result<Vec<(Point, Point, bool)>>>()?;
         let points: Vec<&Point> = pairs.iter().flat_map(|(a, b, _)| [a, b]).collect();
-        let mut tables = crate::lanes::batch::seeded(device, &grid, base_table.as_deref());
+        let mut tables = base_table
+            .as_ref()
+            .map_or_else(Default::default, crate::lanes::batch::DriveTables::seeded);
         let starts = vec![x_star; points.len()];
         let keep = if replay.is_some() {
             Keep::Samples

@@ -42,10 +42,10 @@ pub(super) fn in_lanes(options: &SimulationOptions) -> Result<bool> {
 /// One fixed-grid period of each `points[k]` from `starts[k]`, keeping `keep`. Four at a time
 /// in the lanes where every device has a lane model (bit-identical to the scalar periods,
 /// `crate::lanes::batch`), else on the sensitivity's threads.
-pub(super) fn periods<'a>(
-    points: &[&'a Point],
+pub(super) fn periods(
+    points: &[&Point],
     starts: &[State],
-    (keep, tables): (Keep, &mut crate::lanes::batch::DriveTables<'a>),
+    (keep, tables): (Keep, &mut crate::lanes::batch::DriveTables),
     rk: &RungeKutta,
     options: &SimulationOptions,
 ) -> Result<Vec<Period>> {
