@@ -60,9 +60,16 @@ pub fn field_paths(spec: &Simulation) -> Vec<PathInfo> {
 }
 
 fn listing(spec: &Simulation, walk: Walk<'_>) -> Vec<PathInfo> {
-    let value = serde_json::to_value(spec).expect("a spec serialises");
+    listing_of(
+        &serde_json::to_value(spec).expect("a spec serialises"),
+        walk,
+    )
+}
+
+/// [`listing`] of a spec already serialised as `value`.
+fn listing_of(value: &Value, walk: Walk<'_>) -> Vec<PathInfo> {
     let mut out = Vec::new();
-    walk.walk(&value, schema(), "", "", &mut out);
+    walk.walk(value, schema(), "", "", &mut out);
     out
 }
 
@@ -249,6 +256,20 @@ pub fn resolve(spec: &Simulation, name: &str) -> Result<Parameter> {
 /// # Errors
 /// See [`resolve`].
 pub fn resolve_all(spec: &Simulation, names: &[String]) -> Result<(Vec<Parameter>, Vec<PathInfo>)> {
+    resolve_all_in(
+        spec,
+        &serde_json::to_value(spec).expect("a spec serialises"),
+        names,
+    )
+}
+
+/// [`resolve_all`] with the spec also given serialised (`value`: a caller that has it
+/// saves serialising it again).
+pub fn resolve_all_in(
+    spec: &Simulation,
+    value: &Value,
+    names: &[String],
+) -> Result<(Vec<Parameter>, Vec<PathInfo>)> {
     let wanted: Vec<String> = names
         .iter()
         .filter_map(|name| spellings(spec, name).ok())
@@ -270,7 +291,7 @@ pub fn resolve_all(spec: &Simulation, names: &[String]) -> Result<(Vec<Parameter
         texts: false,
         only: Some(&wanted),
     };
-    resolve(listing(spec, only)).or_else(|_| resolve(field_paths(spec)))
+    resolve(listing_of(value, only)).or_else(|_| resolve(field_paths(spec)))
 }
 
 /// The canonical paths `name` spells (every wing of a `wings[*]` name, `wings[0]` for

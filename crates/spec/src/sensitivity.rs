@@ -10,7 +10,7 @@ use paritysim_error::{Error, Result};
 use serde_json::Value;
 
 use crate::paths::{
-    Parameter, apply_in_place, apply_to, field_paths, get, resolve_all, resolve_in, spec_paths,
+    Parameter, apply_in_place, apply_to, field_paths, get, resolve_all_in, resolve_in, spec_paths,
 };
 use crate::spec::Simulation;
 
@@ -41,8 +41,8 @@ pub fn sensitivity(
     params: &[String],
     metrics: Option<&[String]>,
 ) -> Result<Sensitivity> {
-    let (parameters, units, _) = self::parameters(spec, params)?;
     let value = serde_json::to_value(spec).expect("a spec serialises");
+    let (parameters, units, _) = parameters_in(spec, &value, params)?;
     let (device, options) = prepared(spec, metrics)?;
     differentiate(&value, parameters, units, &device, &options, None)
 }
@@ -163,8 +163,8 @@ pub fn sensitivities(
 ) -> Result<SensitivityRows> {
     // The paths are resolved once on the base spec (as the sweep resolves its columns), the
     // gradients' and each row's: per point only the values change.
-    let (parameters, units, _) = self::parameters(spec, params)?;
     let base = serde_json::to_value(spec).expect("a spec serialises");
+    let (parameters, units, _) = parameters_in(spec, &base, params)?;
     let listed = field_paths(spec);
     let mut columns: Vec<(String, Parameter)> = Vec::new();
     let points: Vec<Result<Vec<(usize, Value)>>> = rows
@@ -273,6 +273,19 @@ pub fn parameters(
     spec: &Simulation,
     params: &[String],
 ) -> Result<(Vec<Parameter>, Vec<String>, Vec<f64>)> {
+    parameters_in(
+        spec,
+        &serde_json::to_value(spec).expect("a spec serialises"),
+        params,
+    )
+}
+
+/// [`parameters`] with the spec also given serialised as `value`.
+fn parameters_in(
+    spec: &Simulation,
+    value: &Value,
+    params: &[String],
+) -> Result<(Vec<Parameter>, Vec<String>, Vec<f64>)> {
     if params.is_empty() {
         return Err(Error::invalid(
             "params",
@@ -280,7 +293,7 @@ pub fn parameters(
             "at least one continuous spec path (see ps.spec_paths)",
         ));
     }
-    let (resolved, listed) = resolve_all(spec, params)?;
+    let (resolved, listed) = resolve_all_in(spec, value, params)?;
     let mut parameters = Vec::new();
     let mut units = Vec::new();
     let mut values = Vec::new();
