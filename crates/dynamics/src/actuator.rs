@@ -41,6 +41,19 @@ pub enum Waveform {
     },
 }
 
+/// `sin(2π f t + φ)`: a sine drive's phase term ([`Waveform::sine_at`], [`Waveform::voltage`]).
+#[inline]
+fn sine_term(frequency_khz: f64, phase: f64, t: f64) -> f64 {
+    (std::f64::consts::TAU * frequency_khz * t + phase).sin()
+}
+
+/// A sine drive's voltage from its [`sine_term`] ([`Waveform::voltage_of_sine`],
+/// [`Waveform::voltage`]).
+#[inline]
+fn sine_voltage(offset_v: f64, amplitude_v: f64, sine: f64) -> f64 {
+    offset_v + amplitude_v * sine
+}
+
 impl Waveform {
     /// A validated sine; `frequency_hz` in Hz (converted to kHz internally).
     pub fn sine(amplitude_v: f64, frequency_hz: f64, offset_v: f64, phase: f64) -> Result<Self> {
@@ -131,7 +144,7 @@ impl Waveform {
                 frequency_khz,
                 phase,
                 ..
-            } => Some((std::f64::consts::TAU * frequency_khz * t + phase).sin()),
+            } => Some(sine_term(*frequency_khz, *phase, t)),
             Waveform::Sampled { .. } => None,
         }
     }
@@ -145,7 +158,7 @@ impl Waveform {
                 amplitude_v,
                 offset_v,
                 ..
-            } => offset_v + amplitude_v * sine,
+            } => sine_voltage(*offset_v, *amplitude_v, sine),
             Waveform::Sampled { .. } => f64::NAN,
         }
     }
@@ -174,7 +187,16 @@ impl Waveform {
     #[inline]
     pub fn voltage(&self, t: f64) -> f64 {
         match self {
-            Waveform::Sine { .. } => self.voltage_of_sine(self.sine_at(t).unwrap_or(f64::NAN)),
+            Waveform::Sine {
+                amplitude_v,
+                frequency_khz,
+                offset_v,
+                phase,
+            } => sine_voltage(
+                *offset_v,
+                *amplitude_v,
+                sine_term(*frequency_khz, *phase, t),
+            ),
             Waveform::Sampled {
                 times_ms,
                 voltages_v,
