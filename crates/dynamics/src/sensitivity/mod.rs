@@ -502,7 +502,7 @@ fn fixed_grid_monodromy(
         .map(|x| MONODROMY_STEP * x.abs().max(1.0))
         .collect();
     let map_compact = |v: &DVector<f64>| map(&State::from_compact(n, v));
-    let jacobian = crate::shooting::newton::difference_jacobian(&base, &steps, &map_compact)?;
+    let jacobian = crate::stability::shooting::difference_jacobian(&base, &steps, &map_compact)?;
     let mapped = State::from_compact(n, &map(x)?);
     Ok((mapped, jacobian))
 }

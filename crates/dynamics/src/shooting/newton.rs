@@ -26,30 +26,6 @@ pub(crate) fn residual(n: usize, y: &State, py: &State) -> (DVector<f64>, f64) {
     (f, r)
 }
 
-/// The Jacobian of a period map at `base` (compact state) by central differences, column `j`
-/// with the step `steps[j]`; the columns run on the sweep engine's threads. The one difference
-/// Jacobian of a map: the stability check of the monodromy
-/// ([`crate::stability::map_jacobian`], adaptive map) and the switched devices' monodromy in a
-/// sensitivity (fixed-grid map).
-///
-/// # Errors
-/// The first failed evaluation of `map`.
-pub(crate) fn difference_jacobian(
-    base: &DVector<f64>,
-    steps: &[f64],
-    map: &(dyn Fn(&DVector<f64>) -> paritysim_error::Result<DVector<f64>> + Sync),
-) -> paritysim_error::Result<DMatrix<f64>> {
-    let columns = crate::stability::rows::run_parts(base.len(), |j| {
-        let shifted = |sign: f64| {
-            let mut v = base.clone();
-            v[j] += sign * steps[j];
-            map(&v)
-        };
-        Ok((shifted(1.0)? - shifted(-1.0)?) / (2.0 * steps[j]))
-    })?;
-    Ok(DMatrix::from_columns(&columns))
-}
-
 /// Whether a failed trial is the run's end rather than Newton's: a cancel, or the run's
 /// budget (wall time) spent, which the transient fallback would only exceed further.
 pub(crate) fn out_of_budget(e: &Error) -> bool {

@@ -215,11 +215,31 @@ pub fn map_jacobian(
         let out = stroboscopic_map(system, integrator, t0, period, &expand_state(n, x))?;
         Ok(compact_state(n, &out))
     };
-    crate::shooting::newton::difference_jacobian(
-        &compact_state(n, y),
-        &fd_steps(n, y, fd_step),
-        &map,
-    )
+    difference_jacobian(&compact_state(n, y), &fd_steps(n, y, fd_step), &map)
+}
+
+/// The Jacobian of a period map at `base` (compact state) by central differences, column `j`
+/// with the step `steps[j]`; the columns run on the sweep engine's threads. The one difference
+/// Jacobian of a map: the stability check of the monodromy
+/// ([`map_jacobian`], adaptive map) and the switched devices' monodromy in a sensitivity
+/// (fixed-grid map).
+///
+/// # Errors
+/// The first failed evaluation of `map`.
+pub(crate) fn difference_jacobian(
+    base: &DVector<f64>,
+    steps: &[f64],
+    map: &(dyn Fn(&DVector<f64>) -> Result<DVector<f64>> + Sync),
+) -> Result<DMatrix<f64>> {
+    let columns = super::rows::run_parts(base.len(), |j| {
+        let shifted = |sign: f64| {
+            let mut v = base.clone();
+            v[j] += sign * steps[j];
+            map(&v)
+        };
+        Ok((shifted(1.0)? - shifted(-1.0)?) / (2.0 * steps[j]))
+    })?;
+    Ok(DMatrix::from_columns(&columns))
 }
 
 /// Finds the periodic orbit of a driven device on the section `t ≡ t0 (mod T)`.
