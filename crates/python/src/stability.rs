@@ -186,13 +186,6 @@ bindings! {
     }
 }
 
-/// The (β0, κ) grid `beta0 × kappa` (row-major, β0 outer) computed in parallel: flat arrays
-/// `beta0, kappa, a, b, spectral_radius, region` (int 1-4; 0 for a failed point, whose numbers
-/// are NaN), `multiplier_error`, `marginal` and `stable` (Region I and not marginal), and the
-/// failed points as `error_index` (flat indices) with their messages `error`.
-/// With `brockett`, also `brockett_bounded` (`floquet::brockett_hill` at every computed point
-/// with κ > 0; false elsewhere), inside the same budget.
-/// `max_wall_ms` bounds the whole chart (None: no budget of its own).
 /// Derivatives of a JSON spec's steady-state metrics (`metrics`, or all) by the continuous
 /// spec paths `params` (`paritysim_spec::sensitivity`), as plain columns. On this thread
 /// (`cancellable_on`): the worker thread of `cancellable` cost 0.2-0.3 ms a call, a fifth
@@ -215,6 +208,13 @@ fn sensitivity<'py>(
     crate::convert::to_py(py, &record)
 }
 
+/// The (β0, κ) grid `beta0 × kappa` (row-major, β0 outer) computed in parallel: flat arrays
+/// `beta0, kappa, a, b, spectral_radius, region` (int 1-4; 0 for a failed point, whose numbers
+/// are NaN), `multiplier_error`, `marginal` and `stable` (Region I and not marginal), and the
+/// failed points as `error_index` (flat indices) with their messages `error`.
+/// With `brockett`, also `brockett_bounded` (`floquet::brockett_hill` at every computed point
+/// with κ > 0; false elsewhere), inside the same budget.
+/// `max_wall_ms` bounds the whole chart (None: no budget of its own).
 #[pyfunction]
 #[pyo3(signature = (beta0, kappa, max_wall_ms = None, brockett = false))]
 fn stability_chart<'py>(
