@@ -17,6 +17,8 @@
 //! not divided by; a metric that changes along them, or whose one-sided differences disagree
 //! (a peak jumping between two maxima), is flagged as not differentiable there.
 
+use std::borrow::Cow;
+
 use nalgebra::{DMatrix, DVector};
 use paritysim_error::{Error, Result};
 
@@ -214,21 +216,15 @@ pub fn steady_sensitivity_at(
     };
     let differenced = differenced(device);
     let (sampler, times) = WindowSampler::of_grid_window(device, &grid, period, options);
-    let kept = orbit.samples.as_ref().filter(|kept| {
-        !differenced && !sampler.reads_work() && kept.states.len() == 2 * n * times.len()
-    });
     // The base window is sampled in the variational period, unless the metrics read the work
     // integrals (which that run does not integrate) or the monodromy is differenced; `Φ` at
-    // its samples then moves the window to nearby starts without integrating again.
-    let (mapped, monodromy, replay, mut base_metrics) = if let Some(kept) = kept {
-        // The run's last shooting period: this very period, integrated there.
-        let replay = Replay {
-            states: kept.states.as_slice().into(),
-            phi: kept.phi.as_slice().into(),
-        };
-        let metrics = kept.metrics.clone();
-        (kept.end, kept.monodromy.clone(), Some(replay), metrics)
-    } else if differenced || sampler.reads_work() {
+    // its samples then moves the window to nearby starts without integrating again. The run's
+    // last shooting period, when it kept its samples, was this very period.
+    let kept = orbit
+        .samples
+        .as_ref()
+        .filter(|kept| kept.states.len() == 2 * n * times.len());
+    let (mapped, monodromy, replay, mut base_metrics) = if differenced || sampler.reads_work() {
         let (mapped, monodromy) = if differenced {
             fixed_grid_monodromy(device, &rk, &grid, &x_star)?
         } else {
@@ -238,23 +234,26 @@ pub fn steady_sensitivity_at(
         let metrics = crate::simulate::grid_window(device, &rk, &grid, period, &x_star, options)?;
         (mapped, monodromy, None, metrics)
     } else {
-        let mut sampler = sampler;
-        let mut states = Vec::with_capacity(2 * n * times.len());
-        let (mapped, monodromy, phi) = rk.with_work(false).flow_with_sensitivity_on_grid_sampled(
-            device,
-            &grid,
-            &x_star,
-            &times,
-            &mut |i, t, y| {
-                y.push_compact(n, &mut states);
-                sampler.add(i, t, y)
-            },
-        )?;
-        let replay = Replay {
-            states: states.into(),
-            phi: phi.into(),
+        let samples = match kept {
+            Some(kept) => Cow::Borrowed(kept),
+            None => Cow::Owned(
+                crate::simulate::sampled_variational_period(
+                    device,
+                    &rk.with_work(false),
+                    &grid,
+                    &x_star,
+                    &times,
+                    sampler,
+                )?
+                .0,
+            ),
         };
-        (mapped, monodromy, Some(replay), sampler.finish().1)
+        let base = (
+            samples.end,
+            samples.monodromy.clone(),
+            samples.metrics.clone(),
+        );
+        (base.0, base.1, Some(Replay { samples }), base.2)
     };
     let residual = crate::shooting::newton::residual(n, &x_star, &mapped.without_work()).1;
     let multipliers = crate::stability::eigenvalues(&monodromy).unwrap_or_default();
@@ -426,7 +425,8 @@ pub fn steady_sensitivity_at(
             let shift = v * (sign * eps);
             match &replay {
                 Some(replay) => {
-                    replay.window_along((device, &grid, period), &replay.states, &shift, options)
+                    let states = &replay.samples.states;
+                    replay.window_along((device, &grid, period), states, &shift, options)
                 }
                 None => {
                     let y = State::from_compact(n, &(x_star.compact(n) + shift));

@@ -7,18 +7,17 @@ use paritysim_error::Result;
 
 use crate::device::Device;
 use crate::integrate::State;
-use crate::simulate::{SimulationOptions, WindowSampler};
+use crate::simulate::{OrbitSamples, SimulationOptions, WindowSampler};
 
 use super::periods::in_lanes;
 
 /// The base window's samples (times, states) and `Φ(t, 0)` at each: the window of a start
 /// `x* + δ` is, to first order in `δ`, the window of the states `y(t) + Φ(t) δ`.
-/// Borrowed from the run's kept period, or owned when the sensitivity integrated its own.
+/// Borrowed from the run's kept period, or owned when the sensitivity integrated its own:
+/// the compact states (`2n` each) and `Φ` (`2n × 2n`, column-major) at the samples, one after
+/// another.
 pub(super) struct Replay<'a> {
-    /// The sample states, compact (`2n` each), one after another.
-    pub(super) states: Cow<'a, [f64]>,
-    /// `Φ` at each sample: `2n × 2n` (compact state), column-major, one after another.
-    pub(super) phi: Cow<'a, [f64]>,
+    pub(super) samples: Cow<'a, OrbitSamples>,
 }
 
 impl Replay<'_> {
@@ -35,7 +34,9 @@ impl Replay<'_> {
     ) -> Result<Vec<(String, f64)>> {
         let m = 2 * device.n_dof();
         let shift = shift.as_slice();
-        let samples = states.chunks_exact(m).zip(self.phi.chunks_exact(m * m));
+        let samples = states
+            .chunks_exact(m)
+            .zip(self.samples.phi.chunks_exact(m * m));
         let (mut sampler, times) = WindowSampler::of_grid_window(device, grid, period, options);
         if let (Some(names), true, Ok(shift)) =
             (&options.metrics, in_lanes(options)?, shift.try_into())
@@ -55,7 +56,7 @@ impl Replay<'_> {
                 return Ok(metrics);
             }
         }
-        let phis = self.phi.chunks_exact(m * m);
+        let phis = self.samples.phi.chunks_exact(m * m);
         match m {
             2 => sample_moved::<2>(&mut sampler, &times, states, phis, shift)?,
             4 => sample_moved::<4>(&mut sampler, &times, states, phis, shift)?,

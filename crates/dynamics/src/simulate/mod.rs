@@ -4,7 +4,9 @@
 mod options;
 mod shooting;
 mod window;
-pub(crate) use window::{WindowSampler, grid_window, grid_window_times, window_times};
+pub(crate) use window::{
+    WindowSampler, grid_window, grid_window_times, sampled_variational_period, window_times,
+};
 
 use paritysim_constraints::Vec6;
 use paritysim_error::{Error, Result, bail, check_positive};

@@ -157,14 +157,33 @@ pub(super) fn record_window_sampled(
     weight: Option<f64>,
 ) -> Result<(Recorded, super::OrbitSamples)> {
     let times: Vec<f64> = window_times(grid[0], period, n_samples).collect();
-    let mut sampler = WindowSampler::new(device, Some(period), columns, stroke, n_samples, weight);
+    let sampler = WindowSampler::new(device, Some(period), columns, stroke, n_samples, weight);
+    let (samples, trajectory) =
+        sampled_variational_period(device, integrator, grid, y, &times, sampler)?;
+    Ok(((trajectory, samples.metrics.clone(), samples.end), samples))
+}
+
+/// The variational period on `grid` from `y` (`integrator` without work integrals), each
+/// sample at `times` fed to `sampler`: the period's [`super::OrbitSamples`] and the sampler's
+/// columns.
+///
+/// # Errors
+/// As [`RungeKutta::flow_with_sensitivity_on_grid_sampled`]; a sample the sampler refuses.
+pub(crate) fn sampled_variational_period(
+    device: &Device,
+    integrator: &RungeKutta,
+    grid: &[f64],
+    y: &State,
+    times: &[f64],
+    mut sampler: WindowSampler<'_>,
+) -> Result<(super::OrbitSamples, Trajectory)> {
     let n = device.n_dof();
     let mut states = Vec::with_capacity(2 * n * times.len());
     let (end, monodromy, phi) = integrator.flow_with_sensitivity_on_grid_sampled(
         device,
         grid,
         y,
-        &times,
+        times,
         &mut |i, t, y| {
             y.push_compact(n, &mut states);
             sampler.add(i, t, y)
@@ -176,9 +195,9 @@ pub(super) fn record_window_sampled(
         monodromy,
         states,
         phi,
-        metrics: metrics.clone(),
+        metrics,
     };
-    Ok(((trajectory, metrics, end), samples))
+    Ok((samples, trajectory))
 }
 
 /// Integrates the recorded window from `(t_start, y)`, evaluating each of the `n_samples + 1`
