@@ -183,7 +183,7 @@ class _Eval:
 
     def gradient(self, metric: str) -> np.ndarray:
         """``d metric / d z``; ``""``: the stability bound's, computed on first use."""
-        if metric not in self.grads and self.stability_gradient is not None:
+        if metric == "" and "" not in self.grads and self.stability_gradient is not None:
             self.grads[metric] = self.stability_gradient()
         return self.grads[metric]
 
