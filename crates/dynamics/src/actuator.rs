@@ -150,16 +150,16 @@ impl Waveform {
     }
 
     /// The voltage of a sine drive whose [`Self::sine_at`] is `sine` (V), by [`Self::voltage`]'s
-    /// own operations; a sampled drive's is NaN.
+    /// own operations (`None`: a sampled drive).
     #[inline]
-    pub fn voltage_of_sine(&self, sine: f64) -> f64 {
+    pub fn voltage_of_sine(&self, sine: f64) -> Option<f64> {
         match self {
             Waveform::Sine {
                 amplitude_v,
                 offset_v,
                 ..
-            } => sine_voltage(*offset_v, *amplitude_v, sine),
-            Waveform::Sampled { .. } => f64::NAN,
+            } => Some(sine_voltage(*offset_v, *amplitude_v, sine)),
+            Waveform::Sampled { .. } => None,
         }
     }
 
@@ -349,10 +349,11 @@ impl Actuator {
     }
 
     /// The force of a sine drive whose [`Waveform::sine_at`] is `sine` at the time, by
-    /// [`Self::force`]'s own operations: a table of sines gives its forces bit for bit.
+    /// [`Self::force`]'s own operations: a table of sines gives its forces bit for bit
+    /// (`None`: a sampled drive).
     #[inline]
-    pub fn force_of_sine(&self, sine: f64) -> f64 {
-        self.force_of_voltage(self.waveform.voltage_of_sine(sine))
+    pub fn force_of_sine(&self, sine: f64) -> Option<f64> {
+        (self.waveform.voltage_of_sine(sine)).map(|v| self.force_of_voltage(v))
     }
 
     /// The force at the drive voltage `v` (the DC treatment, then the force per volt).

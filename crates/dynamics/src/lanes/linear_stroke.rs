@@ -129,13 +129,18 @@ impl DriveTables {
             return table.clone();
         }
         let waveform = actuator.waveform();
-        let table: Rc<[f64]> = match self.sines(grid, waveform) {
-            Some(sines) => sines.iter().map(|&s| actuator.force_of_sine(s)).collect(),
-            None => stage_times(grid)
+        let from_sines = self.sines(grid, waveform).and_then(|sines| {
+            sines
+                .iter()
+                .map(|&s| actuator.force_of_sine(s))
+                .collect::<Option<Rc<[f64]>>>()
+        });
+        let table = from_sines.unwrap_or_else(|| {
+            stage_times(grid)
                 .into_iter()
                 .map(|t| actuator.force(t))
-                .collect(),
-        };
+                .collect()
+        });
         if self.newest_only {
             self.forces.clear();
         }
