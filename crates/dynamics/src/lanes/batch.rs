@@ -6,6 +6,8 @@
 use std::rc::Rc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
+use wide::f64x4;
+
 use crate::device::Device;
 use crate::integrate::State;
 use crate::integrate::lanes::{
@@ -32,18 +34,51 @@ pub(crate) struct Job<'a> {
 }
 
 /// A job's state at its grid's end (compact `[q1, q2, q̇1, q̇2]`) and, for a window, its
-/// metrics or (captured) its sample states (compact, one after another).
+/// metrics or (captured) its sample states.
 pub(crate) struct Done {
     pub(crate) end: [f64; 4],
     pub(crate) metrics: Option<Vec<(String, f64)>>,
-    pub(crate) states: Vec<f64>,
+    pub(crate) states: SampleBlocks,
+}
+
+/// A window's sample states as the lanes read them: sample `s`'s compact component `c` in
+/// vector lane `s % 4` of `blocks[s / 4][c]`, a short last block repeating its last sample.
+pub(crate) type SampleBlocks = Vec<[f64x4; 4]>;
+
+/// Samples of `K` numbers each (one after another) in blocks of four, as [`SampleBlocks`]
+/// holds compact states (`K = 4`): number `k` of sample `s` in vector lane `s % 4` of
+/// `blocks[s / 4][k]`, a short last block repeating its last sample.
+pub(crate) fn blocks_of<const K: usize>(samples: &[f64]) -> Vec<[f64x4; K]> {
+    let mut blocks = Vec::with_capacity(samples.len().div_ceil(LANES * K));
+    let mut full = samples.chunks_exact(LANES * K);
+    for s in &mut full {
+        blocks.push(std::array::from_fn(|k| {
+            f64x4::new([s[k], s[K + k], s[2 * K + k], s[3 * K + k]])
+        }));
+    }
+    let rest = full.remainder();
+    if rest.len() >= K {
+        let last = rest.len() / K - 1;
+        blocks.push(std::array::from_fn(|k| {
+            f64x4::new(std::array::from_fn(|i| rest[i.min(last) * K + k]))
+        }));
+    }
+    blocks
+}
+
+/// The first `count` samples of `blocks` as compact states, one after another.
+pub(crate) fn compact_of(blocks: &[[f64x4; 4]], count: usize) -> Vec<f64> {
+    (0..count)
+        .flat_map(|s| (0..4).map(move |c| blocks[s / LANES][c].as_array()[s % LANES]))
+        .collect()
 }
 
 /// What a job keeps of its window's samples.
 enum Window {
     None,
     Metrics(Box<MetricsAccumulator>),
-    States(Vec<f64>),
+    /// The samples (as many as the window has times) in their blocks.
+    States(SampleBlocks, usize),
 }
 
 impl Window {
@@ -58,9 +93,16 @@ impl Window {
         match self {
             Window::None => true,
             Window::Metrics(m) => feed_samples(model, m, block, closing, with_force),
-            Window::States(states) => {
+            Window::States(blocks, _) => {
+                if block.first % LANES == 0 && block.count == LANES {
+                    blocks[block.first / LANES] = block.y;
+                    return true;
+                }
                 for i in 0..block.count {
-                    states.extend(block.y.iter().map(|component| component.as_array()[i]));
+                    let s = block.first + i;
+                    for (target, component) in blocks[s / LANES].iter_mut().zip(&block.y) {
+                        target.as_mut_array()[s % LANES] = component.as_array()[i];
+                    }
                 }
                 true
             }
@@ -102,7 +144,10 @@ pub(crate) fn run<'a>(
         .iter()
         .map(|j| match (&j.times, capture) {
             (None, _) => Window::None,
-            (Some(times), true) => Window::States(Vec::with_capacity(4 * times.len())),
+            (Some(times), true) => Window::States(
+                vec![[f64x4::ZERO; 4]; times.len().div_ceil(LANES)],
+                times.len(),
+            ),
             (Some(_), false) => Window::Metrics(Box::new(
                 MetricsAccumulator::new(j.device, j.device.period()).with_weight(weight),
             )),
@@ -161,7 +206,19 @@ pub(crate) fn run<'a>(
             let (metrics, states) = match std::mem::replace(&mut windows[k], Window::None) {
                 Window::None => (None, Vec::new()),
                 Window::Metrics(m) => (Some(m.finish_only(Some(metric_names))), Vec::new()),
-                Window::States(states) => (None, states),
+                Window::States(mut blocks, count) => {
+                    // The last block's unused lanes repeat its last sample.
+                    if let Some(last) = blocks.last_mut()
+                        && count % LANES != 0
+                    {
+                        for component in last.iter_mut() {
+                            let lanes = component.as_mut_array();
+                            let value = lanes[count % LANES - 1];
+                            lanes[count % LANES..].fill(value);
+                        }
+                    }
+                    (None, blocks)
+                }
             };
             done[k] = Some(Done {
                 end: y,
@@ -175,12 +232,12 @@ pub(crate) fn run<'a>(
 }
 
 /// The stroke metrics `metric_names` of a window of `device` from its sample states at
-/// `times` (compact `[q1, q2, q̇1, q̇2]`), four samples at a time as [`run`] takes them:
-/// `None` as for [`run`].
+/// `times` ([`SampleBlocks`], one block after another), four samples at a time as [`run`]
+/// takes them: `None` as for [`run`].
 pub(crate) fn window_metrics(
     device: &Device,
     times: &[f64],
-    states: &[[f64; 4]],
+    blocks: impl IntoIterator<Item = [f64x4; 4]>,
     metric_names: &[String],
     weight: Option<f64>,
 ) -> Option<Vec<(String, f64)>> {
@@ -194,19 +251,31 @@ pub(crate) fn window_metrics(
     let with_force = metric_names.iter().any(|m| m == "actuator_force_peak");
     let mut metrics = MetricsAccumulator::new(device, device.period()).with_weight(weight);
     let closing = times.len().saturating_sub(1);
-    for (b, (t, y)) in times.chunks(LANES).zip(states.chunks(LANES)).enumerate() {
-        let count = t.len().min(y.len());
-        // A short last block repeats its last sample in the unused lanes.
-        let compact: [[f64; 4]; LANES] = std::array::from_fn(|i| y[i.min(count - 1)]);
+    for (b, (t, y)) in times.chunks(LANES).zip(blocks).enumerate() {
+        let count = t.len();
         let block = SampleBlock {
             first: b * LANES,
             count,
             t: std::array::from_fn(|i| t[i.min(count - 1)]),
-            y: std::array::from_fn(|c| wide::f64x4::new(std::array::from_fn(|i| compact[i][c]))),
+            y,
         };
         if !feed_samples(&model, &mut metrics, &block, closing, with_force) {
             return None;
         }
     }
     Some(metrics.finish_only(Some(metric_names)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn blocks_hold_the_samples_and_repeat_the_last_in_a_short_block() {
+        let compact: Vec<f64> = (0..4 * 6).map(f64::from).collect();
+        let blocks = blocks_of::<4>(&compact);
+        assert_eq!(blocks.len(), 2);
+        assert_eq!(blocks[1][3].to_array(), [19.0, 23.0, 23.0, 23.0]);
+        assert_eq!(compact_of(&blocks, 6), compact);
+    }
 }

@@ -253,7 +253,12 @@ pub fn steady_sensitivity_at(
             samples.monodromy.clone(),
             samples.metrics.clone(),
         );
-        (base.0, base.1, Some(Replay { samples }), base.2)
+        (
+            base.0,
+            base.1,
+            Some(Replay::new(samples, n, options)?),
+            base.2,
+        )
     };
     let residual = crate::shooting::newton::residual(n, &x_star, &mapped.without_work()).1;
     let multipliers = crate::stability::eigenvalues(&monodromy).unwrap_or_default();
@@ -425,8 +430,8 @@ pub fn steady_sensitivity_at(
             let shift = v * (sign * eps);
             match &replay {
                 Some(replay) => {
-                    let states = &replay.samples.states;
-                    replay.window_along((device, &grid, period), states, &shift, options)
+                    let states = replay.base_states();
+                    replay.window_along((device, &grid, period), &states, &shift, options)
                 }
                 None => {
                     let y = State::from_compact(n, &(x_star.compact(n) + shift));

@@ -21,12 +21,25 @@ pub(super) enum Keep {
 }
 
 /// A perturbed period: its end state (compact; `Keep::End`, `Keep::Samples`), its window's
-/// sample states (`Keep::Samples`, compact, one after another) or metrics (`Keep::Metrics`).
+/// sample states (`Keep::Samples`) or metrics (`Keep::Metrics`).
 #[derive(Default)]
 pub(super) struct Period {
     pub(super) end: DVector<f64>,
-    pub(super) states: Vec<f64>,
+    pub(super) states: WindowStates,
     pub(super) metrics: Vec<(String, f64)>,
+}
+
+/// A window's sample states: compact (`2n` numbers each, one after another) from the scalar
+/// periods, or the lanes' blocks.
+pub(super) enum WindowStates {
+    Compact(Vec<f64>),
+    Blocks(crate::lanes::batch::SampleBlocks),
+}
+
+impl Default for WindowStates {
+    fn default() -> Self {
+        WindowStates::Compact(Vec::new())
+    }
 }
 
 /// Whether the perturbed periods run in the lanes (`crate::lanes::batch`): DOP853 and not
@@ -80,7 +93,7 @@ pub(super) fn periods(
                 .into_iter()
                 .map(|done| Period {
                     end: DVector::from_row_slice(&done.end),
-                    states: done.states,
+                    states: WindowStates::Blocks(done.states),
                     metrics: done.metrics.unwrap_or_default(),
                 })
                 .collect());
@@ -121,7 +134,7 @@ pub(super) fn periods(
         )?;
         Ok(Period {
             end: end.without_work().compact(n),
-            states,
+            states: WindowStates::Compact(states),
             metrics: Vec::new(),
         })
     })
