@@ -417,6 +417,14 @@ pub fn get<'a>(value: &'a Value, path: &str) -> Option<&'a Value> {
     })
 }
 
+/// [`get`], mutable: the existing field at `path`.
+fn get_mut<'a>(value: &'a mut Value, path: &str) -> Option<&'a mut Value> {
+    tokens(path)?.iter().try_fold(value, |node, t| match t {
+        Token::Key(k) => node.get_mut(k),
+        Token::Index(i) => node.get_mut(*i),
+    })
+}
+
 /// Sets `path` (canonical) in a spec value.
 ///
 /// # Errors
@@ -431,7 +439,7 @@ pub fn set(value: &mut Value, path: &str, new: Value) -> Result<()> {
             Token::Key(k) => node
                 .as_object_mut()
                 .ok_or_else(bad)?
-                .entry(k.clone())
+                .entry(k.to_string())
                 .or_insert_with(|| Value::Object(Default::default())),
             Token::Index(i) => node
                 .as_array_mut()
@@ -441,7 +449,9 @@ pub fn set(value: &mut Value, path: &str, new: Value) -> Result<()> {
     }
     match last {
         Token::Key(k) => {
-            node.as_object_mut().ok_or_else(bad)?.insert(k.clone(), new);
+            node.as_object_mut()
+                .ok_or_else(bad)?
+                .insert(k.to_string(), new);
         }
         Token::Index(i) => {
             *node
@@ -453,12 +463,12 @@ pub fn set(value: &mut Value, path: &str, new: Value) -> Result<()> {
     Ok(())
 }
 
-enum Token {
-    Key(String),
+enum Token<'a> {
+    Key(&'a str),
     Index(usize),
 }
 
-fn tokens(path: &str) -> Option<Vec<Token>> {
+fn tokens(path: &str) -> Option<Vec<Token<'_>>> {
     let mut out = Vec::new();
     for part in path.split('.') {
         let (key, mut rest) = match part.find('[') {
@@ -466,7 +476,7 @@ fn tokens(path: &str) -> Option<Vec<Token>> {
             None => (part, ""),
         };
         if !key.is_empty() {
-            out.push(Token::Key(key.to_string()));
+            out.push(Token::Key(key));
         }
         while let Some(r) = rest.strip_prefix('[') {
             let close = r.find(']')?;
@@ -497,7 +507,7 @@ pub fn apply(spec: &Simulation, overrides: &[(&Parameter, &Value)]) -> Result<Si
 /// # Errors
 /// As [`apply`].
 pub fn apply_to(mut value: Value, overrides: &[(&Parameter, &Value)]) -> Result<Simulation> {
-    set_overrides(&mut value, overrides, None)?;
+    set_overrides(&mut value, overrides)?;
     crate::from_value(value).map(|(s, _)| s)
 }
 
@@ -509,46 +519,50 @@ pub fn apply_to(mut value: Value, overrides: &[(&Parameter, &Value)]) -> Result<
 /// # Errors
 /// As [`apply`]; `value` is restored in every case.
 pub fn apply_in_place(value: &mut Value, overrides: &[(&Parameter, &Value)]) -> Result<Simulation> {
-    let absent = overrides
-        .iter()
-        .flat_map(|(param, _)| &param.targets)
-        .any(|(path, _)| get(value, path).is_none());
-    if absent {
-        // A field the value leaves out: set on a copy.
-        return apply_to(value.clone(), overrides);
+    // Each target's old value, taken out as the new one goes in.
+    let mut old: Vec<(&str, Value)> = Vec::new();
+    let mut absent = false;
+    'set: for (param, v) in overrides {
+        if v.is_null() {
+            continue;
+        }
+        for (path, scale) in &param.targets {
+            let Some(field) = get_mut(value, path) else {
+                absent = true;
+                break 'set;
+            };
+            old.push((path, std::mem::replace(field, scaled(v, *scale))));
+        }
     }
-    let mut old = Vec::new();
-    let spec = set_overrides(value, overrides, Some(&mut old)).and_then(|()| {
-        let changed: Vec<&str> = old.iter().map(|(path, _)| path.as_str()).collect();
-        crate::from_changed(value, &changed)
-    });
+    let spec = if absent {
+        None
+    } else {
+        let changed: Vec<&str> = old.iter().map(|(path, _)| *path).collect();
+        Some(crate::from_changed(value, &changed))
+    };
     for (path, before) in old.into_iter().rev() {
-        let restored = set(value, &path, before);
-        debug_assert!(restored.is_ok(), "{path} exists");
+        *get_mut(value, path).expect("a field just set") = before;
     }
-    spec
+    // A field the value leaves out: set on a copy.
+    spec.unwrap_or_else(|| apply_to(value.clone(), overrides))
 }
 
-/// Sets every `(parameter, value)` in `value` (scaled per target), pushing each target's old
-/// value to `old` (when given) before it is replaced.
-fn set_overrides(
-    value: &mut Value,
-    overrides: &[(&Parameter, &Value)],
-    mut old: Option<&mut Vec<(String, Value)>>,
-) -> Result<()> {
+/// The value written at a target: `v × scale` (an `omega_ratio`), or `v`.
+fn scaled(v: &Value, scale: Option<f64>) -> Value {
+    match (scale, v.as_f64()) {
+        (Some(s), Some(x)) => Value::from(x * s),
+        _ => v.clone(),
+    }
+}
+
+/// Sets every `(parameter, value)` in `value` (scaled per target).
+fn set_overrides(value: &mut Value, overrides: &[(&Parameter, &Value)]) -> Result<()> {
     for (param, v) in overrides {
         if v.is_null() {
             continue;
         }
         for (path, scale) in &param.targets {
-            let v = match (scale, v.as_f64()) {
-                (Some(s), Some(x)) => Value::from(x * s),
-                _ => (*v).clone(),
-            };
-            if let (Some(old), Some(before)) = (old.as_deref_mut(), get(value, path)) {
-                old.push((path.clone(), before.clone()));
-            }
-            set(value, path, v)?;
+            set(value, path, scaled(v, *scale))?;
         }
     }
     Ok(())
