@@ -64,13 +64,28 @@ pub fn from_current(value: &Value) -> Result<Simulation> {
 }
 
 /// [`from_current`] of a valid spec's value in which only the fields at the canonical
-/// `changed` paths were set: the schema is checked along those paths only.
+/// `changed` paths were set, `base` the spec it held before: the schema is checked along those
+/// paths only, and when they are all under one top-level field, that field alone is read into
+/// a copy of `base`.
 ///
 /// # Errors
 /// As [`from_value`].
-pub(crate) fn from_changed(value: &Value, changed: &[&str]) -> Result<Simulation> {
+pub(crate) fn from_changed(
+    base: &Simulation,
+    value: &Value,
+    changed: &[&str],
+) -> Result<Simulation> {
     let mut problems = Vec::new();
     schema::check_along(value, changed, &mut problems);
+    let top = |path: &str| path.split(['.', '[']).next().unwrap_or_default().to_owned();
+    if let Some(first) = changed.first().map(|path| top(path))
+        && problems.is_empty()
+        && changed.iter().all(|path| top(path) == first)
+        && let Some(spec) = base.with_field(&first, &value[first.as_str()])
+    {
+        return spec
+            .map_err(|e| Error::invalid("spec", e.to_string(), "a spec matching the schema"));
+    }
     read_checked(value, problems)
 }
 

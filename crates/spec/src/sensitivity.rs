@@ -44,7 +44,7 @@ pub fn sensitivity(
     let value = serde_json::to_value(spec).expect("a spec serialises");
     let (parameters, units, _) = parameters_in(spec, &value, params)?;
     let (device, options) = prepared(spec, metrics)?;
-    differentiate(&value, parameters, units, &device, &options, None)
+    differentiate((spec, &value), parameters, units, &device, &options, None)
 }
 
 /// The device of a sensitivity at `spec` (a fixed body) and its options ([`orbit_options`]:
@@ -65,13 +65,13 @@ fn prepared(
     Ok((device, orbit_options(&options)))
 }
 
-/// The derivatives at the spec serialised as `value` (its `device` and `options`, see
+/// The derivatives at `spec`, serialised as `value` (its `device` and `options`, see
 /// [`prepared`]) by the `parameters` (resolved on it or on a sweep's base spec: the paths are
 /// the same; their values are read from `value`, the perturbed specs are `value` with them
 /// set), at `orbit` when it is known (a sweep's converged point), else at the orbit a run from
 /// the spec's own start reaches.
 fn differentiate(
-    value: &Value,
+    (spec, value): (&Simulation, &Value),
     parameters: Vec<Parameter>,
     units: Vec<String>,
     device: &paritysim_dynamics::Device,
@@ -99,9 +99,9 @@ fn differentiate(
                 .unwrap_or_else(std::sync::PoisonError::into_inner)
         };
         let mut copy = lock().pop().unwrap_or_else(|| value.clone());
-        let spec = apply_in_place(&mut copy, &pairs);
+        let perturbed = apply_in_place(spec, &mut copy, &pairs);
         lock().push(copy);
-        spec?.device()
+        perturbed?.device()
     };
     let result = match orbit {
         Some(orbit) => steady_sensitivity_at(&device_at, device, &values, None, options, orbit)?,
@@ -197,7 +197,8 @@ pub fn sensitivities(
                 point.iter().map(|(k, v)| (&columns[*k].1, v)).collect();
             let spec = apply_to(base.clone(), &pairs)?;
             let value = serde_json::to_value(&spec).expect("a spec serialises");
-            Ok((value, prepared(&spec, metrics)?))
+            let input = prepared(&spec, metrics)?;
+            Ok(((spec, value), input))
         })?;
     let (values, inputs): (Vec<_>, Vec<_>) = rows_prepared
         .into_iter()
@@ -229,9 +230,9 @@ pub fn sensitivities(
             cycles: found.orbit_cycles,
             samples: None,
         };
-        let value = values[i].as_ref().expect("a prepared row has its spec");
+        let (spec, value) = values[i].as_ref().expect("a prepared row has its spec");
         differentiate(
-            value,
+            (spec, value),
             parameters.clone(),
             units.clone(),
             device,

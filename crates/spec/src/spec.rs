@@ -2,6 +2,7 @@
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
+use serde_json::Value;
 
 use crate::actuator::Actuator;
 use crate::body::Body;
@@ -77,4 +78,30 @@ pub struct Simulation {
     /// Integration and steady-state options.
     #[serde(default)]
     pub options: Options,
+}
+
+impl Simulation {
+    /// A copy with the top-level field `key` read from `field` (that field's JSON), the rest
+    /// as in `self`: what reading the whole spec would give when only that field changed, at
+    /// the cost of the one field. `None` for a key not listed here (the caller reads the whole
+    /// spec).
+    pub(crate) fn with_field(&self, key: &str, field: &Value) -> Option<serde_json::Result<Self>> {
+        fn read<T: for<'de> Deserialize<'de>>(
+            field: &Value,
+            into: &mut T,
+        ) -> serde_json::Result<()> {
+            *into = T::deserialize(field)?;
+            Ok(())
+        }
+        let mut spec = self.clone();
+        let read = match key {
+            "wings" => read(field, &mut spec.wings),
+            "drivetrain" => read(field, &mut spec.drivetrain),
+            "actuator" => read(field, &mut spec.actuator),
+            "body" => read(field, &mut spec.body),
+            "options" => read(field, &mut spec.options),
+            _ => return None,
+        };
+        Some(read.map(|()| spec))
+    }
 }

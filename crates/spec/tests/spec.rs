@@ -199,7 +199,7 @@ fn applying_in_place_equals_applying_to_a_copy_and_restores_the_value() {
     let mut value = original.clone();
     let (x, k) = (serde_json::json!(0.75), serde_json::json!(12.5));
     let overrides = [(&wings, &x), (&spring, &k)];
-    let in_place = paths::apply_in_place(&mut value, &overrides).unwrap();
+    let in_place = paths::apply_in_place(&spec, &mut value, &overrides).unwrap();
     assert_eq!(value, original);
     let copied = paths::apply_to(original.clone(), &overrides).unwrap();
     assert_eq!(
@@ -212,7 +212,8 @@ fn applying_in_place_equals_applying_to_a_copy_and_restores_the_value() {
     );
     // A negative spring is refused, and the value is still restored.
     let negative = serde_json::json!(-1.0);
-    let e = paths::apply_in_place(&mut value, &[(&wings, &x), (&spring, &negative)]).unwrap_err();
+    let e = paths::apply_in_place(&spec, &mut value, &[(&wings, &x), (&spring, &negative)])
+        .unwrap_err();
     assert_eq!(e.kind(), "InvalidParameter", "{e}");
     assert_eq!(value, original);
 }
@@ -329,7 +330,7 @@ fn a_spec_checked_along_its_overridden_fields_equals_one_checked_whole() {
             ] {
                 let overrides = [(&param, &new)];
                 let whole = paths::apply_to(original.clone(), &overrides);
-                let along = paths::apply_in_place(&mut value, &overrides);
+                let along = paths::apply_in_place(&spec, &mut value, &overrides);
                 assert_eq!(value, original, "{file}: {}", info.path);
                 match (whole, along) {
                     (Ok(w), Ok(a)) => {
