@@ -26,7 +26,10 @@ struct Variational<'a> {
     calls: usize,
     /// The branch held by event location (switches of the state part; None on fixed grids).
     sides: Option<Sides>,
-    /// `Φ` (column-major, `m × m`) at each sample handed to the sink, when recorded.
+    /// The active coordinates (the first `n_real` of the `n` coordinates and of the rates).
+    n_real: usize,
+    /// `Φ`'s active block (column-major, `2 n_real` square) at each sample handed to the sink,
+    /// when recorded.
     sampled_phi: Option<Vec<f64>>,
 }
 
@@ -142,9 +145,21 @@ impl Variational<'_> {
 
 impl<const M: usize> Rhs<M> for Variational<'_> {
     fn observe_sample(&mut self, c: &[f64; M]) {
-        let m = 2 * self.n;
-        if let Some(phi) = &mut self.sampled_phi {
-            phi.extend_from_slice(&c[m..m + m * m]);
+        let (n, n_real) = (self.n, self.n_real);
+        let m = 2 * n;
+        let Some(sampled) = &mut self.sampled_phi else {
+            return;
+        };
+        let full = &c[m..m + m * m];
+        if n_real == n {
+            sampled.extend_from_slice(full);
+            return;
+        }
+        // Rows/columns of the active entries: coords 0..n_real, rates n..n + n_real.
+        let index = |k: usize| if k < n_real { k } else { n + k - n_real };
+        for j in 0..2 * n_real {
+            let column = &full[index(j) * m..];
+            sampled.extend((0..2 * n_real).map(|i| column[index(i)]));
         }
     }
 
@@ -332,8 +347,9 @@ impl RungeKutta {
             n,
             calls: 0,
             sides: None,
+            n_real,
             sampled_phi: (!along.times.is_empty())
-                .then(|| Vec::with_capacity(along.times.len() * m * m)),
+                .then(|| Vec::with_capacity(along.times.len() * 4 * n_real * n_real)),
         };
         let tol = Tolerances {
             rtol: self.rtol,
@@ -369,20 +385,7 @@ impl RungeKutta {
         let active = |full: &[f64]| {
             DMatrix::from_fn(2 * n_real, 2 * n_real, |i, j| full[index(j) * m + index(i)])
         };
-        // Each sample's active block, column-major, one after another.
-        let sampled = rhs
-            .sampled_phi
-            .as_deref()
-            .map(|all| {
-                all.chunks_exact(m * m)
-                    .flat_map(|full| {
-                        (0..2 * n_real).flat_map(move |j| {
-                            (0..2 * n_real).map(move |i| full[index(j) * m + index(i)])
-                        })
-                    })
-                    .collect()
-            })
-            .unwrap_or_default();
+        let sampled = rhs.sampled_phi.unwrap_or_default();
         Ok((to_state(n, &c[..m]), active(&c[m..]), steps, sampled))
     }
 }

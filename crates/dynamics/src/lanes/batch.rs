@@ -94,12 +94,17 @@ impl Window {
             Window::None => true,
             Window::Metrics(m) => feed_samples(model, m, block, closing, with_force),
             Window::States(blocks, _) => {
+                // The samples come in order: a block is pushed when its first sample arrives.
                 if block.first % LANES == 0 && block.count == LANES {
-                    blocks[block.first / LANES] = block.y;
+                    debug_assert_eq!(block.first / LANES, blocks.len());
+                    blocks.push(block.y);
                     return true;
                 }
                 for i in 0..block.count {
                     let s = block.first + i;
+                    if s / LANES == blocks.len() {
+                        blocks.push([f64x4::ZERO; 4]);
+                    }
                     for (target, component) in blocks[s / LANES].iter_mut().zip(&block.y) {
                         target.as_mut_array()[s % LANES] = component.as_array()[i];
                     }
@@ -144,10 +149,9 @@ pub(crate) fn run<'a>(
         .iter()
         .map(|j| match (&j.times, capture) {
             (None, _) => Window::None,
-            (Some(times), true) => Window::States(
-                vec![[f64x4::ZERO; 4]; times.len().div_ceil(LANES)],
-                times.len(),
-            ),
+            (Some(times), true) => {
+                Window::States(Vec::with_capacity(times.len().div_ceil(LANES)), times.len())
+            }
             (Some(_), false) => Window::Metrics(Box::new(
                 MetricsAccumulator::new(j.device, j.device.period()).with_weight(weight),
             )),
