@@ -162,10 +162,10 @@ def sensitivity(
     device asked for stroke metrics; parameters in pairs on the sweep's threads,
     ``PARITYSIM_THREADS``). Metrics that
     read work integrals (the powers, the work per cycle) integrate each window instead. On the
-    §3.3 benchmark point about 1.9× the instructions of a `paritysim.simulate` with one
-    parameter, 3.15× with eight, 3.5× with ten (about 1.7 simulates, then a sixth of one per
+    §3.3 benchmark point about 1.7× the instructions of a `paritysim.simulate` with one
+    parameter, 2.9× with eight, 3.3× with ten (about 1.5 simulates, then a sixth of one per
     parameter; reading the ``jacobian`` and ``parameters`` tables, built on first use, adds
-    0.1 to 0.2 of a simulate); on the §3.4 1-Cut with 3 parameters about 2.7× (docs/findings.md
+    0.1 to 0.2 of a simulate); on the §3.4 1-Cut with 3 parameters about 2.6× (docs/findings.md
     §30).
 
     Raises
