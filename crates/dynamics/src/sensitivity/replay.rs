@@ -77,10 +77,10 @@ impl<'a> Replay<'a> {
     ) -> Result<Vec<(String, f64)>> {
         let m = 2 * device.n_dof();
         let shift = shift.as_slice();
-        let (mut sampler, times) = WindowSampler::of_grid_window(device, grid, period, options);
         if let (Some(names), Some(lanes), Ok(shift)) =
             (&options.metrics, &self.lanes, <&[f64; 4]>::try_from(shift))
         {
+            let times = crate::simulate::grid_window_times(grid, period, options);
             // The lanes' sampling, as the lanes' windows took theirs (the same bits).
             let blocks = match states {
                 WindowStates::Blocks(blocks) => Cow::Borrowed(blocks),
@@ -97,6 +97,7 @@ impl<'a> Replay<'a> {
                 return Ok(metrics);
             }
         }
+        let (mut sampler, times) = WindowSampler::of_grid_window(device, grid, period, options);
         let states = match states {
             WindowStates::Compact(compact) => Cow::Borrowed(compact),
             WindowStates::Blocks(blocks) => Cow::Owned(compact_of(blocks, times.len())),
