@@ -145,21 +145,9 @@ impl Variational<'_> {
 
 impl<const M: usize> Rhs<M> for Variational<'_> {
     fn observe_sample(&mut self, c: &[f64; M]) {
-        let (n, n_real) = (self.n, self.n_real);
-        let m = 2 * n;
-        let Some(sampled) = &mut self.sampled_phi else {
-            return;
-        };
-        let full = &c[m..m + m * m];
-        if n_real == n {
-            sampled.extend_from_slice(full);
-            return;
-        }
-        // Rows/columns of the active entries: coords 0..n_real, rates n..n + n_real.
-        let index = |k: usize| if k < n_real { k } else { n + k - n_real };
-        for j in 0..2 * n_real {
-            let column = &full[index(j) * m..];
-            sampled.extend((0..2 * n_real).map(|i| column[index(i)]));
+        let m = 2 * self.n;
+        if let Some(sampled) = &mut self.sampled_phi {
+            push_active_block(&c[m..m + m * m], self.n, self.n_real, sampled);
         }
     }
 
@@ -380,13 +368,26 @@ impl RungeKutta {
                 along.sink,
             )?,
         };
-        // Rows/columns of the active entries: coords 0..n_real, rates n..n + n_real.
-        let index = |k: usize| if k < n_real { k } else { n + k - n_real };
-        let active = |full: &[f64]| {
-            DMatrix::from_fn(2 * n_real, 2 * n_real, |i, j| full[index(j) * m + index(i)])
-        };
+        let mut monodromy = Vec::with_capacity(4 * n_real * n_real);
+        push_active_block(&c[m..m + m * m], n, n_real, &mut monodromy);
+        let monodromy = DMatrix::from_vec(2 * n_real, 2 * n_real, monodromy);
         let sampled = rhs.sampled_phi.unwrap_or_default();
-        Ok((to_state(n, &c[..m]), active(&c[m..]), steps, sampled))
+        Ok((to_state(n, &c[..m]), monodromy, steps, sampled))
+    }
+}
+
+/// Appends the active block of `full` (a `2n`-square `Φ`, column-major) to `out`, column-major:
+/// the rows and columns of the coordinates `0..n_real` and of the rates `n..n + n_real`.
+fn push_active_block(full: &[f64], n: usize, n_real: usize, out: &mut Vec<f64>) {
+    let m = 2 * n;
+    if n_real == n {
+        out.extend_from_slice(&full[..m * m]);
+        return;
+    }
+    let index = |k: usize| if k < n_real { k } else { n + k - n_real };
+    for j in 0..2 * n_real {
+        let column = &full[index(j) * m..];
+        out.extend((0..2 * n_real).map(|i| column[index(i)]));
     }
 }
 
