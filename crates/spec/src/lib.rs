@@ -77,11 +77,13 @@ pub(crate) fn from_changed(
 ) -> Result<Simulation> {
     let mut problems = Vec::new();
     schema::check_along(value, changed, &mut problems);
-    let top = |path: &str| path.split(['.', '[']).next().unwrap_or_default().to_owned();
+    fn top(path: &str) -> &str {
+        path.split(['.', '[']).next().unwrap_or_default()
+    }
     if let Some(first) = changed.first().map(|path| top(path))
         && problems.is_empty()
         && changed.iter().all(|path| top(path) == first)
-        && let Some(spec) = base.with_field(&first, &value[first.as_str()])
+        && let Some(spec) = base.with_field(first, &value[first])
     {
         return spec
             .map_err(|e| Error::invalid("spec", e.to_string(), "a spec matching the schema"));

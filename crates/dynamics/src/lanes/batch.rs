@@ -58,12 +58,30 @@ pub(crate) fn blocks_of<const K: usize>(samples: &[f64]) -> Vec<[f64x4; K]> {
     }
     let rest = full.remainder();
     if rest.len() >= K {
-        let last = rest.len() / K - 1;
+        let in_block = rest.len() / K;
         blocks.push(std::array::from_fn(|k| {
-            f64x4::new(std::array::from_fn(|i| rest[i.min(last) * K + k]))
+            f64x4::new(std::array::from_fn(|i| {
+                if i < in_block { rest[i * K + k] } else { 0.0 }
+            }))
         }));
     }
+    repeat_last_sample(&mut blocks, samples.len() / K);
     blocks
+}
+
+/// Fills the unused lanes of the last of the blocks holding `count` samples with its last
+/// sample.
+fn repeat_last_sample<const K: usize>(blocks: &mut [[f64x4; K]], count: usize) {
+    let used = count % LANES;
+    if let Some(last) = blocks.last_mut()
+        && used != 0
+    {
+        for component in last.iter_mut() {
+            let lanes = component.as_mut_array();
+            let value = lanes[used - 1];
+            lanes[used..].fill(value);
+        }
+    }
 }
 
 /// The first `count` samples of `blocks` as compact states, one after another.
@@ -211,16 +229,7 @@ pub(crate) fn run<'a>(
                 Window::None => (None, Vec::new()),
                 Window::Metrics(m) => (Some(m.finish_only(Some(metric_names))), Vec::new()),
                 Window::States(mut blocks, count) => {
-                    // The last block's unused lanes repeat its last sample.
-                    if let Some(last) = blocks.last_mut()
-                        && count % LANES != 0
-                    {
-                        for component in last.iter_mut() {
-                            let lanes = component.as_mut_array();
-                            let value = lanes[count % LANES - 1];
-                            lanes[count % LANES..].fill(value);
-                        }
-                    }
+                    repeat_last_sample(&mut blocks, count);
                     (None, blocks)
                 }
             };
