@@ -163,7 +163,7 @@ def sensitivity(
     ``PARITYSIM_THREADS``). Metrics that
     read work integrals (the powers, the work per cycle) integrate each window instead. On the
     §3.3 benchmark point about 1.7× the instructions of a `paritysim.simulate` with one
-    parameter, 2.9× with eight, 3.3× with ten (about 1.5 simulates, then a sixth of one per
+    parameter, 2.8× with eight, 3.1× with ten (about 1.5 simulates, then a sixth of one per
     parameter; reading the ``jacobian`` and ``parameters`` tables, built on first use, adds
     0.1 to 0.2 of a simulate); on the §3.4 1-Cut (no SIMD lanes: its perturbed periods run
     scalar) about 1.8× with one parameter, 2.6× with three and 5.7× with ten (docs/findings.md
