@@ -416,22 +416,15 @@ impl MetricsAccumulator {
         // A full block inside the window (nearly all of them) takes the same operations in
         // the same order through loops of a known length, which the compiler unrolls.
         if n == 4 && body == 4 {
-            self.add_stroke_values::<4, 4>(b);
+            self.add_stroke_values(b, 4, 4);
         } else {
-            self.add_stroke_values_short(b, n, body);
+            self.add_stroke_values(b, n, body);
         }
-    }
-
-    /// [`Self::add_stroke_block`]'s values of a block of `N` samples, the first `BODY` of them
-    /// in the window's means.
-    #[inline(always)]
-    fn add_stroke_values<const N: usize, const BODY: usize>(&mut self, b: &StrokeBlock) {
-        self.add_stroke_values_short(b, N, BODY);
     }
 
     /// The values of a block's first `n` samples (`body` of them in the means).
     #[inline(always)]
-    fn add_stroke_values_short(&mut self, b: &StrokeBlock, n: usize, body: usize) {
+    fn add_stroke_values(&mut self, b: &StrokeBlock, n: usize, body: usize) {
         let stats = |st: &mut Stats, v: &[f64; 4]| {
             for &x in &v[..n] {
                 st.range.add(x);
