@@ -62,34 +62,85 @@ where
 ///
 /// Where they run: called from a pool thread (a point of a sweep, or a part of an outer
 /// analysis) on that pool, whose threads the sweep already budgets; from a plain call on the
-/// sweep engine's own pool ([`run_rows`]), never rayon's global one; a single part on the
-/// calling thread.
+/// sweep engine's own pool ([`run_rows`]), never rayon's global one, unless the engine has one
+/// thread ([`resolve_threads`]); a single part, or every part with one engine thread, on the
+/// calling thread in index order.
 ///
 /// # Errors
-/// The first failing part's error (in index order); [`Error::Cancelled`] as [`run_rows`].
+/// The first failing part's error (in index order); [`Error::Cancelled`] as [`run_rows`];
+/// [`Error::InvalidParameter`] for a bad `PARITYSIM_THREADS`.
 pub(crate) fn run_parts<T, F>(n: usize, part: F) -> Result<Vec<T>>
 where
     T: Send,
     F: Fn(usize) -> Result<T> + Sync,
 {
-    use rayon::prelude::*;
     if n == 1 {
         // One part: on this thread, under its own budget (no hand-off to a pool and back).
         return Ok(vec![part(0)?]);
     }
     if rayon::current_thread_index().is_some() {
-        let run_budget = budget::current();
-        return (0..n)
-            .into_par_iter()
-            .map(|i| budget::carry(&run_budget, || part(i)))
-            .collect();
+        return run_parts_on(n, None, part);
     }
-    run_rows(n, None, None, part)?.into_iter().collect()
+    run_parts_on(n, Some(resolve_threads(None)?), part)
+}
+
+/// [`run_parts`] from a pool thread (`threads`: `None`) or from a plain call with `threads`
+/// engine threads. One thread runs the parts here: the hand-off to the pool's one worker and
+/// back cost about 0.3 ms a sensitivity of three or more parameters (docs/findings.md §30,
+/// session 27), and the idle worker's spinning counted as the call's instructions.
+fn run_parts_on<T, F>(n: usize, threads: Option<usize>, part: F) -> Result<Vec<T>>
+where
+    T: Send,
+    F: Fn(usize) -> Result<T> + Sync,
+{
+    use rayon::prelude::*;
+    match threads {
+        None => {
+            let run_budget = budget::current();
+            (0..n)
+                .into_par_iter()
+                .map(|i| budget::carry(&run_budget, || part(i)))
+                .collect()
+        }
+        Some(1) => (0..n).map(part).collect(),
+        Some(threads) => run_rows(n, Some(threads), None, part)?
+            .into_iter()
+            .collect(),
+    }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::{run_parts, run_rows};
+    use super::{run_parts, run_parts_on, run_rows};
+
+    #[test]
+    fn with_one_engine_thread_the_parts_run_on_the_calling_thread_in_order() {
+        let caller = std::thread::current().id();
+        let order = std::sync::Mutex::new(Vec::new());
+        let ids = run_parts_on(5, Some(1), |i| {
+            order.lock().unwrap().push(i);
+            Ok(std::thread::current().id())
+        })
+        .unwrap();
+        assert!(ids.iter().all(|id| *id == caller));
+        assert_eq!(*order.lock().unwrap(), vec![0, 1, 2, 3, 4]);
+        // The first failing part stops the rest, and its error is the call's.
+        let seen = std::sync::Mutex::new(Vec::new());
+        let err = run_parts_on(4, Some(1), |i| {
+            seen.lock().unwrap().push(i);
+            if i == 1 {
+                Err(paritysim_error::Error::invalid("part", i, "not 1"))
+            } else {
+                Ok(i)
+            }
+        })
+        .unwrap_err();
+        assert_eq!(err.kind(), "InvalidParameter");
+        assert_eq!(*seen.lock().unwrap(), vec![0, 1]);
+        // With two, they run on the engine's pool, not here.
+        let ids = run_parts_on(4, Some(2), |_| Ok(std::thread::current().id())).unwrap();
+        assert!(ids.iter().all(|id| *id != caller));
+    }
 
     #[test]
     fn the_parts_of_a_row_run_on_the_rows_threads() {
