@@ -162,12 +162,13 @@ def sensitivity(
     device asked for stroke metrics, on the calling thread; otherwise parameters in pairs on
     the engine's threads, ``PARITYSIM_THREADS``). Metrics that read work integrals (the
     powers, the work per cycle) integrate each window instead. On the §3.3 benchmark point
-    about 1.7× a `paritysim.simulate` with one parameter, 2.7× with eight, 3.0× with ten, in
-    instructions (about 1.5 simulates, then a sixth of one per parameter; reading the
-    ``jacobian`` and ``parameters`` tables, built on first use, adds 0.1 to 0.2 of a
-    simulate); on the §3.4 1-Cut (no SIMD lanes: its perturbed periods run scalar) about 1.8×
-    with one parameter, 2.6× with three and 5.7× with ten. ``benchmarks/sensitivity_cost.py``
-    measures these ratios (wall time or instructions) on your machine; docs/findings.md §30.
+    about 1.7× a `paritysim.simulate` with one parameter, 2.8× with eight, 3.1× with ten, in
+    instructions and in wall time (about 1.5 simulates, then a sixth of one per parameter;
+    reading the ``jacobian`` and ``parameters`` tables, built on first use, adds 0.1 to 0.2
+    of a simulate); on the §3.4 1-Cut (no SIMD lanes: its perturbed periods run scalar)
+    about 1.8× with one parameter, 2.6× with three and 5.7× with ten.
+    ``benchmarks/sensitivity_cost.py`` measures these ratios (wall time or instructions) on
+    your machine; docs/findings.md §30.
 
     Raises
     ------
