@@ -344,8 +344,11 @@ class Wing(_Node):
         fields:
             Other :class:`Wing` fields (``shoulder``, ``springs``, ``tunable_hinge``).
 
-        Raises ``InvalidParameterError`` naming the argument (``mass_mg``, ``line_masses[i]``,
-        ``point_masses``, ``hinge``, ``aero_model``, ``air_density_mg_per_mm3``) and its range.
+        Raises
+        ------
+        InvalidParameterError
+            Naming the argument (``mass_mg``, ``line_masses[i]``, ``point_masses``, ``hinge``,
+            ``aero_model``, ``air_density_mg_per_mm3``) and its range.
         """
         from ._errors import invalid, real
         from .aero import MODELS
