@@ -39,19 +39,10 @@ os.environ.setdefault("PARITYSIM_THREADS", "1")
 sys.path.insert(0, str(HERE))
 
 import paritysim as ps  # noqa: E402
+from gradients_vs_jax import PARAMS  # noqa: E402
 
-PARAMS_3_3 = (
-    "wings[0].aero.omega1",
-    "wings[1].aero.omega1",
-    "drivetrain.balance_spring",
-    "actuator.stiffness",
-    "actuator.force_per_volt",
-    "actuator.waveform.amplitude_v",
-    "actuator.waveform.frequency_hz",
-    "drivetrain.transmission_ratio",
-    "wings[0].inertia[0][0]",
-    "actuator.damping",
-)
+# The Jacobian benchmark's eight parameters, then two more kinds.
+PARAMS_3_3 = (*PARAMS, "wings[0].inertia[0][0]", "actuator.damping")
 PARAMS_3_4 = (
     "wings[0].springs.hinge.stiffness",
     "actuator.waveform.amplitude_v",
