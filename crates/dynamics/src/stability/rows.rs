@@ -86,8 +86,9 @@ where
 
 /// [`run_parts`] from a pool thread (`threads`: `None`) or from a plain call with `threads`
 /// engine threads. One thread runs the parts here: the hand-off to the pool's one worker and
-/// back cost about 0.3 ms a sensitivity of three or more parameters (docs/findings.md §30,
-/// session 27), and the idle worker's spinning counted as the call's instructions.
+/// back cost about 0.3 ms of wall time a sensitivity of three or more parameters
+/// (docs/findings.md §30, session 27). A panicking part then unwinds to the caller (as a
+/// single part always did), where the bindings catch it.
 fn run_parts_on<T, F>(n: usize, threads: Option<usize>, part: F) -> Result<Vec<T>>
 where
     T: Send,
