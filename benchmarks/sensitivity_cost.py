@@ -130,6 +130,8 @@ def main() -> None:
         return
     if not all(1 <= k <= 10 for k in args.params):
         parser.error("--params: counts from 1 to 10")
+    if (args.calls is not None and args.calls < 1) or args.rounds < 1:
+        parser.error("--calls and --rounds: at least 1")
     if args.instructions and shutil.which("valgrind") is None:
         parser.error("--instructions needs valgrind on PATH")
     counts = [0, *sorted(set(args.params))]
