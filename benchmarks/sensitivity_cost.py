@@ -7,7 +7,8 @@ most 3× for up to 10 parameters), by the number of parameters, on two devices:
 * ``3.4``: the §3.4 Drag PARITY 1-Cut at K2 = 30 (blade elements, passive rotation, switched),
   four stroke and rotation metrics, ten parameters of six kinds including the drive frequency.
 
-Both calls run on one engine thread. Two counters:
+Both calls run on one engine thread unless ``PARITYSIM_THREADS`` is set (the wall-time counter
+then uses it; the instruction counter always runs one). Two counters:
 
 * wall time (default): per call, the median over ``--rounds`` interleaved rounds of ``--calls``
   calls each (every case once per round, in turn);
@@ -34,7 +35,7 @@ import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-# One engine thread for both calls (read when the pool starts).
+# One engine thread for both calls unless the caller chose (the engine reads it at each call).
 os.environ.setdefault("PARITYSIM_THREADS", "1")
 sys.path.insert(0, str(HERE))
 
