@@ -153,6 +153,9 @@ def test_the_arrays_are_the_tables_and_the_tables_wait_until_read():
         ([], "params"),
         ([3.0], "params"),
         ([""], "params"),
+        # The same field twice (polars raised a ShapeError here), or under two spellings.
+        (["drivetrain.balance_spring", "drivetrain.balance_spring"], "each spec field once"),
+        (["actuator.frequency_hz", "actuator.waveform.frequency_hz"], "= the field of `actuator.frequency_hz`"),
     ],
 )
 def test_bad_parameters_are_named(params, named):

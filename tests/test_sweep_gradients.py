@@ -52,11 +52,25 @@ def test_rows_without_a_steady_state_have_no_gradients():
     assert math.isfinite(good["d(left_stroke_amplitude)/d(actuator.amplitude_v)"][0])
 
 
-@pytest.mark.parametrize(("gradients", "named"), [(["drivetrain.balanse_spring"], "balance_spring"), (["drivetrain.kind"], "drivetrain.kind"), ([""], "gradients")])
+@pytest.mark.parametrize(
+    ("gradients", "named"),
+    [
+        (["drivetrain.balanse_spring"], "balance_spring"),
+        (["drivetrain.kind"], "drivetrain.kind"),
+        ([""], "gradients"),
+        # Two spellings of one field would be two sets of the same columns.
+        (["actuator.frequency_hz", "actuator.waveform.frequency_hz"], "the field of `actuator.frequency_hz`"),
+    ],
+)
 def test_bad_gradient_paths_are_named_before_running(gradients, named):
     with pytest.raises(InvalidParameterError) as e:
         ps.sweep(_spec(), {"actuator.amplitude_v": [100.0]}, gradients=gradients, progress=False)
     assert named in str(e.value)
+
+
+def test_a_gradient_path_listed_twice_is_one_set_of_columns():
+    df = ps.sweep(_spec(), {"actuator.amplitude_v": [100.0]}, metrics=METRICS[:1], gradients=["actuator.stiffness"] * 2, progress=False)
+    assert [c for c in df.columns if c.startswith("d(")] == ["d(left_stroke_amplitude)/d(actuator.stiffness)"]
 
 
 def test_gradients_none_is_a_sweep_without_them():

@@ -408,6 +408,7 @@ def _gradient_paths(spec_json: str, gradients: Sequence[str] | None) -> list[str
     for p in paths:
         if not p.strip():
             raise invalid("gradients", repr(p), "non-empty spec paths")
+    paths = list(dict.fromkeys(paths))  # a path listed twice is one set of columns, as for metrics
     if paths:
         _core.sensitivity_parameters(spec_json, paths)
     return paths

@@ -295,6 +295,17 @@ fn parameters_in(
         ));
     }
     let (resolved, listed) = resolve_all_in(spec, value, params)?;
+    // A field named twice (the same path, or two spellings of it) would be two columns of one
+    // derivative, and two design variables writing one field in `ps.optimize`.
+    for (i, param) in resolved.iter().enumerate() {
+        if let Some(first) = resolved[..i].iter().find(|p| p.targets == param.targets) {
+            return Err(Error::invalid(
+                param.name.clone(),
+                format!("the field of `{}`", first.name),
+                "each spec field once among the parameters",
+            ));
+        }
+    }
     let mut parameters = Vec::new();
     let mut units = Vec::new();
     let mut values = Vec::new();
