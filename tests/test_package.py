@@ -35,6 +35,16 @@ def test_import_is_lazy_and_keeps_the_matplotlib_backend() -> None:
     assert backend == "svg"  # even the plotting modules leave the user's choice alone
 
 
+def test_dir_lists_the_public_names_and_each_resolves() -> None:
+    names = dir(ps)
+    for own_import in ("importlib", "logging", "Any", "TYPE_CHECKING", "annotations", "_cpu"):
+        assert own_import not in names
+    public = [n for n in names if not n.startswith("_")]
+    assert {"simulate", "sweep", "sensitivity", "optimize", "Simulation", "flight"} <= set(public)
+    for name in public:  # tab completion offers nothing that fails
+        getattr(ps, name)
+
+
 def test_sweep_and_section_3_4_are_modules_and_callable() -> None:
     import importlib
 

@@ -89,7 +89,9 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_SUBMODULES) | set(_NAMES))
+    # The public names (tab completion), not this file's own imports (`importlib`, `Any`).
+    dunders = {n for n in globals() if n.startswith("__")}
+    return sorted(dunders | set(__all__) | set(_SUBMODULES))
 
 
 __all__ = [
