@@ -23,6 +23,8 @@ def _cases(tmp: Path) -> dict[str, tuple[list[str], str]]:
     (tmp / "unknown_key.toml").write_text((EXAMPLES / "hmf.toml").read_text().replace("[options]\n", "[options]\nrecord_cyles = 3\n"))
     (tmp / "study_missing_spec.toml").write_text('spec = "nowhere.toml"\n[grid]\n"actuator.voltage_v" = [1.0]\n')
     (tmp / "study_bad_path.toml").write_text(f'spec = "{EXAMPLES / "hmf.toml"}"\n[grid]\n"actuator.volts" = [1.0]\n')
+    (tmp / "study_misspelt_device.toml").write_text('spec = "sreetharan2012_3_3_parit"\n[grid]\n"actuator.voltage_v" = [1.0]\n')
+    (tmp / "optimize_misspelt_device.toml").write_text('spec = "sreetharan2012_3_3_parit"\nobjective = "delta_tau_peak"\n[params]\n"actuator.stiffness" = [100.0, 300.0]\n')
     (tmp / "a_directory.toml").mkdir()
     blocker = tmp / "blocker"
     blocker.write_text("a file where a directory is expected")
@@ -50,6 +52,10 @@ def _cases(tmp: Path) -> dict[str, tuple[list[str], str]]:
         "binary continuation study": (["continue", str(tmp / "binary.toml")], f"`study` = {tmp / 'binary.toml'}: must be a UTF-8 text file holding a continuation study"),
         "missing continuation study": (["continue", str(tmp / "nope.toml")], f"`study` = {tmp / 'nope.toml'}: must be a readable file holding a continuation study"),
         "malformed continuation study": (["continue", str(tmp / "malformed.toml")], f"`study` = {tmp / 'malformed.toml'}: must be a continuation study in valid TOML"),
+        # A misspelt device name: the nearest shipped ones, whichever command reads it.
+        "misspelt device": (["run", "sreetharan2012_3_3_parit", "--out", str(tmp / "o")], "did you mean `sreetharan2012_3_3_parity`"),
+        "study with a misspelt device": (["sweep", str(tmp / "study_misspelt_device.toml"), "--out", str(tmp / "o")], "did you mean `sreetharan2012_3_3_parity`"),
+        "optimize study with a misspelt device": (["optimize", str(tmp / "optimize_misspelt_device.toml"), "--out", str(tmp / "o")], "did you mean `sreetharan2012_3_3_parity`"),
     }
 
 
@@ -74,6 +80,9 @@ CASE_NAMES = [
     "binary continuation study",
     "missing continuation study",
     "malformed continuation study",
+    "misspelt device",
+    "study with a misspelt device",
+    "optimize study with a misspelt device",
 ]
 
 

@@ -490,6 +490,31 @@ def test_cli_runs_a_study_file(tmp_path: Path) -> None:
     assert main(["sweep", str(bad), "--out", str(tmp_path / "runs"), "--quiet"]) == 1
 
 
+def test_a_study_names_a_shipped_device_and_asks_gradients(tmp_path: Path) -> None:
+    """`spec` takes a device name as `paritysim run`, `optimize` and `continue` do, and
+    `gradients` gives the columns `ps.sweep(..., gradients=...)` gives."""
+    study = tmp_path / "named.toml"
+    study.write_text(
+        textwrap.dedent(
+            """
+            spec = "sreetharan2012_3_3_parity"
+            metrics = ["left_stroke_amplitude"]
+            gradients = ["actuator.voltage_v"]
+            [grid]
+            "drivetrain.balance_spring" = [5.0, 10.0]
+            """
+        )
+    )
+    assert main(["sweep", str(study), "--out", str(tmp_path / "runs"), "--threads", "1", "--quiet"]) == 0
+    df = pl.read_parquet(tmp_path / "runs" / "named.parquet")
+    spec = ps.devices.load("sreetharan2012_3_3_parity")
+    for row in df.iter_rows(named=True):
+        point = spec.with_paths({"drivetrain.balance_spring": row["drivetrain.balance_spring"]})
+        s = ps.sensitivity(point, ["actuator.voltage_v"], metrics=["left_stroke_amplitude"], progress=False)
+        # the sweep's chained orbit and a run from rest: the derivatives' own accuracy (rtol 1e-8)
+        assert row["d(left_stroke_amplitude)/d(actuator.voltage_v)"] == pytest.approx(s.derivative("left_stroke_amplitude", "actuator.voltage_v"), rel=2e-5)
+
+
 def test_plot_draws_one_line_per_hue(hmf: ps.Simulation) -> None:
     df = sweep(hmf, {"actuator.voltage_v": [50.0, 100.0], "actuator.frequency_hz": [90.0, 110.0, 130.0]}, progress=False)
     fig = sweep_module.plot(df, "actuator.frequency_hz", "left_stroke_amplitude", hue="actuator.voltage_v")

@@ -74,10 +74,9 @@ def output_stem(name: str, fallback: str) -> str:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from . import devices, load_spec, simulate
+    from . import devices, simulate
 
-    # A named device of the library, or a TOML path.
-    spec = devices.load(args.spec) if args.spec in devices.list() and not Path(args.spec).exists() else load_spec(args.spec)
+    spec = devices._name_or_file(args.spec)  # a TOML path, or a named device of the library
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     stem = output_stem(spec.name, Path(args.spec).stem)

@@ -34,14 +34,10 @@ def run_study(study: str | Path, out: str | Path) -> dict[str, Any]:
     """Runs a continuation study file; returns the result and the written paths."""
     from . import devices
     from .continuation import continuation
-    from .spec import load_spec
 
     data = read_study(study, "a continuation study", _KEYS, ("spec", "path", "stop"), "continue")
     study = Path(study)
-    source = data["spec"]
-    if not isinstance(source, str):
-        raise invalid("spec", repr(source), "a spec file (relative to the study) or a named device")
-    spec = devices.load(source) if source in devices.list() else load_spec(study.parent / source)
+    spec = devices._name_or_file(data["spec"], study.parent)
     settings = data.get("settings", {})
     if not isinstance(settings, dict):
         raise invalid("settings", repr(settings), "a table of paritysim.continuation keywords")
@@ -73,7 +69,7 @@ def _main(args: argparse.Namespace) -> int:
 
 def add_parser(sub: argparse._SubParsersAction, parents: list[argparse.ArgumentParser] | None = None) -> None:  # type: ignore[type-arg]
     """Adds ``paritysim continue``."""
-    p = sub.add_parser("continue", help="continue a periodic orbit in one parameter (branch, bifurcations, plot)", parents=parents or [])
+    p = sub.add_parser("continue", help="continue a periodic orbit in one parameter (branch, bifurcations, plot)", parents=parents or [], description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("study", help="study file, e.g. examples/continuation_whippletree.toml")
     p.add_argument("--out", default="runs", help="output directory (default: runs/)")
     p.add_argument("--quiet", action="store_true", help="no summary")

@@ -43,7 +43,7 @@ from pathlib import Path
 from typing import Any
 
 from ._errors import invalid, read_study
-from .spec import Simulation, load_spec
+from .spec import Simulation
 
 __all__ = ["OptimizeStudy", "add_parser", "load_study", "run_study"]
 
@@ -84,10 +84,7 @@ def load_study(path: str | Path) -> OptimizeStudy:
 
     data = read_study(path, "an optimisation study", _KEYS, ("spec", "objective", "params"), "optimize")
     path = Path(path)
-    source = data["spec"]
-    if not isinstance(source, str) or not source.strip():
-        raise invalid("spec", repr(source)[:60], "a named device (`paritysim devices`) or a spec file relative to the study")
-    spec = devices.load(source) if source in devices.list() and not (path.parent / source).is_file() else load_spec(path.parent / source)
+    spec = devices._name_or_file(data["spec"], path.parent)
     values = _table(data, "set", "a table of spec path = value set before optimising")
     if values:
         spec = spec.with_paths(values)
@@ -170,7 +167,7 @@ def _main(args: argparse.Namespace) -> int:
 
 def add_parser(sub: argparse._SubParsersAction, parents: list[argparse.ArgumentParser] | None = None) -> None:  # type: ignore[type-arg]
     """Adds ``paritysim optimize`` (``parents``: options shared by every subcommand)."""
-    p = sub.add_parser("optimize", help="optimise a design described in a study TOML (objective, params with bounds, constraints)", parents=parents or [])
+    p = sub.add_parser("optimize", help="optimise a design described in a study TOML (objective, params with bounds, constraints)", parents=parents or [], description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("study", help="study file, e.g. examples/optimize_3_4.toml")
     p.add_argument("--out", default=None, help="output directory (default: the study's `out`, else runs/ next to the study)")
     p.add_argument("--quiet", action="store_true", help="no progress bar or summary")

@@ -2,9 +2,13 @@
 
 A study file names the device and the grid::
 
-    spec = "hmf.toml"                      # a device spec, relative to this file (or a [spec] table)
+    spec = "hmf.toml"                      # a spec file relative to this file, a named device
+                                           #   (`paritysim devices`) or a [spec] table
     metrics = ["left_stroke_amplitude"]    # optional: default all
+    gradients = ["actuator.voltage_v"]     # optional: d(metric)/d(path) columns (ps.sweep)
     keep_cycle = false                     # optional: true or a list of trajectory columns
+    threads = 2                            # optional: engine threads (--threads wins)
+    chunk_size = 256                       # optional: points per chunk (a checkpoint saves each)
 
     [options]                              # optional overrides of the spec's options
     max_cycles = 60
@@ -36,11 +40,11 @@ import numpy as np
 import polars as pl
 
 from ._errors import invalid, read_study
-from .spec import Simulation, load_spec
+from .spec import Simulation
 
 __all__ = ["Study", "add_parser", "load_study", "run_study"]
 
-_KEYS = ("spec", "metrics", "keep_cycle", "options", "grid", "plot", "threads", "chunk_size")
+_KEYS = ("spec", "metrics", "gradients", "keep_cycle", "options", "grid", "plot", "threads", "chunk_size")
 
 
 @dataclass(frozen=True)
@@ -50,6 +54,7 @@ class Study:
     spec: Simulation
     grid: dict[str, list[Any]]
     metrics: list[str] | None = None
+    gradients: list[str] | None = None
     keep_cycle: bool | list[str] = False
     options: dict[str, Any] = field(default_factory=dict)
     plot: dict[str, Any] | None = None
@@ -80,12 +85,14 @@ def load_study(path: str | Path) -> Study:
     data = read_study(path, "a sweep study", _KEYS)
     path = Path(path)
     raw_spec = data.get("spec")
-    if isinstance(raw_spec, str):
-        spec = load_spec(path.parent / raw_spec)
-    elif isinstance(raw_spec, dict):
+    if isinstance(raw_spec, dict):
         spec = Simulation.from_dict(raw_spec)
+    elif isinstance(raw_spec, str):
+        from . import devices
+
+        spec = devices._name_or_file(raw_spec, path.parent)
     else:
-        raise invalid("spec", repr(raw_spec), "a spec file path (relative to the study) or a [spec] table")
+        raise invalid("spec", repr(raw_spec), "a named device, a spec file path (relative to the study) or a [spec] table")
     grid = data.get("grid", {})
     if not isinstance(grid, dict):
         raise invalid("grid", repr(grid), "a table of parameter path = values")
@@ -96,6 +103,7 @@ def load_study(path: str | Path) -> Study:
         spec=spec,
         grid={k: _axis(k, v) for k, v in grid.items()},
         metrics=data.get("metrics"),
+        gradients=data.get("gradients"),
         keep_cycle=data.get("keep_cycle", False),
         options=dict(data.get("options", {})),
         plot=plot,
@@ -121,6 +129,7 @@ def run_study(study: Study, out: str | Path, stem: str, threads: int | None = No
         study.spec,
         study.grid,
         metrics=study.metrics,
+        gradients=study.gradients,
         keep_cycle=study.keep_cycle,
         threads=threads if threads is not None else study.threads,
         progress=progress,
@@ -161,7 +170,7 @@ def _main(args: argparse.Namespace) -> int:
 
 def add_parser(sub: argparse._SubParsersAction, parents: list[argparse.ArgumentParser] | None = None) -> None:  # type: ignore[type-arg]
     """Adds ``paritysim sweep`` (``parents``: options shared by every subcommand)."""
-    p = sub.add_parser("sweep", help="run a parameter sweep described in a study TOML (device + grid)", parents=parents or [])
+    p = sub.add_parser("sweep", help="run a parameter sweep described in a study TOML (device + grid)", parents=parents or [], description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("study", help="study file, e.g. examples/sweep_resonance.toml")
     p.add_argument("--out", default="runs", help="output directory (default: runs/)")
     p.add_argument("--threads", type=int, default=None, help="engine threads (default: $PARITYSIM_THREADS or all cores)")

@@ -93,3 +93,21 @@ def load(name: str) -> Simulation:
     from ..spec import load_spec
 
     return load_spec(path(name))
+
+
+def _name_or_file(source: Any, relative_to: str | Path = ".", field: str = "spec") -> Simulation:
+    """What a CLI ``spec`` argument or study key names: a spec file (relative to ``relative_to``,
+    the study's folder), else a shipped device. A file of a device's name wins, so a local copy
+    can shadow it. Neither is an ``InvalidParameterError`` naming ``field``, with the nearest
+    device names."""
+    from .._errors import invalid, suggest
+    from ..spec import load_spec
+
+    if not isinstance(source, str) or not source.strip():
+        raise invalid(field, repr(source)[:60], "a named device (`paritysim devices`) or a spec file")
+    file = Path(relative_to) / source
+    if file.is_file() or source not in _index() and Path(source).suffix == ".toml":
+        return load_spec(file)  # a missing .toml is load_spec's error, naming the path
+    if source in _index():
+        return load(source)
+    raise invalid(field, repr(source), suggest(source, list(), listed_by="`paritysim devices`", what=f"a named device or a spec file (none at {file})"))
