@@ -1,4 +1,4 @@
-"""The bar of one long call (issue 33): ``simulate``, ``calibrate`` and ``trim`` show wall time
+"""The bar of one long call (issue 33): ``simulate``, ``calibrate``, ``trim`` and ``continuation`` show wall time
 against their budget on stderr once they have run `_progress.DELAY_S`; a short call, and
 ``progress=False``, and the CLI's ``--quiet`` show nothing."""
 
@@ -140,3 +140,14 @@ def test_a_forked_child_does_not_inherit_a_held_watcher_lock() -> None:
     finally:
         done.set()
         holder.join()
+
+
+def test_a_long_continuation_shows_its_bar_unless_asked_not_to(soon: None, capsys: pytest.CaptureFixture[str]) -> None:
+    linkage = ps.devices.load("sreetharan2012_3_3_parity_linkage")
+    run = lambda **kw: ps.continuation(linkage, "drivetrain.balance_spring", 900.0, start=1000.0, metrics=False, **kw)  # noqa: E731
+    run(progress=False)
+    assert capsys.readouterr().err == ""
+    branch = run()
+    err = capsys.readouterr().err
+    assert re.search(r"continuation: +\d+%\|[^|]*\| \d+/600 s of the wall budget", err), err
+    assert branch.branch.height >= 2

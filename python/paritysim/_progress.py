@@ -1,4 +1,4 @@
-"""A progress bar for one long call: ``simulate``, ``calibrate`` and ``trim`` (issue 33).
+"""A progress bar for one long call: ``simulate``, ``calibrate``, ``trim`` and ``continuation`` (issue 33).
 
 A single run has no count of work done that the engine reports while it integrates, so the bar
 shows the wall time spent against the call's wall budget (``max_wall_ms``: where it would stop),

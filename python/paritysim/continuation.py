@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING, Any
 
 from . import _core
 from ._errors import invalid, real, suggest
+from ._progress import LongRun
 from .spec import Simulation
 
 if TYPE_CHECKING:
@@ -177,7 +178,7 @@ def _current(spec: Simulation, path: str) -> float:
 MAX_WALL_MS = 600_000.0
 
 
-def continuation(spec: Simulation, path: str, stop: float, *, start: float | None = None, max_wall_ms: float = MAX_WALL_MS, **settings: Any) -> ContinuationResult:
+def continuation(spec: Simulation, path: str, stop: float, *, start: float | None = None, max_wall_ms: float = MAX_WALL_MS, progress: bool = True, **settings: Any) -> ContinuationResult:
     """Follows the periodic orbit of ``spec`` as ``path`` goes from ``start`` (default: the
     spec's value) to ``stop``.
 
@@ -188,7 +189,9 @@ def continuation(spec: Simulation, path: str, stop: float, *, start: float | Non
     integrated coordinate, e.g. 1 for ``q2`` of a K2 = 0 linear whippletree), ``locate``,
     ``metrics`` (orbit metrics per point, default True). The spec's ``options`` set the
     integration (rtol capped at 1e-10 for shooting). ``max_wall_ms`` (default 600 000, 10
-    min) bounds the whole branch; Ctrl-C stops it within tens of milliseconds.
+    min) bounds the whole branch; Ctrl-C stops it within tens of milliseconds. A branch that
+    runs for more than a few seconds shows its wall time against that budget on stderr
+    (``progress=False``: no bar; the CLI's ``--quiet``: none).
 
     Raises
     ------
@@ -209,8 +212,10 @@ def continuation(spec: Simulation, path: str, stop: float, *, start: float | Non
         raise invalid(unknown[0], "<unknown setting>", suggest(unknown[0], SETTINGS, what="a setting of paritysim.continuation"))
     first = _current(spec, path) if start is None else real("start", start)
     settings_json = json.dumps(settings, default=lambda o: o.item() if hasattr(o, "item") else repr(o))  # Rust names a bad value
+    budget_ms = real("max_wall_ms", max_wall_ms)
     try:
-        native = _core.continuation(spec.to_json(), path, first, real("stop", stop), settings_json, real("max_wall_ms", max_wall_ms))
+        with LongRun("continuation", progress, budget_ms):
+            native = _core.continuation(spec.to_json(), path, first, real("stop", stop), settings_json, budget_ms)
     except _core.ParitysimError as exc:
         if not getattr(exc, "field", None):
             import re

@@ -72,5 +72,5 @@ def add_parser(sub: argparse._SubParsersAction, parents: list[argparse.ArgumentP
     p = sub.add_parser("continue", help="continue a periodic orbit in one parameter (branch, bifurcations, plot)", parents=parents or [], description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("study", help="study file, e.g. examples/continuation_whippletree.toml")
     p.add_argument("--out", default="runs", help="output directory (default: runs/)")
-    p.add_argument("--quiet", action="store_true", help="no summary")
+    p.add_argument("--quiet", action="store_true", help="no progress bar or summary")
     p.set_defaults(func=_main)
