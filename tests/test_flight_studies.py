@@ -112,6 +112,16 @@ def test_twist_angle_follows_several_turns_and_sign_flips(axis: str) -> None:
     np.testing.assert_allclose(tilt, expected, atol=1e-6)
 
 
+def test_attitude_angles_name_a_bad_axis_or_a_trajectory_without_a_body() -> None:
+    q = np.array([[1.0, 0.0, 0.0, 0.0]])
+    with pytest.raises(ps.InvalidParameterError, match='`axis` = \'w\': must be one of "roll", "yaw", "pitch"'):
+        flight.twist_angle(_frame(q), "w")
+    clamped = pl.DataFrame({"t": [0.0], "left_phi": [0.1]})  # a fixed-body run's columns
+    for angle in (flight.tilt_angle, lambda df: flight.twist_angle(df, "yaw")):
+        with pytest.raises(ps.InvalidParameterError, match="`df` = columns t, left_phi, ...: must be a free-flight trajectory"):
+            angle(clamped)
+
+
 # ------------------------------------------------------------------ physics of the studies
 
 

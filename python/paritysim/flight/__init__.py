@@ -68,8 +68,18 @@ def with_body(spec: Simulation, **fields: Any) -> Simulation:
     return Simulation.from_dict({**spec.to_dict(), "body": body})
 
 
+#: The attitude quaternion's columns of a free-flight trajectory.
+_QUATERNION = ("body_qw", "body_qx", "body_qy", "body_qz")
+
+
 def _quaternions(df: pl.DataFrame) -> np.ndarray:
-    return np.column_stack([df[c].to_numpy() for c in ("body_qw", "body_qx", "body_qy", "body_qz")])
+    columns = getattr(df, "columns", None)
+    if columns is None or not set(_QUATERNION) <= set(columns):
+        from .._errors import invalid
+
+        what = type(df).__name__ if columns is None else f"columns {', '.join(columns[:4])}, ..."
+        raise invalid("df", what, "a free-flight trajectory (body.mode = \"free\" or a gimbal) with the columns " + ", ".join(_QUATERNION))
+    return np.column_stack([df[c].to_numpy() for c in _QUATERNION])
 
 
 def twist_angle(df: pl.DataFrame, axis: str) -> np.ndarray:
@@ -77,6 +87,10 @@ def twist_angle(df: pl.DataFrame, axis: str) -> np.ndarray:
     over the trajectory: the twist of the swing-twist decomposition of the attitude
     quaternion, ``2 atan2(q_axis, q_w)``. Exact for a single-axis gimbal; for a general motion
     it is the rotation about that axis left after the tilt of the axis is removed."""
+    if axis not in AXES:
+        from .._errors import invalid
+
+        raise invalid("axis", repr(axis), "one of " + ", ".join(f'"{a}"' for a in AXES))
     q = _quaternions(df)
     k = 1 + AXES[axis]
     # The half angle jumps by 2π at the branch cut and by π where q turns into −q (the same
