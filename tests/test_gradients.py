@@ -125,7 +125,23 @@ def test_metric_selection_elasticities_and_plot():
     e = s.elasticities()["actuator.amplitude_v"][0]
     assert 0.3 < e < 1.0
     assert s.derivative("right_stroke_amplitude", "actuator.amplitude_v") > 0
-    assert s.plot().axes
+    fig = s.plot()
+    # Each cell is labelled with its elasticity; a 1 x 1 map keeps room to read it.
+    assert [t.get_text() for t in fig.axes[0].texts] == [f"{e:.3g}"]
+    assert fig.get_figwidth() >= 4.5 and fig.get_figheight() >= 3.0
+    with pytest.raises(InvalidParameterError, match="`metrics` = 'left_stroke_amplitude'"):
+        s.plot(metrics=["left_stroke_amplitude"])  # not among the result's metrics
+
+
+def test_the_heat_map_hatches_what_is_not_differentiable_and_saves(tmp_path):
+    spec = ps.devices.load("sreetharan2012_3_3_parity")  # K2 = 0: a neutral whippletree family
+    s = ps.sensitivity(spec, ["actuator.amplitude_v", "actuator.stiffness"], metrics=["left_stroke_amplitude", "left_stroke_mean"], progress=False)
+    flagged = [r is not None for r in s.reasons]
+    assert any(flagged) and not all(flagged)  # the stroke mean moves along the family
+    fig = s.plot(path=tmp_path / "map.png")
+    hatched = [p for p in fig.axes[0].patches if p.get_hatch()]
+    assert len(hatched) == sum(flagged)
+    assert (tmp_path / "map.png").stat().st_size > 10_000
 
 
 def test_the_arrays_are_the_tables_and_the_tables_wait_until_read():

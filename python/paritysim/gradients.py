@@ -16,14 +16,16 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import polars as pl
 from matplotlib.figure import Figure
+from matplotlib.patches import Rectangle
 
 from . import _core
-from ._errors import invalid
+from ._errors import invalid, unknown_name
 from ._progress import LongRun
 from .spec import Simulation
 
@@ -106,27 +108,42 @@ class SensitivityResult:
             )
         return out
 
-    def plot(self, metrics: Sequence[str] | None = None) -> Figure:
-        """A heat map of the elasticities (metrics x parameters); crossed-out cells are not
-        differentiable there."""
+    def plot(self, metrics: Sequence[str] | None = None, path: str | Path | None = None) -> Figure:
+        """A heat map of the elasticities (metrics x parameters), each cell labelled with its
+        value; a cell whose metric is not differentiable there is hatched, one whose metric is 0
+        (no elasticity) is blank. ``metrics``: the rows to show (default all); ``path``: also
+        save the figure there."""
         e = self.elasticities()
         flags = self.jacobian["differentiable"]
         if metrics is not None:
-            keep = [m in set(metrics) for m in e["metric"]]
-            e, flags = e.filter(pl.Series(keep)), flags.filter(pl.Series(keep))
+            wanted = _names("metrics", metrics)
+            for m in wanted:
+                if m not in self.metric_names:
+                    raise unknown_name("metrics", m, self.metric_names, what="a metric of this result")
+            keep = pl.Series([m in set(wanted) for m in e["metric"]])
+            e, flags = e.filter(keep), flags.filter(keep)
         names = list(self.parameters["parameter"])
         grid = e.select(names).to_numpy().astype(float)
-        fig = Figure(figsize=(1.4 + 1.1 * len(names), 0.9 + 0.32 * e.height), layout="constrained")
+        # Room for the rotated parameter names, the metric names and the colour bar: a 1 x 1
+        # map stays readable, a 10 x 10 one grows with its cells.
+        fig = Figure(figsize=(max(4.8, 2.6 + 0.9 * len(names)), max(3.0, 1.8 + 0.42 * e.height)), layout="constrained")
         ax = fig.subplots()
         bound = float(np.nanmax(np.abs(grid))) if np.isfinite(grid).any() else 1.0
+        bound = bound if bound > 0 else 1.0
         image = ax.imshow(grid, cmap="RdBu_r", vmin=-bound, vmax=bound, aspect="auto")
         ax.set_xticks(range(len(names)), names, rotation=30, ha="right")
         ax.set_yticks(range(e.height), list(e["metric"]))
+        if grid.size <= 150:  # the numbers themselves, where they fit
+            for (i, j), v in np.ndenumerate(grid):
+                if np.isfinite(v):
+                    ax.text(j, i, f"{v + 0.0:.3g}", ha="center", va="center", fontsize=8, color="white" if abs(v) > 0.6 * bound else "black")
         for i, ok in enumerate(flags):
             if not ok:
-                ax.plot([-0.5, len(names) - 0.5], [i, i], color="0.3", lw=0.8, ls=":")
+                ax.add_patch(Rectangle((-0.5, i - 0.5), len(names), 1.0, fill=False, hatch="///", edgecolor="0.35", lw=0.0))
         fig.colorbar(image, ax=ax, label="elasticity (p/m) dm/dp")
-        ax.set_title("steady-state sensitivities")
+        ax.set_title("steady-state sensitivities" + (" (hatched: not differentiable)" if not all(flags) else ""), fontsize=10)
+        if path is not None:
+            fig.savefig(path, dpi=150)
         return fig
 
     def __repr__(self) -> str:
