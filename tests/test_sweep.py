@@ -9,6 +9,7 @@ import dataclasses
 import json
 import importlib
 import math
+import re
 import multiprocessing
 import os
 import pickle
@@ -520,6 +521,11 @@ def test_plot_draws_one_line_per_hue(hmf: ps.Simulation) -> None:
     fig = sweep_module.plot(df, "actuator.frequency_hz", "left_stroke_amplitude", hue="actuator.voltage_v")
     assert len(fig.axes[0].lines) == 2
     assert math.isfinite(fig.axes[0].lines[0].get_ydata()[0])
+    # A column that is not in the result is named by the argument that asked for it.
+    for kwargs, field in [({"x": "voltage"}, "x"), ({"y": "amplitude"}, "y"), ({"y": ["left_stroke_amplitude", "amplitude"]}, "y[1]"), ({"hue": "volts"}, "hue")]:
+        args = {"x": "actuator.frequency_hz", "y": "left_stroke_amplitude", "hue": None, **kwargs}
+        with pytest.raises(ps.InvalidParameterError, match=re.escape(f"invalid `{field}` =")):
+            sweep_module.plot(df, **args)
 
 
 # ----------------------------------------------------------------------------- chunk failures

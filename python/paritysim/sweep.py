@@ -539,9 +539,10 @@ def plot(df: pl.DataFrame, x: str, y: str | Sequence[str], hue: str | None = Non
     from .plots import label_with_unit
 
     ys = [y] if isinstance(y, str) else list(y)
-    for c in [x, *ys, *([hue] if hue else [])]:
+    named = [("x", x), *((("y" if isinstance(y, str) else f"y[{i}]"), c) for i, c in enumerate(ys)), *([("hue", hue)] if hue else [])]
+    for field, c in named:  # the argument (and the study's [plot] key) that names the column
         if c not in df.columns:
-            raise invalid("plot", repr(c), suggest(str(c), df.columns, what="a column of the sweep result"))
+            raise invalid(field, repr(c), suggest(str(c), df.columns, what="a column of the sweep result"))
     ok = df.filter(pl.col("status") == "ok") if "status" in df.columns else df
     if ax is None:
         fig, ax = plt.subplots(figsize=(6, 4), layout="constrained")
