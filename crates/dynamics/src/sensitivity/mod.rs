@@ -436,16 +436,19 @@ pub fn steady_sensitivity_at(
         }
     }
     // A metric that moves along a neutral direction depends on the member of the family.
+    let base_states = replay
+        .as_ref()
+        .filter(|_| !neutral.is_empty())
+        .map(Replay::base_states);
     for v in &neutral {
         let eps = 1e-6;
         let along = |sign: f64| -> Result<Vec<(String, f64)>> {
             let shift = v * (sign * eps);
-            match &replay {
-                Some(replay) => {
-                    let states = replay.base_states();
-                    replay.window_along((device, &grid, period), &states, &shift, options)
+            match (&replay, &base_states) {
+                (Some(replay), Some(states)) => {
+                    replay.window_along((device, &grid, period), states, &shift, options)
                 }
-                None => {
+                _ => {
                     let y = State::from_compact(n, &(x_star.compact(n) + shift));
                     crate::simulate::grid_window(device, &rk, &grid, period, &y, options)
                 }
