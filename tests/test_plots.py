@@ -5,6 +5,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
+import paritysim as ps
 from paritysim import plots
 
 
@@ -29,3 +30,19 @@ def test_labels_carry_units() -> None:
     assert plots.label_with_unit("wings[1].springs[5].stiffness") == "wings[1].springs[5].stiffness (mN·mm/rad)"
     assert plots.label_with_unit("wings.left.omega_ratio") == "wings.left.omega_ratio"  # dimensionless
     assert plots.label_with_unit("mean_actuator_power") == "mean_actuator_power (mW)"
+    # The force and designer metrics (the units crates/dynamics/src/metrics/mod.rs states).
+    assert plots.label_with_unit("lift_mean") == "lift_mean (mN)"
+    assert plots.label_with_unit("left_lift_peak") == "left_lift_peak (mN)"
+    assert plots.label_with_unit("lift_per_power") == "lift_per_power (mN/mW)"  # not a power
+    assert plots.label_with_unit("actuator_power_per_weight") == "actuator_power_per_weight (mW/mN)"
+    assert plots.label_with_unit("lift_to_weight") == "lift_to_weight"  # dimensionless
+
+
+def test_every_metric_of_a_blade_element_device_has_a_unit_or_is_a_ratio() -> None:
+    from paritysim import _core
+
+    spec = ps.flight.with_body(ps.devices.load("sreetharan2012_3_4_parity"))  # a weight: the weighed metrics too
+    dimensionless = ("_pct", "lift_to_weight", "_ratio")
+    for name in _core.sweep_metric_names(spec.to_json()):
+        if not name.endswith(dimensionless):
+            assert plots.label_with_unit(name) != name, name

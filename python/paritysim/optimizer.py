@@ -139,13 +139,15 @@ class OptimizationResult:
         fig = Figure(figsize=(6.4, 6.0), layout="constrained")
         ax_f, ax_v, ax_p = fig.subplots(3, 1, sharex=True)
         ax_f.plot(it, h["objective"].to_numpy(), "o-", ms=3)
-        ax_f.set_ylabel(self.objective_name)
+        from .plots import label_with_unit  # the plot needs matplotlib anyway
+
+        ax_f.set_ylabel(label_with_unit(self.objective_name))
         ax_f.set_title(f"{self.sense}imise {self.objective_name}: {'converged' if self.success else 'not converged'}")
         violation = h["max_violation"].to_numpy()
         ax_v.semilogy(it, np.maximum(violation, 1e-16), "o-", ms=3, color="C3")
         ax_v.set_ylabel("max violation")
         for name, (low, high) in self.bounds.items():
-            ax_p.plot(it, (h[name].to_numpy() - low) / (high - low), "o-", ms=3, label=name)
+            ax_p.plot(it, (h[name].to_numpy() - low) / (high - low), "o-", ms=3, label=f"{name} in [{low:g}, {high:g}]")
         ax_p.set_ylim(-0.05, 1.05)
         ax_p.set_ylabel("parameter (scaled)")
         ax_p.set_xlabel("iteration")

@@ -42,6 +42,7 @@ _UNITS = {
     "omega1": "mg·mm²", "omega2": "mg·mm²", "omega3": "mg·mm²", "omega4": "mg·mm²", "inertia": "mg·mm²",
     "balance_stiffness": "mN·mm/rad", "k2": "mN·mm/rad", "springs": "mN·mm/rad", "q1": "mm", "q2": "rad",
     "transmission_ratio": "rad/mm", "force_per_volt": "mN/V", "actuator.stiffness": "mN/mm", "time_ms": "ms",
+    "lift": "mN",
 }
 
 
@@ -50,6 +51,11 @@ def label_with_unit(column: str) -> str:
     e.g. ``left_roll_aero_peak (mN·mm)``, ``actuator.waveform.frequency_hz (Hz)``; ratios,
     counts and names without a known unit get none (``omega_ratio`` is dimensionless)."""
     name = column.lower()
+    # The ratios of the designer metrics (crates/dynamics/src/metrics/mod.rs) before the
+    # substrings, which would read `lift_per_power` as a power.
+    ratios = {"lift_per_power": "mN/mW", "actuator_power_per_weight": "mW/mN", "lift_to_weight": "-"}
+    if name in ratios:
+        return column if ratios[name] == "-" else f"{column} ({ratios[name]})"
     suffixes = {"_hz": "Hz", "_v": "V", "_mm": "mm", "_ms": "ms", "_deg": "deg", "_pct": "%", "_ratio": "-"}
     for suffix, unit in suffixes.items():
         if name.endswith(suffix):
