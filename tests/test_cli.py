@@ -87,3 +87,14 @@ def test_run_names_its_outputs_after_the_spec_name(tmp_path: Path, capsys: pytes
     assert written == ["hmf_wide_v2.png", "hmf_wide_v2_metrics.csv", "hmf_wide_v2_trajectory.parquet"]
     metrics = pl.read_csv(tmp_path / "out" / "hmf_wide_v2_metrics.csv")
     assert metrics["left_stroke_amplitude"][0] > 0.1
+
+
+def test_run_takes_a_device_name_and_prints_the_headline_numbers_with_units(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["run", "sreetharan2012_3_4_parity", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    metrics = pl.read_csv(tmp_path / "sreetharan2012_3_4_parity_metrics.csv")
+    # each printed number is the written metric, with its unit
+    for label, key in [("lift_mean (mN)", "lift_mean"), ("actuator_power_mean (mW)", "actuator_power_mean"), ("lift_per_power (mN/mW)", "lift_per_power"), ("left_rotation_amplitude (rad)", "left_rotation_amplitude")]:
+        line = next(line for line in out.splitlines() if line.strip().startswith(label))
+        assert float(line.split()[-1]) == pytest.approx(metrics[key][0], rel=1e-5)
+    assert f"({metrics.width} metrics in sreetharan2012_3_4_parity_metrics.csv)" in out

@@ -90,10 +90,31 @@ def _run(args: argparse.Namespace) -> int:
         if result.orbit_cycles > 1:
             state += f", period-{result.orbit_cycles} orbit"
         print(f"{stem}: {result.cycles_run} cycles ({state}) in {time.perf_counter() - start:.2f} s -> {out}/{stem}_*")
-        for key in sorted(result.metrics):
-            if key.endswith(("stroke_amplitude", "roll_aero_peak", "work_actuator_per_cycle")):
-                print(f"  {key:32s} {result.metrics[key]: .6g}")
+        from .plots import label_with_unit  # matplotlib is loaded for the plot already
+
+        for key in _HEADLINE:
+            value = result.metrics.get(key)
+            if value is not None and (value != 0.0 or not key.endswith("rotation_amplitude")):  # fixed wings: no rotation
+                print(f"  {label_with_unit(key):40s} {value: .6g}")
+        print(f"  ({len(result.metrics)} metrics in {stem}_metrics.csv)")
     return 0
+
+
+#: The numbers `paritysim run` prints, where the device has them: the stroke (and rotation) of
+#: each wing, the torques, and a designer's lift, power and efficiency.
+_HEADLINE = (
+    "left_stroke_amplitude",
+    "right_stroke_amplitude",
+    "left_rotation_amplitude",
+    "right_rotation_amplitude",
+    "left_roll_aero_peak",
+    "right_roll_aero_peak",
+    "yaw_total_mean",
+    "lift_mean",
+    "actuator_power_mean",
+    "lift_per_power",
+    "work_actuator_per_cycle",
+)
 
 
 def _common() -> argparse.ArgumentParser:
