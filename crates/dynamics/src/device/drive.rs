@@ -175,12 +175,6 @@ impl DriveSprings<f64> {
         let [m1, m2] = self.masses();
         0.5 * (m1 * q_dot[0] * q_dot[0] + m2 * q_dot[1] * q_dot[1])
     }
-
-    /// The power the drive's dampers dissipate at `q_dot` (mW): `b1 q̇1² + b2 q̇2²`.
-    pub(crate) fn dissipation(&self, q_dot: [f64; 2]) -> f64 {
-        let [d1, d2] = self.damping();
-        -(d1 * q_dot[0] * q_dot[0] + d2 * q_dot[1] * q_dot[1])
-    }
 }
 
 #[cfg(test)]
@@ -253,15 +247,6 @@ mod tests {
                     / (2.0 * h);
                 assert!((springs.damping()[i] - rate_slope).abs() <= 1e-8);
             }
-            let dissipation = springs.dissipation(q_dot);
-            let [b1, b2] = [
-                springs.b1,
-                if springs.dual { springs.b1 } else { springs.b2 },
-            ];
-            assert_eq!(
-                dissipation,
-                b1 * q_dot[0] * q_dot[0] + b2 * q_dot[1] * q_dot[1]
-            );
             if springs.is_linear_lossless() {
                 // Today's load, written out.
                 let today = [

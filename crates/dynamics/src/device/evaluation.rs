@@ -179,15 +179,6 @@ impl Device {
             + self.drive.kinetic([e.drive.q_dot.x, e.drive.q_dot.y])
     }
 
-    /// The power the drive's dampers and the wings' hinge dampers dissipate at `e` (mW):
-    /// `b1 q̇1² + b2 q̇2² + Σ_w bψ ψ̇_w²`.
-    pub fn damping_power(&self, e: &Evaluation) -> f64 {
-        let hinges: f64 = (self.spec.wings.iter().enumerate())
-            .map(|(w, wing)| wing.hinge_damping() * e.p_dot[3 * w + 2] * e.p_dot[3 * w + 2])
-            .sum();
-        self.drive.dissipation([e.drive.q_dot.x, e.drive.q_dot.y]) + hinges
-    }
-
     /// The actuator's effective mass seen on the strokes `(φL, φR)` at the drive state `drive`
     /// and the force its velocity product applies: with `φ̈ = J q̈ + h`, the mass `m` on `q1`
     /// (and `q2` of a dual drive) adds `A = J⁻ᵀ diag(m) J⁻¹` to the mass matrix and `A h` to

@@ -296,19 +296,6 @@ pub fn rows2(m: &nalgebra::Matrix2<f64>) -> [[f64; 2]; 2] {
     [[m[(0, 0)], m[(0, 1)]], [m[(1, 0)], m[(1, 1)]]]
 }
 
-/// Solution matrices `Π(t_i, t0)` of eq. 2.25 at each `t_i >= t0`.
-///
-/// # Errors
-/// As [`hill_solution_matrix`], naming `t[i]`.
-pub fn hill_solutions(beta0: f64, kappa: f64, t0: f64, t: &[f64]) -> Result<Vec<[[f64; 2]; 2]>> {
-    let at = |(i, &ti): (usize, &f64)| {
-        hill_solution_matrix(beta0, kappa, t0, ti)
-            .map(|m| rows2(&m))
-            .map_err(|e| e.at_index(i, Some("t")))
-    };
-    t.iter().enumerate().map(at).collect()
-}
-
 /// Regions (1-4) of Fig. 2.13 for paired half traces `a` and determinants `b`.
 ///
 /// # Errors
