@@ -190,8 +190,9 @@ def sensitivity(
     Raises
     ------
     InvalidParameterError
-        A path that is unknown (with the nearest ones), discrete (a name, a kind, a count) or
-        with different values on the wings of a ``wings[*]`` path; a flying spec.
+        A path that is unknown (with the nearest ones), discrete (a name, a kind, a count),
+        with different values on the wings of a ``wings[*]`` path, or naming a field another
+        parameter names already (the same path twice, or two spellings of it); a flying spec.
     IntegrationError
         When the spec does not reach a periodic steady state (nothing to differentiate).
     """

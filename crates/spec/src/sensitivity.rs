@@ -33,9 +33,9 @@ pub struct Sensitivity {
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming a path that is unknown (with the nearest ones), not a
-/// continuous number (a name, a kind, a count, a flag), or whose `wings[*]` targets differ;
-/// a flying spec (`body.mode` other than fixed); those of
-/// [`steady_sensitivity`].
+/// continuous number (a name, a kind, a count, a flag), whose `wings[*]` targets differ, or
+/// whose field an earlier parameter names; a flying spec (`body.mode` other than fixed); those
+/// of [`steady_sensitivity`].
 pub fn sensitivity(
     spec: &Simulation,
     params: &[String],
