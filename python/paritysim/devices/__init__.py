@@ -106,8 +106,9 @@ def _name_or_file(source: Any, relative_to: str | Path = ".", field: str = "spec
     if not isinstance(source, str) or not source.strip():
         raise invalid(field, repr(source)[:60], "a named device (`paritysim devices`) or a spec file")
     file = Path(relative_to) / source
-    if file.is_file() or source not in _index() and Path(source).suffix == ".toml":
+    named = source in _index()
+    if file.is_file() or (not named and file.suffix == ".toml"):
         return load_spec(file)  # a missing .toml is load_spec's error, naming the path
-    if source in _index():
+    if named:
         return load(source)
     raise invalid(field, repr(source), suggest(source, list(), listed_by="`paritysim devices`", what=f"a named device or a spec file (none at {file})"))
