@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING, Any
 from . import _core
 from ._errors import invalid, real, suggest
 from ._progress import LongRun
-from .spec import Simulation
+from .spec import Simulation, SpecLike, as_simulation
 
 if TYPE_CHECKING:
     import polars as pl
@@ -178,7 +178,7 @@ def _current(spec: Simulation, path: str) -> float:
 MAX_WALL_MS = 600_000.0
 
 
-def continuation(spec: Simulation, path: str, stop: float, *, start: float | None = None, max_wall_ms: float = MAX_WALL_MS, progress: bool = True, **settings: Any) -> ContinuationResult:
+def continuation(spec: SpecLike, path: str, stop: float, *, start: float | None = None, max_wall_ms: float = MAX_WALL_MS, progress: bool = True, **settings: Any) -> ContinuationResult:
     """Follows the periodic orbit of ``spec`` as ``path`` goes from ``start`` (default: the
     spec's value) to ``stop``.
 
@@ -203,8 +203,7 @@ def continuation(spec: Simulation, path: str, stop: float, *, start: float | Non
     """
     import polars as pl
 
-    if not isinstance(spec, Simulation):
-        raise invalid("spec", type(spec).__name__, "a paritysim.Simulation")
+    spec = as_simulation(spec)
     if not isinstance(path, str):
         raise invalid("path", repr(path), "a parameter path (see paritysim.spec_paths)")
     unknown = sorted(set(settings) - set(SETTINGS))

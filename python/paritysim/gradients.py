@@ -27,7 +27,7 @@ from matplotlib.patches import Rectangle
 from . import _core
 from ._errors import invalid, unknown_name
 from ._progress import LongRun
-from .spec import Simulation
+from .spec import Simulation, SpecLike, as_simulation
 
 __all__ = ["SensitivityResult", "sensitivity"]
 
@@ -157,7 +157,7 @@ class SensitivityResult:
 
 
 def sensitivity(
-    spec: Simulation | Mapping[str, Any],
+    spec: SpecLike,
     params: str | Sequence[str],
     *,
     metrics: str | Sequence[str] | None = None,
@@ -196,10 +196,7 @@ def sensitivity(
     IntegrationError
         When the spec does not reach a periodic steady state (nothing to differentiate).
     """
-    if isinstance(spec, Mapping):
-        spec = Simulation.from_dict(dict(spec))
-    elif not isinstance(spec, Simulation):
-        raise invalid("spec", type(spec).__name__, "a paritysim.Simulation or its dict")
+    spec = as_simulation(spec)
     names = _names("params", params)
     if not names:
         raise invalid("params", "[]", "at least one continuous spec path (see ps.spec_paths)")

@@ -22,7 +22,7 @@ from . import _core
 from ._errors import invalid, real, suggest, whole
 from ._exceptions import InvalidParameterError, ParitysimError
 from ._progress import LongRun
-from .spec import Simulation, spec_paths
+from .spec import Simulation, SpecLike, as_simulation, spec_paths
 
 from .gradients import SensitivityResult, sensitivity
 
@@ -196,7 +196,7 @@ def _largest_non_neutral(multipliers: np.ndarray) -> float:
 
 
 def optimize(
-    spec: Simulation | Mapping[str, Any],
+    spec: SpecLike,
     objective: str = "actuator_power_mean",
     params: Mapping[str, Sequence[float]] | None = None,
     constraints: str | Sequence[str] = (),
@@ -243,10 +243,7 @@ def optimize(
     """
     from scipy.optimize import BFGS, Bounds, NonlinearConstraint, minimize
 
-    if isinstance(spec, Mapping):
-        spec = Simulation.from_dict(dict(spec))
-    elif not isinstance(spec, Simulation):
-        raise invalid("spec", type(spec).__name__, "a paritysim.Simulation or its dict")
+    spec = as_simulation(spec)
     run_spec = spec.replace(options=spec.options.with_fields("options", **option_overrides)) if option_overrides else spec
     if sense not in ("min", "max"):
         raise invalid("sense", repr(sense), '"min" or "max"')

@@ -16,7 +16,7 @@ from matplotlib.figure import Figure
 from . import _core, _slow_drive
 from ._errors import invalid, real, suggest
 from ._progress import LongRun
-from .spec import Simulation
+from .spec import Simulation, SpecLike, as_simulation
 
 __all__ = ["SimulationResult", "simulate"]
 
@@ -143,7 +143,7 @@ def _names(names: Sequence[str] | None, field: str) -> list[str] | None:
 
 
 def simulate(
-    spec: Simulation | dict[str, Any],
+    spec: SpecLike,
     *,
     controller: Controller | None = None,
     control_rate_hz: float | None = None,
@@ -196,10 +196,7 @@ def simulate(
     KeyboardInterrupt
         On Ctrl-C: the run stops inside the integration (within about 20 ms).
     """
-    if isinstance(spec, dict):
-        spec = Simulation.from_dict(spec)
-    elif not isinstance(spec, Simulation):
-        raise invalid("spec", type(spec).__name__, "a paritysim.Simulation or its dict")
+    spec = as_simulation(spec)
     if option_overrides:
         spec = spec.replace(options=spec.options.with_fields("options", **option_overrides))
     if controller is None:

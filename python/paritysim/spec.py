@@ -31,7 +31,7 @@ import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Union
 
 import numpy as np
 
@@ -771,17 +771,22 @@ def load_spec(path: str | Path) -> Simulation:
 
     A file that cannot be read (missing, a directory, not UTF-8) raises
     ``InvalidParameterError`` naming ``path``."""
+    return _load_spec(path, "path")
+
+
+def _load_spec(path: Any, field: str) -> Simulation:
+    """:func:`load_spec`, its file errors naming ``field`` (the argument that gave the path)."""
     from ._errors import invalid
 
     if isinstance(path, bytes) or not isinstance(path, str | os.PathLike):
-        raise invalid("path", repr(path)[:60], "a TOML file path (str or os.PathLike)")
+        raise invalid(field, repr(path)[:60], "a TOML file path (str or os.PathLike)")
     file = Path(path)
     try:
         text = file.read_text(encoding="utf-8")
     except UnicodeDecodeError as exc:
-        raise invalid("path", str(file), f"a UTF-8 text file ({exc.reason} at byte {exc.start})") from exc
+        raise invalid(field, str(file), f"a UTF-8 text file ({exc.reason} at byte {exc.start})") from exc
     except OSError as exc:
-        raise invalid("path", str(file), f"a readable TOML file ({exc.strerror or exc})") from exc
+        raise invalid(field, str(file), f"a readable TOML file ({exc.strerror or exc})") from exc
     try:
         canonical, notes = _core.spec_from_toml(text)
     except _core.InvalidParameterError as exc:
@@ -791,13 +796,40 @@ def load_spec(path: str | Path) -> Simulation:
     return _canonical(canonical, notes)
 
 
+#: What every ``spec`` argument of the Python API accepts (the one rule, :func:`as_simulation`).
+SpecLike = Union["Simulation", Mapping[str, Any], str, "os.PathLike[str]"]
+SPEC_ARGUMENT = "a paritysim.Simulation, its dict, a named device (ps.devices.list()) or a TOML spec file"
+
+
+def as_simulation(spec: Any, field: str = "spec") -> Simulation:
+    """The :class:`Simulation` a ``spec`` argument names: a ``Simulation``; its dict
+    (:meth:`Simulation.from_dict`); a shipped device's name (``"sreetharan2012_3_3_parity"``,
+    :func:`paritysim.devices.load`) or a TOML spec file (:func:`load_spec`; a file wins over a
+    device of the same name, as on the command line). Anything else, or a name that is
+    neither, is an ``InvalidParameterError`` naming ``field`` (with the nearest device names)."""
+    from ._errors import invalid
+
+    if isinstance(spec, Simulation):
+        return spec
+    if isinstance(spec, Mapping):
+        return Simulation.from_dict(dict(spec))
+    if isinstance(spec, os.PathLike):
+        return _load_spec(spec, field)
+    if isinstance(spec, str):
+        from .devices import _name_or_file
+
+        return _name_or_file(spec, field=field)
+    raise invalid(field, type(spec).__name__, SPEC_ARGUMENT)
+
+
 def spec_paths(spec: Simulation) -> Any:
     """Every parameter path of ``spec`` (the names :func:`paritysim.sweep`,
     :func:`paritysim.calibrate` and :meth:`Simulation.with_paths` accept) as a Polars DataFrame:
-    ``path``, ``unit``, ``allowed`` (type and range) and ``value`` (JSON text)."""
+    ``path``, ``unit``, ``allowed`` (type and range) and ``value`` (JSON text). ``spec`` is
+    anything :func:`as_simulation` reads (a device's name, too)."""
     import polars as pl
 
-    rows = _core.spec_paths(spec.to_json())
+    rows = _core.spec_paths(as_simulation(spec).to_json())
     return pl.DataFrame(rows, schema=["path", "unit", "allowed", "value"], orient="row")
 
 

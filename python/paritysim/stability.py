@@ -35,7 +35,7 @@ from matplotlib.figure import Figure
 
 from . import _core
 from ._errors import chunked, invalid, real, reals, sized, whole
-from .spec import Simulation
+from .spec import Simulation, SpecLike, as_simulation
 
 __all__ = [
     "FloquetResult",
@@ -220,13 +220,9 @@ def lti_transfer(beta_star: float, kappa0: float, frequency_hz: Any) -> np.ndarr
     return _core.stability_lti_transfer(real("beta_star", beta_star), real("kappa0", kappa0), _f64(frequency_hz, "frequency_hz"))
 
 
-def _device(spec: Simulation | dict[str, Any]) -> str:
+def _device(spec: SpecLike) -> str:
     """The spec as the JSON text the Rust core reads."""
-    if isinstance(spec, Simulation):
-        return spec.to_json()
-    if isinstance(spec, dict):
-        return Simulation.from_dict(spec).to_json()
-    raise invalid("spec", type(spec).__name__, "a paritysim.Simulation or a spec dict")
+    return as_simulation(spec).to_json()
 
 
 @dataclass(frozen=True)
@@ -400,7 +396,7 @@ def _finite_floquet(raw: dict[str, Any], options: dict[str, Any]) -> None:
         raise invalid(field, options.get("fd_step", "<spec>"), "a finite-difference step giving a finite monodromy (the result overflowed or was undefined)")
 
 
-def floquet(spec: Simulation | dict[str, Any], **options: Any) -> FloquetResult:
+def floquet(spec: SpecLike, **options: Any) -> FloquetResult:
     """Periodic orbit of a driven device by shooting, and its Floquet multipliers.
 
     Newton on the stroboscopic map over one drive period (cycle-to-cycle simulation as the
@@ -505,7 +501,7 @@ def _whippletree_block(monodromy: np.ndarray, coordinates: list[str]) -> tuple[n
     return values[np.argsort(-np.abs(values), kind="stable")].astype(complex), coupling
 
 
-def k2_sweep(spec: Simulation | dict[str, Any], k2: Any, **options: Any) -> pl.DataFrame:
+def k2_sweep(spec: SpecLike, k2: Any, **options: Any) -> pl.DataFrame:
     """:func:`floquet` over balance-beam stiffnesses ``k2`` (mN·mm/rad), in parallel in Rust.
 
     Columns: ``k2, spectral_radius, whippletree_radius`` (null without a whippletree block),
@@ -540,7 +536,7 @@ _BYTES_PER_WINDOW_SAMPLE = 512
 _BYTES_PER_RESPONSE_ROW = 1200
 
 
-def linearise(spec: Simulation | dict[str, Any], samples: int = _LINEARISE_SAMPLES, **options: Any) -> dict[str, Any]:
+def linearise(spec: SpecLike, samples: int = _LINEARISE_SAMPLES, **options: Any) -> dict[str, Any]:
     """Places a fixed-wing Drag PARITY device on the charts of §2.6-2.7 from its periodic orbit.
 
     Returns ``physical`` (inertia, drag Ω·C, T, L, K1, K2, stroke amplitude Φ, frequency),
@@ -556,7 +552,7 @@ def linearise(spec: Simulation | dict[str, Any], samples: int = _LINEARISE_SAMPL
 
 
 def disturbance_response(
-    spec: Simulation | dict[str, Any],
+    spec: SpecLike,
     frequency_hz: Any,
     amplitude: float = 0.1,
     *,

@@ -90,7 +90,7 @@ from . import _sweep_chunks as runner
 from ._core import ParitysimError
 from ._errors import invalid, suggest, whole
 from ._sweep_checkpoint import _Checkpoint, _fingerprint, _reuse
-from .spec import Simulation, _dumps
+from .spec import Simulation, SpecLike, _dumps, as_simulation
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -182,7 +182,7 @@ def _table(spec_grid: Any) -> pl.DataFrame:
 
 
 def sweep(
-    spec: Simulation,
+    spec: SpecLike,
     grid: Mapping[str, Iterable[Any]] | pl.DataFrame | Sequence[Mapping[str, Any]] | None = None,
     *,
     metrics: Sequence[str] | None = None,
@@ -270,8 +270,7 @@ def sweep(
         On Ctrl-C, after the finished rows were flushed to the checkpoint; ``.result`` holds
         them.
     """
-    if not isinstance(spec, Simulation):
-        raise invalid("spec", type(spec).__name__, "a paritysim.Simulation")
+    spec = as_simulation(spec)
     if options is not None and not isinstance(options, Mapping):
         raise invalid("options", type(options).__name__, "a mapping of spec options, e.g. {\"max_cycles\": 50}")
     if options:

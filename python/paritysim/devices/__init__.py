@@ -101,14 +101,14 @@ def _name_or_file(source: Any, relative_to: str | Path = ".", field: str = "spec
     can shadow it. Neither is an ``InvalidParameterError`` naming ``field``, with the nearest
     device names."""
     from .._errors import invalid, suggest
-    from ..spec import load_spec
+    from ..spec import _load_spec
 
     if not isinstance(source, str) or not source.strip():
         raise invalid(field, repr(source)[:60], "a named device (`paritysim devices`) or a spec file")
     file = Path(relative_to) / source
     named = source in _index()
     if file.is_file() or (not named and file.suffix == ".toml"):
-        return load_spec(file)  # a missing .toml is load_spec's error, naming the path
+        return _load_spec(file, field)  # a missing .toml: that it cannot be read
     if named:
         return load(source)
     raise invalid(field, repr(source), suggest(source, list(), listed_by="`paritysim devices`", what=f"a named device or a spec file (none at {file})"))

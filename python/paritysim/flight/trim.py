@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from ..spec import Simulation
+from ..spec import Simulation, SpecLike, as_simulation
 
 __all__ = ["EQUATIONS", "Trim", "trim"]
 
@@ -120,7 +120,7 @@ def _metrics(spec: Simulation, deadline: Any = None) -> dict[str, float]:
 
 
 def trim(
-    spec: Simulation,
+    spec: SpecLike,
     knobs: Sequence[str] | None = None,
     equations: Sequence[str] | None = None,
     *,
@@ -166,8 +166,7 @@ def trim(
     """
     from .._errors import finite_reals, invalid, real, suggest, whole
 
-    if not isinstance(spec, Simulation):
-        raise invalid("spec", type(spec).__name__, "a paritysim.Simulation")
+    spec = as_simulation(spec)
     tol = real("tol", tol)
     if not (math.isfinite(tol) and 0.0 < tol <= 1.0):
         raise invalid("tol", tol, "in (0, 1] (a residual over its scale)")

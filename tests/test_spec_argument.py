@@ -1,0 +1,75 @@
+"""Every ``spec`` argument of the Python API reads the same things (``paritysim.spec.as_simulation``):
+a Simulation, its dict, a shipped device's name or a TOML spec file; anything else is an
+``InvalidParameterError`` naming ``spec``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import paritysim as ps
+from paritysim.spec import as_simulation
+
+NAME = "sreetharan2012_3_3_parity"
+
+
+def test_a_name_a_dict_and_a_file_read_as_the_loaded_device(tmp_path: Path) -> None:
+    spec = ps.devices.load(NAME)
+    file = tmp_path / "mine.toml"
+    spec.save(file)
+    for source in (spec, spec.to_dict(), NAME, str(file), file):
+        assert as_simulation(source) == spec
+
+
+def test_a_file_next_to_the_caller_wins_over_the_device_of_its_name(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # A local copy of a device, edited, shadows the shipped one (as on the command line).
+    edited = ps.devices.load(NAME).with_paths({"drivetrain.balance_spring": 123.0})
+    edited.save(tmp_path / NAME)
+    monkeypatch.chdir(tmp_path)
+    assert as_simulation(NAME) == edited
+
+
+@pytest.mark.parametrize("bad", [42, None, b"x", ["a"]])
+def test_other_types_name_spec_and_what_it_accepts(bad: object) -> None:
+    with pytest.raises(ps.InvalidParameterError, match="a named device") as info:
+        ps.simulate(bad)  # type: ignore[arg-type]
+    assert info.value.field == "spec"
+
+
+def test_a_misspelt_device_name_suggests_the_nearest() -> None:
+    with pytest.raises(ps.InvalidParameterError, match=NAME) as info:
+        ps.simulate("sreetharan2012_3_3_parrity")
+    assert info.value.field == "spec"
+
+
+def test_simulate_of_a_name_equals_simulate_of_the_loaded_device() -> None:
+    by_name = ps.simulate(NAME, record_cycles=1, progress=False)
+    loaded = ps.simulate(ps.devices.load(NAME), record_cycles=1, progress=False)
+    assert by_name.metrics == loaded.metrics
+
+
+def test_every_entry_point_takes_a_name() -> None:
+    # Each reads the name through the one rule: a misspelt one fails on `spec` before any work.
+    calls = {
+        "sweep": lambda s: ps.sweep(s, {"drivetrain.balance_spring": [1.0]}, progress=False),
+        "sensitivity": lambda s: ps.sensitivity(s, params=["drivetrain.balance_spring"]),
+        "optimize": lambda s: ps.optimize(s, objective="lift_mean", params={"drivetrain.balance_spring": (1.0, 2.0)}),
+        "continuation": lambda s: ps.continuation(s, "drivetrain.balance_spring", 2.0, progress=False),
+        "floquet": lambda s: ps.stability.floquet(s),
+        "trim": lambda s: ps.flight.trim(s),
+        "spec_paths": lambda s: ps.spec_paths(s),
+    }
+    for what, call in calls.items():
+        with pytest.raises(ps.InvalidParameterError, match="nearest|did you mean|sreetharan") as info:
+            call("sreetharan2012_3_3_parrity")
+        assert info.value.field == "spec", what
+    table = ps.spec_paths(NAME)
+    assert "drivetrain.balance_spring" in table["path"].to_list()
+
+
+def test_a_missing_file_is_an_error_on_spec(tmp_path: Path) -> None:
+    for missing in (str(tmp_path / "nope.toml"), tmp_path / "nope.toml"):
+        with pytest.raises(ps.InvalidParameterError, match="readable TOML file") as info:
+            ps.sensitivity(missing, params=["drivetrain.balance_spring"])
+        assert info.value.field == "spec"
