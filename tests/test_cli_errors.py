@@ -25,6 +25,9 @@ def _cases(tmp: Path) -> dict[str, tuple[list[str], str]]:
     (tmp / "study_bad_path.toml").write_text(f'spec = "{EXAMPLES / "hmf.toml"}"\n[grid]\n"actuator.volts" = [1.0]\n')
     (tmp / "study_misspelt_device.toml").write_text('spec = "sreetharan2012_3_3_parit"\n[grid]\n"actuator.voltage_v" = [1.0]\n')
     (tmp / "optimize_misspelt_device.toml").write_text('spec = "sreetharan2012_3_3_parit"\nobjective = "delta_tau_peak"\n[params]\n"actuator.stiffness" = [100.0, 300.0]\n')
+    (tmp / "study_mixed_axis.toml").write_text('spec = "sreetharan2012_3_3_parity"\n[grid]\n"actuator.frequency_hz" = [100.0, "x"]\n')
+    (tmp / "study_huge_axis.toml").write_text('spec = "sreetharan2012_3_3_parity"\n[grid]\n"actuator.frequency_hz" = {start = 100, stop = 120, num = 100000000000}\n')
+    (tmp / "study_all_fail.toml").write_text('spec = "sreetharan2012_3_3_parity"\n[grid]\n"actuator.frequency_hz" = [-1.0, -2.0]\n')
     (tmp / "a_directory.toml").mkdir()
     blocker = tmp / "blocker"
     blocker.write_text("a file where a directory is expected")
@@ -56,6 +59,10 @@ def _cases(tmp: Path) -> dict[str, tuple[list[str], str]]:
         "misspelt device": (["run", "sreetharan2012_3_3_parit", "--out", str(tmp / "o")], "did you mean `sreetharan2012_3_3_parity`"),
         "study with a misspelt device": (["sweep", str(tmp / "study_misspelt_device.toml"), "--out", str(tmp / "o")], "did you mean `sreetharan2012_3_3_parity`"),
         "optimize study with a misspelt device": (["optimize", str(tmp / "optimize_misspelt_device.toml"), "--out", str(tmp / "o")], "did you mean `sreetharan2012_3_3_parity`"),
+        # A mixed axis made every value text, so every point failed and the command said 0.
+        "study with a mixed axis": (["sweep", str(tmp / "study_mixed_axis.toml"), "--out", str(tmp / "o"), "--quiet"], "`grid['actuator.frequency_hz'][1]` = 'x'"),
+        "study with a huge axis": (["sweep", str(tmp / "study_huge_axis.toml"), "--out", str(tmp / "o"), "--quiet"], "`grid.actuator.frequency_hz.num`"),
+        "study whose every point fails": (["sweep", str(tmp / "study_all_fail.toml"), "--out", str(tmp / "o"), "--quiet"], "every one of the 2 points failed"),
     }
 
 
@@ -83,6 +90,9 @@ CASE_NAMES = [
     "misspelt device",
     "study with a misspelt device",
     "optimize study with a misspelt device",
+    "study with a mixed axis",
+    "study with a huge axis",
+    "study whose every point fails",
 ]
 
 
@@ -91,9 +101,12 @@ def test_bad_input_is_one_line_and_exit_1(case: str, tmp_path: Path, capsys: pyt
     argv, phrase = _cases(tmp_path)[case]
     assert main(argv) == 1
     err = capsys.readouterr().err.strip()
-    assert err.startswith("paritysim: error: "), err
-    assert "Traceback" not in err and len(err.splitlines()) == 1, err
-    assert phrase in err, err
+    lines = err.splitlines()
+    assert lines[-1].startswith("paritysim: error: "), err
+    # Before the error, only the CLI's own one-line warnings (a sweep's failed points).
+    assert all(line.startswith("paritysim: warning: ") for line in lines[:-1]), err
+    assert "Traceback" not in err, err
+    assert phrase in lines[-1], err
 
 
 def test_debug_flag_shows_the_traceback(tmp_path: Path) -> None:
@@ -103,3 +116,14 @@ def test_debug_flag_shows_the_traceback(tmp_path: Path) -> None:
     debug = subprocess.run([str(exe), "run", missing, "--debug"], capture_output=True, text=True, check=False)
     assert plain.returncode == 1 and "Traceback" not in plain.stderr
     assert debug.returncode != 0 and "Traceback" in debug.stderr and "FileNotFoundError" in debug.stderr
+
+
+def test_a_warning_is_one_line_without_python_source(tmp_path: Path) -> None:
+    # Python's default format printed the file, the line and `sys.exit(main())`.
+    study = tmp_path / "half.toml"
+    study.write_text('spec = "sreetharan2012_3_3_parity"\n[grid]\n"actuator.frequency_hz" = [-1.0, -2.0, 110.0]\n')
+    exe = Path(sys.executable).with_name("paritysim")
+    run = subprocess.run([str(exe), "sweep", str(study), "--out", str(tmp_path / "o"), "--quiet"], capture_output=True, text=True, check=False)
+    assert run.returncode == 0, run.stderr
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("paritysim: warning: 2 of 3 sweep points failed"), run.stderr

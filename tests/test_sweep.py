@@ -563,3 +563,35 @@ def test_a_chunk_whose_executor_worker_raises_becomes_error_rows(parity: ps.Simu
     assert df["status"].to_list() == ["error", "error", "ok", "ok"]
     assert df["error"].str.contains("worker lost").to_list() == [True, True, None, None]
     assert df["cycle_left_phi"][0] is None and len(df["cycle_left_phi"][2]) > 8
+
+
+@pytest.mark.parametrize(
+    ("axes", "field"),
+    [
+        ({"actuator.force_per_volt": [1.0, None]}, "grid['actuator.force_per_volt'][1]"),
+        ({"actuator.frequency_hz": [100.0, "x"]}, "grid['actuator.frequency_hz'][1]"),
+        ({"actuator.frequency_hz": [[100.0], [110.0]]}, "grid['actuator.frequency_hz'][0]"),
+        ({"actuator.frequency_hz": range(10**11)}, "grid['actuator.frequency_hz']"),
+        ({"actuator.frequency_hz": range(10**5), "actuator.force_per_volt": range(10**4)}, "grid"),
+    ],
+)
+def test_a_bad_axis_is_an_error_naming_its_value(axes: dict[str, object], field: str) -> None:
+    # A None ran at the spec's own value as an "ok" row; a mixed list made every value text
+    # (every point failed); a huge range raised MemoryError.
+    with pytest.raises(ps.InvalidParameterError) as info:
+        ps.grid(axes)
+    assert info.value.field == field
+
+
+def test_a_lone_value_is_a_one_point_axis(parity: ps.Simulation) -> None:
+    # As in a study file (it raised TypeError: 'float' object is not iterable).
+    df = sweep(parity, {"actuator.force_per_volt": 1.3, "actuator.frequency_hz": np.float64(105.0)}, metrics=["left_stroke_amplitude"], progress=False)
+    assert df.height == 1 and df["actuator.force_per_volt"][0] == 1.3 and df["status"][0] == "ok"
+
+
+def test_with_paths_refuses_none() -> None:
+    # The core reads a null as "keep the value": with_paths({path: None}) changed nothing.
+    spec = ps.devices.load("sreetharan2012_3_3_parity")
+    with pytest.raises(ps.InvalidParameterError) as info:
+        spec.with_paths({"actuator.force_per_volt": None})
+    assert info.value.field == "values['actuator.force_per_volt']"

@@ -7,8 +7,10 @@ import re
 import sys
 import time
 import tomllib
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Any
 
 from tqdm import tqdm
 
@@ -188,6 +190,13 @@ def describe_error(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {exc}"
 
 
+def _one_line_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int, file: Any = None, line: str | None = None) -> None:
+    """A warning as the CLI's one line (``paritysim: warning: ...``), not Python's file, line and
+    source text."""
+    text = " ".join(part.strip() for part in str(message).splitlines() if part.strip())
+    print(f"paritysim: warning: {text}", file=sys.stderr if file is None else file)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``paritysim`` console script (also ``python -m paritysim``).
 
@@ -202,6 +211,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     from ._progress import quiet
 
+    shown = warnings.showwarning
+    if not debug:
+        warnings.showwarning = _one_line_warning
     try:
         with quiet() if getattr(args, "quiet", False) else nullcontext():  # no bar of a long run either
             return int(args.func(args))
@@ -216,6 +228,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         one_line = " ".join(part.strip() for part in describe_error(exc).splitlines() if part.strip())
         print(f"paritysim: error: {one_line}", file=sys.stderr)
         return 1
+    finally:
+        warnings.showwarning = shown
 
 
 if __name__ == "__main__":

@@ -738,6 +738,11 @@ class Simulation(_Node):
                 from ._errors import invalid
 
                 raise invalid("values", repr(key)[:60], "parameter paths (non-empty text, see paritysim.spec_paths) as keys")
+            if values[key] is None:
+                # The core reads a null as "keep the value" (a sweep row that leaves a path out).
+                from ._errors import invalid
+
+                raise invalid(f"values[{key!r}]", "None", "a value for the path (to clear an optional field: Simulation.replace)")
         canonical, notes = _core.spec_apply(self.to_json(), _dumps(dict(values)))
         return _canonical(canonical, notes)
 

@@ -76,6 +76,7 @@ import itertools
 import logging
 import math
 import os
+import numbers
 import warnings
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
@@ -144,20 +145,59 @@ def grid(axes: Mapping[str, Iterable[Any]]) -> pl.DataFrame:
         raise invalid("grid", type(axes).__name__, "a mapping from parameter path to values")
     names = list(axes)
     _check_columns(names)
-    values = []
-    for name in names:
-        raw = axes[name]
-        vals = list(np.asarray(raw).ravel().tolist()) if isinstance(raw, np.ndarray) else list(raw) if not isinstance(raw, str | bytes) else [raw]
-        if not vals:
-            raise invalid(f"grid[{name!r}]", "[]", "at least one value")
-        values.append(vals)
+    values = [_axis(name, axes[name]) for name in names]
     if not names:
         return pl.DataFrame()
+    points = math.prod(len(v) for v in values)
+    if points > MAX_GRID_POINTS:
+        sizes = " × ".join(str(len(v)) for v in values)
+        raise invalid("grid", f"{sizes} = {points:.3g} points", f"at most {MAX_GRID_POINTS:.0e} points (split the study)")
     columns: list[list[Any]] = [[] for _ in names]
     for combo in itertools.product(*values):
         for k, v in enumerate(combo):
             columns[k].append(v)
     return pl.DataFrame({n: pl.Series(n, c, strict=False) for n, c in zip(names, columns, strict=True)})
+
+
+#: The most points a grid may hold (1e8 rows of one float are 0.8 GB before any run).
+MAX_GRID_POINTS = 10**8
+
+
+def _axis(name: str, raw: Any) -> list[Any]:
+    """One axis' values: a list, a numpy array or one value (a scalar path takes one value per
+    point, so a lone number or text is a one-point axis, as in a study file). Each is a number,
+    a text or a flag, one kind per axis: a ``None`` or a mixed axis is an error naming its
+    index (a mixed list became text in every row, so every point failed)."""
+    if isinstance(raw, np.ndarray):
+        vals = raw.ravel().tolist()
+    elif isinstance(raw, str | bytes | numbers.Number) or not isinstance(raw, Iterable):
+        vals = [raw]
+    elif isinstance(raw, range) and len(raw) > MAX_GRID_POINTS:
+        raise invalid(f"grid[{name!r}]", f"{len(raw):.3g} values", f"at most {MAX_GRID_POINTS:.0e} values")
+    else:
+        vals = list(itertools.islice(raw, MAX_GRID_POINTS + 1))
+    if not vals:
+        raise invalid(f"grid[{name!r}]", "[]", "at least one value")
+    if len(vals) > MAX_GRID_POINTS:
+        raise invalid(f"grid[{name!r}]", f"more than {MAX_GRID_POINTS:.0e} values", f"at most {MAX_GRID_POINTS:.0e} values")
+    first = _kind(vals[0])
+    for i, v in enumerate(vals):
+        kind = _kind(v)
+        if kind is None or kind != first:
+            allowed = f"a {first}, as the axis' first value (one kind per axis)" if first and kind else "a number, a text or a flag (a spec path takes one value per point)"
+            raise invalid(f"grid[{name!r}][{i}]", repr(v)[:60], allowed)
+    return [v.item() if isinstance(v, np.generic) else v for v in vals]
+
+
+def _kind(v: Any) -> str | None:
+    """What kind of spec value ``v`` is: ``"flag"``, ``"number"``, ``"text"``, or ``None``."""
+    if isinstance(v, bool | np.bool_):
+        return "flag"
+    if isinstance(v, numbers.Real):
+        return "number"
+    if isinstance(v, str):
+        return "text"
+    return None
 
 
 def _table(spec_grid: Any) -> pl.DataFrame:
@@ -201,12 +241,14 @@ def sweep(
     Parameters
     ----------
     spec:
-        The base design (`paritysim.Simulation`).
+        The base design: a `paritysim.Simulation`, its dict, a device's name or a TOML file.
     grid:
-        A mapping ``{path: values}`` (Cartesian product, see `grid`), a Polars DataFrame
-        whose columns are paths and rows are points, or a list of ``{path: value}`` rows.
-        Paths are listed in the module docstring and by `valid_paths`. None runs the
-        base design once.
+        A mapping ``{path: values}`` (Cartesian product, see `grid`; a lone value is a
+        one-point axis; each axis holds numbers, texts or flags, one kind, no ``None``), a
+        Polars DataFrame whose columns are paths and rows are points, or a list of
+        ``{path: value}`` rows. In the last two a null (a path a row leaves out) keeps the
+        base design's value at that point. Paths are listed in the module docstring and by
+        `valid_paths`. None runs the base design once.
     metrics:
         Metric names to keep (default: all that `paritysim.simulate` reports). They are
         streamed by the engine from every sample of the recorded window, including Table 3.2's

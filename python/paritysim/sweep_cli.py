@@ -39,8 +39,9 @@ from typing import Any
 import numpy as np
 import polars as pl
 
-from ._errors import invalid, read_study
+from ._errors import invalid, read_study, real
 from .spec import Simulation
+from .sweep import MAX_GRID_POINTS
 
 __all__ = ["Study", "add_parser", "load_study", "run_study"]
 
@@ -69,9 +70,9 @@ def _axis(name: str, value: Any) -> list[Any]:
         unknown = sorted(set(value) - {"start", "stop", "num", "log"})
         if unknown or not {"start", "stop", "num"} <= set(value):
             raise invalid(f"grid.{name}", repr(value), "a list or a table {start, stop, num[, log]}")
-        start, stop, num = float(value["start"]), float(value["stop"]), value["num"]
-        if not isinstance(num, int) or num < 1:
-            raise invalid(f"grid.{name}.num", repr(num), "a positive integer")
+        start, stop, num = real(f"grid.{name}.start", value["start"]), real(f"grid.{name}.stop", value["stop"]), value["num"]
+        if isinstance(num, bool) or not isinstance(num, int) or not 1 <= num <= MAX_GRID_POINTS:
+            raise invalid(f"grid.{name}.num", repr(num), f"an integer in [1, {MAX_GRID_POINTS:.0e}]")
         if value.get("log", False):
             if start <= 0 or stop <= 0:
                 raise invalid(f"grid.{name}", repr(value), "start and stop > 0 for a log axis")
@@ -161,8 +162,13 @@ def _main(args: argparse.Namespace) -> int:
     except SweepInterrupted as stop:
         print(f"{stem}: interrupted after {stop.result.height} of {stop.total} points; re-run the same command to resume", file=sys.stderr)
         return 130
+    n_err = df.filter(pl.col("status") == "error").height
+    if df.height and n_err == df.height:
+        # Nothing was computed: an error, with the most common reason.
+        reason = df["error"].drop_nulls().mode().sort().first() or ""
+        print(f"paritysim: error: {stem}: every one of the {df.height} points failed, e.g. {reason}", file=sys.stderr)
+        return 1
     if not args.quiet:
-        n_err = df.filter(pl.col("status") == "error").height
         n_unconverged = df.filter(pl.col("status") == "unconverged").height
         print(f"{stem}: {df.height} points ({n_err} failed, {n_unconverged} unconverged) in {time.perf_counter() - start:.2f} s -> " + ", ".join(str(p) for p in written.values()))
     return 0
