@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import matplotlib.pyplot as plt
+import pytest
 import numpy as np
 
 import paritysim as ps
@@ -46,3 +49,27 @@ def test_every_metric_of_a_blade_element_device_has_a_unit_or_is_a_ratio() -> No
     for name in _core.sweep_metric_names(spec.to_json()):
         if not name.endswith(dimensionless):
             assert plots.label_with_unit(name) != name, name
+
+
+def test_every_plot_path_saves_through_one_checked_writer(tmp_path: Path) -> None:
+    # Each plot method wrote with its own savefig: a bad suffix was matplotlib's ValueError, a
+    # missing folder FileNotFoundError in some and not others, a number a TypeError.
+    import polars as pl
+
+    result = ps.simulate("sreetharan2012_3_3_parity", progress=False)
+    table = pl.DataFrame({"actuator.frequency_hz": [100.0, 110.0], "left_stroke_amplitude": [0.5, 0.6]})
+    draw = {
+        "simulation": lambda path: result.plot(path),
+        "sweep": lambda path: ps.sweep.plot(table, "actuator.frequency_hz", "left_stroke_amplitude", path=path),
+    }
+    for name, plot in draw.items():
+        written = tmp_path / name / "deep" / "figure.svg"
+        fig = plot(written)
+        assert written.read_text().lstrip().startswith("<?xml"), name  # the suffix's format
+        assert plt.fignum_exists(fig.number), name  # the returned figure stays open
+        plt.close(fig)
+        for bad, phrase in ((tmp_path / "figure.foo", "suffix is a figure format"), (5, "a file path")):
+            with pytest.raises(ps.InvalidParameterError, match=phrase) as info:
+                plot(bad)
+            assert info.value.field == "path", name
+    plt.close("all")

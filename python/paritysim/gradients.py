@@ -143,7 +143,9 @@ class SensitivityResult:
         fig.colorbar(image, ax=ax, label="elasticity (p/m) dm/dp")
         ax.set_title("steady-state sensitivities" + (" (hatched: not differentiable)" if not all(flags) else ""), fontsize=10)
         if path is not None:
-            fig.savefig(path, dpi=150)
+            from .plots import save
+
+            save(fig, path, close=False)
         return fig
 
     def __repr__(self) -> str:

@@ -42,6 +42,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from . import plots
 from ._errors import invalid, read_study
 from .spec import Simulation
 
@@ -141,7 +142,7 @@ def run_study(study: OptimizeStudy, out: str | Path, stem: str, progress: bool =
     result.history.write_csv(written["history_csv"])
     result.history.write_parquet(written["history_parquet"])
     fig = result.plot()
-    fig.savefig(written["plot"], dpi=120)
+    plots.save(fig, written["plot"], dpi=120)
     return result, written
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -173,14 +174,30 @@ def calibration_table(result: Any, x: str | None = None, line: str | None = None
         ax.legend(fontsize=7, ncol=2)
     fig.suptitle("Measured (markers) and predicted (lines) per operating line")
     if path is not None:
-        fig.savefig(Path(path), dpi=150)
+        save(fig, path, close=False)
     return fig
 
 
-def save(fig: Figure, path: str | Path) -> Path:
-    """Save a figure (PNG at 150 dpi) and close it."""
+def save(fig: Figure, path: str | Path, *, close: bool = True, dpi: int = 150, field: str = "path") -> Path:
+    """Saves a figure at ``dpi`` in the format of the path's suffix (PNG without one), making
+    its folder, and closes it unless ``close=False`` (a plot method that returns the figure).
+    A path that is not a path, a format matplotlib cannot write or a file that cannot be
+    written is an ``InvalidParameterError`` naming ``field``: every plot's ``path=`` saves
+    through here."""
+    from ._errors import invalid
+
+    if isinstance(path, bytes) or not isinstance(path, str | os.PathLike):
+        raise invalid(field, repr(path)[:60], "a file path (str or os.PathLike), e.g. 'figure.png'")
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
+    formats = fig.canvas.get_supported_filetypes()
+    suffix = path.suffix.lower().lstrip(".")
+    if suffix and suffix not in formats:
+        raise invalid(field, str(path), f"a file whose suffix is a figure format ({', '.join(f'.{k}' for k in sorted(formats))})")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fig.savefig(path, dpi=dpi, format=suffix or "png")
+    except OSError as exc:
+        raise invalid(field, str(path), f"a writable file path ({exc.strerror or exc})") from exc
+    if close:
+        plt.close(fig)
     return path

@@ -83,7 +83,7 @@ class SimulationResult:
 
         fig = plots.simulation(self)
         if path is not None:
-            plots.save(fig, path)
+            plots.save(fig, path, close=False)
         return fig
 
 

@@ -608,8 +608,9 @@ def plot(df: pl.DataFrame, x: str, y: str | Sequence[str], hue: str | None = Non
     if hue or len(ys) > 1:
         ax.legend(fontsize=8)
     if path is not None:
-        Path(path).parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(path, dpi=150)
+        from .plots import save
+
+        save(fig, path, close=False)
     return fig
 
 
