@@ -157,6 +157,9 @@ def test_a_metric_not_differentiable_at_an_iterate_is_warned_about_once():
         ({"params": {"actuator.waveform.amplitud_v": (20, 150)}}, "params", "actuator.waveform.amplitude_v"),
         ({"params": {"actuator.waveform.kind": (0, 1)}}, "params", "discrete"),
         ({"params": {V: (150, 20)}}, "params", "low < high"),
+        # NumPy bounds are read as ps.calibrate reads them (they were "not bounds").
+        ({"params": {V: np.array([150.0, 20.0])}}, "params", "low < high"),
+        ({"params": {V: (20.0,)}}, f"params[{V}]", "a pair of numbers"),
         ({"params": {V: (20, 20000)}}, "params", "10000"),
         ({"params": {}}, "params", "non-empty"),
         ({"x0": {V: 200.0}}, f"x0[{V}]", "[20, 150]"),

@@ -579,8 +579,10 @@ def _parameters(spec: Simulation, params: Any) -> tuple[list[str], np.ndarray, n
     for path, bounds in params.items():
         if not isinstance(path, str) or not path.strip():
             raise invalid("params", repr(path)[:60], "continuous spec paths (non-empty text, see ps.spec_paths) as keys")
+        if isinstance(bounds, np.ndarray):  # as ps.calibrate takes them
+            bounds = bounds.tolist()
         if isinstance(bounds, str | bytes | Mapping) or not isinstance(bounds, Sequence) or len(bounds) != 2:
-            raise invalid("params", f"{path!r}: {bounds!r}"[:80], "bounds (low, high) per path")
+            raise invalid(f"params[{path}]", repr(bounds)[:60], "bounds (low, high): a pair of numbers")
         lo, hi = (real("params", b) for b in bounds)
         if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
             raise invalid("params", f"{path!r}: ({lo}, {hi})", "finite bounds (low, high) with low < high")
