@@ -113,7 +113,7 @@ impl Problem {
     ) -> Self {
         Self {
             field: field.into(),
-            value: value.to_string(),
+            value: value_text(value),
             allowed: allowed.into(),
         }
     }
@@ -165,7 +165,7 @@ impl Error {
     ) -> Self {
         Error::Attributed {
             field: field.into(),
-            value: value.to_string(),
+            value: value_text(value),
             allowed: allowed.into(),
             error: Box::new(self),
         }
@@ -198,7 +198,7 @@ impl Error {
     ) -> Self {
         Error::InvalidParameter {
             field: field.into(),
-            value: value.to_string(),
+            value: value_text(value),
             allowed: allowed.into(),
         }
     }
@@ -300,6 +300,16 @@ pub fn check_finite(field: &'static str, value: f64) -> Result<f64> {
         Ok(value)
     } else {
         Err(Error::invalid(field, value, "a finite number"))
+    }
+}
+
+/// `value` as an error message shows it: a number whose decimal text is longer than its
+/// scientific one (`1e300` displays as 301 digits, `1e-300` as 302) in scientific notation.
+fn value_text(value: impl fmt::Display) -> String {
+    let text = value.to_string();
+    match text.parse::<f64>() {
+        Ok(x) if x.is_finite() && text.len() > 24 => format!("{x:e}"),
+        _ => text,
     }
 }
 
@@ -411,6 +421,19 @@ mod tests {
     fn needs_positive(x: f64) -> Result<f64> {
         ensure!(x > 0.0, invalid "x", x, "> 0");
         Ok(x)
+    }
+
+    #[test]
+    fn huge_and_tiny_numbers_show_in_scientific_notation() {
+        // `1e300` displayed as 301 digits in the message.
+        let e = check_positive("x", -1e300).unwrap_err();
+        assert_eq!(e.to_string(), "invalid `x` = -1e300: must be finite and > 0");
+        let e = Error::invalid("x", 1.5e-300, "> 1");
+        assert_eq!(e.to_string(), "invalid `x` = 1.5e-300: must be > 1");
+        // Ordinary numbers and texts keep their own form.
+        assert_eq!(Error::invalid("x", 0.125, "> 1").to_string(), "invalid `x` = 0.125: must be > 1");
+        let long = "a text of more than twenty-four characters";
+        assert!(Error::invalid("x", long, "y").to_string().contains(long));
     }
 
     #[test]
