@@ -289,3 +289,20 @@ def test_unknown_record_keys_are_typed_errors_naming_the_nearest_field() -> None
         _core.laminate_abd(json.dumps(layers))
     assert exc.value.field == "layers.angel"
     assert "did you mean `angle`" in str(exc.value)
+
+
+def test_malformed_inputs_are_named() -> None:
+    # Each was a bare ValueError (unpacking, float conversion) or a silent NaN.
+    with pytest.raises(ps.InvalidParameterError) as info:
+        ps.laminate.Layup.from_plies([("a", "polyimide")])  # type: ignore[list-item]
+    assert info.value.field == "plies[0]"
+    mobee = ps.laminate.Layup.mobee()
+    for kwargs, field in (({"n": "x"}, "n"), ({"n": [1.0, 2.0]}, "n"), ({"m": [1.0, "a", 3.0]}, "m"), ({"voltages": ["q"]}, "voltages")):
+        with pytest.raises(ps.InvalidParameterError) as info:
+            mobee.response(**kwargs)  # type: ignore[arg-type]
+        assert info.value.field == field
+    flexure = ps.laminate.Flexure(width=1.0, length=0.1)
+    assert flexure.torque(0.2) == pytest.approx(-0.2 * flexure.stiffness)
+    with pytest.raises(ps.InvalidParameterError) as info:
+        flexure.torque(float("nan"))
+    assert info.value.field == "angle"

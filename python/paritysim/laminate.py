@@ -30,7 +30,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _core
-from ._errors import invalid, real, whole
+from ._errors import finite_reals, invalid, real, whole
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -93,10 +93,27 @@ _COLOURS = {
 _METAL_COLOURS = {"titanium": "#9aa4ad", "brass": "#c9a43a", "steel": "#7d8a96"}
 
 
-def _vec3(x: Sequence[float] | FloatArray | None) -> FloatArray:
+def _vec3(x: Sequence[float] | FloatArray | None, field: str) -> FloatArray:
+    """Three resultants ``(x, y, xy)``, or an ``InvalidParameterError`` naming ``field``."""
     if x is None:
         return np.zeros(3)
-    return np.ascontiguousarray(np.asarray(x, dtype=np.float64).ravel())
+    try:
+        v = np.asarray(x, dtype=np.float64).ravel()
+    except (TypeError, ValueError) as exc:
+        raise invalid(field, repr(x)[:60], "three numbers (x, y, xy)") from exc
+    if v.size != 3 or isinstance(x, str | bytes):
+        raise invalid(field, repr(x)[:60], "three numbers (x, y, xy)")
+    return np.ascontiguousarray(v)
+
+
+def _voltages(voltages: Sequence[float] | FloatArray | None) -> FloatArray:
+    """One voltage per layer (V), or an ``InvalidParameterError`` naming ``voltages``."""
+    if voltages is None:
+        return np.zeros(0)
+    try:
+        return np.asarray(voltages, dtype=np.float64).ravel()
+    except (TypeError, ValueError) as exc:
+        raise invalid("voltages", repr(voltages)[:60], "one number (V) per layer") from exc
 
 
 # ------------------------------------------------------------------ materials
@@ -331,7 +348,13 @@ class Layup:
     @classmethod
     def from_plies(cls, plies: Iterable[tuple[str, Material | str, float, float]]) -> Layup:
         """From ``(name, material, thickness mm, angle rad)`` tuples, one single-ply layer each."""
-        return cls(Layer.single(n, m, t, a) for n, m, t, a in plies)
+        layers = []
+        for i, ply in enumerate(plies):
+            if isinstance(ply, str | bytes) or not isinstance(ply, Sequence) or len(ply) != 4:
+                raise invalid(f"plies[{i}]", repr(ply)[:60], "a tuple (name, material, thickness mm, angle rad)")
+            n, m, t, a = ply
+            layers.append(Layer.single(n, m, t, a))
+        return cls(layers)
 
     @classmethod
     def _preset(cls, name: str) -> Layup:
@@ -413,8 +436,7 @@ class Layup:
         """Mid-plane ``strain`` and ``curvature`` (1/mm) under resultants ``n`` (mN/mm), ``m``
         (mN), a temperature change ``delta_t`` (K) and one voltage per layer (V, piezo layers only).
         """
-        v = np.zeros(0) if voltages is None else np.asarray(voltages, dtype=np.float64).ravel()
-        return _core.laminate_response(self._json, _vec3(n), _vec3(m), _f(delta_t, "delta_t"), v)
+        return _core.laminate_response(self._json, _vec3(n, "n"), _vec3(m, "m"), _f(delta_t, "delta_t"), _voltages(voltages))
 
     def thermal_curvature(self, delta_t: float = CURE_DELTA_T) -> FloatArray:
         """Curvature ``(κx, κy, κxy)`` (1/mm) after a uniform temperature change ``delta_t`` (K)
@@ -429,8 +451,7 @@ class Layup:
         voltages: Sequence[float] | FloatArray | None = None,
     ) -> dict[str, np.ndarray]:
         """Stresses (mN/mm², laminate axes) at the bottom and top face of every ply."""
-        v = np.zeros(0) if voltages is None else np.asarray(voltages, dtype=np.float64).ravel()
-        return _core.laminate_ply_stresses(self._json, _vec3(n), _vec3(m), _f(delta_t, "delta_t"), v)
+        return _core.laminate_ply_stresses(self._json, _vec3(n, "n"), _vec3(m, "m"), _f(delta_t, "delta_t"), _voltages(voltages))
 
     # -- drawing
     def plot(self, ax: Axes | None = None, to_scale: bool = True) -> Axes:
@@ -725,5 +746,6 @@ class Flexure:
 
     def torque(self, angle: float | npt.ArrayLike) -> Any:
         """Linear restoring torque ``−k θ`` (mN·mm) at angle(s) ``angle`` (rad)."""
-        out = -self.stiffness * np.asarray(angle, dtype=np.float64)
+        theta = finite_reals("angle", angle)  # a NaN or text angle is named, not passed on
+        out = -self.stiffness * theta
         return float(out) if out.ndim == 0 else out
