@@ -595,3 +595,13 @@ def test_with_paths_refuses_none() -> None:
     with pytest.raises(ps.InvalidParameterError) as info:
         spec.with_paths({"actuator.force_per_volt": None})
     assert info.value.field == "values['actuator.force_per_volt']"
+
+
+def test_a_path_a_row_leaves_out_keeps_the_base_value(parity: ps.Simulation) -> None:
+    # Rows of different paths (null where a row leaves one out), as the docstring says.
+    rows = [{"actuator.force_per_volt": 1.3}, {"actuator.frequency_hz": 105.0}]
+    df = sweep(parity, rows, metrics=["left_stroke_amplitude"], progress=False)
+    assert df["actuator.force_per_volt"].null_count() == 1 and df["actuator.frequency_hz"].null_count() == 1
+    for row, values in zip(df.iter_rows(named=True), rows, strict=True):
+        alone = ps.simulate(parity.with_paths(values), metrics=["left_stroke_amplitude"], progress=False)
+        assert row["left_stroke_amplitude"] == pytest.approx(alone.metrics["left_stroke_amplitude"], rel=1e-6)
