@@ -41,6 +41,25 @@ def test_labels_carry_units() -> None:
     assert plots.label_with_unit("lift_to_weight") == "lift_to_weight"  # dimensionless
 
 
+def test_a_spec_path_is_labelled_with_its_schema_unit() -> None:
+    # The labels guessed from substrings: force_per_volt was "mN", hinge_damping "mN·mm/rad",
+    # omega2 "mg·mm²", actuator.damping and drivetrain.balance_spring had none.
+    for device in ("sreetharan2012_3_4_parity", "sreetharan2012_3_3_parity_linkage", "robobee_dual_linear"):
+        for path, unit, _, _ in ps.spec_paths(device).iter_rows():
+            shown = unit.replace(" ", "·").replace("^2", "²").replace("^3", "³")
+            expected = path if unit in ("", "1") else f"{path} ({shown})"
+            assert plots.label_with_unit(path) == expected, (device, path, unit)
+    assert plots.label_with_unit("wings.left.springs.hinge_damping") == "wings.left.springs.hinge_damping (mN·mm·ms/rad)"
+    assert plots.label_with_unit("actuator.voltage_v") == "actuator.voltage_v (V)"
+
+
+def test_a_gradient_column_is_labelled_with_the_quotient_of_units() -> None:
+    assert plots.label_with_unit("d(lift_mean)/d(actuator.force_per_volt)") == "d(lift_mean)/d(actuator.force_per_volt) (mN/(mN/V))"
+    assert plots.label_with_unit("d(left_stroke_amplitude)/d(actuator.waveform.amplitude_v)") == "d(left_stroke_amplitude)/d(actuator.waveform.amplitude_v) (rad/V)"
+    assert plots.label_with_unit("d(lift_mean)/d(drivetrain.arm_ratio)") == "d(lift_mean)/d(drivetrain.arm_ratio) (mN)"
+    assert plots.label_with_unit("d(lift_to_weight)/d(drivetrain.arm_ratio)") == "d(lift_to_weight)/d(drivetrain.arm_ratio)"
+
+
 def test_every_metric_of_a_blade_element_device_has_a_unit_or_is_a_ratio() -> None:
     from paritysim import _core
 

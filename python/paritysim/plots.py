@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import functools
 import os
+import re
 from pathlib import Path
 from typing import Any
 
@@ -47,17 +49,67 @@ _UNITS = {
 }
 
 
+@functools.lru_cache(maxsize=1)
+def _spec_units() -> dict[str, str]:
+    """Each spec path's unit as the spec's schema states it (``ps.spec_paths``), over the shipped
+    devices (they hold every drivetrain, actuator and aero kind), wing paths as ``wings[*]``."""
+    from . import _core, devices
+
+    units: dict[str, str] = {}
+    for name in devices.list():
+        for path, unit, *_ in _core.spec_paths(devices.load(name).to_json()):
+            units.setdefault(re.sub(r"^wings\[\d+\]", "wings[*]", path), unit)
+    return units
+
+
+#: Spellings of a path that ``ps.sweep`` accepts besides the canonical one.
+_PATH_ALIASES = {"actuator.frequency_hz": "actuator.waveform.frequency_hz", "actuator.amplitude_v": "actuator.waveform.amplitude_v", "actuator.voltage_v": "actuator.waveform.amplitude_v"}
+
+
+def _path_unit(column: str) -> str | None:
+    """The schema's unit of a spec-path column (``""`` for a dimensionless one), in the labels'
+    typography (``mN·mm/rad³``); None when ``column`` is no known path."""
+    path = _PATH_ALIASES.get(column, column)
+    path = re.sub(r"^wings(\[\d+\]|\.left|\.right)", "wings[*]", path)
+    unit = _spec_units().get(path)
+    if unit is None:
+        return None
+    if unit == "1":
+        return ""
+    return unit.replace(" ", "·").replace("^2", "²").replace("^3", "³")
+
+
+def _unit_of(column: str) -> str:
+    """The unit :func:`label_with_unit` puts in parentheses (``""``: none)."""
+    label = label_with_unit(column)
+    return label[len(column) + 2 : -1] if label != column else ""
+
+
 def label_with_unit(column: str) -> str:
     """An axis label for a sweep or trajectory column: the name and its unit (mg-mm-ms-rad-V),
-    e.g. ``left_roll_aero_peak (mN·mm)``, ``actuator.waveform.frequency_hz (Hz)``; ratios,
-    counts and names without a known unit get none (``omega_ratio`` is dimensionless)."""
+    e.g. ``left_roll_aero_peak (mN·mm)``, ``actuator.waveform.frequency_hz (Hz)``; a spec path
+    takes the schema's unit (``ps.spec_paths``), a sweep's ``d(metric)/d(path)`` column the
+    quotient of the two; ratios, counts and names without a known unit get none
+    (``omega_ratio`` is dimensionless)."""
+    derivative = re.fullmatch(r"d\((.+)\)/d\((.+)\)", column)
+    if derivative:
+        top, bottom = (_unit_of(c) for c in derivative.groups())
+        if not (top or bottom):
+            return column
+        if not bottom:
+            return f"{column} ({top})"
+        return f"{column} ({top or '1'}/{bottom if '/' not in bottom and '·' not in bottom else f'({bottom})'})"
+    if "." in column:
+        unit = _path_unit(column)
+        if unit is not None:
+            return f"{column} ({unit})" if unit else column
     name = column.lower()
     # The ratios of the designer metrics (crates/dynamics/src/metrics/mod.rs) before the
     # substrings, which would read `lift_per_power` as a power.
     ratios = {"lift_per_power": "mN/mW", "actuator_power_per_weight": "mW/mN", "lift_to_weight": "-"}
     if name in ratios:
         return column if ratios[name] == "-" else f"{column} ({ratios[name]})"
-    suffixes = {"_hz": "Hz", "_v": "V", "_mm": "mm", "_ms": "ms", "_deg": "deg", "_pct": "%", "_ratio": "-"}
+    suffixes = {"_hz": "Hz", "_v": "V", "_mm": "mm", "_ms": "ms", "_deg": "deg", "_pct": "%", "_mg": "mg", "_ratio": "-"}
     for suffix, unit in suffixes.items():
         if name.endswith(suffix):
             return column if unit == "-" else f"{column} ({unit})"
