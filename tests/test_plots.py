@@ -92,3 +92,21 @@ def test_every_plot_path_saves_through_one_checked_writer(tmp_path: Path) -> Non
                 plot(bad)
             assert info.value.field == "path", name
     plt.close("all")
+
+
+def test_a_simulation_plots_lift_and_any_columns_by_unit() -> None:
+    result = ps.simulate("sreetharan2012_3_4_parity", progress=False)
+    default = result.plot()
+    labels = [ax.get_ylabel() for ax in default.axes]
+    assert labels == ["angle (deg)", "torque (mN·mm)", "lift (mN)"]
+    total = [line for line in default.axes[2].lines if line.get_label() == "total"][0]
+    np.testing.assert_allclose(total.get_ydata(), (result.trajectory["left_lift"] + result.trajectory["right_lift"]).to_numpy())
+    chosen = result.plot(columns=["left_phi", "right_psi", "left_lift", "actuator_power", "aero_power"])
+    assert [ax.get_ylabel() for ax in chosen.axes] == ["deg", "mN", "mW"]  # one panel per unit
+    np.testing.assert_allclose(chosen.axes[0].lines[0].get_ydata(), np.degrees(result.trajectory["left_phi"].to_numpy()))
+    with pytest.raises(ps.InvalidParameterError, match="left_lift") as info:
+        result.plot(columns=["left_lif"])
+    assert info.value.field == "columns[0]"
+    # A device without aerodynamic lift keeps two panels.
+    assert len(ps.simulate("sreetharan2012_3_3_parity", progress=False).plot().axes) == 2
+    plt.close("all")

@@ -6,6 +6,7 @@ import functools
 import os
 import re
 from pathlib import Path
+from collections.abc import Sequence
 from typing import Any
 
 import matplotlib.pyplot as plt  # the backend stays the user's (the CLI picks Agg)
@@ -153,12 +154,28 @@ def fig2_9(df: pl.DataFrame, box_deg: dict[str, tuple[float, float]] | None = No
     return fig
 
 
-def simulation(result: object) -> Figure:
-    """Stroke, deviation and rotation angles and the body roll torques of a simulation."""
+def simulation(result: object, columns: Any = None) -> Figure:
+    """Stroke, deviation and rotation angles and the body roll torques of a simulation, and the
+    wings' lift where the device computes it; or the trajectory ``columns`` against time, one
+    panel per unit."""
     df = result.trajectory  # type: ignore[attr-defined]
+    name = getattr(getattr(result, "spec", None), "name", "") or "simulation"
+    if columns is not None:
+        return _columns_over_time(df, columns, name)
     t = df["time_ms"].to_numpy()
     prefixes = [p for p in ("left", "right", "wing") if f"{p}_phi" in df.columns]
-    fig, (ax_a, ax_t) = plt.subplots(2, 1, figsize=(10, 7), sharex=True, constrained_layout=True)
+    lifts = [p for p in prefixes if f"{p}_lift" in df.columns]
+    fig, axes = plt.subplots(3 if lifts else 2, 1, figsize=(10, 9.5 if lifts else 7), sharex=True, constrained_layout=True)
+    ax_a, ax_t = axes[0], axes[1]
+    if lifts:
+        ax_l = axes[2]
+        for p in lifts:
+            ax_l.plot(t, df[f"{p}_lift"].to_numpy(), label=f"{p} wing")
+        if len(lifts) > 1:
+            ax_l.plot(t, sum(df[f"{p}_lift"].to_numpy() for p in lifts), "k", lw=1.5, label="total")
+        ax_l.axhline(0.0, color="0.6", lw=0.6)
+        ax_l.set_ylabel("lift (mN)")
+        ax_l.legend(ncol=3, fontsize=8)
     for p in prefixes:
         ax_a.plot(t, np.degrees(df[f"{p}_phi"].to_numpy()), label=f"{p} stroke $\\phi$")
         if np.ptp(df[f"{p}_psi"].to_numpy()) > 1e-9:
@@ -170,11 +187,41 @@ def simulation(result: object) -> Figure:
     ax_t.plot(t, df["roll_total"].to_numpy(), "k", lw=1.5, label="net body roll")
     ax_a.set_ylabel("angle (deg)")
     ax_t.set_ylabel("torque (mN·mm)")
-    ax_t.set_xlabel("time (ms)")
+    axes[-1].set_xlabel("time (ms)")
     ax_a.legend(ncol=2, fontsize=8)
     ax_t.legend(ncol=2, fontsize=8)
-    name = getattr(getattr(result, "spec", None), "name", "") or "simulation"
-    fig.suptitle(f"{name}: wing angles and body torques over the recorded cycles")
+    fig.suptitle(f"{name}: wing angles, body torques{' and lift' if lifts else ''} over the recorded cycles")
+    return fig
+
+
+def _columns_over_time(df: pl.DataFrame, columns: Any, name: str) -> Figure:
+    """The trajectory ``columns`` against ``time_ms``, one panel per unit (angles in degrees)."""
+    from ._errors import invalid, suggest
+
+    if isinstance(columns, str):
+        columns = [columns]
+    if isinstance(columns, bytes) or not isinstance(columns, Sequence) or not columns:
+        raise invalid("columns", repr(columns)[:60], "a non-empty list of trajectory column names")
+    recorded = [c for c in df.columns if c != "time_ms"]
+    for i, c in enumerate(columns):
+        if c not in recorded:
+            raise invalid(f"columns[{i}]", repr(c)[:60], suggest(str(c), recorded, what="a column of the trajectory (result.trajectory.columns)"))
+    panels: dict[str, list[str]] = {}
+    for c in columns:
+        unit = label_with_unit(c)[len(c) :].strip(" ()")
+        panels.setdefault(unit, []).append(c)
+    t = df["time_ms"].to_numpy()
+    fig, axes = plt.subplots(len(panels), 1, figsize=(10, 2.2 + 2.4 * len(panels)), sharex=True, constrained_layout=True, squeeze=False)
+    for ax, (unit, cs) in zip(axes[:, 0], panels.items(), strict=True):
+        degrees = unit == "rad"
+        for c in cs:
+            y = df[c].to_numpy()
+            ax.plot(t, np.degrees(y) if degrees else y, label=c)
+        ax.set_ylabel("deg" if degrees else unit or "value")
+        ax.grid(alpha=0.3)
+        ax.legend(ncol=2, fontsize=8)
+    axes[-1, 0].set_xlabel("time (ms)")
+    fig.suptitle(f"{name}: {', '.join(columns) if len(columns) <= 4 else f'{len(columns)} columns'} over the recorded cycles")
     return fig
 
 

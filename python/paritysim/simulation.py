@@ -77,11 +77,13 @@ class SimulationResult:
         """The metrics as a one-row DataFrame."""
         return pl.DataFrame({k: [v] for k, v in self.metrics.items()})
 
-    def plot(self, path: str | Path | None = None) -> Figure:
-        """Angles and torques over the recorded window; saved as PNG when ``path`` is given."""
+    def plot(self, path: str | Path | None = None, columns: Sequence[str] | None = None) -> Figure:
+        """Angles, body torques and (where computed) lift over the recorded window, or the
+        trajectory ``columns`` against time, one panel per unit (angles in degrees); saved to
+        ``path`` when given (the suffix picks the format: ``.png``, ``.pdf``, ``.svg``)."""
         from . import plots
 
-        fig = plots.simulation(self)
+        fig = plots.simulation(self, columns)
         if path is not None:
             plots.save(fig, path, close=False)
         return fig
