@@ -556,7 +556,7 @@ def test_a_grid_of_python_objects_is_refused_naming_its_column(tmp_path: Any) ->
     """Found by the fuzz: with a checkpoint, a grid column of Python objects raised polars'
     ComputeError (an Object column cannot be written); refused up front, naming the column."""
     hmf = ps.load_spec(EXAMPLES / "hmf.toml")
-    _named(lambda: ps.sweep(hmf, {"actuator.frequency_hz": [100.0, object()]}, checkpoint=tmp_path / "s.parquet", progress=False), "actuator.frequency_hz")
+    _named(lambda: ps.sweep(hmf, {"actuator.frequency_hz": [100.0, object()]}, checkpoint=tmp_path / "s.parquet", progress=False), "grid['actuator.frequency_hz'][1]")
 
 
 def test_an_absolute_tolerance_below_1e_30_is_refused_naming_it() -> None:
