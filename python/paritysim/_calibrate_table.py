@@ -217,11 +217,44 @@ def _frame(data: Any) -> pl.DataFrame:
     raise invalid("data", type(data).__name__, "a polars DataFrame, a pandas DataFrame or a mapping {column: values}")
 
 
-def _column(table: pl.DataFrame, name: str) -> np.ndarray:
+def _column(table: pl.DataFrame, name: str, field: str = "data") -> np.ndarray:
     try:
         return table[name].cast(pl.Float64, strict=True).fill_null(np.nan).to_numpy()
     except (pl.exceptions.PolarsError, TypeError, ValueError) as exc:
-        raise invalid(f"data.{name}", f"a column of {table[name].dtype}", "numbers") from exc
+        raise invalid(f"{field}.{name}", f"a column of {table[name].dtype}", "numbers") from exc
+
+
+#: The ``jacobian=`` of a table fit.
+JACOBIANS = ("auto", "sensitivity", "differences")
+
+
+def check_jacobian(jacobian: Any, allowed: Sequence[str] = JACOBIANS, why: str = "") -> str:
+    """``jacobian`` if it is one of ``allowed``, else an ``InvalidParameterError`` naming it
+    (``why``: what the other values need). Both forms of `paritysim.calibrate` check here."""
+    if not isinstance(jacobian, str) or jacobian not in allowed:
+        shown = (", ".join(repr(a) for a in allowed[:-1]) + " or ") if len(allowed) > 1 else ""
+        raise invalid("jacobian", repr(jacobian), f"{shown}{allowed[-1]!r}{why}")
+    return jacobian
+
+
+def check_names(field: str, given: Any, names: Sequence[str], kind: str, what: str) -> None:
+    """``given`` (``x0``, ``scale``) is None or a mapping whose every key is one of ``names``:
+    an unknown key (a typo) is an ``InvalidParameterError`` naming ``field.key`` and the
+    nearest names, never silently unused. Both forms of `paritysim.calibrate` check here."""
+    if given is None:
+        return
+    if not isinstance(given, Mapping):
+        raise invalid(field, type(given).__name__, f"a mapping {{{kind}: value}}")
+    for k in given:
+        if k not in names:
+            raise invalid(f"{field}.{k}", f"<not a {kind}>", suggest(str(k), names, what=what))
+
+
+def not_finite(exc: ValueError, field: str, bounds: Mapping[str, tuple[float, float]], log: list[dict[str, float]]) -> _core.InvalidParameterError:
+    """scipy's own refusal of a fit (a residual or Jacobian that is not finite) as an error
+    naming the bounds and the last point evaluated: the fit may have moved far from its start."""
+    last = {n: v for n, v in log[-1].items() if n in bounds} if log else None
+    return invalid(field, dict(bounds), f"bounds inside which the model's outputs are finite numbers (scipy: {exc}; last evaluated at {last})")
 
 
 def _alias(path: str) -> str:
@@ -293,8 +326,7 @@ def calibrate_table(
         raise invalid("ftol", ftol, "in (0, 1)")
     max_nfev = whole("max_nfev", max_nfev, 1, 1_000_000)
     seed = whole("seed", seed, 0, 2**63 - 1)
-    if jacobian not in ("auto", "sensitivity", "differences"):
-        raise invalid("jacobian", repr(jacobian), "'auto', 'sensitivity' or 'differences'")
+    jacobian = check_jacobian(jacobian)
     deadline = Deadline("max_wall_ms", max_wall_ms)
 
     # --- the parameters and their bounds
@@ -311,11 +343,7 @@ def calibrate_table(
             raise invalid(f"params.{n}", (low, high), "finite bounds with low < high")
         _check_bounds(spec, n, low, high)
         bounds[n] = (low, high)
-    if x0 is not None and not isinstance(x0, Mapping):
-        raise invalid("x0", type(x0).__name__, "a mapping {parameter: value}")
-    for k in x0 or {}:
-        if k not in bounds:
-            raise invalid(f"x0.{k}", "<not a parameter>", suggest(str(k), names, what="a path of params"))
+    check_names("x0", x0, names, "parameter", "a path of params")
     paths_table = _core_paths(spec)
     start = []
     for n in names:
@@ -493,7 +521,8 @@ def calibrate_table(
         except ValueError as exc:
             if isinstance(exc, ParitysimError):
                 raise
-            raise invalid("x0", dict(zip(names, start, strict=True)), f"a start where the model's outputs are finite numbers ({exc})") from exc
+            # Not the start's fault: evaluate() refused a failing start already (issue 34).
+            raise not_finite(exc, "params", bounds, log) from exc
         x = np.asarray(fit.x, dtype=float)
         J = np.asarray(fit.jac, dtype=float)
         # The prediction of every row at the fit (fitted and held out): one sweep.

@@ -20,7 +20,7 @@ import polars as pl
 from scipy.optimize import least_squares
 
 from ._budget import Deadline
-from ._calibrate_table import Measured, TableCalibrationResult, calibrate_table, measured
+from ._calibrate_table import Measured, TableCalibrationResult, _column, calibrate_table, check_jacobian, check_names, measured, not_finite
 from ._errors import invalid, real, suggest, whole
 from ._exceptions import ParitysimError
 from ._progress import LongRun
@@ -66,13 +66,13 @@ def calibrate(
     params: Mapping[str, tuple[float, float]] | None = None,
     measured: Mapping[str, Measured | str] | None = None,
     holdout: float | None = None,
-    seed: int = 0,
+    seed: int | None = None,
     labels: Sequence[str] = (),
     jacobian: str = "auto",
     threads: int | None = None,
     x0: Mapping[str, float] | None = None,
     scale: Mapping[str, float] | None = None,
-    workers: int = 2,
+    workers: int | None = None,
     max_nfev: int = 100,
     xtol: float | None = None,
     ftol: float | None = None,
@@ -107,6 +107,11 @@ def calibrate(
     max errors on the fitted and held-out rows, scipy's convergence status, and plots the
     measured against the predicted values per operating line (:meth:`TableCalibrationResult.plot`).
 
+    Arguments of one form only are refused by the other, never silently unused: ``measured``,
+    ``holdout``, ``seed`` (with ``holdout``), ``labels`` and ``threads`` need ``data=``;
+    ``scale`` and ``workers`` are the single-point form's. ``jacobian`` there is ``"auto"`` or
+    ``"differences"`` (its Jacobian always comes from differences).
+
     ``model``: a :class:`Simulation` (names are the spec paths of :func:`paritysim.spec_paths`,
     the same language as :func:`paritysim.sweep`; outputs are the simulation metrics) or a callable ``f(**values)``
     returning a mapping of outputs.
@@ -121,7 +126,10 @@ def calibrate(
 
     ``targets``: ``{output: value}`` (residual ``(model − target)/scale``, scale defaults to
     ``max(|target|, 1e-12)``), or a DataFrame with ``time_ms`` and columns of the trajectory to
-    match (e.g. ``right_phi``), compared on the recorded window after aligning time origins.
+    match (e.g. ``right_phi``; numbers, at least one row, ``time_ms`` increasing), compared on
+    the recorded window after aligning time origins (scale per column defaults to its max |value|).
+
+    ``workers`` (default 2): simulations run at once for the single-point Jacobian's columns.
 
     ``max_wall_ms`` (default 10 min) bounds the whole fit: each simulation gets what is left as
     its ``options.max_wall_ms`` (a callable model is checked between evaluations); when it is
@@ -131,6 +139,12 @@ def calibrate(
     (wall time against ``max_wall_ms``, runs done); ``False`` turns it off.
     """
     if data is not None:
+        # The single-point form's own arguments, refused rather than dropped.
+        for field_name, point_only, why in (("scale", scale, "the noise scale of a measured column is ps.measured(..., sigma=)"), ("workers", workers, "a table is fitted in sweeps of threads= engine threads")):
+            if point_only is not None:
+                raise invalid(field_name, repr(point_only)[:60], f"None when data= is given ({why})")
+        if seed is not None and holdout is None:
+            raise invalid("seed", repr(seed), "None unless holdout= is given (it chooses the held-out rows)")
         if targets is not None:
             raise invalid("targets", type(targets).__name__, "None when data= is given (the measured columns of data are the targets)")
         if free is not None and params is not None:
@@ -141,7 +155,7 @@ def calibrate(
             params if params is not None else free,
             measured=measured,
             holdout=holdout,
-            seed=seed,
+            seed=0 if seed is None else seed,
             labels=labels,
             x0=x0,
             jacobian=jacobian,
@@ -156,6 +170,13 @@ def calibrate(
     for field_name, extra in (("measured", measured), ("holdout", holdout)):
         if extra is not None:
             raise invalid(field_name, type(extra).__name__, "None unless data= is given (a measured table)")
+    # The table form's arguments mean nothing for one point: refused, never silently unused.
+    for field_name, table_only, why in (("seed", seed, "it chooses the held-out rows of a table"), ("threads", threads, "engine threads of a table's sweeps; one point runs `workers` simulations at once")):
+        if table_only is not None:
+            raise invalid(field_name, repr(table_only)[:60], f"None unless data= is given ({why})")
+    if labels is not None and not (isinstance(labels, Sequence) and not isinstance(labels, str) and len(labels) == 0):
+        raise invalid("labels", repr(labels)[:60], "empty unless data= is given (columns of the table carried into the result)")
+    check_jacobian(jacobian, ("auto", "differences"), " (the single-point form takes its Jacobian from differences; 'sensitivity' needs data=)")
     if params is not None:
         if free is not None:
             raise invalid("free", "given with params", "None when params= is given (one or the other)")
@@ -175,18 +196,16 @@ def calibrate(
     if not (math.isfinite(ftol) and 0 < ftol < 1):
         raise invalid("ftol", ftol, "in (0, 1)")
     max_nfev = whole("max_nfev", max_nfev, 1, 1_000_000)
-    workers = whole("workers", workers, 1, 1024)
+    workers = whole("workers", 2 if workers is None else workers, 1, 1024)
     deadline = Deadline("max_wall_ms", max_wall_ms)
     if not isinstance(model, Simulation) and not callable(model):
         raise invalid("model", type(model).__name__, "a paritysim.Simulation or a callable f(**values) -> outputs")
     if not isinstance(free, Mapping):
         raise invalid("free", type(free).__name__, "a mapping {name: (low, high)}")
-    for field_name, given in (("x0", x0), ("scale", scale)):
-        if given is not None and not isinstance(given, Mapping):
-            raise invalid(field_name, type(given).__name__, "a mapping {name: value}")
     names = list(free)
     if not names:
         raise invalid("free", "{}", "at least one parameter with (low, high) bounds")
+    check_names("x0", x0, names, "parameter", "a name of free")
     bounds = []
     for n in names:
         pair = free[n]
@@ -205,6 +224,8 @@ def calibrate(
     trajectory_target = isinstance(goal_table, pl.DataFrame)
     if not trajectory_target and not isinstance(goal_table, Mapping):
         raise invalid("targets", type(goal_table).__name__, "a mapping {output: value} or a DataFrame with time_ms and trajectory columns")
+    if trajectory_target and not isinstance(model, Simulation):  # a callable returns outputs, no trajectory
+        raise invalid("targets", "a DataFrame", "a mapping {output: value} when model is a callable (a trajectory DataFrame needs a paritysim.Simulation)")
 
     if isinstance(model, Simulation):
         base = model
@@ -226,9 +247,36 @@ def calibrate(
                 raise invalid("model", type(out).__name__, "a callable returning a mapping {output: value}")
             return dict(out)
 
-    if trajectory_target:
+    output_of: Callable[[int], str]
+    if isinstance(goal_table, pl.DataFrame):
+        # Checked before any run: polars' ColumnNotFoundError, numpy's IndexError and
+        # TypeError (a text column) otherwise.
+        if "time_ms" not in goal_table.columns:
+            raise invalid("targets", f"a DataFrame of columns {goal_table.columns[:6]}", "a DataFrame with a `time_ms` column (the sample times, ms) and the trajectory columns to match")
         columns = [c for c in goal_table.columns if c != "time_ms"]
-        t_target = goal_table["time_ms"].to_numpy() - goal_table["time_ms"][0]
+        if not columns:
+            raise invalid("targets", "a DataFrame of time_ms alone", "time_ms and at least one trajectory column to match (e.g. right_phi)")
+        if goal_table.height == 0:
+            raise invalid("targets", "an empty DataFrame", "at least one row (a sample time and its measured values)")
+        measured_at = {c: _column(goal_table, c, "targets") for c in ["time_ms", *columns]}
+        for c, column in measured_at.items():
+            bad = np.flatnonzero(~np.isfinite(column))
+            if bad.size:
+                raise invalid(f"targets.{c}", f"row {int(bad[0])} = {column[bad[0]]}", "a finite number on every row")
+        t_measured = measured_at.pop("time_ms")
+        back = np.flatnonzero(np.diff(t_measured) < 0)
+        if back.size:
+            raise invalid("targets.time_ms", f"row {int(back[0]) + 1} = {t_measured[back[0] + 1]}", "increasing times (each row at or after the one before)")
+        t_target = t_measured - t_measured[0]
+        check_names("scale", scale, columns, "target", "a trajectory column of targets")
+        column_scales = {c: real(f"scale.{c}", (scale or {}).get(c, max(float(np.abs(v).max()), 1e-12))) for c, v in measured_at.items()}
+        for c, size in column_scales.items():
+            if not (math.isfinite(size) and size > 0):
+                raise invalid(f"scale.{c}", size, "finite and > 0")
+
+        # The output a residual belongs to (one block of samples per column), to name a non-finite one.
+        def output_of(i: int) -> str:
+            return columns[i // t_target.size]
 
         def residual_of(out: dict[str, Any]) -> np.ndarray:
             traj = out["__trajectory__"]
@@ -238,13 +286,18 @@ def calibrate(
                 if c not in traj.columns:  # polars' ColumnNotFoundError otherwise
                     raise invalid(f"targets.{c}", "<unknown column>", suggest(c, traj.columns, what="a trajectory column"))
                 sim = np.interp(t_target, t, traj[c].to_numpy())
-                res.append((sim - goal_table[c].to_numpy()) / max(float(np.abs(goal_table[c].to_numpy()).max()), 1e-12))
+                res.append((sim - measured_at[c]) / column_scales[c])
             return np.concatenate(res)
     else:
         keys = list(goal_table)
         if not keys:
             raise invalid("targets", "{}", "at least one output to fit")
         goal = np.array([real(f"targets.{k}", goal_table[k]) for k in keys])
+        check_names("scale", scale, keys, "target", "an output of targets")
+
+        def output_of(i: int) -> str:
+            return keys[i]
+
         scales = np.array([real(f"scale.{k}", (scale or {}).get(k, max(abs(g), 1e-12))) for k, g in zip(keys, goal, strict=True)])
         for k, g, sc in zip(keys, goal, scales, strict=True):
             if not math.isfinite(g):
@@ -265,9 +318,19 @@ def calibrate(
     log: list[dict[str, float]] = []
     lock = threading.Lock()
 
+    start_values = {n: float(v) for n, v in zip(names, start, strict=True)}
+    given_bounds = {n: (float(a), float(b)) for n, a, b in zip(names, lo, hi, strict=True)}
+
     def evaluate(x: np.ndarray) -> np.ndarray:
         values = dict(zip(names, (float(v) for v in x), strict=True))
         r = residual_of(outputs(values))
+        bad = np.flatnonzero(~np.isfinite(r))
+        if bad.size:
+            # Name the point where the outputs broke: the start only if it is the start.
+            what = f"`{output_of(int(bad[0]))}` is not finite"
+            if np.array_equal(x, start):
+                raise invalid("x0", values, f"a start where the model's outputs are finite numbers ({what} there)")
+            raise invalid("free", given_bounds, f"bounds inside which the model's outputs are finite numbers ({what} at {values}, reached by the fit from the start {start_values})")
         with lock:
             log.append({**values, "cost": 0.5 * float(r @ r)})
             bar.done()
@@ -290,9 +353,9 @@ def calibrate(
     except ValueError as exc:
         if isinstance(exc, ParitysimError):
             raise
-        # scipy's own checks (e.g. residuals not finite at the start: an output the model
-        # returned as NaN): a typed error naming what the fit started from (issue 34).
-        raise invalid("x0", {n: float(v) for n, v in zip(names, start, strict=True)}, f"a start where the model's outputs are finite numbers ({exc})") from exc
+        # scipy's own checks (evaluate() has refused non-finite outputs already): a typed
+        # error naming the bounds and the last point evaluated, not the start (issue 34).
+        raise not_finite(exc, "free", given_bounds, log) from exc
     finally:
         pool.shutdown()
     values = dict(zip(names, (float(v) for v in fit.x), strict=True))
