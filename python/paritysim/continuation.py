@@ -30,12 +30,14 @@ from __future__ import annotations
 
 import json
 import math
+import numbers
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from . import _core
-from ._errors import invalid, real, suggest
+from ._core import InvalidParameterError
+from ._errors import invalid, real, suggest, whole
 from ._progress import LongRun
 from .spec import Simulation, SpecLike, as_simulation
 
@@ -45,8 +47,23 @@ if TYPE_CHECKING:
 
 __all__ = ["ContinuationResult", "continuation"]
 
-#: Keywords of `continuation` passed to the Rust settings (validated there, unknown ones named).
-SETTINGS = ("method", "initial_step", "min_step", "max_step", "max_points", "tolerance", "parameter_scale", "multiplier_tolerance", "cyclic", "locate", "metrics")
+#: Keywords of `continuation` passed to the Rust settings (``ContinuationSettings`` of
+#: ``paritysim_spec::continuation``) and the kind of value each takes: `_settings` checks the
+#: kind by name before serialising (JSON has no NaN, and serde's type errors named only
+#: ``settings``); the core checks the ranges and how they combine, and names the setting.
+SETTINGS: dict[str, str] = {
+    "method": "text",
+    "initial_step": "number",
+    "min_step": "number",
+    "max_step": "number",
+    "max_points": "count",
+    "tolerance": "number",
+    "parameter_scale": "number",
+    "multiplier_tolerance": "number",
+    "cyclic": "count",
+    "locate": "flag",
+    "metrics": "flag",
+}
 
 
 @dataclass(frozen=True)
@@ -90,9 +107,17 @@ class ContinuationResult:
         1e-7 (its test function is a derivative of the computed map)."""
         import polars as pl
 
+        n = self.bifurcations.height
+        try:
+            index = whole("bifurcation", bifurcation, 0, n - 1)
+        except InvalidParameterError:
+            found = f": an integer in [0, {n - 1}] (the branch has {n})" if n else f", but the branch has none (stop_reason {self.stop_reason})"
+            raise invalid("bifurcation", repr(bifurcation), f"a row of `bifurcations`{found}") from None
+        if not isinstance(path, str):
+            raise invalid("path", repr(path), "a parameter path (see paritysim.spec_paths)")
         second_start = _current(self.spec, path) if start is None else real("start", start)
         step = None if max_step is None else real("max_step", max_step)
-        curve = self._native.follow(int(bifurcation), path, second_start, real("stop", stop), step)
+        curve = self._native.follow(index, path, second_start, real("stop", stop), step)
         return pl.DataFrame(
             {
                 self.path: list(curve["first"]),
@@ -173,6 +198,39 @@ def _current(spec: Simulation, path: str) -> float:
     return float(value)
 
 
+def _settings(settings: dict[str, Any]) -> dict[str, Any]:
+    """The keyword ``settings`` of `continuation` checked by name for their kind (`SETTINGS`;
+    None: the default), or an ``InvalidParameterError`` naming the setting: an unknown one
+    with the nearest known ones, a number that is not finite, a count that is not a
+    non-negative integer, a flag that is not a bool."""
+    unknown = sorted(set(settings) - set(SETTINGS))
+    if unknown:
+        raise invalid(unknown[0], "<unknown setting>", suggest(unknown[0], SETTINGS, what="a setting of paritysim.continuation"))
+    checked: dict[str, Any] = {}
+    for name, value in settings.items():
+        kind = SETTINGS[name]
+        if value is None:
+            continue
+        if kind == "number":
+            number = real(name, value)
+            if not math.isfinite(number):
+                raise invalid(name, number, "a finite number")
+            checked[name] = number
+        elif kind == "count":
+            if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 0:
+                raise invalid(name, repr(value), "a non-negative integer")
+            checked[name] = int(value)
+        elif kind == "flag":
+            if not isinstance(value, bool) and type(value).__name__ != "bool_":  # numpy's too
+                raise invalid(name, repr(value), "True or False")
+            checked[name] = bool(value)
+        elif isinstance(value, str):
+            checked[name] = value
+        else:
+            raise invalid(name, repr(value), "a text")
+    return checked
+
+
 #: Wall budget of a whole `continuation` by default (ms); each orbit also has the spec's
 #: ``options.max_wall_ms``.
 MAX_WALL_MS = 600_000.0
@@ -187,16 +245,18 @@ def continuation(spec: SpecLike, path: str, stop: float, *, start: float | None 
     ``tolerance`` (Newton, on the state), ``parameter_scale`` (parameter units per state unit;
     default |stop − start| / 10), ``multiplier_tolerance``, ``cyclic`` (index of a cyclic
     integrated coordinate, e.g. 1 for ``q2`` of a K2 = 0 linear whippletree), ``locate``,
-    ``metrics`` (orbit metrics per point, default True). The spec's ``options`` set the
-    integration (rtol capped at 1e-10 for shooting). ``max_wall_ms`` (default 600 000, 10
-    min) bounds the whole branch; Ctrl-C stops it within tens of milliseconds. A branch that
-    runs for more than a few seconds shows its wall time against that budget on stderr
-    (``progress=False``: no bar; the CLI's ``--quiet``: none).
+    ``metrics`` (orbit metrics per point, default True); None for any of them: its default.
+    The spec's ``options`` set the integration (rtol capped at 1e-10 for shooting).
+    ``max_wall_ms`` (default 600 000, 10 min) bounds the whole branch; Ctrl-C stops it
+    within tens of milliseconds. A branch that runs for more than a few seconds shows its
+    wall time against that budget on stderr (``progress=False``: no bar; the CLI's
+    ``--quiet``: none).
 
     Raises
     ------
     InvalidParameterError
-        For an unknown path or setting (named, with the nearest valid one).
+        For an unknown path or setting (named, with the nearest valid one), a setting out of
+        its range (`SETTINGS`) or a ``start`` the path does not allow.
     IntegrationError, OutOfDomainError
         When no periodic orbit is found at ``start``. Failures later on end the branch
         (``stop_reason``) and keep the points found.
@@ -206,11 +266,10 @@ def continuation(spec: SpecLike, path: str, stop: float, *, start: float | None 
     spec = as_simulation(spec)
     if not isinstance(path, str):
         raise invalid("path", repr(path), "a parameter path (see paritysim.spec_paths)")
-    unknown = sorted(set(settings) - set(SETTINGS))
-    if unknown:
-        raise invalid(unknown[0], "<unknown setting>", suggest(unknown[0], SETTINGS, what="a setting of paritysim.continuation"))
+    settings_json = json.dumps(_settings(settings))
     first = _current(spec, path) if start is None else real("start", start)
-    settings_json = json.dumps(settings, default=lambda o: o.item() if hasattr(o, "item") else repr(o))  # Rust names a bad value
+    if start is not None:  # checked as the spec checks the path (the core's run names it twice)
+        spec.with_paths({path: first})
     budget_ms = real("max_wall_ms", max_wall_ms)
     try:
         with LongRun("continuation", progress, budget_ms):

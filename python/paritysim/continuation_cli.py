@@ -41,6 +41,9 @@ def run_study(study: str | Path, out: str | Path) -> dict[str, Any]:
     settings = data.get("settings", {})
     if not isinstance(settings, dict):
         raise invalid("settings", repr(settings), "a table of paritysim.continuation keywords")
+    for key in ("spec", "path", "start", "stop"):
+        if key in settings:  # a keyword given twice
+            raise invalid(f"settings.{key}", repr(settings[key]), f"given as `{key}` at the top of the study, not in [settings]")
     result = continuation(spec, data["path"], data["stop"], start=data.get("start"), **settings)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import json
 import math
+import numbers
 import os
 import re
 from dataclasses import dataclass, field
@@ -35,7 +36,7 @@ from matplotlib.figure import Figure
 
 from . import _core
 from ._errors import chunked, invalid, real, reals, sized, whole
-from .spec import Simulation, SpecLike, as_simulation
+from .spec import Simulation, SpecLike, as_simulation, schema
 
 __all__ = [
     "FloquetResult",
@@ -352,10 +353,48 @@ class FloquetResult:
         )
 
 
+#: The shooting options of :func:`floquet` (``ShootingOptions`` of the Rust core) and the kind
+#: of value each takes: `_shooting` checks the kind by name before serialising (JSON has no NaN,
+#: and serde's type errors named only ``options``); the core checks the ranges and names the
+#: option.
+SHOOTING_OPTIONS: dict[str, str] = {
+    "method": "name",
+    "rtol": "number",
+    "atol": "number",
+    "max_steps": "count",
+    "t0": "number",
+    "warmup_cycles": "count",
+    "warmup_tol": "number",
+    "max_newton": "count",
+    "tol": "number",
+    "fd_step": "number",
+    "fallback_cycles": "count",
+    "orbit_cycles": "count",
+}
+
+
 def _shooting(options: dict[str, Any]) -> str | None:
-    """Options as the JSON record read by ``_core`` (None values dropped: the Rust defaults
-    apply; anything not JSON-like travels as text for Rust to reject with the key)."""
-    given = {k: v for k, v in options.items() if v is not None}
+    """Options as the JSON record read by ``_core``, each of `SHOOTING_OPTIONS` checked for its
+    kind by name (an ``InvalidParameterError`` naming it). None values are dropped (the Rust
+    defaults apply); other names travel as given for Rust to reject with the key."""
+    given: dict[str, Any] = {}
+    for name, value in options.items():
+        kind = SHOOTING_OPTIONS.get(name)
+        if value is None:
+            continue
+        if kind == "number":
+            value = real(name, value)
+            if not math.isfinite(value):
+                raise invalid(name, value, "a finite number")
+        elif kind == "count":
+            if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 0:
+                raise invalid(name, repr(value), "a non-negative integer")
+            value = int(value)
+        elif name == "method":
+            methods = [m["const"] for m in schema()["$defs"]["Method"]["oneOf"]]  # the spec's own list
+            if value not in methods:
+                raise invalid(name, repr(value), " or ".join(f'"{m}"' for m in methods))
+        given[name] = value
     return json.dumps(given, default=lambda o: o.item() if isinstance(o, np.generic) else repr(o)) if given else None
 
 
@@ -576,6 +615,9 @@ def disturbance_response(
     nulls elsewhere; the others are kept).
     """
     freqs = _f64(frequency_hz, "frequency_hz")
+    amplitude = real("amplitude", amplitude)
+    if not (math.isfinite(amplitude) and amplitude > 0):  # before the runs, which would blame each frequency
+        raise invalid("amplitude", amplitude, "finite and > 0 (mN·mm)")
     # One row per frequency (its result or error text): measured 1.15 kB each at peak.
     sized("frequency_hz", f"<{freqs.size} frequencies>", freqs.size, _BYTES_PER_RESPONSE_ROW, "the response rows")
     if settle_cycles is not None:
@@ -589,12 +631,13 @@ def disturbance_response(
     sized("samples_per_cycle" if samples_per_cycle is not None else "max_window_cycles", samples_per_cycle or max_window_cycles, per_window * parallel, _BYTES_PER_WINDOW_SAMPLE, "the measurement windows")
     dist = {"settle_cycles": settle_cycles, "max_window_cycles": max_window_cycles, "samples_per_cycle": samples_per_cycle}
     device = _device(spec)
-    raw = _attributed(lambda: _core.stability_disturbance_response(device, freqs, real("amplitude", amplitude), _shooting(options), _shooting(dist)), {**options, **dist})
+    shooting = _shooting(options)
+    raw = _attributed(lambda: _core.stability_disturbance_response(device, freqs, amplitude, shooting, _shooting(dist)), {**options, **dist})
     h = _complex(raw["transfer"])
     lti = avg = np.full(freqs.size, np.nan + 0j)
     _, n_dof = _core.validate_spec(device)
     if n_dof == 2:  # eq. 2.59 models the whippletree mode of a 2-DOF (Drag PARITY) drivetrain
-        lin = _attributed(lambda: _core.stability_linearise(device, _shooting(options), _LINEARISE_SAMPLES), options)
+        lin = _attributed(lambda: _core.stability_linearise(device, shooting, _LINEARISE_SAMPLES), options)
         lti = lti_transfer(lin["lti"]["beta_star"], lin["lti"]["kappa0"], freqs)
         avg = lti_transfer(lin["lti_averaged"]["beta_star"], lin["lti_averaged"]["kappa0"], freqs)
     return pl.DataFrame(
@@ -618,6 +661,18 @@ def disturbance_response(
 _REGION_COLOURS = {1: "#4daf4a", 2: "#e41a1c", 3: "#377eb8", 4: "#984ea3"}
 
 
+def _chart(chart: Any, columns: tuple[str, ...]) -> pl.DataFrame:
+    """``chart`` when it is a frame with ``columns`` (as :func:`stability_chart` returns it),
+    else an ``InvalidParameterError`` naming ``chart`` and the columns a plot needs."""
+    needed = "a frame from stability_chart, with the columns " + ", ".join(columns)
+    if not isinstance(chart, pl.DataFrame):
+        raise invalid("chart", type(chart).__name__, needed)
+    missing = [c for c in columns if c not in chart.columns]
+    if missing:
+        raise invalid("chart", f"<a frame without {', '.join(missing)}>", needed)
+    return chart
+
+
 def plot_fig2_13(chart: pl.DataFrame | None = None, points: dict[str, tuple[float, float]] | None = None) -> Figure:
     """Fig. 2.13: the (a, b) plane of the monodromy matrix with Regions I-IV.
 
@@ -625,6 +680,8 @@ def plot_fig2_13(chart: pl.DataFrame | None = None, points: dict[str, tuple[floa
     for comparison) and the double-root parabola ``b = a²``. ``chart`` (from
     :func:`stability_chart`) is scattered coloured by region; ``points`` maps labels to (a, b).
     """
+    if chart is not None:
+        chart = _chart(chart, ("a", "b", "region"))
     fig, ax = plt.subplots(figsize=(7.5, 6), constrained_layout=True)
     a = np.linspace(-2.5, 2.5, 801)
     b_grid = np.linspace(-0.5, 2.5, 601)
@@ -660,33 +717,53 @@ def plot_fig2_13(chart: pl.DataFrame | None = None, points: dict[str, tuple[floa
 
 def plot_chart_map(chart: pl.DataFrame, points: dict[str, tuple[float, float]] | None = None) -> Figure:
     """The stability chart as a map over (β0, κ): log10 of the spectral radius (per period π),
-    the Region I boundary, Brockett's guaranteed region, and optional labelled (β0, κ) points."""
-    beta = np.unique(chart["beta0"].to_numpy())
-    kap = np.unique(chart["kappa"].to_numpy())
-    shape = (beta.size, kap.size)
-    rho = chart["spectral_radius"].to_numpy().reshape(shape).T
-    stable = chart["stable"].to_numpy().reshape(shape).T.astype(float)
-    fig, ax = plt.subplots(figsize=(8, 6), constrained_layout=True)
-    mesh = ax.pcolormesh(beta, kap, np.log10(rho), cmap="RdBu_r", vmin=-2, vmax=2, shading="auto")
-    fig.colorbar(mesh, ax=ax, label="$\\log_{10}\\max|\\rho|$ per period $\\pi$ (-)")
-    ax.contour(beta, kap, stable, levels=[0.5], colors="k", linewidths=1.2)
-    if "brockett_bounded" in chart.columns:
-        guaranteed = chart["brockett_bounded"].to_numpy().reshape(shape).T.astype(float)
-        if guaranteed.any():
-            ax.contourf(beta, kap, guaranteed, levels=[0.5, 1.5], colors="none", hatches=["//"])
-            ax.contour(beta, kap, guaranteed, levels=[0.5], colors="0.3", linewidths=0.8, linestyles="--")
-    for label, (x, y) in (points or {}).items():
-        ax.plot([x], [y], "k*", ms=12)
-        ax.annotate(label, (x, y), textcoords="offset points", xytext=(6, 6))
+    the Region I boundary, Brockett's guaranteed region, and optional labelled (β0, κ) points.
+    A chart with one value on an axis (a line or a point of the plane) has no cells or
+    boundaries to draw: its points are drawn in the same colours, the stable and guaranteed
+    ones marked."""
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
-    handles = [
-        Line2D([], [], color="k", lw=1.2, label="Region I boundary (stable inside)"),
-        Patch(facecolor="none", edgecolor="0.3", hatch="//", label="Brockett: bounded guaranteed"),
-    ]
+    chart = _chart(chart, ("beta0", "kappa", "spectral_radius", "stable"))
+    grid = chart.unique(["beta0", "kappa"], keep="first", maintain_order=True).sort("beta0", "kappa")
+    beta = np.unique(grid["beta0"].to_numpy())
+    kap = np.unique(grid["kappa"].to_numpy())
+    shape = (beta.size, kap.size)
+    if grid.height == 0 or grid.height != beta.size * kap.size:
+        raise invalid("chart", f"<{chart.height} points over {beta.size} beta0 x {kap.size} kappa>", "a whole beta0 x kappa grid as stability_chart returns it (at least one point)")
+    fig, ax = plt.subplots(figsize=(8, 6), constrained_layout=True)
+    log_rho = np.log10(grid["spectral_radius"].to_numpy())
+    flat = min(shape) < 2  # an axis with one value: cells of no width and no contours, so the points are drawn
+    if flat:
+        mesh: Any = ax.scatter(grid["beta0"], grid["kappa"], c=log_rho, marker="s", s=60, cmap="RdBu_r", vmin=-2, vmax=2)
+        kept = grid.filter(pl.col("stable"))
+        ax.scatter(kept["beta0"], kept["kappa"], marker="o", s=150, facecolors="none", edgecolors="k")
+        if "brockett_bounded" in grid.columns:
+            kept = grid.filter(pl.col("brockett_bounded"))
+            ax.scatter(kept["beta0"], kept["kappa"], marker="+", s=60, color="0.3")
+        handles: list[Any] = [
+            Line2D([], [], color="k", marker="o", markerfacecolor="none", lw=0, label="Region I (stable)"),
+            Line2D([], [], color="0.3", marker="+", lw=0, label="Brockett: bounded guaranteed"),
+        ]
+    else:
+        mesh = ax.pcolormesh(beta, kap, log_rho.reshape(shape).T, cmap="RdBu_r", vmin=-2, vmax=2, shading="auto")
+        stable = grid["stable"].to_numpy().reshape(shape).T.astype(float)
+        ax.contour(beta, kap, stable, levels=[0.5], colors="k", linewidths=1.2)
+        if "brockett_bounded" in grid.columns:
+            guaranteed = grid["brockett_bounded"].to_numpy().reshape(shape).T.astype(float)
+            if guaranteed.any():
+                ax.contourf(beta, kap, guaranteed, levels=[0.5, 1.5], colors="none", hatches=["//"])
+                ax.contour(beta, kap, guaranteed, levels=[0.5], colors="0.3", linewidths=0.8, linestyles="--")
+        handles = [
+            Line2D([], [], color="k", lw=1.2, label="Region I boundary (stable inside)"),
+            Patch(facecolor="none", edgecolor="0.3", hatch="//", label="Brockett: bounded guaranteed"),
+        ]
+    fig.colorbar(mesh, ax=ax, label="$\\log_{10}\\max|\\rho|$ per period $\\pi$ (-)")
+    for label, (x, y) in (points or {}).items():
+        ax.plot([x], [y], "k*", ms=12)
+        ax.annotate(label, (x, y), textcoords="offset points", xytext=(6, 6))
     # Points whose analysis failed (overflow) are blank in the map: mark them.
-    failed = chart.filter(pl.col("error").is_not_null()) if "error" in chart.columns else chart.clear()
+    failed = grid.filter(pl.col("error").is_not_null()) if "error" in grid.columns else grid.clear()
     if failed.height:
         ax.scatter(failed["beta0"], failed["kappa"], marker="x", s=14, color="k")
         handles.append(Line2D([], [], color="k", marker="x", lw=0, label=f"analysis failed ({failed.height} points, see `error`)"))
