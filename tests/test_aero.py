@@ -169,7 +169,17 @@ def test_dickinson_fits_in_degrees_at_0_45_90() -> None:
     np.testing.assert_allclose(c["drag"], cd, rtol=1e-13)
     np.testing.assert_allclose(c["lift"], cl, rtol=1e-12)
     np.testing.assert_allclose(c["drag"], [0.392710, 1.703746, 3.460875], atol=2e-6)
-    np.testing.assert_allclose(c["center_of_pressure"], aero.center_of_pressure(np.radians(deg)))
+    # Eq. 3.7 in closed form: 0.05, 0.255 and 0.46 of the chord.
+    np.testing.assert_allclose(c["center_of_pressure"], 0.82 * deg / 180.0 + 0.05, rtol=1e-14)
+    np.testing.assert_allclose(aero.center_of_pressure(np.radians(deg)), [0.05, 0.255, 0.46], rtol=1e-14)
+
+
+def test_center_of_pressure_takes_the_coefficients_range() -> None:
+    # It computed eq. 3.7 on its own for any angle (2.66 chords behind the edge at 10 rad).
+    for bad, field in ((10.0, "alpha"), (-1.0, "alpha"), ([0.1, 4.0], "alpha[1]")):
+        with pytest.raises(ps.InvalidParameterError, match="pi") as info:
+            aero.center_of_pressure(bad)
+        assert info.value.field == field, info.value.field
 
 
 def test_dickinson_past_90_degrees_mirrors_the_printed_fit() -> None:

@@ -110,3 +110,38 @@ def test_a_simulation_plots_lift_and_any_columns_by_unit() -> None:
     # A device without aerodynamic lift keeps two panels.
     assert len(ps.simulate("sreetharan2012_3_3_parity", progress=False).plot().axes) == 2
     plt.close("all")
+
+
+def test_columns_are_grouped_by_the_cores_units() -> None:
+    # The units were guessed from names: left_phi_ddot went on the angle axis times 57.3,
+    # q1_dot was labelled mm, body angles and rates shared the torque axis.
+    hmf = ps.devices.load("sreetharan2012_3_4_hmf")
+    result = ps.simulate(hmf, progress=False)
+    assert result.units["left_phi_ddot"] == "rad/ms^2" and result.units["q1_dot"] == "mm/ms"
+    # The work integral's rate is the power column (µJ/ms = mW): the units agree with the data.
+    t, work, power = (result.trajectory[c].to_numpy() for c in ("time_ms", "work_actuator", "actuator_power"))
+    np.testing.assert_allclose(np.gradient(work, t)[5:-5], power[5:-5], rtol=1e-2, atol=1e-2 * np.abs(power).max())
+    fig = result.plot(columns=["left_phi_ddot", "q1_dot", "q2", "actuator_power"])
+    assert [ax.get_ylabel() for ax in fig.axes] == ["rad/ms²", "mm/ms", "deg", "mW"]
+    np.testing.assert_allclose(fig.axes[0].lines[0].get_ydata(), result.trajectory["left_phi_ddot"].to_numpy())  # not in degrees
+    flying = ps.simulate(ps.flight.with_body(hmf, mode="roll"), record_cycles=2, progress=False)
+    fig = flying.plot(columns=["body_roll", "body_omega_roll", "body_torque_roll"])
+    assert [ax.get_ylabel() for ax in fig.axes] == ["deg", "rad/ms", "mN·mm"]
+    with pytest.raises(ps.InvalidParameterError, match="x axis") as info:
+        result.plot(columns=["time_ms"])
+    assert info.value.field == "columns[0]"
+    plt.close("all")
+
+
+def test_a_run_that_recorded_some_columns_plots_those() -> None:
+    # The default figure needed every angle and torque: polars' ColumnNotFoundError.
+    result = ps.simulate("sreetharan2012_3_4_hmf", columns=["left_phi", "right_phi", "actuator_force"], progress=False)
+    fig = result.plot()
+    assert [ax.get_ylabel() for ax in fig.axes] == ["deg", "mN"]
+    plt.close("all")
+
+
+def test_naming_time_ms_among_the_columns_is_no_error() -> None:
+    # It was "must be a known name (none close to `time_ms`)", though every trajectory has it.
+    result = ps.simulate("sreetharan2012_3_4_hmf", columns=["time_ms", "left_phi"], progress=False)
+    assert result.trajectory.columns == ["time_ms", "left_phi"]

@@ -570,7 +570,8 @@ def test_a_chunk_whose_executor_worker_raises_becomes_error_rows(parity: ps.Simu
     [
         ({"actuator.force_per_volt": [1.0, None]}, "grid['actuator.force_per_volt'][1]"),
         ({"actuator.frequency_hz": [100.0, "x"]}, "grid['actuator.frequency_hz'][1]"),
-        ({"actuator.frequency_hz": [[100.0], [110.0]]}, "grid['actuator.frequency_hz'][0]"),
+        ({"actuator.frequency_hz": [100.0, [110.0]]}, "grid['actuator.frequency_hz'][1]"),
+        ({"actuator.frequency_hz": [[100.0, "x"]]}, "grid['actuator.frequency_hz'][0]"),
         ({"actuator.frequency_hz": range(10**11)}, "grid['actuator.frequency_hz']"),
         ({"actuator.frequency_hz": range(10**5), "actuator.force_per_volt": range(10**4)}, "grid"),
     ],

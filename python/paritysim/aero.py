@@ -93,17 +93,20 @@ def coefficients(alpha: npt.ArrayLike, model: str = _core.AERO_DEFAULT_MODEL) ->
     a, shape = _flat(alpha)
     name = _model("model", model)
     sized("alpha", f"{a.size} angles", a.size, 6 * 8, "the coefficients")
-    out = chunked(lambda x: _core.aero_coefficients(x, name), [a], ("alpha",))
+    try:
+        out = chunked(lambda x: _core.aero_coefficients(x, name), [a], ("alpha",))
+    except _core.InvalidParameterError as exc:
+        if shape == () and getattr(exc, "field", None) == "alpha[0]":  # a lone angle is `alpha`
+            raise invalid("alpha", a[0], str(exc).split(": must be ", 1)[-1]) from None
+        raise
     return {k: v.reshape(shape) for k, v in out.items()}
 
 
 def center_of_pressure(alpha: npt.ArrayLike) -> FloatArray:
-    """Eq. 3.7: ``0.82 |alpha| / pi + 0.05`` (fraction of the chord behind the leading edge)."""
-    a = finite_reals("alpha", alpha)
-    out: FloatArray = 0.82 / np.pi * np.abs(a) + 0.05
-    if not np.isfinite(out).all():  # |alpha| near 1.8e308
-        i = tuple(int(j) for j in np.argwhere(~np.isfinite(out))[0])
-        raise invalid("alpha" + "".join(f"[{j}]" for j in i), float(a[i]), "an angle in [0, pi] rad")
+    """Eq. 3.7: ``0.82 alpha / pi + 0.05`` (fraction of the chord behind the leading edge) at
+    angles of attack ``alpha`` (rad, each in [0, pi]): the core's law, as :func:`coefficients`
+    returns it (an angle outside the range is an ``InvalidParameterError`` there too)."""
+    out: FloatArray = coefficients(alpha)["center_of_pressure"]
     return out
 
 

@@ -159,11 +159,20 @@ def simulation(result: object, columns: Any = None) -> Figure:
     wings' lift where the device computes it; or the trajectory ``columns`` against time, one
     panel per unit."""
     df = result.trajectory  # type: ignore[attr-defined]
+    units: dict[str, str] = getattr(result, "units", {})
     name = getattr(getattr(result, "spec", None), "name", "") or "simulation"
-    if columns is not None:
-        return _columns_over_time(df, columns, name)
-    t = df["time_ms"].to_numpy()
     prefixes = [p for p in ("left", "right", "wing") if f"{p}_phi" in df.columns]
+    needed = [f"{p}_{c}" for p in prefixes for c in ("psi", "theta", "roll_aero", "roll_inertial")] + ["roll_total"]
+    if columns is None and (not prefixes or any(c not in df.columns for c in needed)):
+        # A run that recorded some columns (ps.simulate(columns=...)): those, by unit.
+        columns = [c for c in df.columns if c != "time_ms"]
+        if not columns:
+            from ._errors import invalid
+
+            raise invalid("columns", "[]", "a run that recorded trajectory columns (ps.simulate(..., columns=None) records them all)")
+    if columns is not None:
+        return _columns_over_time(df, columns, name, units)
+    t = df["time_ms"].to_numpy()
     lifts = [p for p in prefixes if f"{p}_lift" in df.columns]
     fig, axes = plt.subplots(3 if lifts else 2, 1, figsize=(10, 9.5 if lifts else 7), sharex=True, constrained_layout=True)
     ax_a, ax_t = axes[0], axes[1]
@@ -194,8 +203,13 @@ def simulation(result: object, columns: Any = None) -> Figure:
     return fig
 
 
-def _columns_over_time(df: pl.DataFrame, columns: Any, name: str) -> Figure:
-    """The trajectory ``columns`` against ``time_ms``, one panel per unit (angles in degrees)."""
+#: The core's unit texts (`crates/dynamics/src/trajectory.rs`) as the labels print them.
+_UNIT_TEXT = {"mN*mm": "mN·mm", "uJ": "µJ", "uJ/ms": "mW", "rad/ms^2": "rad/ms²", "mm/ms^2": "mm/ms²", "mg*mm/ms": "mg·mm/ms", "mg*mm^2/ms": "mg·mm²/ms", "1": ""}
+
+
+def _columns_over_time(df: pl.DataFrame, columns: Any, name: str, units: dict[str, str]) -> Figure:
+    """The trajectory ``columns`` against ``time_ms``, one panel per unit (the core's units;
+    angles in degrees)."""
     from ._errors import invalid, suggest
 
     if isinstance(columns, str):
@@ -204,11 +218,14 @@ def _columns_over_time(df: pl.DataFrame, columns: Any, name: str) -> Figure:
         raise invalid("columns", repr(columns)[:60], "a non-empty list of trajectory column names")
     recorded = [c for c in df.columns if c != "time_ms"]
     for i, c in enumerate(columns):
+        if c == "time_ms":
+            raise invalid(f"columns[{i}]", "'time_ms'", "a column to draw against time (time_ms is the x axis)")
         if c not in recorded:
             raise invalid(f"columns[{i}]", repr(c)[:60], suggest(str(c), recorded, what="a column of the trajectory (result.trajectory.columns)"))
     panels: dict[str, list[str]] = {}
     for c in columns:
-        unit = label_with_unit(c)[len(c) :].strip(" ()")
+        unit = units.get(c)
+        unit = _UNIT_TEXT.get(unit, unit) if unit is not None else label_with_unit(c)[len(c) :].strip(" ()")
         panels.setdefault(unit, []).append(c)
     t = df["time_ms"].to_numpy()
     fig, axes = plt.subplots(len(panels), 1, figsize=(10, 2.2 + 2.4 * len(panels)), sharex=True, constrained_layout=True, squeeze=False)

@@ -72,6 +72,13 @@ class SimulationResult:
         t_end = self.trajectory["time_ms"][-1]
         return self.trajectory.filter(pl.col("time_ms") >= t_end - self.orbit_cycles * self.period_ms - 1e-9)
 
+    @cached_property
+    def units(self) -> dict[str, str]:
+        """Each trajectory column's unit as the core defines it (``left_phi_dot``: ``rad/ms``,
+        ``actuator_power``: ``uJ/ms`` = mW, ``body_omega_roll``: ``rad/ms``), ``time_ms`` first."""
+        recorded = set(self.columns)
+        return {"time_ms": "ms", **{name: unit for name, unit in _core.trajectory_column_units(self.spec.to_json()) if name in recorded}}
+
     @property
     def metrics_frame(self) -> pl.DataFrame:
         """The metrics as a one-row DataFrame."""
@@ -141,6 +148,8 @@ def _names(names: Sequence[str] | None, field: str) -> list[str] | None:
     for n in listed:
         if not isinstance(n, str):
             raise invalid(field, repr(n)[:60], "names (str)")
+    if field == "columns":  # every trajectory has its time column: naming it is no error
+        listed = [n for n in listed if n != "time_ms"]
     return listed
 
 

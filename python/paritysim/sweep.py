@@ -164,10 +164,11 @@ MAX_GRID_POINTS = 10**8
 
 
 def _axis(name: str, raw: Any) -> list[Any]:
-    """One axis' values: a list, a numpy array or one value (a scalar path takes one value per
-    point, so a lone number or text is a one-point axis, as in a study file). Each is a number,
-    a text or a flag, one kind per axis: a ``None`` or a mixed axis is an error naming its
-    index (a mixed list became text in every row, so every point failed)."""
+    """One axis' values: a list, a numpy array or one value (a lone number or text is a
+    one-point axis, as in a study file). Each is a number, a text, a flag or a list (a path
+    such as ``body.set_points[0].values`` takes one), one kind per axis: a ``None`` or a mixed
+    axis is an error naming its index (a mixed list became text in every row, so every point
+    failed)."""
     if isinstance(raw, np.ndarray):
         vals = raw.ravel().tolist()
     elif isinstance(raw, str | bytes | numbers.Number) or not isinstance(raw, Iterable):
@@ -184,7 +185,7 @@ def _axis(name: str, raw: Any) -> list[Any]:
     for i, v in enumerate(vals):
         kind = _kind(v)
         if kind is None or kind != first:
-            allowed = f"a {first}, as the axis' first value (one kind per axis)" if first and kind else "a number, a text or a flag (a spec path takes one value per point)"
+            allowed = f"a {first}, as the axis' first value (one kind per axis)" if first and kind else "a number, a text, a flag or a list of numbers (one value per point)"
             raise invalid(f"grid[{name!r}][{i}]", repr(v)[:60], allowed)
     return [v.item() if isinstance(v, np.generic) else v for v in vals]
 
@@ -197,6 +198,8 @@ def _kind(v: Any) -> str | None:
         return "number"
     if isinstance(v, str):
         return "text"
+    if isinstance(v, list | tuple) and all(_kind(x) == "number" for x in v):
+        return "list"
     return None
 
 

@@ -427,11 +427,17 @@ mod tests {
     fn huge_and_tiny_numbers_show_in_scientific_notation() {
         // `1e300` displayed as 301 digits in the message.
         let e = check_positive("x", -1e300).unwrap_err();
-        assert_eq!(e.to_string(), "invalid `x` = -1e300: must be finite and > 0");
+        assert_eq!(
+            e.to_string(),
+            "invalid `x` = -1e300: must be finite and > 0"
+        );
         let e = Error::invalid("x", 1.5e-300, "> 1");
         assert_eq!(e.to_string(), "invalid `x` = 1.5e-300: must be > 1");
         // Ordinary numbers and texts keep their own form.
-        assert_eq!(Error::invalid("x", 0.125, "> 1").to_string(), "invalid `x` = 0.125: must be > 1");
+        assert_eq!(
+            Error::invalid("x", 0.125, "> 1").to_string(),
+            "invalid `x` = 0.125: must be > 1"
+        );
         let long = "a text of more than twenty-four characters";
         assert!(Error::invalid("x", long, "y").to_string().contains(long));
     }

@@ -29,6 +29,6 @@ pub use mechanisms::Mechanism;
 pub use model::Inputs;
 pub use model::{FlightEval, FlightModel, STATE_LEN};
 pub use run::{
-    Controller, FlightSample, FlightSystem, Release, Schedule, body_values, flight_columns,
-    flight_metrics, fly, fly_controlled, integrate_flight,
+    Controller, FlightSample, FlightSystem, Release, Schedule, body_values, flight_column_units,
+    flight_columns, flight_metrics, fly, fly_controlled, integrate_flight,
 };

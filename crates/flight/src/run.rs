@@ -232,6 +232,12 @@ impl FlightColumn {
             FlightColumn::Body(b) => b.0.to_string(),
         }
     }
+    fn unit(&self) -> &'static str {
+        match self {
+            FlightColumn::Device(c) => c.unit,
+            FlightColumn::Body(b) => b.1,
+        }
+    }
     fn get(&self, s: &FlightSample) -> f64 {
         match self {
             FlightColumn::Device(c) => c.get(&s.sample),
@@ -252,6 +258,14 @@ fn all_columns(model: &FlightModel) -> Vec<FlightColumn> {
 /// Every trajectory column name of a flight run (device columns, then body columns).
 pub fn flight_columns(model: &FlightModel) -> Vec<String> {
     all_columns(model).iter().map(FlightColumn::name).collect()
+}
+
+/// [`flight_columns`] with each column's unit (`mN*mm`, `rad/ms`, ...).
+pub fn flight_column_units(model: &FlightModel) -> Vec<(String, &'static str)> {
+    all_columns(model)
+        .iter()
+        .map(|c| (c.name(), c.unit()))
+        .collect()
 }
 
 /// Every metric name of a flight run (the device's, then [`BODY_METRICS`]).

@@ -146,6 +146,12 @@ bindings! {
         spec.column_names(&spec.device()?)
     }
 
+    /// The trajectory columns of a JSON spec (without `time_ms`) with their units, in order.
+    fn trajectory_column_units(spec: &str) -> Vec<(String, &'static str)> {
+        let spec = parse(spec)?;
+        spec.column_units(&spec.device()?)
+    }
+
     /// The thread count a sweep would use: `threads`, else `$PARITYSIM_THREADS`, else all cores.
     #[pyo3(signature = (threads=None))]
     fn sweep_resolve_threads(threads: Option<usize>) -> usize {

@@ -341,9 +341,21 @@ impl Simulation {
     /// # Errors
     /// As [`Simulation::flight`].
     pub fn column_names(&self, device: &Device) -> Result<Vec<String>> {
+        let units = self.column_units(device)?;
+        Ok(units.into_iter().map(|(name, _)| name).collect())
+    }
+
+    /// [`Self::column_names`] with each column's unit (`mN*mm`, `rad/ms`, `uJ`, ...).
+    ///
+    /// # Errors
+    /// As [`Self::column_names`].
+    pub fn column_units(&self, device: &Device) -> Result<Vec<(String, &'static str)>> {
         Ok(match self.flight(device)? {
-            None => paritysim_dynamics::sweep::trajectory_columns(device),
-            Some(f) => paritysim_flight::flight_columns(&f.model),
+            None => paritysim_dynamics::trajectory::column_table(device)
+                .into_iter()
+                .map(|c| (c.name, c.unit))
+                .collect(),
+            Some(f) => paritysim_flight::flight_column_units(&f.model),
         })
     }
 }

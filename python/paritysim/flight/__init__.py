@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 import polars as pl
 
-from ..spec import Simulation
+from ..spec import Simulation, SpecLike, as_simulation
 from .trim import Trim, trim
 
 __all__ = ["AXES", "Trim", "body_of", "tilt_angle", "trim", "twist_angle", "with_body"]
@@ -52,7 +52,7 @@ def body_of(spec: Simulation) -> dict[str, Any]:
     return _plain_body(canonical.body)
 
 
-def with_body(spec: Simulation, **fields: Any) -> Simulation:
+def with_body(spec: SpecLike, **fields: Any) -> Simulation:
     """A copy of ``spec`` with ``body`` fields replaced (e.g. ``mode="free"``,
     ``mass_mg=80.0``, ``mechanisms=[{"kind": "gravity_pendulum", "moment_mg_mm": 100.0}]``);
     a spec without a body section gets one (defaults for the fields not given). The result's
@@ -63,6 +63,7 @@ def with_body(spec: Simulation, **fields: Any) -> Simulation:
     InvalidParameterError
         For an unknown field or a value out of range (raised in Rust, naming ``body.<field>``).
     """
+    spec = as_simulation(spec)
     body = _plain_body(getattr(spec, "body", None))
     body.update(fields)
     return Simulation.from_dict({**spec.to_dict(), "body": body})

@@ -204,11 +204,15 @@ def trim(
             )
     clamped, body = _clamped(spec)
     weight, radius = _weight(body)
+    if not weight > 0.0:  # the residuals are scaled by the weight
+        raise invalid("body.gravity_mm_per_ms2", body["gravity_mm_per_ms2"], "a non-zero gravity (trim balances lift against weight; the default is 9.81e-3 mm/ms²)")
     scales = {e: (weight if e == "lift" else weight * radius) for e in EQUATIONS}
     paths = {row[0]: row[3] for row in _path_values(clamped)}
     for k in knobs:
         if k not in paths:
             raise invalid("knobs", repr(k), suggest(k, paths, listed_by="ps.spec_paths(spec)", what="a parameter path of this spec"))
+        if not isinstance(paths[k], float):  # a name, a flag or a count (JSON integers are counts)
+            raise invalid("knobs", repr(k), f"a continuous number to solve for ({k} = {paths[k]!r} is discrete or not a number)")
     if initial is not None:
         x0 = np.atleast_1d(finite_reals("initial", initial))
         if x0.shape != (len(knobs),):
