@@ -119,3 +119,31 @@ def test_animation_writes_mp4_with_ffmpeg_and_falls_back_to_gif(tmp_path: Path, 
     with pytest.warns(UserWarning, match="no ffmpeg"):
         gif = fplots.animate(run.trajectory, tmp_path / "b.mp4", frames=6)
     assert gif.name == "b.gif" and gif.read_bytes()[:6] in (b"GIF87a", b"GIF89a")
+
+
+def test_flight_pictures_name_bad_input(tmp_path: Path) -> None:
+    # Each was polars' ColumnNotFoundError, an IndexError, a ZeroDivisionError or matplotlib's
+    # ValueError.
+    from paritysim.flight import plots as fplots
+
+    fixed = ps.simulate(_spec(mode="fixed"), record_cycles=1, samples_per_cycle=12, progress=False).trajectory
+    free = ps.simulate(_spec(mode="free"), record_cycles=1, samples_per_cycle=12, progress=False).trajectory
+    cases = [
+        (lambda: fplots.trajectory_3d({"a": fixed}), "frames['a']"),
+        (lambda: fplots.trajectory_3d({"a": free.head(0)}), "frames['a']"),
+        (lambda: fplots.trajectory_3d({"a": free}, arrows=-1), "arrows"),
+        (lambda: fplots.attitude(free, 9.09), "frames"),  # a frame, not a mapping of them
+        (lambda: fplots.attitude({"a": free}, 0), "period_ms"),
+        (lambda: fplots.animate(fixed, tmp_path / "a.gif"), "df"),
+        (lambda: fplots.animate(free, tmp_path / "a.gif", frames=0), "frames"),
+        (lambda: fplots.animate(free, tmp_path / "a.gif", fps=0), "fps"),
+        (lambda: fplots.animate(free, tmp_path / "a.gif", dpi=0), "dpi"),
+        (lambda: fplots.animate(free, tmp_path / "a.xyz"), "path"),
+    ]
+    for call, field in cases:
+        with pytest.raises(ps.InvalidParameterError) as info:
+            call()
+        assert info.value.field == field
+    import matplotlib.pyplot as plt
+
+    plt.close("all")

@@ -10,8 +10,10 @@ figure (save it with :func:`paritysim.plots.save`) or the path written.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import polars as pl
@@ -38,6 +40,35 @@ def ffmpeg_path() -> str | None:
     return shutil.which("ffmpeg")
 
 
+#: The columns each picture reads (a flight trajectory has them all).
+_POSITION = ("time_ms", "body_x", "body_y", "body_z")
+_ATTITUDE = ("body_qw", "body_qx", "body_qy", "body_qz")
+
+
+def _frame(df: Any, needed: tuple[str, ...], field: str) -> pl.DataFrame:
+    """``df`` when it is a non-empty frame with the ``needed`` columns, else an
+    ``InvalidParameterError`` naming ``field``."""
+    from .._errors import invalid
+
+    if not isinstance(df, pl.DataFrame):
+        raise invalid(field, type(df).__name__, "a flight trajectory (SimulationResult.trajectory of a spec with a moving body)")
+    missing = [c for c in needed if c not in df.columns]
+    if missing:
+        raise invalid(field, f"<a frame without {', '.join(missing[:4])}>", "a flight trajectory: a spec with a moving body (ps.flight.with_body(spec, mode='free')) records the body's columns")
+    if df.height < 2:
+        raise invalid(field, f"<{df.height} rows>", "a trajectory of at least two samples")
+    return df
+
+
+def _frames(frames: Any, needed: tuple[str, ...]) -> dict[str, pl.DataFrame]:
+    """``frames`` as a label -> trajectory mapping, each checked by :func:`_frame`."""
+    from .._errors import invalid
+
+    if not isinstance(frames, Mapping) or not frames:
+        raise invalid("frames", type(frames).__name__, "a non-empty mapping {label: trajectory}, e.g. {'free': result.trajectory}")
+    return {str(k): _frame(v, needed, f"frames[{k!r}]") for k, v in frames.items()}
+
+
 def _wingbeats(df: pl.DataFrame, period_ms: float) -> np.ndarray:
     t = df["time_ms"].to_numpy()
     return (t - t[0]) / period_ms
@@ -49,6 +80,12 @@ def attitude(frames: Mapping[str, pl.DataFrame], period_ms: float, *, axes: tupl
     frame."""
     import matplotlib.pyplot as plt
 
+    from .._errors import invalid, real
+
+    frames = _frames(frames, _POSITION + _ATTITUDE if position else ("time_ms", *_ATTITUDE))
+    period_ms = real("period_ms", period_ms)
+    if not (np.isfinite(period_ms) and period_ms > 0):
+        raise invalid("period_ms", period_ms, "the drive period, finite and > 0 ms (SimulationResult.period_ms)")
     rows = len(axes) + 1 + (1 if position else 0)
     fig, ax = plt.subplots(rows, 1, figsize=(9, 1.9 * rows + 0.6), sharex=True, constrained_layout=True, squeeze=False)
     ax = ax[:, 0]
@@ -82,6 +119,10 @@ def trajectory_3d(frames: Mapping[str, pl.DataFrame], *, title: str = "", arrows
     stroke axis drawn as arrows at ``arrows`` instants, one colour per frame."""
     import matplotlib.pyplot as plt
 
+    from .._errors import whole
+
+    frames = _frames(frames, _POSITION + _ATTITUDE)
+    arrows = whole("arrows", arrows, 0, 10_000)
     fig = plt.figure(figsize=(7.5, 6.5), constrained_layout=True)
     ax = fig.add_subplot(projection="3d")
     span = 1.0  # the horizontal extent: arrows scaled to it stay readable after a long fall
@@ -131,14 +172,25 @@ def animate(df: pl.DataFrame, path: str | Path, *, shoulders_mm: tuple[tuple[flo
 
     The format follows ``path``'s suffix: ``.mp4`` through matplotlib's FFMpegWriter (H.264)
     when :func:`ffmpeg_path` finds a binary; without one a ``UserWarning`` says so and the GIF
-    is written next to it (``path`` with the suffix ``.gif``); any other suffix is a GIF
-    (PillowWriter). Returns the path written."""
+    is written next to it (``path`` with the suffix ``.gif``); ``.gif`` is a GIF
+    (PillowWriter). Any other suffix is an ``InvalidParameterError`` on ``path``. Returns the
+    path written."""
     import warnings
 
     import matplotlib.pyplot as plt
     from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
 
+    from .._errors import invalid, whole
+
+    df = _frame(df, _POSITION + _ATTITUDE + tuple(f"{s}_{a}" for s in ("left", "right") for a in ("phi", "psi")), "df")
+    frames = whole("frames", frames, 2, 100_000)
+    fps = whole("fps", fps, 1, 1000)
+    dpi = whole("dpi", dpi, 10, 2400)
+    if isinstance(path, bytes) or not isinstance(path, str | os.PathLike):
+        raise invalid("path", repr(path)[:60], "a .gif or .mp4 file path")
     path = Path(path)
+    if path.suffix.lower() not in (".gif", ".mp4"):
+        raise invalid("path", str(path), "a .gif or .mp4 file path")
     ffmpeg = ffmpeg_path() if path.suffix.lower() == ".mp4" else None
     if path.suffix.lower() == ".mp4" and ffmpeg is None:
         warnings.warn(
