@@ -147,3 +147,25 @@ def test_flight_pictures_name_bad_input(tmp_path: Path) -> None:
     import matplotlib.pyplot as plt
 
     plt.close("all")
+
+
+def test_inputs_that_could_not_act_are_refused() -> None:
+    # Both ran and did nothing: a set point on a fixed body (the device alone) and q2_bias on a
+    # configuration that ties the strokes (the HMF's whippletree cannot move).
+    hmf = ps.devices.load("sreetharan2012_3_4_hmf")
+    gain = {"input": "actuator_gain", "times_ms": [0.0], "values": [5.0]}
+    with pytest.raises(ps.InvalidParameterError, match="clamped") as info:
+        ps.simulate(ps.flight.with_body(hmf, set_points=[gain]), progress=False)
+    assert info.value.field == "body.set_points"
+    with pytest.raises(ps.InvalidParameterError) as info:
+        ps.simulate(ps.flight.with_body(hmf, control={"input": "actuator_gain", "kp": 1.0}), progress=False)
+    assert info.value.field == "body.control"
+    bias = {"input": "q2_bias", "times_ms": [0.0], "values": [0.5]}
+    with pytest.raises(ps.InvalidParameterError, match="ties the strokes") as info:
+        ps.simulate(ps.flight.with_body(hmf, mode="clamped", set_points=[bias]), progress=False)
+    assert info.value.field == "body.set_points[0].input"
+    # Where the whippletree is free the same bias acts: it rolls the clamped body.
+    parity = ps.devices.load("sreetharan2012_3_4_parity")
+    still = ps.simulate(ps.flight.with_body(parity, mode="clamped"), progress=False).metrics["body_torque_roll_mean"]
+    biased = ps.simulate(ps.flight.with_body(parity, mode="clamped", set_points=[bias]), progress=False).metrics["body_torque_roll_mean"]
+    assert abs(biased - still) > 1e-3

@@ -111,6 +111,9 @@ def test_leading_edge_spar_on_a_rectangle_is_a_line_mass_at_x_le() -> None:
     both = tensor(ps.Wing.from_planform(outline, mass_mg=mm, line_masses=[("leading_edge", ms)]))
     membrane = tensor(ps.Wing.from_planform(outline, mass_mg=mm))
     np.testing.assert_allclose(both, membrane + spar, rtol=1e-13, atol=1e-15)
+    # One bare pair, as docs/api/planform.md writes it (it was read as two rows).
+    bare = tensor(ps.Wing.from_planform(outline, mass_mg=mm, line_masses=("leading_edge", ms)))
+    np.testing.assert_allclose(bare, both, rtol=1e-15)
     # The same spar as an explicit row [z0, x0, z1, x1, mass_mg], in either direction.
     for row in ([r0, le, r1, le, ms], [r1, le, r0, le, ms]):
         np.testing.assert_allclose(tensor(ps.Wing.from_planform(outline, mass_mg=mm, line_masses=[row])), both, rtol=1e-13)

@@ -431,6 +431,8 @@ def _line_mass_rows(planform: Any, line_masses: Any) -> Any:
 
     if isinstance(line_masses, Mapping):
         line_masses = list(line_masses.items())
+    elif isinstance(line_masses, tuple | list) and len(line_masses) == 2 and isinstance(line_masses[0], str):
+        line_masses = [line_masses]  # one ("leading_edge", mass_mg) pair, as the docs write it
     elif isinstance(line_masses, np.ndarray):
         line_masses = list(line_masses.reshape(-1, line_masses.shape[-1]) if line_masses.size else [])
     elif isinstance(line_masses, str) or not isinstance(line_masses, list | tuple):

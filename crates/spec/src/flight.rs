@@ -62,6 +62,17 @@ fn check_input(device: &Device, i: ControlInput, field: &str) -> Result<()> {
             ),
         ));
     }
+    // A configuration that ties the strokes (`hmf`) holds the whippletree: its reaction would
+    // take the input, which would then do nothing.
+    if engine.needs_whippletree()
+        && paritysim_dynamics::device::ties_strokes(&device.spec().constraints)
+    {
+        return Err(Error::invalid(
+            field.clone(),
+            value,
+            "an input of a free whippletree: this configuration ties the strokes (phi_L = phi_R, as the HMF's), so q2 cannot move; q2_bias and log_q3 need a PARITY configuration (drag_parity, lift_parity, ...)",
+        ));
+    }
     if engine.needs_dual() && !device.is_dual() {
         return Err(Error::invalid(
             field.clone(),
@@ -128,6 +139,23 @@ impl Simulation {
     /// [`Error::InvalidParameter`] naming the `body.` field; the device's errors.
     pub fn flight(&self, device: &Device) -> Result<Option<Flight>> {
         let Some(b) = self.body.as_ref().filter(|_| self.flies()) else {
+            // A fixed body runs the device alone: its inputs would be silently unused.
+            if let Some(b) = &self.body {
+                let field = if !b.set_points.is_empty() {
+                    Some("body.set_points")
+                } else if b.control.is_some() {
+                    Some("body.control")
+                } else {
+                    None
+                };
+                if let Some(field) = field {
+                    return Err(Error::invalid(
+                        field,
+                        "given with body.mode = \"fixed\"",
+                        "empty on a fixed body (inputs act through the body's dynamics: mode = \"clamped\" holds the body and applies them)",
+                    ));
+                }
+            }
             return Ok(None);
         };
         let mechanisms = b
