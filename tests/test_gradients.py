@@ -266,3 +266,19 @@ def test_the_cost_benchmark_computes_its_ratios_and_verdicts() -> None:
     assert all(float(r[1]) > 0 and float(r[2]) > 0 and r[3] == "met" for r in rows)
     never = run("1e-9")
     assert never.count("NOT met") == 2 and "2 case(s) above 1e-09x" in never
+
+
+def test_a_metric_held_at_zero_by_symmetry_is_differentiable_with_slope_zero() -> None:
+    # The HMF ties the strokes, so the net pitch torque's mean is zero at every transmission
+    # ratio (ps.simulate: ~1e-14). Its replayed windows carry the replay's 1e-9 error on both
+    # sides, which the kink check read as one-sided slopes of ±5.8e-5: "not differentiable".
+    hmf = ps.devices.load("sreetharan2012_3_4_hmf_1cut")
+    path = "drivetrain.transmission_ratio"
+    s = ps.sensitivity(hmf, [path], metrics=["pitch_total_mean", "yaw_total_mean"], rtol=1e-11, atol=1e-13)
+    row = s.jacobian.filter(pl.col("metric") == "pitch_total_mean").row(0, named=True)
+    assert row["differentiable"], row["reason"]
+    assert abs(row[f"d/d({path})"]) < 1e-6
+    ratio = hmf.drivetrain.transmission_ratio
+    step = 1e-3 * ratio
+    ends = [ps.simulate(hmf.with_paths({path: ratio + d}), metrics=["pitch_total_mean"], rtol=1e-11, atol=1e-13, progress=False).metrics["pitch_total_mean"] for d in (-step, step)]
+    assert max(abs(v) for v in ends) < 1e-10  # zero on both sides: the slope is zero
