@@ -28,6 +28,9 @@ def _cases(tmp: Path) -> dict[str, tuple[list[str], str]]:
     (tmp / "study_mixed_axis.toml").write_text('spec = "sreetharan2012_3_3_parity"\n[grid]\n"actuator.frequency_hz" = [100.0, "x"]\n')
     (tmp / "study_huge_axis.toml").write_text('spec = "sreetharan2012_3_3_parity"\n[grid]\n"actuator.frequency_hz" = {start = 100, stop = 120, num = 100000000000}\n')
     (tmp / "study_all_fail.toml").write_text('spec = "sreetharan2012_3_3_parity"\n[grid]\n"actuator.frequency_hz" = [-1.0, -2.0]\n')
+    (tmp / "study_options_not_a_table.toml").write_text('spec = "sreetharan2012_3_3_parity"\noptions = 5\n[grid]\n"actuator.frequency_hz" = [100.0]\n')
+    (tmp / "study_log_text.toml").write_text('spec = "sreetharan2012_3_3_parity"\n[grid]\n"actuator.frequency_hz" = {start = 100, stop = 400, num = 3, log = "false"}\n')
+    (tmp / "study_plot_typo.toml").write_text('spec = "sreetharan2012_3_3_parity"\nmetrics = ["left_stroke_amplitude"]\n[grid]\n"actuator.frequency_hz" = [100.0]\n[plot]\nx = "actuator.frequency_hz"\ny = "left_stroke_amplitud"\n')
     (tmp / "a_directory.toml").mkdir()
     blocker = tmp / "blocker"
     blocker.write_text("a file where a directory is expected")
@@ -62,6 +65,11 @@ def _cases(tmp: Path) -> dict[str, tuple[list[str], str]]:
         # A mixed axis made every value text, so every point failed and the command said 0.
         "study with a mixed axis": (["sweep", str(tmp / "study_mixed_axis.toml"), "--out", str(tmp / "o"), "--quiet"], "`grid['actuator.frequency_hz'][1]` = 'x'"),
         "study with a huge axis": (["sweep", str(tmp / "study_huge_axis.toml"), "--out", str(tmp / "o"), "--quiet"], "`grid.actuator.frequency_hz.num`"),
+        "study whose options are not a table": (["sweep", str(tmp / "study_options_not_a_table.toml"), "--out", str(tmp / "o"), "--quiet"], "`options` = 5"),
+        # "false" was read as true: a log axis.
+        "study with a text log flag": (["sweep", str(tmp / "study_log_text.toml"), "--out", str(tmp / "o"), "--quiet"], "`grid.actuator.frequency_hz.log`"),
+        # Checked before the run (it failed after every point had run).
+        "study with a misspelt plot column": (["sweep", str(tmp / "study_plot_typo.toml"), "--out", str(tmp / "o_typo"), "--quiet"], "did you mean `left_stroke_amplitude`"),
         "study whose every point fails": (["sweep", str(tmp / "study_all_fail.toml"), "--out", str(tmp / "o"), "--quiet"], "every one of the 2 points failed"),
     }
 
@@ -93,6 +101,9 @@ CASE_NAMES = [
     "study with a mixed axis",
     "study with a huge axis",
     "study whose every point fails",
+    "study whose options are not a table",
+    "study with a text log flag",
+    "study with a misspelt plot column",
 ]
 
 
@@ -127,3 +138,9 @@ def test_a_warning_is_one_line_without_python_source(tmp_path: Path) -> None:
     assert run.returncode == 0, run.stderr
     lines = run.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("paritysim: warning: 2 of 3 sweep points failed"), run.stderr
+
+
+def test_a_misspelt_plot_column_fails_before_any_point_runs(tmp_path: Path) -> None:
+    _cases(tmp_path)
+    assert main(["sweep", str(tmp_path / "study_plot_typo.toml"), "--out", str(tmp_path / "o_typo"), "--quiet"]) == 1
+    assert not (tmp_path / "o_typo" / "study_plot_typo.parquet").exists()

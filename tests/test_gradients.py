@@ -282,3 +282,19 @@ def test_a_metric_held_at_zero_by_symmetry_is_differentiable_with_slope_zero() -
     step = 1e-3 * ratio
     ends = [ps.simulate(hmf.with_paths({path: ratio + d}), metrics=["pitch_total_mean"], rtol=1e-11, atol=1e-13, progress=False).metrics["pitch_total_mean"] for d in (-step, step)]
     assert max(abs(v) for v in ends) < 1e-10  # zero on both sides: the slope is zero
+
+
+def test_elasticities_are_null_where_undefined_and_a_nan_derivative_is_named() -> None:
+    # balance_spring = 0 gave -0.0 and an undefined metric gave NaN where the docstring says null.
+    s = ps.sensitivity("sreetharan2012_3_3_parity", ["drivetrain.balance_spring", "wings.left.omega_ratio"], metrics=["left_stroke_amplitude", "left_rotation_phase_lag"], progress=False)
+    e = s.elasticities()
+    stroke = e.filter(pl.col("metric") == "left_stroke_amplitude").row(0, named=True)
+    assert stroke["drivetrain.balance_spring"] is None  # the parameter is 0
+    assert stroke["wings.left.omega_ratio"] == pytest.approx(s.derivative("left_stroke_amplitude", "wings.left.omega_ratio") / s.jacobian["value"][0])
+    lag = e.filter(pl.col("metric") == "left_rotation_phase_lag").row(0, named=True)
+    assert lag["wings.left.omega_ratio"] is None and lag["drivetrain.balance_spring"] is None
+    with pytest.raises(ps.InvalidParameterError) as info:
+        s.derivative("left_rotation_phase_lag", "wings.left.omega_ratio")
+    assert info.value.field == "metric"
+    # An omega_ratio multiplies Ω1: dimensionless, not mg·mm².
+    assert s.parameters.filter(pl.col("parameter") == "wings.left.omega_ratio")["unit"].item() == "1"

@@ -173,6 +173,9 @@ def test_a_metric_not_differentiable_at_an_iterate_is_warned_about_once():
         ({"method": "nelder-mead"}, "method", "SLSQP"),
         ({"stability": -1.0}, "stability", "positive"),
         ({"max_iterations": 0}, "max_iterations", "integer"),
+        # The spec's options as a mapping, for the names optimize takes itself (`method`).
+        ({"options": {"methd": "dopri5"}}, "options.methd", "method"),
+        ({"options": 5}, "options", "mapping"),
     ],
 )
 def test_bad_input_is_refused_naming_the_argument(drag_parity, kwargs, field, text):
@@ -204,3 +207,10 @@ def test_the_result_prints_on_one_line_plots_and_saves_its_spec(drag_parity, tmp
     # The saved design has the optimum's metrics.
     again = ps.simulate(saved, columns=[], progress=False)
     assert again.metrics["left_stroke_amplitude"] == pytest.approx(0.6, abs=1e-6)
+
+
+def test_spec_options_named_like_optimize_arguments_go_in_options(drag_parity):
+    # `paritysim optimize` passed a study's [options] method = "dopri5" as a keyword: TypeError
+    # "got multiple values for keyword argument 'method'" (the optimiser's own).
+    r = ps.optimize(drag_parity, "actuator_power_mean", {V: (20.0, 150.0)}, ["left_stroke_amplitude >= 0.6"], options={"method": "dopri5"}, max_iterations=2, progress=False)
+    assert r.evaluations >= 1 and r.spec.options.method == drag_parity.options.method  # the runs', not the returned spec's

@@ -145,3 +145,13 @@ def test_naming_time_ms_among_the_columns_is_no_error() -> None:
     # It was "must be a known name (none close to `time_ms`)", though every trajectory has it.
     result = ps.simulate("sreetharan2012_3_4_hmf", columns=["time_ms", "left_phi"], progress=False)
     assert result.trajectory.columns == ["time_ms", "left_phi"]
+
+
+def test_trajectory_columns_are_labelled_with_the_cores_units() -> None:
+    # The substring table read left_tau_aero_phi as an angle and knew no rates.
+    expected = {
+        "left_tau_aero_phi": "mN·mm", "left_tau_spring_psi": "mN·mm", "left_phi_dot": "rad/ms", "left_phi_ddot": "rad/ms²",
+        "q1_dot": "mm/ms", "voltage": "V", "actuator_power": "mW", "work_aero": "µJ", "body_omega_roll": "rad/ms", "momentum_x": "mg·mm/ms",
+    }
+    for column, unit in expected.items():
+        assert plots.label_with_unit(column) == f"{column} ({unit})"

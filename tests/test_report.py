@@ -12,6 +12,7 @@ from pathlib import Path
 import polars as pl
 import pytest
 
+from paritysim import InvalidParameterError
 from paritysim import claims as cl
 from paritysim.claims import Claim
 from paritysim.trials import REGISTRY
@@ -232,3 +233,17 @@ def test_every_trial_wrote_its_files(reproduced: Path) -> None:
     assert row["actuator stiffness"] == pytest.approx(467.0, rel=1e-6)
     assert row["actuator force per volt"] == pytest.approx(1.2, rel=1e-6)
     assert row["linkage sublaminate cure curvature (max)"] < 1e-12
+
+
+def test_claims_files_are_read_and_written_by_any_path_with_typed_errors(tmp_path) -> None:
+    from paritysim import claims
+
+    claim = claims.Claim.holds("it holds", True, computed="yes", criterion="true")
+    written = claims.save(str(tmp_path / "c.json"), [claim], {"x": 1.0})  # a str path too
+    loaded, values = claims.load(str(written))
+    assert loaded[0].statement == "it holds" and values == {"x": 1.0}
+    (tmp_path / "empty.json").write_text("{}")
+    for bad in (tmp_path / "missing.json", tmp_path / "empty.json"):
+        with pytest.raises(InvalidParameterError) as info:
+            claims.load(bad)
+        assert info.value.field == "path"

@@ -244,3 +244,19 @@ def test_spec_json_equals_the_asdict_formulation() -> None:
     for s in specs:
         assert s.to_json() == by_asdict(s)
     assert '"steady_tol": "nan"' in specs[-1].to_json()
+
+
+def test_replace_builds_a_section_given_as_a_mapping_and_keeps_specs_hashable() -> None:
+    # A dict stayed a dict: validate() passed and ps.simulate raised AttributeError; a dict
+    # waveform or a list of wings made the spec unhashable.
+    spec = ps.devices.load("sreetharan2012_3_3_parity")
+    tight = spec.replace(options={"rtol": 1e-9})
+    assert isinstance(tight.options, ps.spec.Options) and tight.options.rtol == 1e-9
+    assert tight.options.max_cycles == ps.spec.Options().max_cycles  # the others at their defaults
+    assert ps.simulate(tight, metrics=["left_stroke_amplitude"], progress=False).converged
+    waved = spec.replace(actuator=spec.actuator.replace(waveform={"kind": "sine", "amplitude_v": 90.0, "frequency_hz": 110.0}))
+    assert waved == ps.Simulation.from_dict(waved.to_dict()) and isinstance(hash(waved), int)
+    assert hash(spec.replace(wings=list(spec.wings))) == hash(spec)
+    with pytest.raises(ps.InvalidParameterError, match="rtol") as info:
+        spec.replace(options={"rtoll": 1e-9})
+    assert info.value.field == "Options.rtoll"

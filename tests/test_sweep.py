@@ -29,7 +29,7 @@ import pytest
 import paritysim as ps
 from paritysim import _core
 from paritysim.cli import main
-from paritysim.sweep import grid, sweep, valid_paths
+from paritysim.sweep import grid, plot, sweep, valid_paths
 
 # The module (``paritysim.sweep`` may be re-exported as the function of the same name).
 sweep_module = importlib.import_module("paritysim.sweep")
@@ -606,3 +606,18 @@ def test_a_path_a_row_leaves_out_keeps_the_base_value(parity: ps.Simulation) -> 
     for row, values in zip(df.iter_rows(named=True), rows, strict=True):
         alone = ps.simulate(parity.with_paths(values), metrics=["left_stroke_amplitude"], progress=False)
         assert row["left_stroke_amplitude"] == pytest.approx(alone.metrics["left_stroke_amplitude"], rel=1e-6)
+
+
+def test_plot_names_what_it_cannot_draw(parity: ps.Simulation) -> None:
+    df = sweep(parity, {"actuator.frequency_hz": [100.0, 110.0]}, metrics=["left_stroke_amplitude"], keep_cycle=["left_phi"], progress=False)
+    x = "actuator.frequency_hz"
+    for kwargs, field in (({"y": "cycle_left_phi"}, "y"), ({"y": "left_stroke_amplitude", "ax": 5}, "ax"), ({"y": []}, "y")):
+        with pytest.raises(ps.InvalidParameterError) as info:
+            plot(df, x, **kwargs)
+        assert info.value.field == field
+    with pytest.raises(ps.InvalidParameterError) as info:
+        plot({"a": [1]}, "a", "a")  # type: ignore[arg-type]
+    assert info.value.field == "df"
+    fig = plot(df, x, "left_stroke_amplitude", hue="converged")
+    assert [t.get_text() for t in fig.axes[0].get_legend().get_texts()] == ["converged = True"]  # was "= 1"
+    assert sweep(parity, {x: [100.0]}, metrics=["left_stroke_amplitude"], chunk_size=np.int64(1), progress=False).height == 1

@@ -131,14 +131,29 @@ def render(claims: list[Claim], *, note_column: bool = True) -> str:
     return "\n".join(lines)
 
 
-def save(path: Path, claims: list[Claim], values: dict[str, Any] | None = None) -> Path:
+def save(path: str | Path, claims: list[Claim], values: dict[str, Any] | None = None) -> Path:
     """Writes ``{"claims": [...], "values": {...}}`` (``values``: numbers the report text needs)."""
+    from ._errors import invalid
+
     payload = {"claims": [c.to_dict() for c in claims], "values": values or {}}
-    path.write_text(json.dumps(payload, indent=1, allow_nan=True))
+    path = Path(path)
+    try:
+        path.write_text(json.dumps(payload, indent=1, allow_nan=True))
+    except OSError as exc:
+        raise invalid("path", str(path), f"a writable file path ({exc.strerror or exc})") from exc
     return path
 
 
-def load(path: Path) -> tuple[list[Claim], dict[str, Any]]:
-    """Reads what :func:`save` wrote."""
-    payload = json.loads(path.read_text())
-    return [Claim.from_dict(d) for d in payload["claims"]], payload.get("values", {})
+def load(path: str | Path) -> tuple[list[Claim], dict[str, Any]]:
+    """Reads what :func:`save` wrote; a file that cannot be read or holds something else is an
+    ``InvalidParameterError`` naming ``path``."""
+    from ._errors import invalid
+
+    path = Path(path)
+    try:
+        payload = json.loads(path.read_text())
+        return [Claim.from_dict(d) for d in payload["claims"]], payload.get("values", {})
+    except OSError as exc:
+        raise invalid("path", str(path), f"a readable claims file ({exc.strerror or exc})") from exc
+    except (ValueError, KeyError, TypeError, AttributeError) as exc:
+        raise invalid("path", str(path), f"a claims file as paritysim.claims.save writes it ({type(exc).__name__}: {exc})") from exc

@@ -13,6 +13,7 @@ multiplier at 1, e.g. the whippletree at K2 = 0) are reported and left out, neve
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -94,18 +95,22 @@ class SensitivityResult:
             raise invalid("metric", metric, "one of the result's metrics: " + ", ".join(self.metric_names[:5]))
         if parameter not in self.parameter_names:
             raise invalid("parameter", parameter, "one of " + ", ".join(self.parameter_names))
-        return float(self.matrix[self.metric_names.index(metric), self.parameter_names.index(parameter)])
+        row = self.metric_names.index(metric)
+        slope = float(self.matrix[row, self.parameter_names.index(parameter)])
+        if not math.isfinite(slope):  # a metric not defined at this point (a phase lag of a still wing)
+            raise invalid("metric", metric, f"a metric defined at this point ({metric} is {self.jacobian['value'][row]}: {self.reasons[row] or 'not finite'})")
+        return slope
 
     def elasticities(self) -> pl.DataFrame:
         """``(p / m) dm/dp``: the relative change of each metric per relative change of each
-        parameter (null where the metric or the parameter is 0)."""
+        parameter (null where the metric or the parameter is 0, or the metric or its
+        derivative is not defined there)."""
         out = self.jacobian.select("metric")
+        value = self.jacobian["value"]
         for name, p in zip(self.parameters["parameter"], self.parameters["value"], strict=True):
-            column = f"d/d({name})"
-            value = self.jacobian["value"]
-            out = out.with_columns(
-                pl.when(value != 0).then(self.jacobian[column] * p / value).otherwise(None).alias(name)
-            )
+            slope = self.jacobian[f"d/d({name})"]
+            defined = (value != 0) & value.is_finite() & slope.is_finite() & pl.lit(p != 0 and math.isfinite(p))
+            out = out.with_columns(pl.when(defined).then(slope * p / value).otherwise(None).alias(name))
         return out
 
     def plot(self, metrics: Sequence[str] | None = None, path: str | Path | None = None) -> Figure:

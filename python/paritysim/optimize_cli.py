@@ -128,7 +128,7 @@ def run_study(study: OptimizeStudy, out: str | Path, stem: str, progress: bool =
         max_iterations=study.max_iterations,
         tol=study.tol,
         progress=progress,
-        **study.options,
+        options=study.options,
     )
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

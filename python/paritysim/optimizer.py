@@ -208,6 +208,7 @@ def optimize(
     max_iterations: int = 100,
     tol: float = 1e-9,
     progress: bool = True,
+    options: Mapping[str, Any] | None = None,
     **option_overrides: Any,
 ) -> OptimizationResult:
     """Minimise (``sense="min"``) or maximise a steady-state metric over continuous spec paths,
@@ -225,7 +226,9 @@ def optimize(
     sensitivity per parameter and iterate; the multipliers' modulus is not smooth where two
     of them meet). ``x0``: the start (default: the spec's values, clipped into the bounds).
     ``option_overrides`` replace fields of ``spec.options`` for the runs (e.g. ``rtol=1e-10``),
-    not in the returned spec.
+    not in the returned spec; ``options`` is the same as a mapping, for the names this function
+    takes itself (``options={"method": "dopri5"}``: the integrator, where ``method`` is the
+    optimiser).
 
     A metric marked not differentiable at an iterate (see `sensitivity`: a kink, a family of
     orbits) is warned about once (a ``RuntimeWarning`` naming it and the first such iterate);
@@ -244,6 +247,9 @@ def optimize(
     from scipy.optimize import BFGS, Bounds, NonlinearConstraint, minimize
 
     spec = as_simulation(spec)
+    if options is not None and not isinstance(options, Mapping):
+        raise invalid("options", type(options).__name__, "a mapping of spec options, e.g. {\"method\": \"dopri5\"}")
+    option_overrides = {**{str(k): v for k, v in (options or {}).items()}, **option_overrides}
     run_spec = spec.replace(options=spec.options.with_fields("options", **option_overrides)) if option_overrides else spec
     if sense not in ("min", "max"):
         raise invalid("sense", repr(sense), '"min" or "max"')

@@ -63,6 +63,26 @@ def _spec_units() -> dict[str, str]:
     return units
 
 
+#: The core's unit texts (`crates/dynamics/src/trajectory.rs`) as the labels print them.
+_UNIT_TEXT = {"mN*mm": "mN·mm", "uJ": "µJ", "uJ/ms": "mW", "rad/ms^2": "rad/ms²", "mm/ms^2": "mm/ms²", "mg*mm/ms": "mg·mm/ms", "mg*mm^2/ms": "mg·mm²/ms", "1": ""}
+
+
+@functools.lru_cache(maxsize=1)
+def _column_units() -> dict[str, str]:
+    """Each trajectory column's unit as the core defines it, over the shipped devices fixed and
+    flying (the body's columns), in the labels' typography."""
+    from . import _core, devices
+    from .flight import with_body
+
+    units: dict[str, str] = {}
+    names = devices.list()
+    specs = [devices.load(n) for n in names] + [with_body(names[0], mode="free")]
+    for spec in specs:
+        for column, unit in _core.trajectory_column_units(spec.to_json()):
+            units.setdefault(column, _UNIT_TEXT.get(unit, unit))
+    return units
+
+
 #: Spellings of a path that ``ps.sweep`` accepts besides the canonical one.
 _PATH_ALIASES = {"actuator.frequency_hz": "actuator.waveform.frequency_hz", "actuator.amplitude_v": "actuator.waveform.amplitude_v", "actuator.voltage_v": "actuator.waveform.amplitude_v"}
 
@@ -104,6 +124,9 @@ def label_with_unit(column: str) -> str:
         unit = _path_unit(column)
         if unit is not None:
             return f"{column} ({unit})" if unit else column
+    elif column in _column_units():
+        unit = _column_units()[column]
+        return f"{column} ({unit})" if unit else column
     name = column.lower()
     # The ratios of the designer metrics (crates/dynamics/src/metrics/mod.rs) before the
     # substrings, which would read `lift_per_power` as a power.
@@ -201,10 +224,6 @@ def simulation(result: object, columns: Any = None) -> Figure:
     ax_t.legend(ncol=2, fontsize=8)
     fig.suptitle(f"{name}: wing angles, body torques{' and lift' if lifts else ''} over the recorded cycles")
     return fig
-
-
-#: The core's unit texts (`crates/dynamics/src/trajectory.rs`) as the labels print them.
-_UNIT_TEXT = {"mN*mm": "mN·mm", "uJ": "µJ", "uJ/ms": "mW", "rad/ms^2": "rad/ms²", "mm/ms^2": "mm/ms²", "mg*mm/ms": "mg·mm/ms", "mg*mm^2/ms": "mg·mm²/ms", "1": ""}
 
 
 def _columns_over_time(df: pl.DataFrame, columns: Any, name: str, units: dict[str, str]) -> Figure:

@@ -174,6 +174,30 @@ def _tuples(x: Any) -> Any:
     return tuple(_tuples(v) for v in x) if isinstance(x, list | tuple) else x
 
 
+def _coerced(owner: str, changes: dict[str, Any]) -> dict[str, Any]:
+    """``changes`` to fields of class ``owner`` as its constructors make them: a mapping for a
+    section built as that section's class (``options={"rtol": 1e-6}``: an ``Options`` with
+    the other fields at their defaults; an unknown key named), lists as tuples (frozen and
+    hashable). A dict kept as a dict broke ``ps.simulate`` with an AttributeError."""
+    fields = {key: (ref, is_list) for key, _, ref, is_list in _fields(owner)}
+    out = {}
+    for key, value in changes.items():
+        ref, is_list = fields.get(key, (None, False))
+        if ref in _MODELS and value is not None:
+            value = tuple(_section(ref, v) for v in value) if is_list and isinstance(value, list | tuple) else _section(ref, value)
+        elif isinstance(value, list):
+            value = _tuples(value)
+        out[key] = value
+    return out
+
+
+def _section(name: str, value: Any) -> Any:
+    """``value`` as class ``name``: built from a mapping (see :func:`_coerced`), else as given."""
+    if isinstance(value, Mapping):
+        return _CLASSES[name](**_coerced(name, dict(value)))
+    return value
+
+
 class _Node:
     """Conveniences shared by every spec class."""
 
@@ -186,15 +210,17 @@ class _Node:
                 from ._errors import invalid, suggest
 
                 raise invalid(f"{path}.{key}", "<unknown field>", suggest(key, names))
-        return dataclasses.replace(self, **changes)  # type: ignore[type-var]
+        return dataclasses.replace(self, **_coerced(type(self).__name__, changes))  # type: ignore[type-var]
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data (``None`` fields left out), as the Rust core reads it."""
         return _strip_none(dataclasses.asdict(self))  # type: ignore[call-overload]
 
     def replace(self, **changes: Any) -> Any:
-        """A copy with fields replaced (``dataclasses.replace``)."""
-        return dataclasses.replace(self, **changes)  # type: ignore[type-var]
+        """A copy with fields replaced (``dataclasses.replace``); a section may be given as a
+        mapping (``options={"rtol": 1e-6}``: an ``Options`` with the others at their defaults)
+        and a list as a tuple, as the constructors take them."""
+        return dataclasses.replace(self, **_coerced(type(self).__name__, changes))  # type: ignore[type-var]
 
 
 class _Tagged(_Node):

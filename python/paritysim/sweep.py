@@ -349,8 +349,8 @@ def sweep(
         if not isinstance(executor, cf.Executor):
             raise invalid("executor", type(executor).__name__, "a concurrent.futures.Executor")
         n_threads = _core.sweep_resolve_threads(threads if threads is not None else 1)
-    if chunk_size is not None and (not isinstance(chunk_size, int) or isinstance(chunk_size, bool) or chunk_size < 1):
-        raise invalid("chunk_size", repr(chunk_size), "a positive integer")
+    if chunk_size is not None:
+        chunk_size = whole("chunk_size", chunk_size, 1, 2**31)  # numpy integers too, as threads
 
     rows = param_table.rows() if param_table.width else [()] * max(table.height, 1)
     n = len(rows)
@@ -582,11 +582,19 @@ def plot(df: pl.DataFrame, x: str, y: str | Sequence[str], hue: str | None = Non
 
     from .plots import label_with_unit
 
-    ys = [y] if isinstance(y, str) else list(y)
+    if not isinstance(df, pl.DataFrame):
+        raise invalid("df", type(df).__name__, "a sweep result (a polars DataFrame from ps.sweep)")
+    ys = [y] if isinstance(y, str) else list(y) if isinstance(y, Sequence) else [y]
+    if not ys:
+        raise invalid("y", "[]", "a column name or a non-empty list of them")
     named = [("x", x), *((("y" if isinstance(y, str) else f"y[{i}]"), c) for i, c in enumerate(ys)), *([("hue", hue)] if hue else [])]
     for field, c in named:  # the argument (and the study's [plot] key) that names the column
         if c not in df.columns:
             raise invalid(field, repr(c), suggest(str(c), df.columns, what="a column of the sweep result"))
+        if df[c].dtype.is_nested():  # a kept cycle is a list per row
+            raise invalid(field, repr(c), f"a column of one value per row ({c} holds {df[c].dtype}: a kept cycle is plotted per row, e.g. plt.plot(row['cycle_time_ms'], row['{c}']))")
+    if ax is not None and not hasattr(ax, "plot"):
+        raise invalid("ax", type(ax).__name__, "a matplotlib Axes (or None for a new figure)")
     ok = df.filter(pl.col("status") == "ok") if "status" in df.columns else df
     if ax is None:
         fig, ax = plt.subplots(figsize=(6, 4), layout="constrained")
@@ -600,7 +608,7 @@ def plot(df: pl.DataFrame, x: str, y: str | Sequence[str], hue: str | None = Non
             if hue:
                 v = g[hue][0]
                 unit = label_with_unit(hue)[len(hue) :].strip(" ()")
-                parts.append(f"{hue} = {v:g}{' ' + unit if unit else ''}" if isinstance(v, float | int) else f"{hue} = {v}")
+                parts.append(f"{hue} = {v:g}{' ' + unit if unit else ''}" if isinstance(v, float | int) and not isinstance(v, bool) else f"{hue} = {v}")
             if len(ys) > 1:
                 parts.append(label_with_unit(col))
             ax.plot(g[x].to_numpy(), g[col].to_numpy(), marker="o", ms=3, label=", ".join(parts) or None)

@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 import polars as pl
 
-from ._errors import invalid, read_study, real
+from ._errors import invalid, read_study, real, suggest
 from .spec import Simulation
 from .sweep import MAX_GRID_POINTS
 
@@ -73,7 +73,10 @@ def _axis(name: str, value: Any) -> list[Any]:
         start, stop, num = real(f"grid.{name}.start", value["start"]), real(f"grid.{name}.stop", value["stop"]), value["num"]
         if isinstance(num, bool) or not isinstance(num, int) or not 1 <= num <= MAX_GRID_POINTS:
             raise invalid(f"grid.{name}.num", repr(num), f"an integer in [1, {MAX_GRID_POINTS:.0e}]")
-        if value.get("log", False):
+        log = value.get("log", False)
+        if not isinstance(log, bool):
+            raise invalid(f"grid.{name}.log", repr(log), "true or false")
+        if log:
             if start <= 0 or stop <= 0:
                 raise invalid(f"grid.{name}", repr(value), "start and stop > 0 for a log axis")
             return np.geomspace(start, stop, num).tolist()
@@ -100,13 +103,16 @@ def load_study(path: str | Path) -> Study:
     plot = data.get("plot")
     if plot is not None and (not isinstance(plot, dict) or not {"x", "y"} <= set(plot) or set(plot) - {"x", "y", "hue"}):
         raise invalid("plot", repr(plot), "a table with x, y and optionally hue")
+    options = data.get("options", {})
+    if not isinstance(options, dict):
+        raise invalid("options", repr(options)[:60], "a table of the spec's options to override (e.g. max_cycles = 50)")
     return Study(
         spec=spec,
         grid={k: _axis(k, v) for k, v in grid.items()},
         metrics=data.get("metrics"),
         gradients=data.get("gradients"),
         keep_cycle=data.get("keep_cycle", False),
-        options=dict(data.get("options", {})),
+        options=dict(options),
         plot=plot,
         threads=data.get("threads"),
         chunk_size=data.get("chunk_size"),
@@ -118,6 +124,8 @@ def run_study(study: Study, out: str | Path, stem: str, threads: int | None = No
     Returns the result and the written paths. ``fresh`` discards earlier results first."""
     from .sweep import plot, sweep
 
+    if study.plot is not None:
+        _check_plot_columns(study)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     table = out / f"{stem}.parquet"
@@ -149,6 +157,25 @@ def run_study(study: Study, out: str | Path, stem: str, threads: int | None = No
         plt.close(fig)
         written["plot"] = out / f"{stem}.png"
     return df, written
+
+
+def _check_plot_columns(study: Study) -> None:
+    """The [plot] table's columns among those the sweep will write, checked before it runs (a
+    misspelt one failed after every point had run)."""
+    from . import _core
+    from .sweep import STATUS_COLUMNS, _gradient_columns
+
+    assert study.plot is not None
+    metrics = list(study.metrics) if isinstance(study.metrics, list) else _core.sweep_metric_names(study.spec.to_json())
+    gradients = [study.gradients] if isinstance(study.gradients, str) else list(study.gradients or [])
+    columns = ["point", *study.grid, *metrics, *STATUS_COLUMNS, *_gradient_columns(metrics, gradients)]
+    ys = study.plot["y"] if isinstance(study.plot["y"], list) else [study.plot["y"]]
+    keys = [("plot.x", study.plot["x"]), *((f"plot.y[{i}]" if isinstance(study.plot["y"], list) else "plot.y", y) for i, y in enumerate(ys))]
+    if study.plot.get("hue") is not None:
+        keys.append(("plot.hue", study.plot["hue"]))
+    for key, column in keys:
+        if column not in columns:
+            raise invalid(key, repr(column), suggest(str(column), columns, what="a column the sweep writes (a grid path, a metric, a status column)"))
 
 
 def _main(args: argparse.Namespace) -> int:

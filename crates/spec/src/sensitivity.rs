@@ -334,7 +334,12 @@ fn parameters_in(
             match base {
                 None => {
                     base = Some(x);
-                    units.push(info.unit.clone());
+                    // An `omega_ratio` scales the target (Ω1): a multiplier, dimensionless.
+                    units.push(if scale.is_some() {
+                        "1".to_string()
+                    } else {
+                        info.unit.clone()
+                    });
                 }
                 Some(b) if b != x => {
                     return Err(Error::invalid(
