@@ -746,12 +746,7 @@ class Simulation(_Node):
             from ._errors import invalid
 
             raise invalid("text", type(text).__name__, "JSON text (str)")
-        try:
-            canonical, notes = _core.spec_normalize(text)
-        except _core.InvalidParameterError as exc:
-            if getattr(exc, "field", None) == "":  # the document itself (not a table)
-                exc.field = "spec"  # type: ignore[attr-defined]
-            raise
+        canonical, notes = _core.spec_normalize(text)  # the document itself is `spec` in errors
         return _canonical(canonical, notes)
 
     def with_paths(self, values: Mapping[str, Any]) -> Simulation:
@@ -820,12 +815,7 @@ def _load_spec(path: Any, field: str) -> Simulation:
         raise invalid(field, str(file), f"a UTF-8 text file ({exc.reason} at byte {exc.start})") from exc
     except OSError as exc:
         raise invalid(field, str(file), f"a readable TOML file ({exc.strerror or exc})") from exc
-    try:
-        canonical, notes = _core.spec_from_toml(text)
-    except _core.InvalidParameterError as exc:
-        if getattr(exc, "field", None) == "":
-            exc.field = "spec"  # type: ignore[attr-defined]
-        raise
+    canonical, notes = _core.spec_from_toml(text)
     return _canonical(canonical, notes)
 
 

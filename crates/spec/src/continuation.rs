@@ -120,7 +120,8 @@ pub fn continue_path(
     let build = builder(spec, &params);
     let (_, sim_options) = spec.model()?;
     let shoot = shooting(&sim_options);
-    let first = build(&[start]).map_err(|e| e.in_field(path))?;
+    // Its errors name their spec paths already (`apply` resolves `path`).
+    let first = build(&[start])?;
     let orbit = periodic_orbit(&first, &shoot)?;
     let map = DevicePeriodMap::new(&build, &[start], &shoot)?;
     let mut options = ContinuationOptions::new(0, stop);

@@ -354,3 +354,27 @@ fn a_spec_checked_along_its_overridden_fields_equals_one_checked_whole() {
         );
     }
 }
+
+#[test]
+fn a_document_that_is_not_a_table_names_spec() {
+    // The root's problem named the empty field: "invalid `` = []: must be a table".
+    let e = from_json("[]").unwrap_err();
+    assert_eq!(e.field(), Some("spec"));
+    assert!(e.to_string().contains("invalid `spec` = "), "{e}");
+}
+
+#[test]
+fn a_continuation_start_out_of_range_names_its_path_once() {
+    // The start's error was prefixed with the path it already named:
+    // `drivetrain.balance_spring.drivetrain.balance_spring`.
+    let (spec, _) = from_toml(&example("drag_parity.toml")).unwrap();
+    let e = paritysim_spec::continuation::continue_path(
+        &spec,
+        "drivetrain.balance_spring",
+        -5.0,
+        10.0,
+        &Default::default(),
+    )
+    .unwrap_err();
+    assert_eq!(e.field(), Some("drivetrain.balance_spring"), "{e}");
+}

@@ -236,6 +236,16 @@ enum Path<'a> {
 }
 
 impl Path<'_> {
+    /// The field a problem here names: the path, or `spec` for the document itself.
+    fn field(&self) -> String {
+        let text = self.text();
+        if text.is_empty() {
+            "spec".to_string()
+        } else {
+            text
+        }
+    }
+
     fn text(&self) -> String {
         match self {
             Path::Root(p) => (*p).to_string(),
@@ -301,7 +311,7 @@ fn walk(
         }
         Node::Tagged { schema, tags } => {
             let Some(obj) = value.as_object() else {
-                problems.push(Problem::new(path.text(), short(value), describe(schema)));
+                problems.push(Problem::new(path.field(), short(value), describe(schema)));
                 return;
             };
             let names = || tags.iter().map(|(t, _)| *t);
@@ -341,7 +351,7 @@ fn walk(
                 sub.is_empty()
             });
             if !fits {
-                problems.push(Problem::new(path.text(), short(value), describe(schema)));
+                problems.push(Problem::new(path.field(), short(value), describe(schema)));
             }
         }
     }
@@ -362,13 +372,13 @@ fn walk_plain(
                 Some(word) => suggestion(word, names.iter().copied()),
                 None => format!("one of {}", join_values(allowed)),
             };
-            problems.push(Problem::new(path.text(), short(value), text));
+            problems.push(Problem::new(path.field(), short(value), text));
         }
         return;
     }
     if let Some(c) = s.constant {
         if c != value {
-            problems.push(Problem::new(path.text(), short(value), format!("{c}")));
+            problems.push(Problem::new(path.field(), short(value), format!("{c}")));
         }
         return;
     }
@@ -391,7 +401,7 @@ fn walk_plain(
         } else {
             allowed
         };
-        problems.push(Problem::new(path.text(), short(value), allowed));
+        problems.push(Problem::new(path.field(), short(value), allowed));
         return;
     }
     match value {
@@ -402,7 +412,7 @@ fn walk_plain(
             let above =
                 s.maximum.is_some_and(|m| x > m) || s.exclusive_maximum.is_some_and(|m| x >= m);
             if below || above || !x.is_finite() {
-                problems.push(Problem::new(path.text(), n.to_string(), described()));
+                problems.push(Problem::new(path.field(), n.to_string(), described()));
             }
         }
         Value::Array(items) => {
@@ -417,7 +427,7 @@ fn walk_plain(
                     (None, None) => String::new(),
                 };
                 problems.push(Problem::new(
-                    path.text(),
+                    path.field(),
                     format!("{} items", items.len()),
                     want,
                 ));
