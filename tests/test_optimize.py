@@ -198,8 +198,9 @@ def test_the_result_prints_on_one_line_plots_and_saves_its_spec(drag_parity, tmp
     r = ps.optimize(drag_parity, "actuator_power_mean", {V: (20.0, 150.0)}, ["left_stroke_amplitude >= 0.6"], progress=False)
     text = repr(r)
     assert "\n" not in text and text.startswith("OptimizationResult(success") and "actuator_power_mean" in text
-    fig = r.plot()
+    fig = r.plot(tmp_path / "convergence.pdf")
     assert isinstance(fig, Figure) and len(fig.axes) == 3
+    assert (tmp_path / "convergence.pdf").read_bytes()[:4] == b"%PDF"
     saved = ps.load_spec(r.save(tmp_path / "optimum.toml"))
     assert saved.to_dict() == r.spec.to_dict()
     assert saved.to_dict()["actuator"]["waveform"]["amplitude_v"] == r.x[V]

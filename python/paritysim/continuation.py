@@ -167,7 +167,7 @@ class ContinuationResult:
         if path is not None:
             from .plots import save
 
-            save(fig, path)
+            save(fig, path, close=False)
         return fig
 
 

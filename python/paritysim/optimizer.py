@@ -131,9 +131,10 @@ class OptimizationResult:
         """Writes the optimal spec as TOML (``Simulation.save``; ``ps.load_spec`` reads it back)."""
         return self.spec.save(path)
 
-    def plot(self) -> Figure:
+    def plot(self, path: str | Path | None = None) -> Figure:
         """Convergence: the objective, the largest constraint violation and the parameters
-        (scaled to [0, 1] by their bounds) per iteration."""
+        (scaled to [0, 1] by their bounds) per iteration; saved to ``path`` when given (the
+        suffix picks the format), as every result's plot is."""
         h = self.history
         it = h["iteration"].to_numpy()
         fig = Figure(figsize=(6.4, 6.0), layout="constrained")
@@ -152,6 +153,10 @@ class OptimizationResult:
         ax_p.set_ylabel("parameter (scaled)")
         ax_p.set_xlabel("iteration")
         ax_p.legend(fontsize="small")
+        if path is not None:
+            from .plots import save
+
+            save(fig, path, close=False)
         return fig
 
     def __repr__(self) -> str:
