@@ -244,3 +244,13 @@ def test_moments_flip_with_stroke_velocity_and_errata_12_law() -> None:
     assert float(m["normal"][0]) / float(unit["normal"]) == pytest.approx(
         float(aero.coefficients(np.pi / 2)["normal"])
     )
+
+
+def test_moments_name_an_unknown_omegas_key() -> None:
+    # A misspelt `force` dropped the lift and drag outputs without a word.
+    omegas = dict(Planform.hmf_like().omegas())
+    omegas["forse"] = omegas.pop("force")
+    with pytest.raises(ps.InvalidParameterError, match="did you mean `force`") as info:
+        aero.moments(omegas, 0.1, 0.0, 0.3, 0.5)
+    assert info.value.field == "omegas['forse']"
+    assert "lift" not in aero.moments(aero.TABLE_3_3["left"], 0.1, 0.0, 0.3, 0.5)  # Table 3.3's own keys still read

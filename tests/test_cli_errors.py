@@ -144,3 +144,12 @@ def test_a_misspelt_plot_column_fails_before_any_point_runs(tmp_path: Path) -> N
     _cases(tmp_path)
     assert main(["sweep", str(tmp_path / "study_plot_typo.toml"), "--out", str(tmp_path / "o_typo"), "--quiet"]) == 1
     assert not (tmp_path / "o_typo" / "study_plot_typo.parquet").exists()
+
+
+@pytest.mark.parametrize("flag", ["--all", "--list"])
+def test_reproduce_all_or_list_with_trial_names_is_refused(flag: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # `reproduce --all table3.3` ignored the name and ran every trial.
+    assert main(["reproduce", flag, "table3.3", "--out", str(tmp_path), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("paritysim: error:") and f"{flag} takes no trial names" in err
+    assert not any(tmp_path.iterdir())

@@ -93,7 +93,7 @@ def test_wing_terms_reject_bad_input() -> None:
     spec = ps.Simulation(wings=(WING,), configuration=ps.Configuration(name=None))
     with pytest.raises(ps.InvalidParameterError) as e:
         ps.dynamics.wing_terms(spec, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), index=1)
-    assert e.value.field == "wing"
+    assert e.value.field == "index"  # the argument that picks the wing
     with pytest.raises(ps.OutOfDomainError):
         ps.dynamics.wing_terms(WING, (1.5, 1.5, 0.0), (0.0, 0.0, 0.0))
 

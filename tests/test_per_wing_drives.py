@@ -118,3 +118,18 @@ def test_one_wing_errors_name_the_field() -> None:
     spec["drivetrain"]["cubic_ratio"] = 2e4
     with pytest.raises(ps.InvalidParameterError, match="drivetrain.cubic_ratio"):
         ps.simulate(ps.Simulation.from_dict(spec))
+
+
+def test_the_actuator_power_column_counts_both_drives() -> None:
+    # It was the left side's: its cycle integral was half of work_actuator_per_cycle, its mean
+    # half of actuator_power_mean.
+    result = ps.simulate(ps.devices.load("robobee_dual_linear"), progress=False)
+    cycle = result.cycle
+    t, power = cycle["time_ms"].to_numpy(), cycle["actuator_power"].to_numpy()
+    work = np.trapezoid(power, t)
+    assert work == pytest.approx(result.metrics["work_actuator_per_cycle"], rel=1e-6)
+    assert work / (t[-1] - t[0]) == pytest.approx(result.metrics["actuator_power_mean"], rel=1e-6)
+    # And the rate of the work integral, sample by sample.
+    total = result.trajectory
+    rate = np.gradient(total["work_actuator"].to_numpy(), total["time_ms"].to_numpy())
+    np.testing.assert_allclose(rate[5:-5], total["actuator_power"].to_numpy()[5:-5], atol=2e-2 * np.abs(power).max())

@@ -72,3 +72,21 @@ def test_zero_fraction_is_the_same_planform_and_bad_input_is_typed() -> None:
         wing.cut(0.2, where="root")
     with pytest.raises(ps.InvalidParameterError, match="measure"):
         wing.cut(0.2, measure="volume")
+
+
+@pytest.mark.parametrize("fraction", [0.01, 0.25, 0.9])
+def test_a_trailing_cut_by_area_removes_that_fraction_of_the_area(fraction: float) -> None:
+    # The root finder's far bracket left a sliver whose GeometryError ended every such cut.
+    for outline in (ps.Planform.rectangle(10.0, 2.0), ps.Planform.hmf_like()):
+        kept = outline.cut(fraction, "trailing", measure="area")
+        assert kept.area == pytest.approx((1.0 - fraction) * outline.area, rel=1e-10)
+    rectangle = ps.Planform.rectangle(10.0, 2.0)  # a rectangle cut at the back by area is cut by chord
+    assert rectangle.cut(0.25, "trailing", measure="area").area == pytest.approx(rectangle.cut(0.25, "trailing").area, rel=1e-10)
+
+
+def test_scaling_below_the_smallest_outline_names_the_argument() -> None:
+    # A GeometryError naming `points` (a degenerate polygon) where the docstring promises the argument.
+    for kwargs in ({"factor": 1e-300}, {"span_mm": 1e-9}, {"area_mm2": 1e-20}):
+        with pytest.raises(ps.InvalidParameterError, match="1e-06 mm across") as info:
+            ps.Planform.hmf_like().scaled(**kwargs)
+        assert info.value.field == next(iter(kwargs))

@@ -260,3 +260,17 @@ def test_replace_builds_a_section_given_as_a_mapping_and_keeps_specs_hashable() 
     with pytest.raises(ps.InvalidParameterError, match="rtol") as info:
         spec.replace(options={"rtoll": 1e-9})
     assert info.value.field == "Options.rtoll"
+
+
+def test_drivetrain_constructors_name_a_misspelt_field() -> None:
+    # A bare TypeError from the **deprecated catch-all.
+    with pytest.raises(ps.InvalidParameterError, match="did you mean `arm_ratio`") as info:
+        ps.spec.Drivetrain.linear_differential(3.0, 2.5, arm_ratioo=1.0)
+    assert info.value.field == "Drivetrain.arm_ratioo"
+
+
+def test_wing_terms_names_its_index() -> None:
+    device = ps.devices.load("sreetharan2012_3_4_parity")
+    with pytest.raises(ps.InvalidParameterError, match=r"\[0, 1\]") as info:
+        ps.dynamics.wing_terms(device, [0.1, 0.0, 0.2], [0.1, 0.0, 0.3], index=2)
+    assert info.value.field == "index"

@@ -321,3 +321,13 @@ def test_bad_scale_targets_name_the_argument_and_range() -> None:
         outline.scaled(span_mm=15.0, area_mm2=1e6)  # the chord would leave the 1e3 mm bound
     with pytest.raises(ps.InvalidParameterError, match=r"in \(0, 750\] mm"):
         outline.scaled(span_mm=1e4)
+
+
+def test_a_hinge_given_twice_is_refused() -> None:
+    # springs.hinge was dropped for `hinge` without a word.
+    outline = ps.Planform.hmf_like()
+    with pytest.raises(ps.InvalidParameterError, match="one hinge spring") as info:
+        ps.Wing.from_planform(outline, mass_mg=0.4, hinge=3.0, springs=ps.Springs(hinge=ps.Spring(7.0)))
+    assert info.value.field == "hinge"
+    kept = ps.Wing.from_planform(outline, mass_mg=0.4, hinge=3.0, springs=ps.Springs(stroke=ps.Spring(7.0)))
+    assert kept.springs.hinge.stiffness == 3.0 and kept.springs.stroke.stiffness == 7.0

@@ -22,7 +22,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _core
-from ._errors import chunked, finite_reals, invalid, real, reals, sized, whole
+from ._errors import chunked, finite_reals, invalid, real, reals, sized, suggest, whole
 
 __all__ = [
     "AIR_DENSITY",
@@ -146,6 +146,12 @@ def moments(
     """
     force: float | None = None
     if isinstance(omegas, dict):
+        # Table 3.3's inertia entries and Ω5..Ω8 (Planform.quasi_steady_omegas) may come along;
+        # any other key is a misspelling (a `forse` dropped the lift outputs without a word).
+        known = (*(f"omega{k}" for k in range(1, 9)), "force", "ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+        for key in omegas:
+            if key not in known:
+                raise invalid(f"omegas[{key!r}]", "<unknown key>", suggest(str(key), known, what="a key of Planform.omegas() or TABLE_3_3"))
         missing = [f"omega{k}" for k in range(1, 5) if f"omega{k}" not in omegas]
         if missing:
             raise invalid("omegas", f"keys {sorted(map(str, omegas))}", "a dict with omega1..omega4 (and optionally force), e.g. Planform.omegas()")

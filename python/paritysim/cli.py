@@ -24,6 +24,11 @@ def _trials() -> dict[str, Callable[[Path], list[Path]]]:
 
 
 def _reproduce(args: argparse.Namespace) -> int:
+    if args.names and (args.all or args.list):
+        # `--all table3.3` ran every trial (minutes) where one was meant.
+        flag = "--all" if args.all else "--list"
+        print(f"paritysim: error: {flag} takes no trial names (got {', '.join(args.names)}): name the trials alone, or pass {flag} alone", file=sys.stderr)
+        return 2
     if args.list:
         print("\n".join(_trials()))
         return 0

@@ -63,7 +63,7 @@ def wing_terms(wing: Wing | Simulation, p: Any, p_dot: Any, *, index: int = 0) -
         raise invalid("wing", type(wing).__name__, "a paritysim.Wing or a paritysim.Simulation")
     spec = wing if isinstance(wing, Simulation) else Simulation(wings=(wing,), configuration=Configuration(name=None))
     p3, v3 = _vec3(p, "p"), _vec3(p_dot, "p_dot")
-    raw = _core.dynamics_wing_terms(spec.to_json(), whole("index", index, 0, 2**31), p3, v3)
+    raw = _core.dynamics_wing_terms(spec.to_json(), whole("index", index, 0, len(spec.wings) - 1), p3, v3)
     bad = [k for k, v in raw.items() if not np.isfinite(np.asarray(v, dtype=float)).all()]
     if bad:
         # Huge finite rates overflow the quadratic terms (issue 34): name the input.

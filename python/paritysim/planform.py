@@ -36,6 +36,8 @@ FloatArray = npt.NDArray[np.float64]
 
 #: Largest |z|, |x| of an outline vertex (mm), as the Rust outline check allows.
 _MAX_COORDINATE = 1e3
+#: The smallest extent of an outline either way (mm), as `Planform.rectangle` takes it.
+_MIN_EXTENT = 1e-6
 
 
 def _shape_error(name: str, message: str) -> Exception:
@@ -248,6 +250,12 @@ class Planform:
                 name, top = "area_mm2", _MAX_COORDINATE / reach_x * self.area * sz
             unit = {"factor": "", "span_mm": " mm", "area_mm2": " mm^2"}[name]
             raise invalid(name, targets[name], f"in (0, {top:.6g}]{unit} (the outline must stay within {_MAX_COORDINATE:g} mm)")
+        # The smallest outline, as Planform.rectangle's (1e-6 mm across each way): a smaller
+        # one is a degenerate polygon to the geometry (a GeometryError naming `points`).
+        extent_z, extent_x = self.span, float(np.ptp(self.points[:, 1]))
+        if min(extent_z * sz, extent_x * sx) < _MIN_EXTENT:
+            name = next(n for n in ("factor", "span_mm", "area_mm2") if n in targets) if extent_z * sz < _MIN_EXTENT else ("area_mm2" if "area_mm2" in targets else next(iter(targets)))
+            raise invalid(name, targets[name], f"large enough that the outline stays at least {_MIN_EXTENT:g} mm across (span {extent_z * sz:.3g} mm, chord {extent_x * sx:.3g} mm here)")
         return Planform(self.points * np.array([sz, sx]))
 
     def translated(self, dz: float = 0.0, dx: float = 0.0) -> Planform:
@@ -297,7 +305,10 @@ class Planform:
         target = (1.0 - f) * self.area
 
         def excess(s: float) -> float:
-            kept = _core.aero_planform_properties(_core.aero_planform_cut(self.points, s, str(where)), AIR_DENSITY, None)
+            try:
+                kept = _core.aero_planform_properties(_core.aero_planform_cut(self.points, s, str(where)), AIR_DENSITY, None)
+            except _core.GeometryError:  # a cut near the far edge leaves a sliver: no area
+                return -target
             return float(kept["area"]) - target
 
         # Kept area falls continuously and monotonically from the full area (s = 0) to 0 (s -> 1).

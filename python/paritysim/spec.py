@@ -446,6 +446,9 @@ class Wing(_Node):
                     springs = _build_known("Springs", dict(springs))
                 elif isinstance(springs, list | tuple):
                     springs = Springs.from_joints(springs)
+                if springs.hinge is not None and springs.hinge != Springs().hinge and springs.hinge != spring:
+                    # Two hinge springs: the one in springs was dropped without a word.
+                    raise invalid("hinge", repr(hinge)[:60], f"left out when springs.hinge is given ({springs.hinge}): one hinge spring")
                 fields["springs"] = springs.replace(hinge=spring)
         return cls(inertia=tensor, aero=aero, **fields)  # type: ignore[call-arg]
 
@@ -594,8 +597,12 @@ def _balance(value: float | None, deprecated: dict[str, float]) -> float | None:
     if "balance_stiffness" in deprecated:
         warnings.warn("balance_stiffness= is deprecated: use balance_spring=", DeprecationWarning, stacklevel=3)
         value = deprecated.pop("balance_stiffness")
-    if deprecated:
-        raise TypeError(f"unexpected keyword arguments: {', '.join(deprecated)}")
+    if deprecated:  # a misspelt field: named with the nearest, as Drivetrain(kind=..., ...) does
+        from ._errors import invalid, suggest
+
+        key = next(iter(deprecated))
+        names = [n for n in _field_names(Drivetrain) if n != "kind"]
+        raise invalid(f"Drivetrain.{key}", "<unknown field>", suggest(key, names))
     return value
 
 
@@ -659,7 +666,7 @@ class Actuator(_Node):
         _derived_fields("Actuator.from_blocked_force", fields)
         for name, value in (("blocked_force_mn", blocked_force_mn), ("free_deflection_mm", free_deflection_mm), ("voltage_v", voltage_v)):
             if not (isinstance(value, numbers.Real) and math.isfinite(value) and value > 0):
-                raise invalid(name, value, "a finite number > 0")
+                raise invalid(name, repr(value), "a finite number > 0")  # repr: a text "1" shows as '1'
         return cls(waveform=waveform or Waveform(), force_per_volt=float(blocked_force_mn) / float(voltage_v), stiffness=float(blocked_force_mn) / float(free_deflection_mm), **fields)
 
 

@@ -37,6 +37,9 @@ pub struct Sample {
     pub force: [Vector3<f64>; 2],
     /// Power the wings give to the air (mW = µJ/ms; the rate of `−work_aero`).
     pub aero_power: f64,
+    /// Power the drive delivers, both sides of a dual drivetrain ([`Device::actuator_power`];
+    /// mW, the rate of `work_actuator`).
+    pub actuator_power: f64,
     /// Drive voltage (V).
     pub voltage: f64,
     /// Mechanical energy (µJ).
@@ -68,6 +71,11 @@ impl Sample {
             energy: device.energy(&eval),
             force: forces::of_evaluation(device, &eval),
             aero_power: forces::aero_power(device, &eval),
+            actuator_power: device.actuator_power(
+                time,
+                eval.drive.actuator_force,
+                &eval.drive.q_dot,
+            ),
             eval,
             aero,
             inertial,
@@ -292,9 +300,8 @@ const PER_DEVICE: [DeviceGetter; 14] = [
     ("q2_dot", "rad/ms", |s| s.eval.drive.q_dot.y),
     ("voltage", "V", |s| s.voltage),
     ("actuator_force", "mN", |s| s.eval.drive.actuator_force),
-    ("actuator_power", "uJ/ms", |s| {
-        s.eval.drive.actuator_force * s.eval.drive.q_dot.x
-    }),
+    // Both sides of a dual drivetrain: the rate of `work_actuator` (it was the left side's).
+    ("actuator_power", "uJ/ms", |s| s.actuator_power),
     ("work_actuator", "uJ", |s| s.state.work_actuator),
     ("work_aero", "uJ", |s| s.state.work_aero),
     ("mechanical_energy", "uJ", |s| s.energy),

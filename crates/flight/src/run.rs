@@ -123,6 +123,7 @@ impl FlightSample {
             force: f.wing_aero_force,
             // The power the wings give to the air (the flight's is that of the air on them).
             aero_power: -f.aero_power,
+            actuator_power: device.actuator_power(t, f.drive.actuator_force, &f.drive.q_dot),
             voltage,
             energy: f.kinetic + f.potential + f.gravity_potential,
         };

@@ -70,7 +70,11 @@ def list() -> builtins.list[str]:  # noqa: A001  (the PyBaMM-style name is the p
 
 
 def _check(name: str) -> str:
-    if not isinstance(name, str) or name not in _index():
+    if not isinstance(name, str):
+        from .._errors import invalid
+
+        raise invalid("name", repr(name)[:60], "a device name (str; ps.devices.list() lists them)")
+    if name not in _index():
         from .._errors import invalid, suggest
 
         raise invalid("name", repr(name), suggest(str(name), list(), listed_by="ps.devices.list()", what="a shipped device"))
