@@ -221,6 +221,8 @@ def test_no_grid_runs_the_base_design_and_an_empty_table_runs_nothing(parity: ps
     empty = sweep(parity, pl.DataFrame({"drivetrain.balance_spring": []}, schema={"drivetrain.balance_spring": pl.Float64}), metrics=["q2_amplitude"], progress=False)
     assert empty.height == 0
     assert empty.columns == ["point", "drivetrain.balance_spring", "q2_amplitude", "converged", "cycles_run", "orbit_cycles", "status", "error", "error_kind"]
+    # An empty list of rows is an empty table too (it ran the base design once).
+    assert sweep(parity, [], metrics=["q2_amplitude"], progress=False).height == 0
 
 
 def test_keep_cycle_returns_the_last_cycle_as_list_columns(hmf: ps.Simulation) -> None:

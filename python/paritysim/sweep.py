@@ -251,7 +251,8 @@ def sweep(
         Polars DataFrame whose columns are paths and rows are points, or a list of
         ``{path: value}`` rows. In the last two a null (a path a row leaves out) keeps the
         base design's value at that point. Paths are listed in the module docstring and by
-        `valid_paths`. None runs the base design once.
+        `valid_paths`. None (or ``{}``, the product of no axes) runs the base design once; an
+        empty table or list of rows runs nothing.
     metrics:
         Metric names to keep (default: all that `paritysim.simulate` reports). They are
         streamed by the engine from every sample of the recorded window, including Table 3.2's
@@ -321,6 +322,8 @@ def sweep(
     if options:
         spec = spec.replace(options=spec.options.with_fields("options", **{str(k): v for k, v in options.items()}))
     table = _table(grid)
+    # An empty list of rows runs nothing, as an empty table does (None runs the base design).
+    no_rows = isinstance(grid, Sequence) and not isinstance(grid, str | bytes) and len(grid) == 0
     _check_values(table)
     label_names = _names("labels", labels)
     if metrics is not None:
@@ -352,7 +355,7 @@ def sweep(
     if chunk_size is not None:
         chunk_size = whole("chunk_size", chunk_size, 1, 2**31)  # numpy integers too, as threads
 
-    rows = param_table.rows() if param_table.width else [()] * max(table.height, 1)
+    rows = param_table.rows() if param_table.width else [] if no_rows else [()] * max(table.height, 1)
     n = len(rows)
     fingerprinted = [*metric_names, *_gradient_columns(metric_names, gradient_paths)]
     store = _Checkpoint(checkpoint, _fingerprint(spec_json, table.columns, fingerprinted, cycle_columns), table.columns) if checkpoint is not None else None
