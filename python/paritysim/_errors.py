@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-from numbers import Integral, Real
+import math
 import re
 from collections.abc import Iterable
+from numbers import Integral, Real
 from typing import Any
 
 from . import _core
@@ -28,6 +29,29 @@ def real(field: str, value: Any) -> float:
         return float(value)
     except (TypeError, ValueError, OverflowError) as exc:
         raise invalid(field, repr(value), "a real number") from exc
+
+
+def of_kind(field: str, value: Any, kind: str) -> Any:
+    """``value`` as a record for the core reads it, checked for its ``kind`` by name before it is
+    serialised (JSON has no NaN, and serde's type errors name only the record): ``"number"`` a
+    finite float, ``"count"`` a non-negative int, ``"flag"`` a bool (numpy's too), ``"text"`` a
+    str. The ranges are the core's, which names the field."""
+    if kind == "number":
+        number = real(field, value)
+        if not math.isfinite(number):
+            raise invalid(field, number, "a finite number")
+        return number
+    if kind == "count":
+        if isinstance(value, bool) or not isinstance(value, Integral) or value < 0:
+            raise invalid(field, repr(value), "a non-negative integer")
+        return int(value)
+    if kind == "flag":
+        if not isinstance(value, bool) and type(value).__name__ != "bool_":
+            raise invalid(field, repr(value), "True or False")
+        return bool(value)
+    if not isinstance(value, str):
+        raise invalid(field, repr(value), "a text")
+    return value
 
 
 def whole(field: str, value: Any, lo: int = 0, hi: int = 2**53) -> int:

@@ -30,14 +30,13 @@ from __future__ import annotations
 
 import json
 import math
-import numbers
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from . import _core
 from ._core import InvalidParameterError
-from ._errors import invalid, real, suggest, whole
+from ._errors import invalid, of_kind, real, suggest, whole
 from ._progress import LongRun
 from .spec import Simulation, SpecLike, as_simulation
 
@@ -206,29 +205,7 @@ def _settings(settings: dict[str, Any]) -> dict[str, Any]:
     unknown = sorted(set(settings) - set(SETTINGS))
     if unknown:
         raise invalid(unknown[0], "<unknown setting>", suggest(unknown[0], SETTINGS, what="a setting of paritysim.continuation"))
-    checked: dict[str, Any] = {}
-    for name, value in settings.items():
-        kind = SETTINGS[name]
-        if value is None:
-            continue
-        if kind == "number":
-            number = real(name, value)
-            if not math.isfinite(number):
-                raise invalid(name, number, "a finite number")
-            checked[name] = number
-        elif kind == "count":
-            if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 0:
-                raise invalid(name, repr(value), "a non-negative integer")
-            checked[name] = int(value)
-        elif kind == "flag":
-            if not isinstance(value, bool) and type(value).__name__ != "bool_":  # numpy's too
-                raise invalid(name, repr(value), "True or False")
-            checked[name] = bool(value)
-        elif isinstance(value, str):
-            checked[name] = value
-        else:
-            raise invalid(name, repr(value), "a text")
-    return checked
+    return {name: of_kind(name, value, SETTINGS[name]) for name, value in settings.items() if value is not None}
 
 
 #: Wall budget of a whole `continuation` by default (ms); each orbit also has the spec's

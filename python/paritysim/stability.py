@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import json
 import math
-import numbers
 import os
 import re
 from dataclasses import dataclass, field
@@ -35,7 +34,7 @@ import polars as pl
 from matplotlib.figure import Figure
 
 from . import _core
-from ._errors import chunked, invalid, real, reals, sized, whole
+from ._errors import chunked, invalid, of_kind, real, reals, sized, whole
 from .spec import Simulation, SpecLike, as_simulation, schema
 
 __all__ = [
@@ -382,14 +381,8 @@ def _shooting(options: dict[str, Any]) -> str | None:
         kind = SHOOTING_OPTIONS.get(name)
         if value is None:
             continue
-        if kind == "number":
-            value = real(name, value)
-            if not math.isfinite(value):
-                raise invalid(name, value, "a finite number")
-        elif kind == "count":
-            if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 0:
-                raise invalid(name, repr(value), "a non-negative integer")
-            value = int(value)
+        if kind in ("number", "count"):
+            value = of_kind(name, value, kind)
         elif name == "method":
             methods = [m["const"] for m in schema()["$defs"]["Method"]["oneOf"]]  # the spec's own list
             if value not in methods:
