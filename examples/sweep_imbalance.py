@@ -63,12 +63,14 @@ def main() -> None:
     ax1.set_ylabel("roll imbalance 1 − τL/τR (peak drag torques)")
     plot(df, "wings.left.omega_ratio", "left_stroke_amplitude", hue="design", ax=ax2)
     ax2.set_ylabel("left stroke amplitude (rad)")
-    fig.savefig(args.out / "sweep_imbalance.png", dpi=150)
+    ps.plots.save(fig, args.out / "sweep_imbalance.png")
 
     summary = df.group_by("design", maintain_order=True).agg(
         ok=(pl.col("status") == "ok").sum(),
         failed=(pl.col("status") == "error").sum(),
-        imbalance_at_min_ratio=pl.col("roll_imbalance").filter(pl.col("status") == "ok").first(),
+        # At the smallest ratio that ran (the linkage fails below about 0.85): say which.
+        smallest_ok_ratio=pl.col("wings.left.omega_ratio").filter(pl.col("status") == "ok").min(),
+        imbalance_there=pl.col("roll_imbalance").filter(pl.col("status") == "ok").sort_by(pl.col("wings.left.omega_ratio").filter(pl.col("status") == "ok")).first(),
     )
     print(summary)
     print(f"wrote {args.out / 'sweep_imbalance.parquet'} and {args.out / 'sweep_imbalance.png'}")

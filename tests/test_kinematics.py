@@ -139,3 +139,16 @@ def test_random_inputs_never_panic_or_leak_nan(alpha2: float, alpha3: float, phi
         return
     assert np.isfinite(pose["wing_angles"]).all()
     assert np.isfinite(pose["link_rotations"]).all()
+
+
+def test_fig2_9_grid_stays_within_its_limit() -> None:
+    # np.arange overshot: step 7 reached 92 deg, step 200 reached 110 deg.
+    for kwargs in ({"step_deg": 7.0}, {"step_deg": 200.0}, {"step_deg": 0.7, "limit_deg": 10.0}):
+        df = ps.trials.fig2_9(**kwargs)
+        limit = kwargs.get("limit_deg", 90.0)
+        assert df["phi_deg"].min() == -limit and df["phi_deg"].max() <= limit
+        assert df["theta_deg"].max() <= limit
+    assert ps.trials.fig2_9(step_deg=5.0)["phi_deg"].n_unique() == 37  # -90..90 by 5, both ends
+    with pytest.raises(ps.InvalidParameterError) as info:
+        ps.trials.fig2_9(step_deg="1")  # type: ignore[arg-type]
+    assert info.value.field == "step_deg"

@@ -30,7 +30,8 @@ def test_nothing_close_lists_nothing_long():
     text = suggest("zzz", paths)
     assert "none close to `zzz`" in text and text.count("`") <= 8
     assert suggest("qqq", ["lift", "drag"]) == "one of: `lift`, `drag`"
-    assert suggest("lfit", ["lift", "drag"]).startswith("did you mean `lift`?")
+    # Read after "must be": it began "did you mean", so messages said "must be did you mean".
+    assert suggest("lfit", ["lift", "drag"]) == "one of: `lift`, `drag`: did you mean `lift`?"
 
 
 def test_every_name_taking_argument_shows_a_handful_not_the_list():

@@ -61,3 +61,35 @@ def test_flipping_ixz_flips_the_inertially_driven_rotation() -> None:
 def test_unknown_parameter_is_rejected() -> None:
     with pytest.raises(ps.InvalidParameterError, match="hinge"):
         s34.params(hinge=1.0)
+
+
+def test_the_trials_inputs_are_checked_by_name() -> None:
+    # A typo in `aero` ran the blade element; device/summarize raised KeyError/AttributeError;
+    # whitney_wood_omegas(nan) returned NaNs.
+    for kwargs, field in (({"aero": "foo"}, "aero"), ({"model": "dickinson"}, "model"), ({"dc_offset": "none"}, "dc_offset")):
+        with pytest.raises(ps.InvalidParameterError) as info:
+            s34.params(**kwargs)
+        assert info.value.field == field
+    p = s34.params(hinge_stiffness=2.5)
+    for args, field in ((("FOO", "Uncut"), "drivetrain"), (("PARITY", "3-Cut"), "trial")):
+        with pytest.raises(ps.InvalidParameterError) as info:
+            s34.device(p, *args)
+        assert info.value.field == field
+    with pytest.raises(ps.InvalidParameterError) as info:
+        s34.summarize(s34.device(p, "PARITY", "Uncut"))  # a spec, not its run
+    assert info.value.field == "result"
+    for bad in (float("nan"), -1.0, 0.0):
+        with pytest.raises(ps.InvalidParameterError) as info:
+            s34.whitney_wood_omegas(bad)
+        assert info.value.field == "omega3"
+
+
+def test_the_pinned_hinge_reaches_a_rotation_outside_the_first_bracket() -> None:
+    # brentq's fixed bracket [1.5, 6] raised scipy's ValueError for 90 deg.
+    p = s34.params(target_rotation_deg=90.0, max_cycles=80)
+    k = s34.hinge_stiffness(p)
+    rotation = ps.simulate(s34.device(p, "PARITY", "Uncut", hinge=k), progress=False).metrics["right_rotation_amplitude"]
+    assert math.degrees(rotation) == pytest.approx(90.0, abs=0.05)
+    with pytest.raises(ps.InvalidParameterError) as info:
+        s34.hinge_stiffness(s34.params(target_rotation_deg=-5.0, max_cycles=80))
+    assert info.value.field == "target_rotation_deg"

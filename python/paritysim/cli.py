@@ -96,7 +96,7 @@ def _run(args: argparse.Namespace) -> int:
         state = "converged" if result.converged else "NOT converged"
         if result.orbit_cycles > 1:
             state += f", period-{result.orbit_cycles} orbit"
-        print(f"{stem}: {result.cycles_run} cycles ({state}) in {time.perf_counter() - start:.2f} s -> {out}/{stem}_*")
+        print(f"{stem}: {result.cycles_run} cycles ({state}) in {time.perf_counter() - start:.2f} s -> {out}/{stem}.png, {stem}_trajectory.parquet, {stem}_metrics.csv")
         from .plots import label_with_unit  # matplotlib is loaded for the plot already
 
         for key in _HEADLINE:
@@ -199,7 +199,8 @@ def _one_line_warning(message: Warning | str, category: type[Warning], filename:
     """A warning as the CLI's one line (``paritysim: warning: ...``), not Python's file, line and
     source text."""
     text = " ".join(part.strip() for part in str(message).splitlines() if part.strip())
-    print(f"paritysim: warning: {text}", file=sys.stderr if file is None else file)
+    # tqdm.write: on a line of its own above a running progress bar, not glued to it.
+    tqdm.write(f"paritysim: warning: {text}", file=sys.stderr if file is None else file)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

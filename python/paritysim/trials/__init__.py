@@ -46,3 +46,9 @@ def _discover() -> dict[str, Callable[[Path], list[Path]]]:
 
 #: CLI trial name -> runner(out_dir) -> written files, from every trial module.
 REGISTRY: dict[str, Callable[[Path], list[Path]]] = _discover()
+
+
+def __dir__() -> list[str]:
+    """The public names (`__all__`) and the trial modules, not this file's own imports."""
+    modules = [info.name for info in pkgutil.iter_modules(__path__) if not info.name.startswith("_")]
+    return sorted({*__all__, *modules})

@@ -32,13 +32,17 @@ def fig2_9(step_deg: float = 1.0, limit_deg: float = 90.0) -> pl.DataFrame:
     DataFrame with columns ``alpha2_deg, alpha3_deg, phi_deg, theta_deg, theta_w_deg,
     reachable``; ``theta_w_deg`` is null where the pose is outside the joint limit.
     """
-    from .._errors import invalid
+    from .._errors import invalid, real
 
+    step_deg, limit_deg = real("step_deg", step_deg), real("limit_deg", limit_deg)
     if not (np.isfinite(step_deg) and step_deg > 0):
         raise invalid("step_deg", step_deg, "finite and > 0")
     if not (np.isfinite(limit_deg) and 0 < limit_deg <= 90):
         raise invalid("limit_deg", limit_deg, "in (0, 90]")
-    axis = np.arange(-limit_deg, limit_deg + 0.5 * step_deg, step_deg)
+    # Whole steps from -limit within the span (a step that does not divide it stops short),
+    # and the limit itself within a step's rounding: arange overshot to 92 deg at step 7.
+    count = int(np.floor(2.0 * limit_deg / step_deg + 1e-9))
+    axis = np.clip(-limit_deg + step_deg * np.arange(count + 1), -limit_deg, limit_deg)
     phi_deg, theta_deg = np.meshgrid(axis, axis, indexing="xy")
     frames = []
     for a2, a3 in FIG2_9_CONFIGS_DEG:

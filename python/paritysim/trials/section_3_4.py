@@ -72,8 +72,13 @@ def whitney_wood_omegas(omega3: float) -> dict[str, float]:
     integrals of one shape, so this is the planform scaled uniformly to the wing's Ω3)."""
     from ..planform import Planform
 
+    from .._errors import invalid, real
+
+    w3 = real("omega3", omega3)
+    if not (math.isfinite(w3) and w3 > 0):
+        raise invalid("omega3", omega3, "finite and > 0 (mg·mm²)")
     shape = Planform.hmf_like()
-    scale = omega3 / shape.omegas()["omega3"]
+    scale = w3 / shape.omegas()["omega3"]
     return {k: scale * v for k, v in shape.quasi_steady_omegas().items()}
 
 
@@ -90,6 +95,11 @@ def _wing(key: str, hinge: float, p: Params) -> Wing:
 
 def device(p: Params, drivetrain: str, trial: str, hinge: float | None = None) -> Simulation:
     """The §3.4 device for ``drivetrain`` in ("HMF", "PARITY") and ``trial`` in TRIALS."""
+    from .._errors import invalid, suggest
+
+    for name, value, allowed in (("drivetrain", drivetrain, DRIVETRAINS), ("trial", trial, TRIALS)):
+        if value not in allowed:
+            raise invalid(name, repr(value), suggest(str(value), list(allowed), what=f"a {name} of §3.4"))
     k = hinge if hinge is not None else hinge_stiffness(p)
     return Simulation(
         name=f"§3.4 {drivetrain} {trial}",
@@ -114,7 +124,25 @@ def hinge_stiffness(p: Params) -> float:
         r = simulate(device(p, "PARITY", "Uncut", hinge=k))
         return math.degrees(r.metrics["right_rotation_amplitude"]) - p.target_rotation_deg
 
-    return float(brentq(excess, 1.5, 6.0, xtol=1e-4))
+    # The rotation falls as the hinge stiffens: widen the bracket (×2 each way, a few times)
+    # until it holds the target, else name the target with the rotations it spans.
+    low, high = 1.5, 6.0
+    f_low, f_high = excess(low), excess(high)
+    for _ in range(4):
+        if f_low >= 0.0 >= f_high:
+            return float(brentq(excess, low, high, xtol=1e-4))
+        if f_low < 0.0:
+            low /= 2.0
+            f_low = excess(low)
+        if f_high > 0.0:
+            high *= 2.0
+            f_high = excess(high)
+    if f_low >= 0.0 >= f_high:
+        return float(brentq(excess, low, high, xtol=1e-4))
+    from .._errors import invalid
+
+    span = (p.target_rotation_deg + f_high, p.target_rotation_deg + f_low)
+    raise invalid("target_rotation_deg", p.target_rotation_deg, f"a rotation amplitude hinge stiffnesses {low:g}..{high:g} mN·mm/rad reach at these settings: {span[0]:.4g}..{span[1]:.4g} deg")
 
 
 def params(**overrides: Any) -> Params:
@@ -125,6 +153,16 @@ def params(**overrides: Any) -> Params:
         from .._errors import invalid, suggest
 
         raise invalid(unknown[0], overrides[unknown[0]], suggest(unknown[0], sorted(names), what="a parameter of this trial"))
+    from .._errors import invalid, suggest
+    from ..aero import MODELS
+    from ..spec import schema
+
+    # The choices (a typo fell back to the blade element without a word); the model and the
+    # DC law as the core lists them, the aero laws this trial builds.
+    dc_laws = [v["const"] for v in schema()["$defs"]["DcOffset"]["oneOf"]]
+    for name, allowed in (("aero", ("blade_element", "whitney_wood2010")), ("model", MODELS), ("dc_offset", dc_laws)):
+        if name in overrides and overrides[name] not in allowed:
+            raise invalid(name, repr(overrides[name]), suggest(str(overrides[name]), list(allowed), what=f"a value of {name}"))
     return Params(**overrides)
 
 
@@ -142,6 +180,10 @@ def _angle_of_attack(cycle: pl.DataFrame, wing: str) -> tuple[float, float]:
 
 def summarize(result: SimulationResult) -> dict[str, float | None]:
     """The §3.4 quantities of one run (angles in degrees, torques in mN·mm)."""
+    if not isinstance(result, SimulationResult):
+        from .._errors import invalid
+
+        raise invalid("result", type(result).__name__, "a paritysim.SimulationResult (ps.simulate(device(...)))")
     m, cycle = result.metrics, result.cycle
     out: dict[str, float | None] = {}
     for wing in ("left", "right"):

@@ -375,7 +375,8 @@ pub fn suggestion_for<'a>(
     };
     if list.len() <= SHOWN_NAMES {
         return match near.first() {
-            Some(best) => format!("did you mean `{best}`? (one of: {})", quoted(&list)),
+            // Read after "must be": "one of: `a`, `b`: did you mean `a`?".
+            Some(best) => format!("one of: {}: did you mean `{best}`?", quoted(&list)),
             None => format!("one of: {}", quoted(&list)),
         };
     }
@@ -527,7 +528,7 @@ mod tests {
         );
         assert_eq!(
             suggestion("lfit", ["lift", "drag"]),
-            "did you mean `lift`? (one of: `lift`, `drag`)"
+            "one of: `lift`, `drag`: did you mean `lift`?"
         );
         assert_eq!(
             suggestion("qqq", ["lift", "drag"]),
