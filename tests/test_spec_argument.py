@@ -1,4 +1,4 @@
-"""Every ``spec`` argument of the Python API reads the same things (``paritysim.spec.as_simulation``):
+"""Every ``spec`` argument of the Python API reads the same things (``paritysim.devices.as_simulation``):
 a Simulation, its dict, a shipped device's name or a TOML spec file; anything else is an
 ``InvalidParameterError`` naming ``spec``."""
 
@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 import paritysim as ps
-from paritysim.spec import as_simulation
+from paritysim.devices import as_simulation
 
 NAME = "sreetharan2012_3_3_parity"
 

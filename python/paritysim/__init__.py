@@ -50,7 +50,8 @@ if TYPE_CHECKING:  # what type checkers see; at run time the names below load la
     from .optimizer import OptimizationResult, optimize
     from .planform import Planform
     from .simulation import SimulationResult, simulate
-    from .spec import Actuator, Aero, Body, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, Springs, TunableHinge, Waveform, Wing, load_spec, spec_paths
+    from .devices import spec_paths
+    from .spec import Actuator, Aero, Body, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, Springs, TunableHinge, Waveform, Wing, load_spec
     from .sweep import grid, sweep
 
 #: Lazily loaded submodules.
@@ -71,7 +72,8 @@ _NAMES = {
     "SimulationResult": "simulation",
     "simulate": "simulation",
     "grid": "sweep",
-    **{n: "spec" for n in ("Actuator", "Aero", "Body", "Configuration", "Drivetrain", "Options", "Shoulder", "Simulation", "Spring", "Springs", "TunableHinge", "Waveform", "Wing", "load_spec", "spec_paths")},
+    **{n: "spec" for n in ("Actuator", "Aero", "Body", "Configuration", "Drivetrain", "Options", "Shoulder", "Simulation", "Spring", "Springs", "TunableHinge", "Waveform", "Wing", "load_spec")},
+    "spec_paths": "devices",  # any spec argument, a device's name too
 }
 
 

@@ -38,7 +38,8 @@ from . import _core
 from ._core import InvalidParameterError
 from ._errors import invalid, of_kind, real, suggest, whole
 from ._progress import LongRun
-from .spec import Simulation, SpecLike, as_simulation
+from .devices import as_simulation
+from .spec import Simulation, SpecLike
 
 if TYPE_CHECKING:
     import polars as pl

@@ -28,7 +28,8 @@ from matplotlib.patches import Rectangle
 from . import _core
 from ._errors import invalid, unknown_name
 from ._progress import LongRun
-from .spec import Simulation, SpecLike, as_simulation
+from .devices import as_simulation
+from .spec import Simulation, SpecLike
 
 __all__ = ["SensitivityResult", "sensitivity"]
 

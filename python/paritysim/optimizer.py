@@ -22,7 +22,8 @@ from . import _core
 from ._errors import invalid, real, suggest, whole
 from ._exceptions import InvalidParameterError, ParitysimError
 from ._progress import LongRun
-from .spec import Simulation, SpecLike, as_simulation, spec_paths
+from .devices import as_simulation
+from .spec import Simulation, SpecLike, spec_paths
 
 from .gradients import SensitivityResult, sensitivity
 

@@ -72,11 +72,11 @@ def _column_units() -> dict[str, str]:
     """Each trajectory column's unit as the core defines it, over the shipped devices fixed and
     flying (the body's columns), in the labels' typography."""
     from . import _core, devices
-    from .flight import with_body
+    from .spec import Simulation
 
     units: dict[str, str] = {}
-    names = devices.list()
-    specs = [devices.load(n) for n in names] + [with_body(names[0], mode="free")]
+    specs = [devices.load(n) for n in devices.list()]
+    specs.append(Simulation.from_dict({**specs[0].to_dict(), "body": {"mode": "free"}}))  # the body's columns
     for spec in specs:
         for column, unit in _core.trajectory_column_units(spec.to_json()):
             units.setdefault(column, _UNIT_TEXT.get(unit, unit))

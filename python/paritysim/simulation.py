@@ -16,7 +16,8 @@ from matplotlib.figure import Figure
 from . import _core, _slow_drive
 from ._errors import invalid, real, suggest
 from ._progress import LongRun
-from .spec import Simulation, SpecLike, as_simulation
+from .devices import as_simulation
+from .spec import Simulation, SpecLike
 
 __all__ = ["SimulationResult", "simulate"]
 

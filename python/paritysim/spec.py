@@ -828,38 +828,14 @@ def _load_spec(path: Any, field: str) -> Simulation:
 
 #: What every ``spec`` argument of the Python API accepts (the one rule, :func:`as_simulation`).
 SpecLike = Union["Simulation", Mapping[str, Any], str, "os.PathLike[str]"]
-SPEC_ARGUMENT = "a paritysim.Simulation, its dict, a named device (ps.devices.list()) or a TOML spec file"
-
-
-def as_simulation(spec: Any, field: str = "spec") -> Simulation:
-    """The :class:`Simulation` a ``spec`` argument names: a ``Simulation``; its dict
-    (:meth:`Simulation.from_dict`); a shipped device's name (``"sreetharan2012_3_3_parity"``,
-    :func:`paritysim.devices.load`) or a TOML spec file (:func:`load_spec`; a file wins over a
-    device of the same name, as on the command line). Anything else, or a name that is
-    neither, is an ``InvalidParameterError`` naming ``field`` (with the nearest device names)."""
-    from ._errors import invalid
-
-    if isinstance(spec, Simulation):
-        return spec
-    if isinstance(spec, Mapping):
-        return Simulation.from_dict(dict(spec))
-    if isinstance(spec, os.PathLike):
-        return _load_spec(spec, field)
-    if isinstance(spec, str):
-        from .devices import _name_or_file
-
-        return _name_or_file(spec, field=field)
-    raise invalid(field, type(spec).__name__, SPEC_ARGUMENT)
-
-
 def spec_paths(spec: Simulation) -> Any:
     """Every parameter path of ``spec`` (the names :func:`paritysim.sweep`,
     :func:`paritysim.calibrate` and :meth:`Simulation.with_paths` accept) as a Polars DataFrame:
-    ``path``, ``unit``, ``allowed`` (type and range) and ``value`` (JSON text). ``spec`` is
-    anything :func:`as_simulation` reads (a device's name, too)."""
+    ``path``, ``unit``, ``allowed`` (type and range) and ``value`` (JSON text).
+    (``paritysim.spec_paths`` also takes a device's name or a file: ``devices.spec_paths``.)"""
     import polars as pl
 
-    rows = _core.spec_paths(as_simulation(spec).to_json())
+    rows = _core.spec_paths(spec.to_json())
     return pl.DataFrame(rows, schema=["path", "unit", "allowed", "value"], orient="row")
 
 

@@ -35,7 +35,8 @@ from matplotlib.figure import Figure
 
 from . import _core
 from ._errors import chunked, invalid, of_kind, real, reals, sized, whole
-from .spec import Simulation, SpecLike, as_simulation, schema
+from .devices import as_simulation
+from .spec import Simulation, SpecLike, schema
 
 __all__ = [
     "FloquetResult",

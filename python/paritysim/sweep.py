@@ -91,7 +91,8 @@ from . import _sweep_chunks as runner
 from ._core import ParitysimError
 from ._errors import invalid, suggest, whole
 from ._sweep_checkpoint import _Checkpoint, _fingerprint, _reuse
-from .spec import Simulation, SpecLike, _dumps, as_simulation
+from .devices import as_simulation
+from .spec import Simulation, SpecLike, _dumps
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

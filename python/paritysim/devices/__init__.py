@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from ..spec import Simulation
 
-__all__ = ["DeviceInfo", "info", "list", "load", "path"]
+__all__ = ["DeviceInfo", "as_simulation", "info", "list", "load", "path", "spec_paths"]
 
 
 @dataclass(frozen=True)
@@ -116,3 +116,41 @@ def _name_or_file(source: Any, relative_to: str | Path = ".", field: str = "spec
     if named:
         return load(source)
     raise invalid(field, repr(source), suggest(source, list(), listed_by="`paritysim devices`", what=f"a named device or a spec file (none at {file})"))
+
+
+#: What every ``spec`` argument of the Python API accepts (the one rule, :func:`as_simulation`).
+SPEC_ARGUMENT = "a paritysim.Simulation, its dict, a named device (ps.devices.list()) or a TOML spec file"
+
+
+def as_simulation(spec: Any, field: str = "spec") -> Simulation:
+    """The :class:`~paritysim.Simulation` a ``spec`` argument names: a ``Simulation``; its dict
+    (:meth:`Simulation.from_dict`); a shipped device's name (``"sreetharan2012_3_3_parity"``,
+    :func:`load`) or a TOML spec file (:func:`paritysim.load_spec`; a file wins over a device of
+    the same name, as on the command line). Anything else, or a name that is neither, is an
+    ``InvalidParameterError`` naming ``field`` (with the nearest device names). It lives with
+    the device library, which it reads; the spec module knows no devices."""
+    from collections.abc import Mapping
+    from os import PathLike
+
+    from .._errors import invalid
+    from ..spec import Simulation, _load_spec
+
+    if isinstance(spec, Simulation):
+        return spec
+    if isinstance(spec, Mapping):
+        return Simulation.from_dict(dict(spec))
+    if isinstance(spec, PathLike):
+        return _load_spec(spec, field)
+    if isinstance(spec, str):
+        return _name_or_file(spec, field=field)
+    raise invalid(field, type(spec).__name__, SPEC_ARGUMENT)
+
+
+def spec_paths(spec: Any) -> Any:
+    """Every parameter path of ``spec`` (anything :func:`as_simulation` reads: a device's name,
+    too) as a Polars DataFrame: ``path``, ``unit``, ``allowed`` (type and range) and ``value``
+    (JSON text); the names :func:`paritysim.sweep`, :func:`paritysim.calibrate` and
+    :meth:`Simulation.with_paths` accept. ``paritysim.spec_paths`` is this function."""
+    from .. import spec as _spec
+
+    return _spec.spec_paths(as_simulation(spec))

@@ -27,7 +27,8 @@ from typing import Any
 import numpy as np
 import polars as pl
 
-from ..spec import Simulation, SpecLike, as_simulation
+from ..devices import as_simulation
+from ..spec import Simulation, SpecLike
 from .trim import Trim, trim
 
 __all__ = ["AXES", "Trim", "body_of", "tilt_angle", "trim", "twist_angle", "with_body"]

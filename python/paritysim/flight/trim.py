@@ -29,7 +29,8 @@ from typing import Any
 
 import numpy as np
 
-from ..spec import Simulation, SpecLike, as_simulation
+from ..devices import as_simulation
+from ..spec import Simulation, SpecLike
 
 __all__ = ["EQUATIONS", "Trim", "trim"]
 
