@@ -153,3 +153,13 @@ def test_reproduce_all_or_list_with_trial_names_is_refused(flag: str, tmp_path: 
     err = capsys.readouterr().err
     assert err.startswith("paritysim: error:") and f"{flag} takes no trial names" in err
     assert not any(tmp_path.iterdir())
+
+
+def test_the_cli_shows_a_deprecated_spelling_as_one_warning(tmp_path: Path) -> None:
+    # Python hides DeprecationWarnings outside __main__: `drivetrain.k2` in a study ran silently.
+    study = tmp_path / "k2.toml"
+    study.write_text('spec = "sreetharan2012_3_3_parity"\nmetrics = ["left_stroke_amplitude"]\n[grid]\n"drivetrain.k2" = [0.0]\n')
+    exe = Path(sys.executable).with_name("paritysim")
+    run = subprocess.run([str(exe), "sweep", str(study), "--out", str(tmp_path / "o"), "--quiet"], capture_output=True, text=True, check=False)
+    assert run.returncode == 0, run.stderr
+    assert run.stderr.strip() == "paritysim: warning: parameter `drivetrain.k2` is deprecated: use `drivetrain.balance_spring`"

@@ -274,3 +274,11 @@ def test_wing_terms_names_its_index() -> None:
     with pytest.raises(ps.InvalidParameterError, match=r"\[0, 1\]") as info:
         ps.dynamics.wing_terms(device, [0.1, 0.0, 0.2], [0.1, 0.0, 0.3], index=2)
     assert info.value.field == "index"
+
+
+def test_every_omega_of_the_blade_element_is_in_mg_mm2() -> None:
+    # Ω2 = ½ρ∬|x|³dA (mg/mm³ · mm⁵) was listed as mg·mm; M = Ω2 C ω|ω| is a torque in mN·mm only
+    # in mg·mm² (docs/concepts.md's units table).
+    table = ps.spec_paths("sreetharan2012_3_4_parity")
+    units = dict(zip(table["path"], table["unit"], strict=True))
+    assert [units[f"wings[0].aero.omega{k}"] for k in range(1, 5)] == ["mg mm^2"] * 4

@@ -220,6 +220,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     shown = warnings.showwarning
     if not debug:
         warnings.showwarning = _one_line_warning
+    # Python hides DeprecationWarnings outside __main__: the CLI shows paritysim's own (an old
+    # spelling in a spec or study file) as the API does.
+    filters = warnings.filters[:]
+    warnings.filterwarnings("default", category=DeprecationWarning, module=r"paritysim(\.|$)")
     try:
         with quiet() if getattr(args, "quiet", False) else nullcontext():  # no bar of a long run either
             return int(args.func(args))
@@ -236,6 +240,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
     finally:
         warnings.showwarning = shown
+        warnings.filters[:] = filters
 
 
 if __name__ == "__main__":

@@ -301,8 +301,9 @@ def sweep(
     -------
     polars.DataFrame
         ``point``, the parameter columns, the metrics, ``converged``, ``cycles_run``,
-        ``status`` (``"ok"`` converged, ``"unconverged"``, ``"error"``), ``error``,
-        ``error_kind`` (and ``cycle_*``). A ``RuntimeWarning`` names how many points did not
+        ``orbit_cycles``, ``status`` (``"ok"`` converged, ``"unconverged"``, ``"error"``),
+        ``error``, ``error_kind``, and with ``gradients`` the ``d(metric)/d(path)`` columns
+        and ``gradient_error``, with ``keep_cycle`` the ``cycle_*`` columns. A ``RuntimeWarning`` names how many points did not
         converge, and, when more than half of the points fail, the most common error (the
         ``"paritysim"`` logger records both).
 

@@ -140,8 +140,8 @@ pub struct BladeElement {
     /// Ω1 (mg·mm²), in [0, 1e5].
     #[schemars(range(min = 0.0, max = 1e5), extend("x-unit" = "mg mm^2"))]
     pub omega1: f64,
-    /// Ω2 (mg·mm), in [-1e6, 1e6].
-    #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm"))]
+    /// Ω2 (mg·mm², ½ρ∬|x|³dA), in [-1e6, 1e6].
+    #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
     pub omega2: f64,
     /// Ω3 (mg·mm²), in [-1e6, 1e6].
     #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
@@ -185,8 +185,8 @@ pub struct WhitneyWood2010 {
     /// Ω1 (mg·mm²), in [0, 1e5].
     #[schemars(range(min = 0.0, max = 1e5), extend("x-unit" = "mg mm^2"))]
     pub omega1: f64,
-    /// Ω2 (mg·mm), in [-1e6, 1e6].
-    #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm"))]
+    /// Ω2 (mg·mm², ½ρ∬|x|³dA), in [-1e6, 1e6].
+    #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
     pub omega2: f64,
     /// Ω3 (mg·mm²), in [-1e6, 1e6].
     #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
