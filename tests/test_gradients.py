@@ -298,3 +298,10 @@ def test_elasticities_are_null_where_undefined_and_a_nan_derivative_is_named() -
     assert info.value.field == "metric"
     # An omega_ratio multiplies Ω1: dimensionless, not mg·mm².
     assert s.parameters.filter(pl.col("parameter") == "wings.left.omega_ratio")["unit"].item() == "1"
+
+
+def test_an_old_spelling_warns_as_in_sweep() -> None:
+    # It was accepted silently (sweep, with_paths and calibrate warn).
+    with pytest.warns(DeprecationWarning, match="drivetrain.balance_spring"):
+        s = ps.sensitivity("sreetharan2012_3_3_parity", ["drivetrain.k2"], metrics=["left_stroke_amplitude"], progress=False)
+    assert s.parameter_names == ("drivetrain.k2",)

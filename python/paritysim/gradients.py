@@ -14,6 +14,7 @@ multiplier at 1, e.g. the whippletree at K2 = 0) are reported and left out, neve
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -213,6 +214,8 @@ def sensitivity(
         spec = spec.replace(options=spec.options.with_fields("options", **option_overrides))
     with LongRun("sensitivity", progress, spec.options.max_wall_ms):
         raw = _core.sensitivity(spec.to_json(), names, wanted)
+    for note in raw.get("notes", ()):  # an old spelling warns here as in sweep and with_paths
+        warnings.warn(note, DeprecationWarning, stacklevel=2)
     multipliers = np.array([complex(re, im) for re, im in raw["multipliers"]], dtype=complex)
     state = np.asarray(raw["state_jacobian"], dtype=float).T if len(raw["state_jacobian"]) else np.zeros((0, 0))
     parameter_names, metric_names = tuple(raw["parameter"]), tuple(raw["metric"])

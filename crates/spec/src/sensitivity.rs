@@ -382,6 +382,8 @@ pub struct SensitivityRecord {
     pub neutral_directions: usize,
     /// The orbit's period-map residual on its grid.
     pub residual: f64,
+    /// Deprecation notes of the parameter names (an old spelling such as `drivetrain.k2`).
+    pub notes: Vec<String>,
 }
 
 impl Sensitivity {
@@ -409,6 +411,11 @@ impl Sensitivity {
             multipliers: r.multipliers.iter().map(|z| [z.re, z.im]).collect(),
             neutral_directions: r.neutral_directions,
             residual: r.residual,
+            notes: self
+                .parameters
+                .iter()
+                .flat_map(|p| p.notes.iter().cloned())
+                .collect(),
         }
     }
 }
