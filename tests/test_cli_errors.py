@@ -129,15 +129,23 @@ def test_debug_flag_shows_the_traceback(tmp_path: Path) -> None:
     assert debug.returncode != 0 and "Traceback" in debug.stderr and "FileNotFoundError" in debug.stderr
 
 
-def test_a_warning_is_one_line_without_python_source(tmp_path: Path) -> None:
-    # Python's default format printed the file, the line and `sys.exit(main())`.
-    study = tmp_path / "half.toml"
-    study.write_text('spec = "sreetharan2012_3_3_parity"\n[grid]\n"actuator.frequency_hz" = [-1.0, -2.0, 110.0]\n')
+@pytest.mark.parametrize(
+    ("grid", "warning"),
+    [
+        # Python's default format printed the file, the line and `sys.exit(main())`.
+        ('"actuator.frequency_hz" = [-1.0, -2.0, 110.0]', "paritysim: warning: 2 of 3 sweep points failed"),
+        # Python hides DeprecationWarnings outside __main__: `drivetrain.k2` ran silently.
+        ('"drivetrain.k2" = [0.0]', "paritysim: warning: parameter `drivetrain.k2` is deprecated: use `drivetrain.balance_spring`"),
+    ],
+)
+def test_a_warning_is_one_line_without_python_source(grid: str, warning: str, tmp_path: Path) -> None:
+    study = tmp_path / "study.toml"
+    study.write_text(f'spec = "sreetharan2012_3_3_parity"\nmetrics = ["left_stroke_amplitude"]\n[grid]\n{grid}\n')
     exe = Path(sys.executable).with_name("paritysim")
     run = subprocess.run([str(exe), "sweep", str(study), "--out", str(tmp_path / "o"), "--quiet"], capture_output=True, text=True, check=False)
     assert run.returncode == 0, run.stderr
     lines = run.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("paritysim: warning: 2 of 3 sweep points failed"), run.stderr
+    assert len(lines) == 1 and lines[0].startswith(warning), run.stderr
 
 
 def test_a_misspelt_plot_column_fails_before_any_point_runs(tmp_path: Path) -> None:
@@ -153,13 +161,3 @@ def test_reproduce_all_or_list_with_trial_names_is_refused(flag: str, tmp_path: 
     err = capsys.readouterr().err
     assert err.startswith("paritysim: error:") and f"{flag} takes no trial names" in err
     assert not any(tmp_path.iterdir())
-
-
-def test_the_cli_shows_a_deprecated_spelling_as_one_warning(tmp_path: Path) -> None:
-    # Python hides DeprecationWarnings outside __main__: `drivetrain.k2` in a study ran silently.
-    study = tmp_path / "k2.toml"
-    study.write_text('spec = "sreetharan2012_3_3_parity"\nmetrics = ["left_stroke_amplitude"]\n[grid]\n"drivetrain.k2" = [0.0]\n')
-    exe = Path(sys.executable).with_name("paritysim")
-    run = subprocess.run([str(exe), "sweep", str(study), "--out", str(tmp_path / "o"), "--quiet"], capture_output=True, text=True, check=False)
-    assert run.returncode == 0, run.stderr
-    assert run.stderr.strip() == "paritysim: warning: parameter `drivetrain.k2` is deprecated: use `drivetrain.balance_spring`"
