@@ -98,7 +98,7 @@ impl Omegas {
     /// Published Ω1..Ω4 without a planform (no force parameter).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) unless `omega1 > 0`, `omega2 >= 0`, `omega3 >= 0` and
+    /// [`Error::InvalidParameter`] unless `omega1 > 0`, `omega2 >= 0`, `omega3 >= 0` and
     /// `omega4` is finite.
     pub fn new(omega1: f64, omega2: f64, omega3: f64, omega4: f64) -> Result<Self> {
         let o = Self {
@@ -115,7 +115,7 @@ impl Omegas {
     /// Adds the force parameter `½ρ∬z²dA` (mg·mm).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) (`force`) unless finite and >= 0.
+    /// [`Error::InvalidParameter`] (`force`) unless finite and >= 0.
     pub fn with_force(mut self, force: f64) -> Result<Self> {
         check_non_negative("force", force)?;
         self.force = Some(force);
@@ -125,7 +125,7 @@ impl Omegas {
     /// Checks the ranges listed in [`Self::new`] (and `force >= 0` when present).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) naming `omegas.omegaK` or `omegas.force`.
+    /// [`Error::InvalidParameter`] naming `omegas.omegaK` or `omegas.force`.
     pub fn validate(&self) -> Result<()> {
         let r = (|| -> Result<()> {
             paritysim_error::check_positive("omega1", self.omega1)?;
@@ -222,7 +222,7 @@ impl WingState {
     /// A validated state.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) naming the first non-finite field.
+    /// [`Error::InvalidParameter`] naming the first non-finite field.
     pub fn new(
         phi: f64,
         theta: f64,
@@ -471,7 +471,7 @@ impl<C: CoefficientModel> BladeElementModel<C> {
     /// A model with `C_rd = `[`DEFAULT_ROTATIONAL_DAMPING`] and [`NormalForceLaw::Coefficient`].
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) for out-of-range [`Omegas`] (see [`Omegas::validate`]).
+    /// [`Error::InvalidParameter`] for out-of-range [`Omegas`] (see [`Omegas::validate`]).
     pub fn new(omegas: Omegas, coefficients: C) -> Result<Self> {
         omegas.validate()?;
         Ok(Self {
@@ -485,7 +485,7 @@ impl<C: CoefficientModel> BladeElementModel<C> {
     /// Replaces `C_rd` (eq. 3.10).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) (`rotational_damping`) unless finite and >= 0.
+    /// [`Error::InvalidParameter`] (`rotational_damping`) unless finite and >= 0.
     pub fn with_rotational_damping(mut self, c_rd: f64) -> Result<Self> {
         check_non_negative("rotational_damping", c_rd)?;
         self.rotational_damping = c_rd;
@@ -877,7 +877,7 @@ impl<C: CoefficientModel> BladeElementModel<C> {
     /// Lift and drag forces and torques in the body frame (see [`AeroLoads`]).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) (`omegas.force`) if the model has no force parameter (built
+    /// [`Error::InvalidParameter`] (`omegas.force`) if the model has no force parameter (built
     /// from [`Omegas::new`] without [`Omegas::with_force`]).
     pub fn loads(&self, state: &WingState) -> Result<AeroLoads> {
         self.loads_omega(&state.angular_velocity(), &state.rotation())

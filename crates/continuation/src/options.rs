@@ -13,7 +13,7 @@ pub enum Method {
     PseudoArclength,
 }
 
-/// Settings of [`continue_orbits`].
+/// Settings of [`crate::continue_orbits`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContinuationOptions {
     /// Index of the continued parameter in the parameter vector.

@@ -121,8 +121,8 @@ impl Device {
     /// Validates the spec and precomputes the coordinate map.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] for a wrong wing count; [`Error::Shape`] when `C` does not have
-    /// 3 columns per wing; [`Error::Constraint`] when an actuator has no drivetrain, a 2-DOF
+    /// [`Error::InvalidParameter`](paritysim_error::Error::InvalidParameter) for a wrong wing count; [`Error::Shape`](paritysim_error::Error::Shape) when `C` does not have
+    /// 3 columns per wing; [`Error::Constraint`](paritysim_error::Error::Constraint) when an actuator has no drivetrain, a 2-DOF
     /// drivetrain has one wing, or a 1-DOF drivetrain drives two wings whose strokes `C` does not
     /// tie together (`φL = φR`).
     pub fn new(spec: DeviceSpec) -> Result<Self> {
@@ -253,7 +253,7 @@ impl Device {
     /// `(p, ṗ)` from an integrator state.
     ///
     /// # Errors
-    /// With drivetrain coordinates, [`Error::OutOfDomain`] when `q` is beyond the linkage's reach.
+    /// With drivetrain coordinates, [`Error::OutOfDomain`](paritysim_error::Error::OutOfDomain) when `q` is beyond the linkage's reach.
     #[inline]
     pub fn coordinates(&self, y: &State) -> Result<(Vec6, Vec6)> {
         if self.form.stroke_only().is_some() {
@@ -417,7 +417,7 @@ impl Device {
     /// An integrator state from `(p, ṗ)` after checking `C p = c0`, `C ṗ = 0`.
     ///
     /// # Errors
-    /// [`Error::Constraint`] for an inconsistent initial state; [`Error::InvalidParameter`] for
+    /// [`Error::Constraint`](paritysim_error::Error::Constraint) for an inconsistent initial state; [`Error::InvalidParameter`](paritysim_error::Error::InvalidParameter) for
     /// non-finite values.
     pub fn state_from(&self, p: &Vec6, p_dot: &Vec6) -> Result<State> {
         paritysim_error::check_all_finite("initial.p", p.as_slice())?;

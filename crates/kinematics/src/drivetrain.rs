@@ -109,7 +109,7 @@ impl RodCrank {
 
     /// Largest lift of the rod top along the rod (`dx = 0`) before the linkage toggles (mm):
     /// the crank pivot and the rod top are at most `L2 + L3` apart (triangle inequality, the
-    /// `|k| < 1` of [`Self::solve`]), so `(L2 + dy)² + L3² < (L2 + L3)²`, i.e.
+    /// `|k| < 1` of `Self::solve`), so `(L2 + dy)² + L3² < (L2 + L3)²`, i.e.
     /// `dy < √(L2² + 2 L2 L3) − L2`.
     pub fn reach(&self) -> f64 {
         let (l3, l2) = (self.crank, self.rod);

@@ -29,7 +29,7 @@ use crate::rotation::{rot_axis, rot_x, rot_y, rot_z};
 const SINGULAR_TOL: f64 = 1e-12;
 
 /// Smallest `alpha2` and `alpha2 - alpha3` (rad): the rest pose's closure determinant
-/// `sin(alpha2 - alpha3)` stays six orders above [`SINGULAR_TOL`].
+/// `sin(alpha2 - alpha3)` stays six orders above `SINGULAR_TOL`.
 pub const MIN_LINK_ANGLE: f64 = 1e-6;
 
 /// Spherical five-bar shoulder parameterised by `α2, α3` (eq. 2.7).

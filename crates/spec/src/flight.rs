@@ -310,7 +310,7 @@ impl Simulation {
         result
     }
 
-    /// Runs the spec: the engine's [`paritysim_dynamics::simulate`] for a fixed body, free
+    /// Runs the spec: the engine's [`paritysim_dynamics::simulate()`] for a fixed body, free
     /// flight ([`paritysim_flight::fly`]) otherwise. `device` and `options` are those of
     /// [`Simulation::model`] (the caller may set a cancel flag on the options).
     ///

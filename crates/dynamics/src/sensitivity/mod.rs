@@ -110,7 +110,7 @@ pub fn orbit_options(options: &SimulationOptions) -> SimulationOptions {
 /// `p` (see the module) at the orbit a run of [`orbit_options`] from the spec's own start
 /// reaches.
 /// `steps[j]`: the finite-difference step of parameter `j` (`None`: [`PARAMETER_STEP`] ×
-/// max(|p0[j]|, 1e-3)).
+/// `max(|p0[j]|, 1e-3)`).
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for a non-finite or non-positive step; those of `device_at`

@@ -43,7 +43,7 @@ pub struct PointOutput {
     pub orbit_cycles: usize,
     /// Whether the orbit belongs to a family of orbits (a Floquet multiplier within
     /// [`NEUTRAL_MULTIPLIER_TOL`] of 1, e.g. the whippletree's differential offset at K2 = 0):
-    /// such an orbit neither continues a chain nor is taken from one ([`super::chain`]).
+    /// such an orbit neither continues a chain nor is taken from one (`sweep/chain.rs`).
     pub neutral: bool,
 }
 
