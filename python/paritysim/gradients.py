@@ -196,6 +196,14 @@ def sensitivity(
     ``benchmarks/sensitivity_cost.py`` measures these ratios (wall time or instructions) on
     your machine; docs/findings.md §30.
 
+    Limit: at an orbit with a neutral direction (``neutral_directions`` > 0, e.g. a linear
+    whippletree at ``drivetrain.balance_spring = 0``), a parameter that breaks the family
+    (the balance spring itself) selects a member as it moves, which ``dx*/dp`` cannot see: a
+    metric that changes along the family is flagged, but one that changes only slightly
+    (``q2_amplitude``, the works) can be off by up to tens of percent without a flag
+    (measured on the §3.3 1-Cut at K2 = 0; docs/findings.md §30). Differentiate such a
+    parameter just off the neutral point (K2 = 1e-3 agreed with differences to 1e-4).
+
     Raises
     ------
     InvalidParameterError
