@@ -169,3 +169,14 @@ def test_inputs_that_could_not_act_are_refused() -> None:
     still = ps.simulate(ps.flight.with_body(parity, mode="clamped"), progress=False).metrics["body_torque_roll_mean"]
     biased = ps.simulate(ps.flight.with_body(parity, mode="clamped", set_points=[bias]), progress=False).metrics["body_torque_roll_mean"]
     assert abs(biased - still) > 1e-3
+
+
+def test_trim_names_a_zero_gravity_and_a_discrete_knob() -> None:
+    # A ZeroDivisionError (residuals scaled by the weight) and a ValueError from float('linear_differential').
+    hmf = ps.devices.load("sreetharan2012_3_4_hmf")
+    with pytest.raises(ps.InvalidParameterError) as info:
+        ps.flight.trim(ps.flight.with_body(hmf, mode="clamped", gravity_mm_per_ms2=[0.0, 0.0, 0.0]), progress=False)
+    assert info.value.field == "body.gravity_mm_per_ms2"
+    with pytest.raises(ps.InvalidParameterError, match="discrete") as info:
+        ps.flight.trim(hmf, knobs=["drivetrain.kind", "actuator.waveform.offset_v"], progress=False)
+    assert info.value.field == "knobs"

@@ -51,35 +51,47 @@ _UNITS = {
 
 
 @functools.lru_cache(maxsize=1)
+def _shipped() -> tuple[Any, ...]:
+    """The shipped devices (every drivetrain, actuator and aero kind among them) and one flying
+    (the body's columns): where the unit tables below read the core's units."""
+    from . import devices
+    from .spec import Simulation
+
+    specs = [devices.load(n) for n in devices.list()]
+    return (*specs, Simulation.from_dict({**specs[0].to_dict(), "body": {"mode": "free"}}))
+
+
+def _typeset(unit: str) -> str:
+    """A unit as the core writes it (``mN*mm``, ``mg mm^2``, ``uJ/ms``, ``1``) as labels print
+    it (``mN·mm``, ``mg·mm²``, ``mW``, no unit)."""
+    if unit == "1":
+        return ""
+    text = unit.replace("uJ/ms", "mW").replace("uJ", "µJ").replace("*", "·").replace(" ", "·")
+    return text.replace("^2", "²").replace("^3", "³")
+
+
+@functools.lru_cache(maxsize=1)
 def _spec_units() -> dict[str, str]:
-    """Each spec path's unit as the spec's schema states it (``ps.spec_paths``), over the shipped
-    devices (they hold every drivetrain, actuator and aero kind), wing paths as ``wings[*]``."""
-    from . import _core, devices
+    """Each spec path's unit as the schema states it (``ps.spec_paths``), wing paths as
+    ``wings[*]``, typeset."""
+    from . import _core
 
     units: dict[str, str] = {}
-    for name in devices.list():
-        for path, unit, *_ in _core.spec_paths(devices.load(name).to_json()):
-            units.setdefault(re.sub(r"^wings\[\d+\]", "wings[*]", path), unit)
+    for spec in _shipped():
+        for path, unit, *_ in _core.spec_paths(spec.to_json()):
+            units.setdefault(re.sub(r"^wings\[\d+\]", "wings[*]", path), _typeset(unit))
     return units
-
-
-#: The core's unit texts (`crates/dynamics/src/trajectory.rs`) as the labels print them.
-_UNIT_TEXT = {"mN*mm": "mN·mm", "uJ": "µJ", "uJ/ms": "mW", "rad/ms^2": "rad/ms²", "mm/ms^2": "mm/ms²", "mg*mm/ms": "mg·mm/ms", "mg*mm^2/ms": "mg·mm²/ms", "1": ""}
 
 
 @functools.lru_cache(maxsize=1)
 def _column_units() -> dict[str, str]:
-    """Each trajectory column's unit as the core defines it, over the shipped devices fixed and
-    flying (the body's columns), in the labels' typography."""
-    from . import _core, devices
-    from .spec import Simulation
+    """Each trajectory column's unit as the core's column table defines it, typeset."""
+    from . import _core
 
     units: dict[str, str] = {}
-    specs = [devices.load(n) for n in devices.list()]
-    specs.append(Simulation.from_dict({**specs[0].to_dict(), "body": {"mode": "free"}}))  # the body's columns
-    for spec in specs:
+    for spec in _shipped():
         for column, unit in _core.trajectory_column_units(spec.to_json()):
-            units.setdefault(column, _UNIT_TEXT.get(unit, unit))
+            units.setdefault(column, _typeset(unit))
     return units
 
 
@@ -92,12 +104,7 @@ def _path_unit(column: str) -> str | None:
     typography (``mN·mm/rad³``); None when ``column`` is no known path."""
     path = _PATH_ALIASES.get(column, column)
     path = re.sub(r"^wings(\[\d+\]|\.left|\.right)", "wings[*]", path)
-    unit = _spec_units().get(path)
-    if unit is None:
-        return None
-    if unit == "1":
-        return ""
-    return unit.replace(" ", "·").replace("^2", "²").replace("^3", "³")
+    return _spec_units().get(path)
 
 
 def _unit_of(column: str) -> str:
@@ -244,7 +251,7 @@ def _columns_over_time(df: pl.DataFrame, columns: Any, name: str, units: dict[st
     panels: dict[str, list[str]] = {}
     for c in columns:
         unit = units.get(c)
-        unit = _UNIT_TEXT.get(unit, unit) if unit is not None else label_with_unit(c)[len(c) :].strip(" ()")
+        unit = _typeset(unit) if unit is not None else label_with_unit(c)[len(c) :].strip(" ()")
         panels.setdefault(unit, []).append(c)
     t = df["time_ms"].to_numpy()
     fig, axes = plt.subplots(len(panels), 1, figsize=(10, 2.2 + 2.4 * len(panels)), sharex=True, constrained_layout=True, squeeze=False)
