@@ -98,6 +98,32 @@ def test_a_neutral_family_is_reported_and_flagged_not_divided_by():
     assert "1 neutral direction" in repr(s) and "\n" not in repr(s)
 
 
+def test_a_parameter_that_breaks_the_family_has_no_derivative_there():
+    """At K2 = 0 every stroke offset is an orbit; the balance spring selects one as it leaves
+    0. On wings that differ (the 1-Cut) the run from rest ends on a member with an offset, and
+    a run at a small K2 on another: the metric jumps (its change does not shrink with the
+    step), so the balance spring's column is NaN with the reason, not a slope that looks
+    right (it was 55 % off in q2_amplitude). On identical wings symmetry keeps the member."""
+    spec = ps.devices.load("sreetharan2012_3_3_parity_1cut")
+    at = {k2: _metrics(spec, {"drivetrain.balance_spring": k2})["left_stroke_mean"] for k2 in (0.0, 1e-3, 4e-3)}
+    jumps = [abs(at[h] - at[0.0]) for h in (1e-3, 4e-3)]
+    assert min(jumps) > 0.9 * max(jumps) and min(jumps) > 1e-4, at  # a jump, not a slope
+    paths = ["drivetrain.balance_spring", "actuator.waveform.frequency_hz"]
+    s = ps.sensitivity(spec, paths, progress=False)
+    assert s.parameter_reasons[1] is None and np.isfinite(s.matrix[:, 1][np.isfinite(s.values)]).all()
+    assert s.parameter_reasons[0] is not None and "family" in s.parameter_reasons[0]
+    assert np.isnan(s.matrix[:, 0]).all() and np.isnan(s.state_jacobian[:, 0]).all()
+    assert s.parameters["differentiable"].to_list() == [False, True]
+    assert "1 parameter(s) not differentiable in" in repr(s)
+    with pytest.raises(InvalidParameterError, match="drivetrain.balance_spring.*family"):
+        s.derivative("q2_amplitude", "drivetrain.balance_spring")
+    assert s.derivative("q2_amplitude", "actuator.waveform.frequency_hz") == s.matrix[s.metric_names.index("q2_amplitude"), 1]
+    hatched = [p for p in s.plot(metrics=["q2_amplitude"]).axes[0].patches if p.get_hatch()]
+    assert len(hatched) == 1  # the balance spring's column
+    symmetric = ps.sensitivity(ps.devices.load("sreetharan2012_3_3_parity"), paths, progress=False)
+    assert symmetric.parameter_reasons == (None, None)
+
+
 def test_metrics_without_work_replay_the_window_and_agree_with_the_integrated_windows():
     """Metrics that read no work integral take the base window from the variational period and
     the neutral-direction check from its Φ (no window integrated again); all metrics integrate
@@ -202,8 +228,11 @@ def test_sensitivity_periods_in_lanes_equal_the_scalar_ones(balance_spring: floa
     monkeypatch.setenv("PARITYSIM_LANES", "1")
     scalar = ps.sensitivity(spec, params, metrics=metrics, progress=False)
     assert lanes.jacobian.equals(scalar.jacobian)
-    assert np.array_equal(lanes.state_jacobian, scalar.state_jacobian)
-    assert np.isfinite(lanes.jacobian.select(pl.col("^d/d.*$")).to_numpy()).all()
+    assert np.array_equal(lanes.state_jacobian, scalar.state_jacobian, equal_nan=True)
+    # At K2 = 0 on wings that differ the balance spring breaks the family: its column is NaN.
+    broken = [r is not None for r in lanes.parameter_reasons]
+    assert broken == [r is not None for r in scalar.parameter_reasons] == [p == "drivetrain.balance_spring" and balance_spring == 0.0 for p in params]
+    assert np.isfinite(lanes.matrix[:, ~np.array(broken)]).all()
 
 
 @pytest.mark.parametrize("threads", ["1", "2", "3"])

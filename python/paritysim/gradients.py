@@ -43,11 +43,13 @@ class SensitivityResult:
     (``d metric / d parameter``, metrics x parameters, metric units per parameter unit),
     ``reasons`` (per metric: why its derivatives are not to be trusted, ``None`` where they
     are: a kink such as a peak switching between two maxima, a metric that moves along a
-    family of orbits, or one not defined here), ``parameter_names``, ``units`` and
-    ``parameter_values``.
+    family of orbits, or one not defined here), ``parameter_names``, ``units``,
+    ``parameter_values`` and ``parameter_reasons`` (per parameter: why the orbit is not
+    differentiable in it here, ``None`` where it is: a parameter that breaks a family of
+    orbits, whose ``matrix`` column is then NaN).
     As tables (built on first use): ``jacobian``, one row per metric: ``metric``, ``value``,
     one column ``d/d(<path>)`` per parameter, ``differentiable`` and ``reason``;
-    ``parameters``: ``parameter``, ``unit``, ``value``.
+    ``parameters``: ``parameter``, ``unit``, ``value``, ``differentiable`` and ``reason``.
     ``multipliers``: Floquet multipliers of the exact monodromy, largest modulus first.
     ``neutral_directions``: directions with a multiplier at 1, left out of ``dx*/dp``.
     ``state_jacobian``: ``dx*/dp``, the orbit's start state (coordinates, then rates) per
@@ -61,6 +63,7 @@ class SensitivityResult:
     parameter_names: tuple[str, ...]
     units: tuple[str, ...]
     parameter_values: np.ndarray
+    parameter_reasons: tuple[str | None, ...]
     multipliers: np.ndarray
     neutral_directions: int
     state_jacobian: np.ndarray
@@ -84,10 +87,13 @@ class SensitivityResult:
 
     @cached_property
     def parameters(self) -> pl.DataFrame:
-        """``parameter``, ``unit``, ``value``."""
+        """``parameter``, ``unit``, ``value``, ``differentiable``, ``reason``."""
         return pl.DataFrame(
-            list(zip(self.parameter_names, self.units, (float(v) for v in self.parameter_values), strict=True)),
-            schema={"parameter": pl.String, "unit": pl.String, "value": pl.Float64},
+            [
+                (name, unit, float(value), reason is None, reason)
+                for name, unit, value, reason in zip(self.parameter_names, self.units, self.parameter_values, self.parameter_reasons, strict=True)
+            ],
+            schema={"parameter": pl.String, "unit": pl.String, "value": pl.Float64, "differentiable": pl.Boolean, "reason": pl.String},
             orient="row",
         )
 
@@ -97,8 +103,10 @@ class SensitivityResult:
             raise invalid("metric", metric, "one of the result's metrics: " + ", ".join(self.metric_names[:5]))
         if parameter not in self.parameter_names:
             raise invalid("parameter", parameter, "one of " + ", ".join(self.parameter_names))
-        row = self.metric_names.index(metric)
-        slope = float(self.matrix[row, self.parameter_names.index(parameter)])
+        row, column = self.metric_names.index(metric), self.parameter_names.index(parameter)
+        slope = float(self.matrix[row, column])
+        if self.parameter_reasons[column] is not None:
+            raise invalid("parameter", parameter, f"a parameter the orbit is differentiable in here (it {self.parameter_reasons[column]})")
         if not math.isfinite(slope):  # a metric not defined at this point (a phase lag of a still wing)
             raise invalid("metric", metric, f"a metric defined at this point ({metric} is {self.jacobian['value'][row]}: {self.reasons[row] or 'not finite'})")
         return slope
@@ -117,8 +125,8 @@ class SensitivityResult:
 
     def plot(self, metrics: Sequence[str] | None = None, path: str | Path | None = None) -> Figure:
         """A heat map of the elasticities (metrics x parameters), each cell labelled with its
-        value; a cell whose metric is not differentiable there is hatched, one whose metric is 0
-        (no elasticity) is blank. ``metrics``: the rows to show (default all); ``path``: also
+        value; a row whose metric, or a column whose parameter, is not differentiable there is
+        hatched, a cell whose metric is 0 (no elasticity) is blank. ``metrics``: the rows to show (default all); ``path``: also
         save the figure there."""
         e = self.elasticities()
         flags = self.jacobian["differentiable"]
@@ -147,8 +155,12 @@ class SensitivityResult:
         for i, ok in enumerate(flags):
             if not ok:
                 ax.add_patch(Rectangle((-0.5, i - 0.5), len(names), 1.0, fill=False, hatch="///", edgecolor="0.35", lw=0.0))
+        for j, reason in enumerate(self.parameter_reasons):
+            if reason is not None:
+                ax.add_patch(Rectangle((j - 0.5, -0.5), 1.0, e.height, fill=False, hatch="\\\\\\", edgecolor="0.35", lw=0.0))
         fig.colorbar(image, ax=ax, label="elasticity (p/m) dm/dp")
-        ax.set_title("steady-state sensitivities" + (" (hatched: not differentiable)" if not all(flags) else ""), fontsize=10)
+        hatched = not all(flags) or any(r is not None for r in self.parameter_reasons)
+        ax.set_title("steady-state sensitivities" + (" (hatched: not differentiable)" if hatched else ""), fontsize=10)
         if path is not None:
             from .plots import save
 
@@ -157,10 +169,11 @@ class SensitivityResult:
 
     def __repr__(self) -> str:
         bad = sum(reason is not None for reason in self.reasons)
+        broken = sum(reason is not None for reason in self.parameter_reasons)
         largest = abs(self.multipliers[0]) if len(self.multipliers) else float("nan")
         return (
             f"SensitivityResult({len(self.metric_names)} metrics x {len(self.parameter_names)} parameters, "
-            f"{bad} not differentiable, {self.neutral_directions} neutral direction(s), "
+            f"{bad} not differentiable, " + (f"{broken} parameter(s) not differentiable in, " if broken else "") + f"{self.neutral_directions} neutral direction(s), "
             f"largest |multiplier| {largest:.4g}, orbit residual {self.residual:.1e})"
         )
 
@@ -196,13 +209,15 @@ def sensitivity(
     ``benchmarks/sensitivity_cost.py`` measures these ratios (wall time or instructions) on
     your machine; docs/findings.md §30.
 
-    Limit: at an orbit with a neutral direction (``neutral_directions`` > 0, e.g. a linear
-    whippletree at ``drivetrain.balance_spring = 0``), a parameter that breaks the family
-    (the balance spring itself) selects a member as it moves, which ``dx*/dp`` cannot see: a
-    metric that changes along the family is flagged, but one that changes only slightly
-    (``q2_amplitude``, the works) can be off by up to tens of percent without a flag
-    (measured on the §3.3 1-Cut at K2 = 0; docs/findings.md §30). Differentiate such a
-    parameter just off the neutral point (K2 = 1e-3 agreed with differences to 1e-4).
+    At an orbit with a neutral direction (``neutral_directions`` > 0, e.g. a linear
+    whippletree at ``drivetrain.balance_spring = 0``), a metric that changes along the family
+    is flagged (which member is meant decides its derivative), and a parameter that breaks
+    the family (the balance spring itself, on wings that differ) is not differentiable there:
+    as it moves the steady state jumps to the member the parameter selects, so its column is
+    NaN and ``parameter_reasons`` / the ``parameters`` table say why (the numbers a
+    first-order method gives there were up to 55 % off whole runs; docs/findings.md §30).
+    Differentiate such a parameter just off the neutral point (K2 = 1e-3 agrees with
+    differences to 1e-4).
 
     Raises
     ------
@@ -237,6 +252,7 @@ def sensitivity(
         parameter_names=parameter_names,
         units=tuple(raw["unit"]),
         parameter_values=np.asarray(raw["parameter_value"], dtype=float),
+        parameter_reasons=tuple(reason or None for reason in raw["parameter_not_differentiable"]),
         multipliers=multipliers,
         neutral_directions=int(raw["neutral_directions"]),
         state_jacobian=state,

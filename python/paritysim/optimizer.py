@@ -335,6 +335,9 @@ def optimize(
         except ParitysimError as exc:
             raise _Stop(f"no steady state to differentiate at {shown}: {exc}") from exc
         counts["evaluations"] += 1
+        for path, reason in zip(paths, s.parameter_reasons, strict=True):
+            if reason is not None:
+                raise _Stop(f"the steady state is not differentiable in {path} at {shown}: it {reason}")
         values: dict[str, float] = {}
         grads: dict[str, np.ndarray] = {}
         # The result's arrays (the columns are `paths`, in order), not its tables.

@@ -288,8 +288,8 @@ def sweep(
     gradients:
         Continuous spec paths (as `paritysim.sensitivity` takes them): every converged row
         gains ``d(<metric>)/d(<path>)`` columns, the derivatives `paritysim.sensitivity` gives
-        at that point (null where the metric is not differentiable there, or the point did not
-        converge; ``gradient_error`` says why a converged point has none). They are taken at
+        at that point (null where the metric, or the orbit in the path, is not differentiable
+        there, or the point did not converge; ``gradient_error`` says why a converged point has none). They are taken at
         the orbits a sweep finds (chained from neighbours, as the rows' metrics), so they agree
         with `paritysim.sensitivity`'s, taken at the orbit of a run from rest, to their own
         accuracy (at rtol 1e-8 within about 1e-5 relative; both are that close to rtol-1e-11

@@ -372,6 +372,9 @@ pub struct SensitivityRecord {
     pub unit: Vec<String>,
     /// Their values in the spec.
     pub parameter_value: Vec<f64>,
+    /// Per parameter: why the orbit is not differentiable in it here (empty: it is; its
+    /// `jacobian` and `state_jacobian` columns are then NaN).
+    pub parameter_not_differentiable: Vec<String>,
     /// `∂metric/∂parameter`: one column (over the metrics) per parameter.
     pub jacobian: Vec<Vec<f64>>,
     /// `dx*/dp`: the orbit's start state (coordinates, then rates), one column per parameter.
@@ -406,6 +409,11 @@ impl Sensitivity {
             parameter: self.parameters.iter().map(|p| p.name.clone()).collect(),
             unit: self.units.clone(),
             parameter_value: self.values.clone(),
+            parameter_not_differentiable: r
+                .parameter_not_differentiable
+                .iter()
+                .map(|f| f.clone().unwrap_or_default())
+                .collect(),
             jacobian: columns(&r.jacobian),
             state_jacobian: columns(&r.state_jacobian),
             multipliers: r.multipliers.iter().map(|z| [z.re, z.im]).collect(),

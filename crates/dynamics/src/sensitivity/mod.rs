@@ -15,7 +15,10 @@
 //! windows. Directions with a
 //! multiplier at 1 (a neutral family, K2 = 0's whippletree) are left out of `(∂P/∂x − I)⁺`,
 //! not divided by; a metric that changes along them, or whose one-sided differences disagree
-//! (a peak jumping between two maxima), is flagged as not differentiable there.
+//! (a peak jumping between two maxima), is flagged as not differentiable there. A parameter
+//! whose `∂P/∂p` has a part `(∂P/∂x − I)` cannot reach (the solvability residual `uᵀ ∂P/∂p`,
+//! `u` a left null vector) breaks the family: no orbit through `x*` follows it, and its
+//! column is NaN with the reason.
 
 use std::borrow::Cow;
 
@@ -48,7 +51,26 @@ pub const NEUTRAL_CHANGE_TOLERANCE: f64 = 1e-6;
 /// was flagged at 1e-9).
 const REPLAY_ACCURACY: f64 = 5e-9;
 
-/// Relative finite-difference step of the parameters (absolute below a size of 1e-3).
+/// A parameter whose `∂P/∂p` has more than this fraction outside the range of `∂P/∂x − I`
+/// breaks a neutral family. Measured (docs/findings.md §30): parameters that keep the family
+/// (frequency, amplitude, Ω1) leave up to 9e-6 at the default tolerances (7e-7 at rtol
+/// 1e-10); the balance spring at K2 = 0 of the §3.3 1-Cut, 2-Cut and §3.4 K2 = 0 PARITY and
+/// 1-Cut leaves 1.7e-2, 5.7e-2, 0.63 and 0.47.
+pub const FAMILY_BREAK_TOLERANCE: f64 = 1e-3;
+
+/// ... unless the part along the family changes the period map by less than this (relative to
+/// `1 + ‖x*‖∞`) over a change of the parameter by its size (`|p|`, or 1e-3 near 0): round-off.
+/// Measured: the balance spring on identical wings acts on a coordinate symmetry holds at 0,
+/// so its `∂P/∂p` is round-off (3e-28) of any direction: 1.4e-31 there, about 6e-11 on the
+/// §3.3 1-Cut.
+pub const FAMILY_BREAK_FLOOR: f64 = 1e-15;
+
+/// A parameter's size for its step and the family check: `|p|`, or 1e-3 near 0 (K2 = 0).
+fn parameter_size(p: f64) -> f64 {
+    p.abs().max(1e-3)
+}
+
+/// Relative finite-difference step of the parameters (of their [`parameter_size`]).
 pub const PARAMETER_STEP: f64 = 1e-5;
 
 /// What [`steady_sensitivity`] computes.
@@ -64,6 +86,10 @@ pub struct SteadySensitivity {
     pub multipliers: Vec<nalgebra::Complex<f64>>,
     /// How many directions were neutral (a multiplier at 1) and left out.
     pub neutral_directions: usize,
+    /// Per parameter: why the orbit is not differentiable in it here (`None`: it is), e.g. a
+    /// parameter that breaks a neutral family ([`FAMILY_BREAK_TOLERANCE`]); its columns of
+    /// `jacobian` and `state_jacobian` are NaN.
+    pub parameter_not_differentiable: Vec<Option<String>>,
     /// Per metric: why its derivative is not to be trusted (`None`: differentiable).
     pub not_differentiable: Vec<Option<String>>,
     /// The period-map residual `‖P(x*) − x*‖∞ / (1 + ‖x*‖∞)` on the fixed grid.
@@ -151,7 +177,7 @@ fn finite_difference_steps(p0: &[f64], steps: Option<&[f64]>) -> Result<Vec<f64>
         Some(s) => s.to_vec(),
         None => p0
             .iter()
-            .map(|p| PARAMETER_STEP * p.abs().max(1e-3))
+            .map(|p| PARAMETER_STEP * parameter_size(*p))
             .collect(),
     };
     if steps.len() != p0.len() {
@@ -282,6 +308,7 @@ pub fn steady_sensitivity_at(
             .collect();
     }
     let n_params = p0.len();
+    let state_size = 1.0 + x_star.compact(n).amax();
     let base_map = mapped.without_work().compact(n);
     // Per parameter: its two perturbed points, central (p0 ± h) or, where p0 − h is outside
     // the parameter's range (K2 = 0), one-sided (p0 + h, p0 + 2h: the second-order formula).
@@ -349,14 +376,27 @@ pub fn steady_sensitivity_at(
             .map(|(k, ((_, _, central), j))| {
                 let (near, far) = (&maps[2 * k].end, &maps[2 * k + 1].end);
                 let dp = difference(*central, steps[j], &base_map, near, far);
-                least_squares.step(&dp).ok_or_else(non_finite)
+                let unreachable = least_squares.unreachable(&dp);
+                let fraction = unreachable / dp.norm();
+                // A change of the map below `FAMILY_BREAK_FLOOR` over the parameter's size is
+                // round-off (a spring on a coordinate that symmetry holds at zero).
+                let felt = unreachable * parameter_size(p0[j]) > FAMILY_BREAK_FLOOR * state_size;
+                let broken = (felt && fraction > FAMILY_BREAK_TOLERANCE).then(|| {
+                    format!(
+                        "breaks a family of orbits (a multiplier at 1): {fraction:.1e} of the \
+                         period map's change with it is along the family, which no nearby \
+                         orbit absorbs, so the steady state moves to another member (a jump) \
+                         as it changes"
+                    )
+                });
+                Ok((least_squares.step(&dp).ok_or_else(non_finite)?, broken))
             })
             .collect::<Result<Vec<_>>>()?;
         let shifts: Vec<DVector<f64>> = pairs
             .iter()
             .zip(group)
             .zip(&dxs)
-            .flat_map(|(((_, _, central), j), dx)| {
+            .flat_map(|(((_, _, central), j), (dx, _))| {
                 let offsets = if *central { [-1.0, 1.0] } else { [1.0, 2.0] };
                 offsets.map(|o| dx * (o * steps[j]))
             })
@@ -387,13 +427,14 @@ pub fn steady_sensitivity_at(
         Ok(pairs
             .iter()
             .zip(dxs)
-            .map(|((_, _, central), dx)| {
+            .map(|((_, _, central), (dx, broken))| {
                 let (near, far) = (windows.next(), windows.next());
                 (
                     dx,
                     near.unwrap_or_default(),
                     far.unwrap_or_default(),
                     *central,
+                    broken,
                 )
             })
             .collect::<Vec<_>>())
@@ -420,12 +461,20 @@ pub fn steady_sensitivity_at(
         .iter()
         .map(|(_, m)| (!m.is_finite()).then(|| "not defined at this point (NaN)".to_string()))
         .collect();
-    for (j, (dx, m_near, m_far, central)) in columns.iter().enumerate() {
-        state_jacobian.set_column(j, dx);
+    let mut parameter_not_differentiable = vec![None; n_params];
+    for (j, (dx, m_near, m_far, central, broken)) in columns.into_iter().enumerate() {
+        if broken.is_some() {
+            // No derivative to give: NaN with the reason, never a number that looks right.
+            state_jacobian.set_column(j, &DVector::from_element(2 * n, f64::NAN));
+            jacobian.set_column(j, &DVector::from_element(n_metrics, f64::NAN));
+            parameter_not_differentiable[j] = broken;
+            continue;
+        }
+        state_jacobian.set_column(j, &dx);
         let h = steps[j];
         for (i, (name, m0)) in base_metrics.iter().enumerate() {
-            let (near, far) = (value_of(m_near, name), value_of(m_far, name));
-            if !*central {
+            let (near, far) = (value_of(&m_near, name), value_of(&m_far, name));
+            if !central {
                 jacobian[(i, j)] = (-3.0 * m0 + 4.0 * near - far) / (2.0 * h);
                 continue;
             }
@@ -482,6 +531,7 @@ pub fn steady_sensitivity_at(
         state_jacobian,
         multipliers,
         neutral_directions: neutral.len(),
+        parameter_not_differentiable,
         not_differentiable,
         residual,
     })

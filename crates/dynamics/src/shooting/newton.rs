@@ -82,6 +82,21 @@ impl LeastSquares {
         self.svd.solve(&(-f), self.cutoff).ok()
     }
 
+    /// The part of `f` no step reaches: the norm of its components along the left singular
+    /// vectors of the neutral directions (the solvability residuals `uᵀ f`); 0 without
+    /// neutral directions.
+    pub(crate) fn unreachable(&self, f: &DVector<f64>) -> f64 {
+        let values = &self.svd.singular_values;
+        let Some(u) = &self.svd.u else {
+            return 0.0;
+        };
+        (0..values.len())
+            .filter(|&i| values[i] <= self.cutoff)
+            .map(|i| u.column(i).dot(f).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    }
+
     /// The neutral directions: right singular vectors of singular values at or below the
     /// cutoff.
     pub(crate) fn neutral_directions(&self) -> Vec<DVector<f64>> {

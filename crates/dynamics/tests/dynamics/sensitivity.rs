@@ -119,6 +119,43 @@ fn a_neutral_family_is_left_out_and_the_metrics_moving_along_it_are_flagged() {
 }
 
 #[test]
+fn a_parameter_that_breaks_the_family_has_no_derivative_where_the_wings_differ() {
+    // On identical wings symmetry keeps the orbit's member (no offset) as K2 leaves 0: every
+    // parameter is differentiable. On wings that differ the run from rest ends on a member
+    // with an offset, and K2 > 0 pulls the orbit to another one: no derivative in K2 (a NaN
+    // column with the reason), while Ω^L, the amplitude and the frequency keep the family.
+    let symmetric = [31.3, 0.0, 50.0, 110.0];
+    let s = steady_sensitivity(
+        &design,
+        &design(&symmetric).unwrap(),
+        &symmetric,
+        None,
+        &tight(),
+    )
+    .unwrap();
+    assert!(
+        s.parameter_not_differentiable.iter().all(Option::is_none),
+        "{:?}",
+        s.parameter_not_differentiable
+    );
+    let cut = [25.0, 0.0, 50.0, 110.0];
+    let s = steady_sensitivity(&design, &design(&cut).unwrap(), &cut, None, &tight()).unwrap();
+    assert_eq!(s.neutral_directions, 1);
+    for (j, reason) in s.parameter_not_differentiable.iter().enumerate() {
+        assert_eq!(reason.is_some(), j == 1, "parameter {j}: {reason:?}");
+        let column_defined = s.state_jacobian.column(j).iter().all(|v| v.is_finite());
+        assert_eq!(column_defined, j != 1, "parameter {j}");
+    }
+    assert!(s.jacobian.column(1).iter().all(|v| v.is_nan()));
+    assert!(
+        s.parameter_not_differentiable[1]
+            .as_ref()
+            .unwrap()
+            .contains("family")
+    );
+}
+
+#[test]
 fn bad_steps_are_named() {
     let e = steady_sensitivity(
         &design,
