@@ -70,7 +70,7 @@ fn parameter_size(p: f64) -> f64 {
     p.abs().max(1e-3)
 }
 
-/// Relative finite-difference step of the parameters (of their [`parameter_size`]).
+/// Relative finite-difference step of the parameters (of `|p|`, or of 1e-3 near 0).
 pub const PARAMETER_STEP: f64 = 1e-5;
 
 /// What [`steady_sensitivity`] computes.
