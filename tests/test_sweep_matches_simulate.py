@@ -83,6 +83,21 @@ def test_every_shipped_device_rows_equal_simulate(name: str) -> None:
     _assert_rows_equal_simulate(spec, df, [AMPLITUDE], metric_names)
 
 
+@pytest.mark.parametrize("name", ["sreetharan2012_3_4_parity", "sreetharan2012_3_4_parity_1cut", "sreetharan2012_3_4_parity_2cut"])
+def test_a_family_point_after_a_stiff_neighbour_equals_simulate(name: str) -> None:
+    """K2 = 0 (a family) or nearly (1e-3, 1e-9) right after a stiffer K2: the neighbour's
+    Jacobian put the slow multiplier at 0.974 where it is 1, so the chain's Newton stayed on
+    (or ran along the family to) another member and the row said `ok` (stroke offset 0.0001
+    against simulate's 0.0217 rad; up to 10 rad in a study). The variational equations at a
+    soft point's orbit now decide, and a family point runs from the spec's own start."""
+    spec = ps.devices.load(name)
+    k2 = "drivetrain.balance_spring"
+    rows = pl.DataFrame({k2: [10.0, 0.0, 2.0, 1e-3, 0.5, 0.0, 30.0, 1e-9], "wings.left.omega_ratio": [1.0, 1.0, 0.8, 0.8, 1.0, 1.0, 1.0, 1.0]})
+    metrics = ["left_stroke_mean", "right_stroke_mean", "yaw_total_mean", "left_rotation_amplitude"]
+    df = ps.sweep(spec, rows, metrics=metrics, threads=1, progress=False)
+    _assert_rows_equal_simulate(spec, df, [k2, "wings.left.omega_ratio"], metrics)
+
+
 def test_unconverged_rows_are_not_ok() -> None:
     """A point stopped by `max_cycles` before its steady state is `unconverged`, with the reason,
     and the sweep warns with their number."""

@@ -27,6 +27,7 @@ mod free_deviation;
 pub(crate) mod linear_map;
 mod null_space;
 mod ode_system;
+mod soft_direction;
 mod stroke_plane;
 mod switches;
 mod transmission;

@@ -123,6 +123,11 @@ impl<'a> LanePoint<'a> {
             )
         } else {
             let (p0, pd0) = options.initial?;
+            if device.has_soft_direction() {
+                // The scalar path checks a soft point's multipliers at its orbit
+                // (simulate/shooting.rs): one rule, so the lanes leave such points to it.
+                return None;
+            }
             let jac = options.shooting_jacobian.clone()?;
             let grid = options.shooting_grid.clone()?;
             if jac.shape() != (4, 4) || grid.first() != Some(&0.0) || grid.last() != Some(&period) {

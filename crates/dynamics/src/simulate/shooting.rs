@@ -258,6 +258,18 @@ pub(crate) fn shooting_steady_state(
         // orbit, on the stepping stone's coarser grid (a third of the second grid's steps).
         exact_jacobian_at_orbit(device, &first_rk, &first.grid, &mut orbit)?;
     }
+    if options.shooting_jacobian.is_some()
+        && !orbit.jacobian_at_orbit
+        && device.has_soft_direction()
+    {
+        // A neighbour's Jacobian says nothing reliable about a soft direction's multiplier
+        // (§3.4 1-Cut at K2 = 0 after K2 = 10: 0.974 where it is 1, and chained Newton moved
+        // the stroke offset up to 10 rad along the family): the variational equations at the
+        // orbit decide whether it is one of a family, which the sweep then runs from the
+        // spec's own start (sweep/chain.rs).
+        let grid = orbit.grid.clone();
+        exact_jacobian_at_orbit(device, transient, &grid, &mut orbit)?;
+    }
     let mut multipliers = crate::floquet::eigenvalues(&orbit.jacobian).unwrap_or_default();
     let largest = multipliers.first().map_or(0.0, |m| m.norm());
     if !orbit.jacobian_at_orbit

@@ -159,8 +159,15 @@ fn lane_widths_and_thread_counts_give_bit_identical_sweeps() {
         let before = points_completed_in_lanes();
         let other = run(&points, threads, lanes);
         if lanes > 1 {
-            // Every point, chain starts included, ran in the lanes (none fell back).
-            assert!(points_completed_in_lanes() - before >= points.len());
+            // Every point, chain starts included, ran in the lanes, but for continued points
+            // with a soft direction (small K2), whose multipliers the scalar path checks at
+            // the orbit.
+            let soft = points
+                .iter()
+                .filter(|p| p.as_ref().unwrap().0.has_soft_direction())
+                .count();
+            assert!(soft < points.len() / 2, "{soft} soft points");
+            assert!(points_completed_in_lanes() - before >= points.len() - soft);
         }
         for (i, (a, b)) in scalar.iter().zip(&other).enumerate() {
             let (a, b) = (a.as_ref().unwrap(), b.as_ref().unwrap());
