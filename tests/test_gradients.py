@@ -124,6 +124,32 @@ def test_a_parameter_that_breaks_the_family_has_no_derivative_there():
     assert symmetric.parameter_reasons == (None, None)
 
 
+def test_a_parameter_at_zero_is_stepped_on_the_scale_of_its_units():
+    """A drive offset at 0 V was stepped by 1e-8 V (a size floor of 1e-3): the map's change sat
+    at round-off, which the slow balance-beam multiplier (1 - 1.6e-3 at K2 = 1) amplified.
+    The stroke means are exactly linear in the offset (a DC force on a linear map), so wide
+    central differences of whole runs are exact; ours was 5.9e-5 off, 64 % at K2 = 1e-3."""
+    spec = ps.devices.load("sreetharan2012_3_3_parity_1cut").with_paths({"drivetrain.balance_spring": 1.0})
+    metrics = ["left_stroke_mean", "right_stroke_mean"]
+    s = ps.sensitivity(spec, ["actuator.waveform.offset_v"], metrics=metrics, progress=False, **TIGHT)
+    assert s.reasons == (None, None) and s.parameter_reasons == (None,)
+    plus, minus = _metrics(spec, {"actuator.waveform.offset_v": 1.0}), _metrics(spec, {"actuator.waveform.offset_v": -1.0})
+    for k, m in enumerate(metrics):
+        reference = (plus[m] - minus[m]) / 2.0
+        assert abs(s.matrix[k, 0] - reference) <= 1e-5 * abs(reference), (m, s.matrix[k, 0], reference)
+
+
+def test_a_metric_along_a_nearly_neutral_direction_is_flagged():
+    """At K2 = 1e-3 the balance-beam multiplier is 1 - 1.6e-6 (a sweep treats the point as a
+    family): the stroke means' derivatives divide the map's error by that, and are flagged;
+    the stroke amplitude, which does not move along the beam, keeps its derivative."""
+    spec = ps.devices.load("sreetharan2012_3_3_parity_1cut").with_paths({"drivetrain.balance_spring": 1e-3})
+    s = ps.sensitivity(spec, ["actuator.waveform.offset_v"], metrics=["left_stroke_mean", "left_stroke_amplitude"], progress=False)
+    assert s.neutral_directions == 0 and 0 < 1 - abs(s.multipliers[0]) < 1e-3
+    assert s.reasons[0] is not None and "nearly neutral" in s.reasons[0]
+    assert s.reasons[1] is None
+
+
 def test_metrics_without_work_replay_the_window_and_agree_with_the_integrated_windows():
     """Metrics that read no work integral take the base window from the variational period and
     the neutral-direction check from its Φ (no window integrated again); all metrics integrate

@@ -59,18 +59,22 @@ const REPLAY_ACCURACY: f64 = 5e-9;
 pub const FAMILY_BREAK_TOLERANCE: f64 = 1e-3;
 
 /// ... unless the part along the family changes the period map by less than this (relative to
-/// `1 + ‖x*‖∞`) over a change of the parameter by its size (`|p|`, or 1e-3 near 0): round-off.
+/// `1 + ‖x*‖∞`) over a change of the parameter by its size (`|p|`, or 1 near 0): round-off.
 /// Measured: the balance spring on identical wings acts on a coordinate symmetry holds at 0,
-/// so its `∂P/∂p` is round-off (3e-28) of any direction: 1.4e-31 there, about 6e-11 on the
-/// §3.3 1-Cut.
+/// so its `∂P/∂p` is round-off (3e-28) of any direction: about 1e-28 there, 6e-8 on the §3.3
+/// 1-Cut.
 pub const FAMILY_BREAK_FLOOR: f64 = 1e-15;
 
-/// A parameter's size for its step and the family check: `|p|`, or 1e-3 near 0 (K2 = 0).
+/// A parameter's size for its step and the family check: `|p|`, or 1 near 0. In
+/// mg-mm-ms-rad-V the parameters a designer moves are O(1) and up (a K2 of 1e-3 mN·mm/rad is
+/// a whisper); with a floor of 1e-3, a parameter at 0 stepped by 1e-8 and its map's change
+/// sat at round-off, which a slow multiplier amplified: d(stroke mean)/d(offset_v) at
+/// K2 = 1e-3 on the §3.3 1-Cut was 64 % off without a flag (docs/findings.md §30).
 fn parameter_size(p: f64) -> f64 {
-    p.abs().max(1e-3)
+    p.abs().max(1.0)
 }
 
-/// Relative finite-difference step of the parameters (of `|p|`, or of 1e-3 near 0).
+/// Relative finite-difference step of the parameters (of `|p|`, or of 1 near 0).
 pub const PARAMETER_STEP: f64 = 1e-5;
 
 /// What [`steady_sensitivity`] computes.
@@ -492,12 +496,21 @@ pub fn steady_sensitivity_at(
             }
         }
     }
-    // A metric that moves along a neutral direction depends on the member of the family.
+    // A metric that moves along a neutral direction depends on the member of the family; one
+    // that moves along a nearly neutral one (a multiplier within the sweeps' family tolerance
+    // of 1) has a derivative that divides the period map's error by a small singular value
+    // (the §3.3 1-Cut at K2 = 1e-3: d(stroke mean)/d(offset) 4.7e-4 off, docs/findings.md §30).
+    let slow = least_squares.slow_directions(crate::sweep::NEUTRAL_MULTIPLIER_TOL);
+    let directions: Vec<(Option<f64>, &DVector<f64>)> = neutral
+        .iter()
+        .map(|v| (None, v))
+        .chain(slow.iter().map(|(sigma, v)| (Some(*sigma), v)))
+        .collect();
     let base_states = replay
         .as_ref()
-        .filter(|_| !neutral.is_empty())
+        .filter(|_| !directions.is_empty())
         .map(Replay::base_states);
-    for v in &neutral {
+    for (sigma, v) in directions {
         let eps = 1e-6;
         let along = |sign: f64| -> Result<Vec<(String, f64)>> {
             let shift = v * (sign * eps);
@@ -517,11 +530,19 @@ pub fn steady_sensitivity_at(
             if not_differentiable[i].is_none()
                 && slope.abs() > NEUTRAL_CHANGE_TOLERANCE.max(1e-4 * m0.abs())
             {
-                not_differentiable[i] = Some(format!(
-                    "changes along a neutral direction of the orbit (slope {slope:e}): a \
-                     family of orbits (a multiplier at 1), so the derivative depends on the \
-                     member"
-                ));
+                not_differentiable[i] = Some(match sigma {
+                    None => format!(
+                        "changes along a neutral direction of the orbit (slope {slope:e}): a \
+                         family of orbits (a multiplier at 1), so the derivative depends on the \
+                         member"
+                    ),
+                    Some(sigma) => format!(
+                        "changes along a nearly neutral direction of the orbit (slope \
+                         {slope:e}; a multiplier within {tol:e} of 1, which a sweep treats as a \
+                         family): its derivative divides the period map's error by {sigma:.1e}",
+                        tol = crate::sweep::NEUTRAL_MULTIPLIER_TOL
+                    ),
+                });
             }
         }
     }

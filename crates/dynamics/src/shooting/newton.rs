@@ -97,6 +97,20 @@ impl LeastSquares {
             .sqrt()
     }
 
+    /// The nearly neutral directions: right singular vectors whose singular values lie above
+    /// the cutoff and at or below `limit` times the largest, with those values (relative).
+    pub(crate) fn slow_directions(&self, limit: f64) -> Vec<(f64, DVector<f64>)> {
+        let values = &self.svd.singular_values;
+        let largest = values.max().max(f64::MIN_POSITIVE);
+        match &self.svd.v_t {
+            Some(v_t) => (0..values.len())
+                .filter(|&i| values[i] > self.cutoff && values[i] <= limit * largest)
+                .map(|i| (values[i] / largest, v_t.row(i).transpose()))
+                .collect(),
+            None => Vec::new(),
+        }
+    }
+
     /// The neutral directions: right singular vectors of singular values at or below the
     /// cutoff.
     pub(crate) fn neutral_directions(&self) -> Vec<DVector<f64>> {
