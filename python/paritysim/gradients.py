@@ -216,7 +216,7 @@ def sensitivity(
     as it moves the steady state jumps to the member the parameter selects, so its column is
     NaN and ``parameter_reasons`` / the ``parameters`` table say why (the numbers a
     first-order method gives there were up to 55 % off whole runs; docs/findings.md §30).
-    Near such a point (a multiplier within 1e-3 of 1, K2 below about 0.5 on the §3.3 1-Cut)
+    Near such a point (a multiplier within 1e-3 of 1, K2 below about 0.6 on the §3.3 1-Cut)
     the orbit is nearly a family: a metric that moves along the slow direction is flagged (its
     derivative divides the period map's error by the small distance to 1); the others keep
     theirs. Differentiate the balance spring well off 0 (K2 = 1 agrees with whole runs to
