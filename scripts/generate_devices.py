@@ -54,7 +54,7 @@ ROBOBEE_STATED = [
     "Linear transmission 2.67 rad/mm, a wing of 54 mm² and 0.55 mg, drive 120-200 V at 60-180 Hz (the one-wing RoboBee-class bench sweep described in issue 35; its data carry no licence and are not shipped): drivetrain.transmission_ratio, the outline's area and the wing mass",
 ]
 ROBOBEE_CHOICES = [
-    "Wing outline: Planform.hmf_like() scaled to a 15 mm span (half the 3 cm wingspan of Ma et al. 2013, the shoulder offset neglected: representative) and 54 mm²; its inertia tensor and Ω1..Ω4 from Wing.from_planform",
+    "Wing outline: Planform.hmf_like() scaled to a 15 mm span (half the 3 cm wingspan of Ma et al. 2013, the shoulder offset neglected: representative) and 54 mm²; its inertia tensor, Ω1..Ω4 and the force parameter ½ρ∬z²dA from Wing.from_planform",
     "Wing mass split 0.45 mg membrane + 0.10 mg leading-edge spar (the 0.55 mg total is stated; the split is a representative estimate)",
     "Actuator 150 mN blocked force and 0.5 mm free deflection at 200 V (Actuator.from_blocked_force: 0.75 mN/V, 300 mN/mm): a representative estimate for a RoboBee-class bimorph, no published datasheet value found",
     "Actuator massless and lossless (actuator.mass_mg = damping = 0, the thesis' §3.2.2 assumption): free flight refuses an actuator mass",

@@ -59,6 +59,28 @@ def test_rectangle_inertia_and_omegas_are_the_closed_forms(root: float, le: floa
     for k, v in expected.items():
         assert got[k] == pytest.approx(v, rel=1e-12, abs=1e-15), k
     assert wing.aero.kind == "blade_element" and wing.aero.model == ps.aero.MODELS[0]
+    # The lift/drag force parameter ½ρ∬z²dA = ½ρ c (r1³ - r0³)/3: the outline's own, not the
+    # body-wide estimate Ω1 / force_radius (Ω1 / 12 mm would be 3 r1/(4·12) of it at r0 = 0).
+    assert wing.aero.force_parameter == pytest.approx(H * chord * (r1**3 - r0**3) / 3, rel=1e-12)
+
+
+def test_the_lift_takes_the_wings_own_force_parameter() -> None:
+    """The RoboBee wing's outline (Planform.hmf_like() at 15 mm and 54 mm²) has ½ρ∬z²dA =
+    5.52 mg·mm where Ω1 / 12 mm is 6.76 (its ∬z³/∬z² is 14.7 mm): lift was 22 % high. The force
+    parameter scales the forces only (the moments are Ω1..Ω4), so the motion is unchanged and
+    the lift scales by exactly the parameters' ratio."""
+    spec = ps.devices.load("robobee_dual_linear")
+    outline = ps.Planform.hmf_like().scaled(span_mm=15.0, area_mm2=54.0)
+    assert spec.wings[0].aero.force_parameter == pytest.approx(outline.omegas()["force"], rel=1e-12)
+    d = spec.to_dict()
+    for wing in d["wings"]:
+        del wing["aero"]["force_parameter"]
+    estimate = ps.Simulation.from_dict(d)
+    ours, before = (ps.simulate(s, columns=[], progress=False).metrics for s in (spec, estimate))
+    assert ours["left_stroke_amplitude"] == before["left_stroke_amplitude"]
+    ratio = spec.wings[0].aero.force_parameter / (spec.wings[0].aero.omega1 / 12.0)
+    assert ratio == pytest.approx(0.8167, abs=1e-4)
+    assert ours["lift_mean"] == pytest.approx(ratio * before["lift_mean"], rel=1e-12)
 
 
 def test_triangle_inertia_and_omegas_are_the_closed_forms() -> None:

@@ -422,7 +422,10 @@ class Wing(_Node):
                 names = ("omega1", "omega2", "omega3", "omega4")
             if kind == "whitney_wood2010":
                 names += ("omega5", "omega6", "omega7", "omega8")
-            aero = base.replace(**{k: omegas[k] for k in names})
+            exact = {k: omegas[k] for k in names}
+            if kind in ("blade_element", "whitney_wood2010"):
+                exact["force_parameter"] = omegas["force"]  # ½ρ∬z²dA of this outline, not Ω1 / 12 mm
+            aero = base.replace(**exact)
 
         if hinge is not None:
             if isinstance(hinge, TunableHinge):

@@ -164,17 +164,19 @@ impl Simulation {
     }
 }
 
-/// The §3.2.4 blade element of a spec aero (`omegas` Ω1..Ω4) with the force parameter
-/// `Ω1 / force_radius`.
+/// The §3.2.4 blade element of a spec aero (`omegas` Ω1..Ω4) with its force parameter, or
+/// `Ω1 / force_radius` without one.
 fn blade_element(
     omegas: [f64; 4],
+    force_parameter: Option<f64>,
     model: CoefficientModel,
     rotational_damping: Option<f64>,
     normal_force_law: NormalForceLaw,
     force_radius: f64,
 ) -> Result<BladeElementModel<CoefficientSet>> {
     let [o1, o2, o3, o4] = omegas;
-    let omegas = Omegas::new(o1, o2, o3, o4).and_then(|o| o.with_force(o1 / force_radius))?;
+    let force = force_parameter.unwrap_or(o1 / force_radius);
+    let omegas = Omegas::new(o1, o2, o3, o4).and_then(|o| o.with_force(force))?;
     let coefficients = CoefficientSet::from_name(match model {
         CoefficientModel::Dickinson1999 => "dickinson1999",
         CoefficientModel::WhitneyWood2010 => "whitney_wood2010",
@@ -189,8 +191,9 @@ fn blade_element(
         .with_normal_force_law(law))
 }
 
-/// The engine wing of a spec wing; a blade element gets the force parameter
-/// `Ω1 / force_radius` (mg·mm), so its lift and drag forces are defined on every body mode.
+/// The engine wing of a spec wing; a blade element gets its force parameter, or
+/// `Ω1 / force_radius` (mg·mm) without one, so its lift and drag forces are defined on every
+/// body mode.
 fn wing(w: &Wing, force_radius: f64) -> Result<EngineWing> {
     let shoulder = SphericalShoulder::new(w.shoulder.alpha2, w.shoulder.alpha3)
         .map_err(|e| e.in_field("shoulder"))?;
@@ -208,6 +211,7 @@ fn wing(w: &Wing, force_radius: f64) -> Result<EngineWing> {
         Some(Aero::BladeElement(a)) => WingAero::BladeElement(
             blade_element(
                 [a.omega1, a.omega2, a.omega3, a.omega4],
+                a.force_parameter,
                 a.model,
                 a.rotational_damping,
                 a.normal_force_law,
@@ -218,6 +222,7 @@ fn wing(w: &Wing, force_radius: f64) -> Result<EngineWing> {
         Some(Aero::WhitneyWood2010(a)) => {
             let blade = blade_element(
                 [a.omega1, a.omega2, a.omega3, a.omega4],
+                a.force_parameter,
                 a.model,
                 a.rotational_damping,
                 a.normal_force_law,

@@ -149,6 +149,13 @@ pub struct BladeElement {
     /// Ω4 (mg·mm²), in [-1e6, 1e6].
     #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
     pub omega4: f64,
+    /// The force parameter `½ρ∬z²dA` of the lift and drag forces (mg·mm), in [0, 1e5];
+    /// absent: `Ω1 / body.force_radius_mm` (a body-wide estimate, 12 mm by default).
+    /// `Wing.from_planform` gives the outline's own (22 % below the estimate on the RoboBee
+    /// wing, docs/findings.md §32).
+    #[schemars(range(min = 0.0, max = 1e5), extend("x-unit" = "mg mm"))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub force_parameter: Option<f64>,
     /// Coefficient model.
     pub model: CoefficientModel,
     /// Rotational damping coefficient (dimensionless), in [0, 100]; absent: the aero crate's
@@ -167,6 +174,7 @@ impl Default for BladeElement {
             omega2: 0.0,
             omega3: 0.0,
             omega4: 0.0,
+            force_parameter: None,
             model: CoefficientModel::default(),
             rotational_damping: None,
             normal_force_law: NormalForceLaw::default(),
@@ -194,6 +202,13 @@ pub struct WhitneyWood2010 {
     /// Ω4 (mg·mm²), in [-1e6, 1e6].
     #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
     pub omega4: f64,
+    /// The force parameter `½ρ∬z²dA` of the lift and drag forces (mg·mm), in [0, 1e5];
+    /// absent: `Ω1 / body.force_radius_mm` (a body-wide estimate, 12 mm by default).
+    /// `Wing.from_planform` gives the outline's own (22 % below the estimate on the RoboBee
+    /// wing, docs/findings.md §32).
+    #[schemars(range(min = 0.0, max = 1e5), extend("x-unit" = "mg mm"))]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub force_parameter: Option<f64>,
     /// Ω5 = ½ρ∫ z c² x_m dz, `x_m = l − c/2` the mid-chord (mg·mm²), in [-1e6, 1e6], with
     /// `|Ω5| <= √(Ω3 Ω6)`: the added inertia's stroke-pitch product.
     #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
@@ -238,6 +253,7 @@ impl Default for WhitneyWood2010 {
             omega2: 0.0,
             omega3: 0.0,
             omega4: 0.0,
+            force_parameter: None,
             omega5: 0.0,
             omega6: 0.0,
             omega7: 0.0,
