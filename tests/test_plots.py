@@ -124,6 +124,13 @@ def test_columns_are_grouped_by_the_cores_units() -> None:
     fig = result.plot(columns=["left_phi_ddot", "q1_dot", "q2", "actuator_power"])
     assert [ax.get_ylabel() for ax in fig.axes] == ["rad/ms²", "mm/ms", "deg", "mW"]
     np.testing.assert_allclose(fig.axes[0].lines[0].get_ydata(), result.trajectory["left_phi_ddot"].to_numpy())  # not in degrees
+    # A dual drivetrain's q2 is the right actuator's displacement (right_phi = -T q2), in mm.
+    dual = ps.devices.load("robobee_dual_linear")
+    run = ps.simulate(dual, progress=False)
+    assert (run.units["q2"], run.units["q2_dot"]) == ("mm", "mm/ms")
+    ratio = dual.drivetrain.transmission_ratio
+    np.testing.assert_allclose(run.trajectory["right_phi"].to_numpy(), -ratio * run.trajectory["q2"].to_numpy(), rtol=1e-12, atol=1e-14)
+    assert run.plot(columns=["q2"]).axes[0].get_ylabel() == "mm"
     flying = ps.simulate(ps.flight.with_body(hmf, mode="roll"), record_cycles=2, progress=False)
     fig = flying.plot(columns=["body_roll", "body_omega_roll", "body_torque_roll"])
     assert [ax.get_ylabel() for ax in fig.axes] == ["deg", "rad/ms", "mN·mm"]

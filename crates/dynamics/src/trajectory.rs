@@ -110,7 +110,7 @@ pub struct StrokeSample {
     pub roll_aero: [f64; 2],
     /// Actuator force (mN; with [`StrokeNeeds::force`] or [`StrokeNeeds::torques`]).
     pub actuator_force: f64,
-    /// Whippletree angle `q2` (rad).
+    /// Whippletree angle `q2` (rad; on a dual drivetrain the right actuator's displacement, mm).
     pub q2: f64,
     /// Body reaction torque (aerodynamic + inertial, roll/yaw/pitch, left mirrored) per wing,
     /// as [`Sample::wing_torque`] (with [`StrokeNeeds::torques`]).
@@ -341,6 +341,13 @@ pub fn column_table(device: &Device) -> Vec<Column> {
         }
     }
     for (name, unit, g) in PER_DEVICE {
+        // A dual drivetrain's second coordinate is the right actuator's displacement, not a
+        // whippletree angle (`right_phi = −T q2`).
+        let unit = match (device.is_dual(), name) {
+            (true, "q2") => "mm",
+            (true, "q2_dot") => "mm/ms",
+            _ => unit,
+        };
         out.push(Column {
             name: name.to_string(),
             unit,
