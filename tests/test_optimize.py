@@ -215,3 +215,37 @@ def test_spec_options_named_like_optimize_arguments_go_in_options(drag_parity):
     # "got multiple values for keyword argument 'method'" (the optimiser's own).
     r = ps.optimize(drag_parity, "actuator_power_mean", {V: (20.0, 150.0)}, ["left_stroke_amplitude >= 0.6"], options={"method": "dopri5"}, max_iterations=2, progress=False)
     assert r.evaluations >= 1 and r.spec.options.method == drag_parity.options.method  # the runs', not the returned spec's
+
+
+def test_a_slow_real_mode_counts_against_the_stability_bound():
+    """Every multiplier within 1e-3 of 1 was left out of the bound as "neutral": at K2 = 0.05
+    on the §3.4 1-Cut the orbit decays at |μ| = 0.99987 a cycle (an isolated orbit, no
+    family), yet the bound read 0.0497 and an optimiser started near K2 = 0 stopped there.
+    Only a family's multipliers (the core's neutral_directions) are left out now."""
+    spec = ps.devices.load("sreetharan2012_3_4_parity_1cut")
+    for k2, family in ((0.05, False), (0.0, True)):
+        point = spec.with_paths({"drivetrain.balance_spring": k2})
+        s = ps.sensitivity(point, "actuator.waveform.amplitude_v", metrics=["lift_mean"], progress=False)
+        assert s.neutral_directions == int(family)
+        result = ps.optimize(point, "actuator_power_mean", params={"actuator.waveform.amplitude_v": (99.0, 101.0)}, stability=0.9, max_iterations=1, progress=False)
+        value = result.constraints.filter(result.constraints["constraint"].str.starts_with("max |multiplier|"))["value"].item()
+        mu = np.sort(np.abs(result.multipliers))[::-1]
+        if family:  # the family's multiplier (1 to round-off) is left out, the next one counts
+            assert abs(mu[0] - 1.0) < 1e-6 and value == pytest.approx(mu[1], rel=1e-12)
+        else:
+            assert value == pytest.approx(mu[0], rel=1e-12) and 0.999 < value < 1.0
+            assert not result.success and "max |multiplier|" in result.message
+
+
+def test_trust_constr_does_not_stop_a_barrier_away_from_the_bound():
+    """scipy's interior point stopped on its subproblem's optimality with the barrier parameter
+    at 1.6e-4: power 3.3e-4 above SLSQP's optimum, the lift bound 3.4e-4 away, reported as
+    success. Restarting with a smaller barrier brings it within 1e-5 (the bound is the answer)."""
+    spec = ps.devices.load("sreetharan2012_3_4_parity").with_paths({"drivetrain.balance_spring": 30.0})
+    problem = {"params": {"actuator.waveform.amplitude_v": (30.0, 200.0)}, "constraints": ["lift_mean >= 1.1261571"], "progress": False}
+    exact = ps.optimize(spec, "actuator_power_mean", **problem)
+    interior = ps.optimize(spec, "actuator_power_mean", method="trust-constr", **problem)
+    assert exact.success and exact.active == ["lift_mean >= 1.1261571"]
+    assert interior.success
+    assert interior.objective == pytest.approx(exact.objective, rel=3e-5)
+    assert interior.constraints["value"][0] == pytest.approx(1.1261571, rel=3e-5)
