@@ -73,3 +73,11 @@ def test_a_missing_file_is_an_error_on_spec(tmp_path: Path) -> None:
         with pytest.raises(ps.InvalidParameterError, match="readable TOML file") as info:
             ps.sensitivity(missing, params=["drivetrain.balance_spring"])
         assert info.value.field == "spec"
+
+
+def test_metric_names_are_the_metrics_a_run_reports() -> None:
+    # docs/reference/metrics.md named ps.sweep_metric_names, which did not exist.
+    for name in ("robobee_dual_linear", "sreetharan2012_3_4_parity_1cut"):
+        names = ps.metric_names(name)
+        assert names == ps.devices.metric_names(ps.devices.load(name))
+        assert set(names) == set(ps.simulate(name, columns=[], progress=False).metrics)

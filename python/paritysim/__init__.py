@@ -50,7 +50,7 @@ if TYPE_CHECKING:  # what type checkers see; at run time the names below load la
     from .optimizer import OptimizationResult, optimize
     from .planform import Planform
     from .simulation import SimulationResult, simulate
-    from .devices import spec_paths
+    from .devices import metric_names, spec_paths
     from .spec import Actuator, Aero, Body, Configuration, Drivetrain, Options, Shoulder, Simulation, Spring, Springs, TunableHinge, Waveform, Wing, load_spec
     from .sweep import grid, sweep
 
@@ -74,6 +74,7 @@ _NAMES = {
     "grid": "sweep",
     **{n: "spec" for n in ("Actuator", "Aero", "Body", "Configuration", "Drivetrain", "Options", "Shoulder", "Simulation", "Spring", "Springs", "TunableHinge", "Waveform", "Wing", "load_spec")},
     "spec_paths": "devices",  # any spec argument, a device's name too
+    "metric_names": "devices",
 }
 
 
@@ -139,6 +140,7 @@ __all__ = [
     "laminate",
     "load_spec",
     "measured",
+    "metric_names",
     "planform",
     "optimize",
     "plots",

@@ -151,8 +151,8 @@ pub struct BladeElement {
     pub omega4: f64,
     /// The force parameter `½ρ∬z²dA` of the lift and drag forces (mg·mm), in [0, 1e5];
     /// absent: `Ω1 / body.force_radius_mm` (a body-wide estimate, 12 mm by default).
-    /// `Wing.from_planform` gives the outline's own (22 % below the estimate on the RoboBee
-    /// wing, docs/findings.md §32).
+    /// `Wing.from_planform` gives the outline's own (the estimate is 22 % above it on the RoboBee
+    /// wing, docs/findings.md §25).
     #[schemars(range(min = 0.0, max = 1e5), extend("x-unit" = "mg mm"))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub force_parameter: Option<f64>,
@@ -204,8 +204,8 @@ pub struct WhitneyWood2010 {
     pub omega4: f64,
     /// The force parameter `½ρ∬z²dA` of the lift and drag forces (mg·mm), in [0, 1e5];
     /// absent: `Ω1 / body.force_radius_mm` (a body-wide estimate, 12 mm by default).
-    /// `Wing.from_planform` gives the outline's own (22 % below the estimate on the RoboBee
-    /// wing, docs/findings.md §32).
+    /// `Wing.from_planform` gives the outline's own (the estimate is 22 % above it on the RoboBee
+    /// wing, docs/findings.md §25).
     #[schemars(range(min = 0.0, max = 1e5), extend("x-unit" = "mg mm"))]
     #[serde(skip_serializing_if = "Option::is_none")]
     pub force_parameter: Option<f64>,

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from ..spec import Simulation
 
-__all__ = ["DeviceInfo", "as_simulation", "info", "list", "load", "path", "spec_paths"]
+__all__ = ["DeviceInfo", "as_simulation", "info", "list", "load", "metric_names", "path", "spec_paths"]
 
 
 @dataclass(frozen=True)
@@ -154,3 +154,13 @@ def spec_paths(spec: Any) -> Any:
     from .. import spec as _spec
 
     return _spec.spec_paths(as_simulation(spec))
+
+
+def metric_names(spec: Any) -> builtins.list[str]:
+    """The metrics ``spec``'s device reports (anything :func:`as_simulation` reads), in the
+    core's order: what ``metrics=`` of :func:`paritysim.simulate`, :func:`paritysim.sweep` and
+    :func:`paritysim.sensitivity`, and the constraints of :func:`paritysim.optimize`, accept.
+    ``paritysim.metric_names`` is this function."""
+    from .. import _core
+
+    return builtins.list(_core.sweep_metric_names(as_simulation(spec).to_json()))
