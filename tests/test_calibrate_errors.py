@@ -124,3 +124,25 @@ def test_the_checked_arguments_still_fit() -> None:
     fit = ps.calibrate(_breaks_above(0.6), {"y": 0.3}, {"a": (0.0, 1.0)}, x0={"a": 0.5}, scale={"y": 0.1}, jacobian="differences", workers=1, labels=[], progress=False)
     assert fit.values["a"] == pytest.approx(0.3, abs=1e-6) and fit.iterations["a"][0] == 0.5
     assert np.isfinite(fit.residuals).all()
+
+
+def test_a_video_longer_than_the_recorded_window_is_refused(spec: ps.Simulation) -> None:
+    """np.interp held the window's last value for every later sample: a 3-cycle video against
+    a 1-cycle window fitted both parameters to their bounds and said success."""
+    video = ps.simulate(spec.replace(options=spec.options.with_fields("options", record_cycles=3))).trajectory.select("time_ms", "left_phi")[::4]
+    with pytest.raises(ps.InvalidParameterError) as err:
+        ps.calibrate(spec, video, FREE, max_nfev=1, progress=False)
+    assert err.value.field == "targets.time_ms" and "record_cycles >= 3" in str(err.value)
+    one_cycle = video.filter(pl.col("time_ms") <= video["time_ms"][0] + 1e3 / spec.actuator.waveform.frequency_hz)
+    assert ps.calibrate(spec, one_cycle, FREE, max_nfev=1, progress=False) is not None
+
+
+def test_a_zero_metric_target_needs_a_scale(spec: ps.Simulation) -> None:
+    """A residual is divided by its target's size: a zero target's floor of 1e-12 turned a
+    metric held at zero by symmetry (round-off) into the largest residual, and the fit stayed
+    at its start and said converged."""
+    with pytest.raises(ps.InvalidParameterError) as err:
+        ps.calibrate(spec, {**POINT, "left_stroke_mean": 0.0}, FREE, max_nfev=1, progress=False)
+    assert err.value.field == "targets.left_stroke_mean" and "scale" in str(err.value)
+    fit = ps.calibrate(spec, {**POINT, "left_stroke_mean": 0.0}, FREE, scale={"left_stroke_mean": 0.01}, max_nfev=1, progress=False)
+    assert fit is not None

@@ -236,6 +236,8 @@ def test_plot_has_a_line_per_operating_line(spec: ps.Simulation, small: pl.DataF
         (lambda d, kw: ([1, 2], kw), "data", "DataFrame"),
         (lambda d, kw: (d, {**kw, "jacobian": "exact"}), "jacobian", "sensitivity"),
         (lambda d, kw: (d, {**kw, "targets": {"left_stroke_amplitude": 0.5}}), "targets", "None when data="),
+        # A spec-path column in labels ran every row at the spec's own value (silently).
+        (lambda d, kw: (d, {**kw, "labels": ["actuator.waveform.frequency_hz"]}), "labels.actuator.waveform.frequency_hz", "never applied"),
     ],
 )
 def test_bad_input_is_a_typed_error_naming_the_argument(spec: ps.Simulation, small: pl.DataFrame, change, field: str, hint: str) -> None:  # type: ignore[no-untyped-def]
@@ -283,3 +285,14 @@ def test_a_long_fit_shows_its_sweeps(spec: ps.Simulation, small: pl.DataFrame, m
     counts = [int(n) for n in re.findall(r"(\d+) sweeps done", err)]
     assert "calibrate:" in err and counts and counts == sorted(counts) and counts[-1] <= fit.sweeps, err
     assert "sweep:" not in err and "pt/s" not in err  # no bar of ps.sweep (desc "sweep", unit "pt")
+
+
+def test_a_parameter_the_data_cannot_see_has_no_finite_standard_error(spec: ps.Simulation, small: pl.DataFrame) -> None:
+    """The deviation is held on this device, so its spring moves nothing: a zero column of
+    the Jacobian. The pseudo-inverse gave it a standard error of 0 ("perfectly determined");
+    it is infinite, and the parameters the data see keep theirs."""
+    params = {**BOUNDS, "wings[*].springs.deviation.stiffness": (0.0, 100.0)}
+    fit = ps.calibrate(spec, data=_noisy(small, 1), params=params, measured={"stroke_pp_deg": PP_DEG}, progress=False)
+    assert fit.stderr["wings[*].springs.deviation.stiffness"] == math.inf
+    assert all(0 < fit.stderr[p] < math.inf for p in BOUNDS)
+    assert any("singular" in note for note in fit.notes)

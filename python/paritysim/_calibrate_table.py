@@ -379,6 +379,11 @@ def calibrate_table(
         if m.metric not in metric_names:
             raise invalid(f"measured.{c}", repr(m.metric), suggest(m.metric, metric_names, listed_by="simulate(spec).metrics", what="a metric of this device"))
     paths = set(valid_paths(spec))
+    for c in labels:
+        if c in paths:
+            # Every row then ran at the spec's own value (frequency in labels: fitted 0.597 and
+            # 421 where the truth was 0.55 and 260, success=True).
+            raise invalid(f"labels.{c}", "<a spec path>", "a column that is not a spec path: a label is carried along, never applied, so each row's value would be ignored; leave it out of labels to run each row at its value, or rename the column")
     operating = [c for c in table.columns if c not in taken and c not in labels]
     for c in operating:
         if c not in paths:
@@ -540,6 +545,13 @@ def calibrate_table(
         notes.append("the Jacobian at the fit is singular: some parameters are not identified by these data (pseudo-inverse)")
     cov = s2 * inv
     se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    # A parameter the data cannot see (a column of J that others span, or zero) has no finite
+    # error: the pseudo-inverse gave it 0, "perfectly determined" (a wing's force parameter
+    # fitted to stroke amplitudes read 0.0 %).
+    _, singular, vt = np.linalg.svd(J, full_matrices=True)
+    rank = int(np.sum(singular > 1e-10 * singular.max())) if singular.size and singular.max() > 0 else 0
+    unseen = np.any(np.abs(vt[rank:]) > 1e-6, axis=0) if rank < p else np.zeros(p, dtype=bool)
+    se = np.where(unseen, math.inf, se)
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(se, se)
     if dof <= 0:

@@ -281,6 +281,11 @@ def calibrate(
         def residual_of(out: dict[str, Any]) -> np.ndarray:
             traj = out["__trajectory__"]
             t = traj["time_ms"].to_numpy() - traj["time_ms"][0]
+            if t_target[-1] > t[-1] * (1 + 1e-9):
+                # np.interp would hold the window's last value for every later sample: a 3-cycle
+                # video against a 1-cycle window fitted both parameters to their bounds.
+                cycles = math.ceil(t_target[-1] / t[-1] * model.options.record_cycles - 1e-9)
+                raise invalid("targets.time_ms", f"a video of {t_target[-1]:.6g} ms", f"within the model's recorded window ({t[-1]:.6g} ms): record more cycles (options.record_cycles >= {cycles}) or trim the video")
             res = []
             for c in columns:
                 if c not in traj.columns:  # polars' ColumnNotFoundError otherwise
@@ -298,7 +303,13 @@ def calibrate(
         def output_of(i: int) -> str:
             return keys[i]
 
-        scales = np.array([real(f"scale.{k}", (scale or {}).get(k, max(abs(g), 1e-12))) for k, g in zip(keys, goal, strict=True)])
+        for k, g in zip(keys, goal, strict=True):
+            if g == 0 and k not in (scale or {}):
+                # Its residual would be divided by a floor of 1e-12: a metric held at zero by
+                # symmetry (round-off, 1e-11) then outweighed every other target, and the fit
+                # stayed at its start and said converged.
+                raise invalid(f"targets.{k}", 0.0, f"a nonzero target, or a scale for it (scale={{{k!r}: <the size a miss matters at>}}): a residual is divided by its target's size")
+        scales = np.array([real(f"scale.{k}", (scale or {}).get(k, abs(g))) for k, g in zip(keys, goal, strict=True)])
         for k, g, sc in zip(keys, goal, scales, strict=True):
             if not math.isfinite(g):
                 raise invalid(f"targets.{k}", float(g), "a finite number")
