@@ -296,3 +296,13 @@ def test_a_parameter_the_data_cannot_see_has_no_finite_standard_error(spec: ps.S
     assert fit.stderr["wings[*].springs.deviation.stiffness"] == math.inf
     assert all(0 < fit.stderr[p] < math.inf for p in BOUNDS)
     assert any("singular" in note for note in fit.notes)
+
+
+def test_degrees_of_a_dual_drivetrains_q2_are_refused() -> None:
+    """On a dual drivetrain q2 is the right actuator's displacement (mm): a column of it "in
+    degrees" was divided by 57.3 and the fit ran to a bound with success=True."""
+    spec = ps.devices.load("robobee_dual_linear")
+    data = pl.DataFrame({"actuator.waveform.amplitude_v": [80.0, 100.0], "q2_deg": [10.0, 12.0]})
+    with pytest.raises(ps.InvalidParameterError) as err:
+        ps.calibrate(spec, data=data, params={"actuator.force_per_volt": (0.2, 1.5)}, measured={"q2_deg": ps.measured("q2_amplitude", unit="deg")}, progress=False)
+    assert err.value.field == "measured.q2_deg" and "mm" in str(err.value)

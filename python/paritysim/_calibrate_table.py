@@ -375,9 +375,14 @@ def calibrate_table(
             if c not in table.columns:
                 raise invalid(f"measured.{c}", "<not a column of data>", suggest(str(c), table.columns, what="a column of data"))
             taken[str(c)] = measured_of(str(c), m)
+    column_units = dict(_core.trajectory_column_units(spec.to_json()))
     for c, m in taken.items():
         if m.metric not in metric_names:
             raise invalid(f"measured.{c}", repr(m.metric), suggest(m.metric, metric_names, listed_by="simulate(spec).metrics", what="a metric of this device"))
+        if m.unit is not None and m.metric.startswith("q2_") and column_units.get("q2") != "rad":
+            # A dual drivetrain's q2 is the right actuator's displacement (mm): degrees of it
+            # were taken as 57.3 × mm, and the fit ran to a bound.
+            raise invalid(f"measured.{c}", f"{m.metric} in {m.unit}", f"no unit for `{m.metric}` on this device: its q2 is in {column_units.get('q2')}, not an angle")
     paths = set(valid_paths(spec))
     for c in labels:
         if c in paths:
