@@ -81,3 +81,14 @@ def test_metric_names_are_the_metrics_a_run_reports() -> None:
         names = ps.metric_names(name)
         assert names == ps.devices.metric_names(ps.devices.load(name))
         assert set(names) == set(ps.simulate(name, columns=[], progress=False).metrics)
+
+
+@pytest.mark.parametrize(("path", "value", "allowed"), [("wings[0].aero.omega1", 0.0, "(0, 100000]"), ("wings[0].aero.omega2", -0.1, "[0, 1000000]"), ("wings[1].aero.force_parameter", -1.0, "[0, 100000]")])
+def test_an_omega_out_of_range_names_its_spec_path_and_the_engines_range(path: str, value: float, allowed: str) -> None:
+    # The schema gave Ω1 >= 0 and Ω2, Ω3 >= -1e6 where the engine needs Ω1 > 0, Ω2, Ω3 >= 0; the
+    # engine's error named `wings[0].aero.omegas.omega2`, a path with_paths refused.
+    spec = ps.devices.load("sreetharan2012_3_4_parity_1cut")
+    with pytest.raises(ps.InvalidParameterError) as err:
+        ps.simulate(spec.with_paths({path: value}), progress=False)
+    assert err.value.field == path and allowed in str(err.value)
+    spec.with_paths({err.value.field: 1.0})  # the named field is a path

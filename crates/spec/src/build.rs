@@ -176,7 +176,25 @@ fn blade_element(
 ) -> Result<BladeElementModel<CoefficientSet>> {
     let [o1, o2, o3, o4] = omegas;
     let force = force_parameter.unwrap_or(o1 / force_radius);
-    let omegas = Omegas::new(o1, o2, o3, o4).and_then(|o| o.with_force(force))?;
+    // The aero crate names its own fields (`omegas.omega2`, `force`); the spec's are `omega2`
+    // and `force_parameter` (an error's field is a path `with_paths` takes).
+    let omegas = Omegas::new(o1, o2, o3, o4)
+        .and_then(|o| o.with_force(force))
+        .map_err(|e| match e {
+            paritysim_error::Error::InvalidParameter {
+                field,
+                value,
+                allowed,
+            } => paritysim_error::Error::InvalidParameter {
+                field: match field.trim_start_matches("omegas.") {
+                    "force" => "force_parameter".into(),
+                    name => name.to_string().into(),
+                },
+                value,
+                allowed,
+            },
+            other => other,
+        })?;
     let coefficients = CoefficientSet::from_name(match model {
         CoefficientModel::Dickinson1999 => "dickinson1999",
         CoefficientModel::WhitneyWood2010 => "whitney_wood2010",

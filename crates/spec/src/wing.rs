@@ -137,14 +137,14 @@ impl Default for StrokeDrag {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct BladeElement {
-    /// Ω1 (mg·mm²), in [0, 1e5].
-    #[schemars(range(min = 0.0, max = 1e5), extend("x-unit" = "mg mm^2"))]
+    /// Ω1 (mg·mm², ½ρ∬z³dA), in (0, 1e5].
+    #[schemars(range(max = 1e5), extend("exclusiveMinimum" = 0.0, "x-unit" = "mg mm^2"))]
     pub omega1: f64,
-    /// Ω2 (mg·mm², ½ρ∬|x|³dA), in [-1e6, 1e6].
-    #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
+    /// Ω2 (mg·mm², ½ρ∬|x|³dA), in [0, 1e6].
+    #[schemars(range(min = 0.0, max = 1e6), extend("x-unit" = "mg mm^2"))]
     pub omega2: f64,
-    /// Ω3 (mg·mm²), in [-1e6, 1e6].
-    #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
+    /// Ω3 (mg·mm², ½ρ∫z²c²dz), in [0, 1e6].
+    #[schemars(range(min = 0.0, max = 1e6), extend("x-unit" = "mg mm^2"))]
     pub omega3: f64,
     /// Ω4 (mg·mm²), in [-1e6, 1e6].
     #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
@@ -190,14 +190,14 @@ impl Default for BladeElement {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct WhitneyWood2010 {
-    /// Ω1 (mg·mm²), in [0, 1e5].
-    #[schemars(range(min = 0.0, max = 1e5), extend("x-unit" = "mg mm^2"))]
+    /// Ω1 (mg·mm², ½ρ∬z³dA), in (0, 1e5].
+    #[schemars(range(max = 1e5), extend("exclusiveMinimum" = 0.0, "x-unit" = "mg mm^2"))]
     pub omega1: f64,
-    /// Ω2 (mg·mm², ½ρ∬|x|³dA), in [-1e6, 1e6].
-    #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
+    /// Ω2 (mg·mm², ½ρ∬|x|³dA), in [0, 1e6].
+    #[schemars(range(min = 0.0, max = 1e6), extend("x-unit" = "mg mm^2"))]
     pub omega2: f64,
-    /// Ω3 (mg·mm²), in [-1e6, 1e6].
-    #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
+    /// Ω3 (mg·mm², ½ρ∫z²c²dz), in [0, 1e6].
+    #[schemars(range(min = 0.0, max = 1e6), extend("x-unit" = "mg mm^2"))]
     pub omega3: f64,
     /// Ω4 (mg·mm²), in [-1e6, 1e6].
     #[schemars(range(min = -1e6, max = 1e6), extend("x-unit" = "mg mm^2"))]
