@@ -19,9 +19,9 @@ use super::Device;
 pub(crate) const SOFT_LIMIT: f64 = 0.1;
 
 impl Device {
-    /// Whether the device has a soft direction ([`SOFT_LIMIT`]): the smallest singular value
-    /// of `∂(accelerations)/∂(coordinates)` at rest (central differences), times `T²`. `false`
-    /// without a drive period or when the probe cannot be evaluated.
+    /// Whether the device has a soft direction: the smallest singular value of
+    /// `∂(accelerations)/∂(coordinates)` at rest (central differences), times `T²`, below 0.1
+    /// (`SOFT_LIMIT`). `false` without a drive period or when the probe cannot be evaluated.
     pub fn has_soft_direction(&self) -> bool {
         let Some(period) = self.period() else {
             return false;
