@@ -230,6 +230,7 @@ def test_plot_has_a_line_per_operating_line(spec: ps.Simulation, small: pl.DataF
         (lambda d, kw: (d, {**kw, "holdout": 1.0}), "holdout", "(0, 1)"),
         (lambda d, kw: (d, {**kw, "holdout": 0.0}), "holdout", "(0, 1)"),
         (lambda d, kw: (d, {**kw, "holdout": 0.95}), "holdout", "at least 2 measured values"),
+        (lambda d, kw: (d, {**kw, "holdout": 0.02}), "holdout", "at least one of the 12 rows"),
         (lambda d, kw: (d, {**kw, "x0": {"actuator.force_per_volt": 5.0}}), "x0.actuator.force_per_volt", "within the bounds"),
         (lambda d, kw: (d.with_columns(pl.lit(None, dtype=pl.Float64).alias("actuator.waveform.amplitude_v")), kw), "data.actuator.waveform.amplitude_v", "finite"),
         (lambda d, kw: (d.select("stroke_pp_deg"), kw), "data", "operating"),

@@ -417,6 +417,8 @@ def calibrate_table(
         if not (0.0 < fraction < 1.0):
             raise invalid("holdout", holdout, "a fraction in (0, 1) of the rows to hold out")
         n_held = int(round(fraction * n_rows))
+        if n_held == 0:  # 0.02 of 15 rows held out none, and the held-out errors were NaN
+            raise invalid("holdout", holdout, f"a fraction that holds out at least one of the {n_rows} rows (>= {0.5 / n_rows:.3g}), or None")
         split[np.random.default_rng(seed).choice(n_rows, size=n_held, replace=False)] = True
     fit_rows = np.flatnonzero(~split)
     n_obs = sum(int(np.isfinite(y[c][fit_rows]).sum()) for c in taken)

@@ -11,8 +11,9 @@ pub struct Shoulder {
     /// gives a decoupled shoulder (eq. 2.7).
     #[schemars(range(min = 1e-6, max = std::f64::consts::PI), extend("x-unit" = "rad"))]
     pub alpha2: f64,
-    /// Second link angle (rad), in [0, pi) and at most `alpha2 - 1e-6` (the closure is singular
-    /// as `alpha2 - alpha3 -> 0`).
+    /// Second link angle (rad), in [0, pi), at most `alpha2 - 1e-6` (the closure is singular
+    /// as `alpha2 - alpha3 -> 0`) and above `alpha2 - pi` (eq. 2.14 is singular at
+    /// `alpha2 - alpha3 = pi`: `alpha2 = pi` needs `alpha3 > 0`).
     #[schemars(range(min = 0.0, max = std::f64::consts::PI), extend("x-unit" = "rad"))]
     pub alpha3: f64,
 }
