@@ -195,17 +195,6 @@ class _Eval:
         return self.grads[metric]
 
 
-def _largest_non_neutral(s: SensitivityResult) -> float:
-    """The largest |multiplier| but the orbit's neutral ones: the ``neutral_directions`` nearest
-    1 (a family of orbits, as the core's SVD of the monodromy counts them). A slow real mode is
-    not one: every multiplier within 1e-3 of 1 was left out, so K2 = 0.05 on the §3.4 1-Cut,
-    whose orbit decays at 0.99987 a cycle, read 0.0497 and met a bound of 0.9."""
-    mu = s.multipliers
-    keep = np.ones(len(mu), dtype=bool)
-    keep[np.argsort(np.abs(mu - 1.0))[: s.neutral_directions]] = False
-    return float(np.max(np.abs(mu[keep]))) if keep.any() else 0.0
-
-
 def optimize(
     spec: SpecLike,
     objective: str = "actuator_power_mean",
@@ -325,7 +314,7 @@ def optimize(
         # Only the multipliers are read: they are the exact monodromy's at the orbit, whatever
         # the parameters, so one parameter's derivatives (not every path's) come with them.
         s = solve(at(x_of(z)), metrics[:1], paths[:1])
-        return _largest_non_neutral(s)
+        return s.largest_non_neutral
 
     def evaluate(z: np.ndarray) -> _Eval:
         z = np.asarray(z, dtype=float)
@@ -356,7 +345,7 @@ def optimize(
             if reason is not None and name not in warned:
                 warned[name] = f"ps.optimize: {name} is not differentiable at {shown} ({reason}); its derivative there is the core's and may mislead the optimiser"
             values[name], grads[name] = float(value), g
-        rho = _largest_non_neutral(s)
+        rho = s.largest_non_neutral
 
         def stability_gradient() -> np.ndarray:
             g = np.empty(len(paths))
