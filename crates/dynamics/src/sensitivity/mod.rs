@@ -30,8 +30,11 @@ use crate::integrate::{RungeKutta, State};
 use crate::shooting::newton::LeastSquares;
 use crate::simulate::{SimulationOptions, SteadyState, WindowSampler, simulate};
 
+mod families;
 mod periods;
 mod replay;
+
+pub use families::{FAMILY_BREAK_FLOOR, FAMILY_BREAK_TOLERANCE, NEUTRAL_CHANGE_TOLERANCE};
 
 use periods::{Keep, periods};
 use replay::Replay;
@@ -40,30 +43,12 @@ use replay::Replay;
 /// mark a kink: a peak switching between two maxima, a clipped quantity.
 pub const KINK_TOLERANCE: f64 = 1e-2;
 
-/// A metric that changes along a neutral direction of the orbit by more than this (relative to
-/// its size, per unit of the neutral vector) depends on which member of the family is meant.
-pub const NEUTRAL_CHANGE_TOLERANCE: f64 = 1e-6;
-
 /// How closely a replayed window's metrics follow an integrated one's (measured: within 5e-9,
 /// docs/findings.md §30). Their second-order error is even in the step, so it does not cancel
 /// in `right − left` of the kink check as it does in the central difference: the check's
 /// floor is two of these (a metric held at zero by symmetry, the HMF's `pitch_total_mean`,
 /// was flagged at 1e-9).
 const REPLAY_ACCURACY: f64 = 5e-9;
-
-/// A parameter whose `∂P/∂p` has more than this fraction outside the range of `∂P/∂x − I`
-/// breaks a neutral family. Measured (docs/findings.md §30): parameters that keep the family
-/// (frequency, amplitude, Ω1) leave up to 9e-6 at the default tolerances (7e-7 at rtol
-/// 1e-10); the balance spring at K2 = 0 of the §3.3 1-Cut, 2-Cut and §3.4 K2 = 0 PARITY and
-/// 1-Cut leaves 1.7e-2, 5.7e-2, 0.63 and 0.47.
-pub const FAMILY_BREAK_TOLERANCE: f64 = 1e-3;
-
-/// ... unless the part along the family changes the period map by less than this (relative to
-/// `1 + ‖x*‖∞`) over a change of the parameter by its size (`|p|`, or 1 near 0): round-off.
-/// Measured: the balance spring on identical wings acts on a coordinate symmetry holds at 0,
-/// so its `∂P/∂p` is round-off (3e-28) of any direction: about 1e-28 there, 6e-8 on the §3.3
-/// 1-Cut.
-pub const FAMILY_BREAK_FLOOR: f64 = 1e-15;
 
 /// A parameter's size for its step and the family check: `|p|`, or 1 near 0. In
 /// mg-mm-ms-rad-V the parameters a designer moves are O(1) and up (a K2 of 1e-3 mN·mm/rad is
@@ -380,19 +365,8 @@ pub fn steady_sensitivity_at(
             .map(|(k, ((_, _, central), j))| {
                 let (near, far) = (&maps[2 * k].end, &maps[2 * k + 1].end);
                 let dp = difference(*central, steps[j], &base_map, near, far);
-                let unreachable = least_squares.unreachable(&dp);
-                let fraction = unreachable / dp.norm();
-                // A change of the map below `FAMILY_BREAK_FLOOR` over the parameter's size is
-                // round-off (a spring on a coordinate that symmetry holds at zero).
-                let felt = unreachable * parameter_size(p0[j]) > FAMILY_BREAK_FLOOR * state_size;
-                let broken = (felt && fraction > FAMILY_BREAK_TOLERANCE).then(|| {
-                    format!(
-                        "breaks a family of orbits (a multiplier at 1): {fraction:.1e} of the \
-                         period map's change with it is along the family, which no nearby \
-                         orbit absorbs, so the steady state moves to another member (a jump) \
-                         as it changes"
-                    )
-                });
+                let broken =
+                    families::broken(&least_squares, &dp, parameter_size(p0[j]), state_size);
                 Ok((least_squares.step(&dp).ok_or_else(non_finite)?, broken))
             })
             .collect::<Result<Vec<_>>>()?;
@@ -496,56 +470,29 @@ pub fn steady_sensitivity_at(
             }
         }
     }
-    // A metric that moves along a neutral direction depends on the member of the family; one
-    // that moves along a nearly neutral one (a multiplier within the sweeps' family tolerance
-    // of 1) has a derivative that divides the period map's error by a small singular value
-    // (the §3.3 1-Cut at K2 = 1e-3: d(stroke mean)/d(offset) 4.7e-4 off, docs/findings.md §30).
-    let slow = least_squares.slow_directions(crate::sweep::NEUTRAL_MULTIPLIER_TOL);
-    let directions: Vec<(Option<f64>, &DVector<f64>)> = neutral
-        .iter()
-        .map(|v| (None, v))
-        .chain(slow.iter().map(|(sigma, v)| (Some(*sigma), v)))
-        .collect();
-    let base_states = replay
-        .as_ref()
-        .filter(|_| !directions.is_empty())
-        .map(Replay::base_states);
-    for (sigma, v) in directions {
-        let eps = 1e-6;
-        let along = |sign: f64| -> Result<Vec<(String, f64)>> {
-            let shift = v * (sign * eps);
-            match (&replay, &base_states) {
-                (Some(replay), Some(states)) => {
-                    replay.window_along((device, &grid, period), states, &shift, options)
-                }
-                _ => {
-                    let y = State::from_compact(n, &(x_star.compact(n) + shift));
-                    crate::simulate::grid_window(device, &rk, &grid, period, &y, options)
-                }
+    // Metrics that move along a (nearly) neutral direction: their windows along it, replayed
+    // from the base window's Φ where it was kept.
+    // (The base window's states are copied only at such orbits.)
+    let base_states = std::cell::OnceCell::new();
+    let window_along = |shift: &DVector<f64>| -> Result<Vec<(String, f64)>> {
+        match &replay {
+            Some(replay) => {
+                let states = base_states.get_or_init(|| replay.base_states());
+                replay.window_along((device, &grid, period), states, shift, options)
             }
-        };
-        let (mp, mm) = (along(1.0)?, along(-1.0)?);
-        for (i, (name, m0)) in base_metrics.iter().enumerate() {
-            let slope = (value_of(&mp, name) - value_of(&mm, name)) / (2.0 * eps);
-            if not_differentiable[i].is_none()
-                && slope.abs() > NEUTRAL_CHANGE_TOLERANCE.max(1e-4 * m0.abs())
-            {
-                not_differentiable[i] = Some(match sigma {
-                    None => format!(
-                        "changes along a neutral direction of the orbit (slope {slope:e}): a \
-                         family of orbits (a multiplier at 1), so the derivative depends on the \
-                         member"
-                    ),
-                    Some(sigma) => format!(
-                        "changes along a nearly neutral direction of the orbit (slope \
-                         {slope:e}; a multiplier within {tol:e} of 1, which a sweep treats as a \
-                         family): its derivative divides the period map's error by {sigma:.1e}",
-                        tol = crate::sweep::NEUTRAL_MULTIPLIER_TOL
-                    ),
-                });
+            None => {
+                let y = State::from_compact(n, &(x_star.compact(n) + shift));
+                crate::simulate::grid_window(device, &rk, &grid, period, &y, options)
             }
         }
-    }
+    };
+    families::flag_moving_metrics(
+        &least_squares,
+        &neutral,
+        &window_along,
+        &base_metrics,
+        &mut not_differentiable,
+    )?;
     Ok(SteadySensitivity {
         metrics: base_metrics,
         jacobian,
